@@ -1,0 +1,1 @@
+"""HTTP submission service for gymgrade."""

@@ -1,0 +1,1 @@
+"""Reference solutions and exact oracles for the OpenGym AI lab."""
