@@ -1,0 +1,230 @@
+"""`ClassicEnv`: a gymnasium environment seen through the classic gym API the lab was written for."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+from gymnasium.wrappers import TimeLimit
+
+from . import events
+from .errors import UnsupportedRenderModeError
+from .quiet import STEP_AFTER_TERMINATED, quiet_gymnasium
+
+
+class ClassicEnv:
+    """Classic gym (0.17 to 0.21) behaviour on top of a gymnasium 1.4 environment.
+
+    - `reset()` returns the observation only (`return_info=True` gives `(obs, info)`);
+    - `step(a)` returns `(obs, reward, done, info)` with `done = terminated or truncated`, and
+      `info["TimeLimit.truncated"]` when the time limit ended the episode, as classic `TimeLimit` did;
+    - `seed(s)` stores `s` for the next reset; `render()` draws nothing and returns None.
+
+    Where classic gym tolerated what gymnasium refuses, this class behaves as classic gym did and
+    records a `CompatEvent` (see `grader.compat.events`): a step before the first reset resets first
+    (classic Blackjack dealt its first hand in the constructor; classic envs with a time limit refused
+    such a step, the layer resets them all alike and the event tells), a step after done is passed
+    through to the env (gymnasium's envs and `TimeLimit` accept it, as classic ones did), numpy integer
+    actions for a `Discrete` space become ints (gymnasium accepts them too; ints keep the logs plain).
+
+    Attribute reads not defined here go down the gymnasium wrapper stack (`env.P`, `env.s`), as
+    classic `gym.Wrapper.__getattr__` did; private names are not forwarded.
+    """
+
+    def __init__(self, env: gymnasium.Env[Any, Any], requested_id: str) -> None:
+        """Wrap `env`, which `gymnasium.make` created for the classic id `requested_id`."""
+        self.env = env
+        self.requested_id = requested_id
+        self._discrete_actions = isinstance(env.action_space, spaces.Discrete)
+        self._needs_reset = True
+        self._done = False
+        self._next_seed: int | None = None
+        self._render_recorded = False
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None, return_info: bool = False
+    ) -> Any:
+        """Start an episode; return the first observation (and info if `return_info`).
+
+        Args:
+            seed: seed for this reset; if None, the seed given to `seed()` since the last reset, if any.
+            options: passed to the gymnasium reset.
+            return_info: return `(obs, info)` as gym 0.22 to 0.25 did.
+        """
+        if seed is None:
+            seed = self._next_seed
+        self._next_seed = None
+        observation, info = self.env.reset(seed=seed, options=options)
+        self._needs_reset = False
+        self._done = False
+        return (observation, info) if return_info else observation
+
+    def step(self, action: Any) -> tuple[Any, Any, bool, dict[str, Any]]:
+        """Take one step; return `(obs, reward, done, info)` (see the class docstring)."""
+        if self._needs_reset:
+            events.record(
+                events.STEP_BEFORE_RESET,
+                self.requested_id,
+                "step() was called before reset(); the layer reset the environment first, as classic "
+                "Blackjack had dealt a hand in its constructor",
+            )
+            self.reset()
+        if self._discrete_actions and type(action) is not int:
+            action = self._plain_action(action)
+        if self._done:
+            events.record(
+                events.STEP_AFTER_DONE,
+                self.requested_id,
+                "step() was called after the episode returned done=True and before reset(); the step "
+                "was passed to the environment as classic gym did, so what followed is undefined",
+            )
+            with quiet_gymnasium(STEP_AFTER_TERMINATED):
+                observation, reward, terminated, truncated, info = self.env.step(action)
+        else:
+            observation, reward, terminated, truncated, info = self.env.step(action)
+        if truncated:
+            info = {**info, "TimeLimit.truncated": not terminated}
+        done = bool(terminated or truncated)
+        self._done = self._done or done
+        return observation, reward, done, info
+
+    def _plain_action(self, action: Any) -> Any:
+        if isinstance(action, np.integer) or (
+            isinstance(action, np.ndarray) and action.shape == () and np.issubdtype(action.dtype, np.integer)
+        ):
+            events.record(
+                events.NUMPY_ACTION,
+                self.requested_id,
+                f"step() received a numpy integer action ({type(action).__module__}."
+                f"{type(action).__name__}); the layer passed it on as a Python int",
+            )
+            return int(action)
+        return action
+
+    def seed(self, seed: int | None = None) -> list[int | None]:
+        """Classic `env.seed(s)`: use `s` at the next reset; return `[s]`."""
+        events.record(
+            events.LEGACY_SEED_CALL,
+            self.requested_id,
+            "env.seed() is the classic API; the layer seeds the next reset() with it "
+            "(gymnasium: env.reset(seed=...))",
+        )
+        self._next_seed = seed
+        return [seed]
+
+    def render(self, mode: str | None = None, **kwargs: Any) -> Any:
+        """Draw the environment the classic way.
+
+        With no mode (or `"human"`), when the env was not made with a render mode, nothing is drawn and
+        None is returned: there is no window to draw into. Any other mode the environment supports
+        (`"rgb_array"`, `"ansi"`) returns what gymnasium's render gives in that mode.
+
+        Raises:
+            UnsupportedRenderModeError: the environment cannot draw in `mode`.
+        """
+        own_mode = self.env.render_mode
+        if own_mode is not None and mode in (None, own_mode):
+            return self.env.render()
+        if mode in (None, "human"):
+            if not self._render_recorded:
+                self._render_recorded = True
+                events.record(
+                    events.RENDER_WITHOUT_MODE,
+                    self.requested_id,
+                    f"render({'' if mode is None else repr(mode)}) would open a window; there is none, so "
+                    "nothing was drawn (pass render_mode='rgb_array' to gym.make to get frames)",
+                )
+            return None
+        return self._render_in(mode)
+
+    def _render_in(self, mode: str) -> Any:
+        base = self.env.unwrapped
+        supported = base.metadata.get("render_modes", [])
+        if mode not in supported:
+            raise UnsupportedRenderModeError(
+                f"{self.requested_id} cannot render in mode {mode!r}; it supports "
+                f"{', '.join(map(repr, supported)) or 'no mode at all'}. Use one of those."
+            )
+        previous = base.render_mode
+        base.render_mode = mode
+        try:
+            return base.render()
+        finally:
+            base.render_mode = previous
+
+    def close(self) -> None:
+        """Close the environment."""
+        self.env.close()
+
+    @property
+    def unwrapped(self) -> gymnasium.Env[Any, Any]:
+        """The innermost gymnasium environment (its own API is gymnasium's)."""
+        return self.env.unwrapped
+
+    @property
+    def spec(self) -> Any:
+        """The gymnasium spec of the environment actually made."""
+        return self.env.spec
+
+    @property
+    def action_space(self) -> spaces.Space[Any]:
+        """The action space."""
+        return self.env.action_space
+
+    @property
+    def observation_space(self) -> spaces.Space[Any]:
+        """The observation space."""
+        return self.env.observation_space
+
+    @property
+    def metadata(self) -> dict[str, Any]:
+        """The environment's metadata."""
+        return self.env.metadata
+
+    @property
+    def np_random(self) -> np.random.Generator:
+        """The environment's random generator."""
+        return self.env.np_random
+
+    @property
+    def _max_episode_steps(self) -> int | None:
+        """Classic `TimeLimit`'s step limit, which classic code read (and set) on the env; None if none."""
+        limit = self._time_limit()
+        return None if limit is None else limit._max_episode_steps
+
+    @_max_episode_steps.setter
+    def _max_episode_steps(self, steps: int) -> None:
+        limit = self._time_limit()
+        if limit is None:
+            raise AttributeError(f"the {self.requested_id} environment has no step limit to change")
+        limit._max_episode_steps = steps
+
+    def _time_limit(self) -> TimeLimit[Any, Any] | None:
+        env = self.env
+        while isinstance(env, gymnasium.Wrapper):
+            if isinstance(env, TimeLimit):
+                return env
+            env = env.env
+        return None
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(f"accessing private attribute {name!r} of a gym environment is prohibited")
+        env = self.__dict__.get("env")
+        if env is None:
+            raise AttributeError(name)
+        try:
+            return env.get_wrapper_attr(name)
+        except AttributeError:
+            raise AttributeError(f"the {self.requested_id} environment has no attribute {name!r}") from None
+
+    def __enter__(self) -> ClassicEnv:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"<ClassicEnv{self.env}>"

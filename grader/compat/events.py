@@ -1,0 +1,65 @@
+"""What the compatibility layer had to tolerate, recorded as `CompatEvent`s until drained."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+STEP_BEFORE_RESET = "step_before_reset"
+STEP_AFTER_DONE = "step_after_done"
+NUMPY_ACTION = "numpy_action"
+RENDER_WITHOUT_MODE = "render_without_mode"
+LEGACY_SEED_CALL = "legacy_seed_call"
+RENAMED_ID = "renamed_id"
+
+KINDS = (STEP_BEFORE_RESET, STEP_AFTER_DONE, NUMPY_ACTION, RENDER_WITHOUT_MODE, LEGACY_SEED_CALL, RENAMED_ID)
+
+
+@dataclass(frozen=True)
+class CompatEvent:
+    """One thing classic gym allowed that gymnasium 1.4 refuses (or does differently).
+
+    Attributes:
+        kind: one of `KINDS`.
+        env_id: the id the student asked for (`"Blackjack-v0"`).
+        detail: a sentence a student can read; ends with "(N times)" when it happened N > 1 times.
+    """
+
+    kind: str
+    env_id: str
+    detail: str
+
+
+# One entry per (kind, env_id), the first detail and how many times it happened: code that steps
+# millions of times with numpy actions must not grow this without bound.
+_pending: dict[tuple[str, str], tuple[str, int]] = {}
+
+
+def record(kind: str, env_id: str, detail: str) -> None:
+    """Record that `kind` happened in an env made as `env_id`.
+
+    Args:
+        kind: one of `KINDS`.
+        env_id: the id the student asked for.
+        detail: what happened and what the layer did about it (kept from the first occurrence).
+
+    Raises:
+        ValueError: `kind` is not one of `KINDS`.
+    """
+    key = (kind, env_id)
+    seen = _pending.get(key)
+    if seen is not None:
+        _pending[key] = (seen[0], seen[1] + 1)
+        return
+    if kind not in KINDS:
+        raise ValueError(f"unknown compat event kind {kind!r}; expected one of {', '.join(KINDS)}")
+    _pending[key] = (detail, 1)
+
+
+def drain() -> list[CompatEvent]:
+    """Return the events recorded since the last drain, in first-occurrence order, and forget them."""
+    drained = [
+        CompatEvent(kind=kind, env_id=env_id, detail=detail if count == 1 else f"{detail} ({count} times)")
+        for (kind, env_id), (detail, count) in _pending.items()
+    ]
+    _pending.clear()
+    return drained

@@ -1,0 +1,3 @@
+"""`gym.error`: gymnasium's errors under their classic name."""
+
+from gymnasium.error import *  # noqa: F403

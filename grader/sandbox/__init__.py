@@ -1,0 +1,16 @@
+"""Untrusted execution of student code: isolated children, plain-data results, trusted replay."""
+
+from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.errors import IsolationUnavailable, SandboxClosedError, SandboxError
+from grader.sandbox.isolation import probe_isolation
+from grader.sandbox.isolation.protocol import IsolationReport, LayerReport
+from grader.sandbox.limits import IsolationPolicy, Limits
+from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo, PlainValue
+from grader.sandbox.replay import Replay, replay_episode
+from grader.sandbox.runner import Sandbox, run_calls
+
+__all__ = [
+    "Call", "CallOutcome", "EpisodeLog", "FunctionInfo", "IsolationPolicy", "IsolationReport",
+    "IsolationUnavailable", "LayerReport", "Limits", "OutcomeStatus", "ParameterInfo", "PlainValue", "Replay",
+    "Sandbox", "SandboxClosedError", "SandboxError", "probe_isolation", "replay_episode", "run_calls",
+]

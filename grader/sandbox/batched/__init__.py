@@ -1,0 +1,10 @@
+"""Batched replay: many episodes of one env at once, bit-identical to gymnasium's scalar env."""
+
+from grader.sandbox.batched.cartpole import CartPoleReplayer
+from grader.sandbox.batched.protocol import BatchedEpisode, BatchedReplayer
+from grader.sandbox.batched.taxi import TaxiReplayer
+
+REPLAYERS: tuple[BatchedReplayer, ...] = (CartPoleReplayer(), TaxiReplayer())
+"""Tried in order for each log; a log no replayer accepts is replayed by the scalar env."""
+
+__all__ = ["REPLAYERS", "BatchedEpisode", "BatchedReplayer", "CartPoleReplayer", "TaxiReplayer"]

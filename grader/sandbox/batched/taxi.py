@@ -1,0 +1,79 @@
+"""Replay many Taxi episodes at once from gymnasium's own transition table.
+
+`TaxiEnv.step` looks up `P[state][action]`, a list of `(probability, next_state, reward,
+terminated)`; with default arguments (no rain, no fickle passenger) every list holds one transition
+of probability 1.0, so the random draw `step` makes cannot change the outcome and an episode is
+a chain of table lookups. Here the parent's own env provides the table (checked to be deterministic)
+and the initial states (its own `reset(seed)`); all episodes advance in lockstep, one array lookup
+per step. `grader.sandbox.replay` checks every batch against the scalar env, which stays the
+authority for every mismatch.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from gymnasium.envs.toy_text.taxi import TaxiEnv
+
+from grader.sandbox.batched.protocol import (
+    BatchedEpisode,
+    action_matrix,
+    finish,
+    horizon,
+    int_actions,
+    plain_arguments,
+    unlimited_env,
+)
+from grader.sandbox.episodes import EpisodeLog
+
+ENV_IDS = frozenset({"Taxi-v4"})
+ACTIONS = 6
+
+
+class TaxiReplayer:
+    """`BatchedReplayer` for `Taxi-v4` with default arguments (optionally `max_episode_steps`)."""
+
+    def is_batchable(self, log: EpisodeLog) -> bool:
+        """Plain Taxi arguments, no reset options, actions 0 to 5."""
+        return plain_arguments(log, ENV_IDS) and int_actions(log.actions, ACTIONS)
+
+    def replay(self, logs: Sequence[EpisodeLog]) -> list[BatchedEpisode]:
+        """Replay Taxi logs sharing `env_id` and `env_kwargs` in lockstep.
+
+        Raises:
+            TypeError: the registered env is not gymnasium's deterministic `TaxiEnv`.
+        """
+        scalar = unlimited_env(logs[0].env_id)
+        taxi = scalar.unwrapped
+        if type(taxi) is not TaxiEnv:
+            raise TypeError(f"{logs[0].env_id} is not gymnasium's TaxiEnv")
+        try:
+            next_states, rewards, terminal = _tables(taxi)
+            states = np.empty(len(logs), dtype=np.int64)
+            for column, log in enumerate(logs):
+                states[column] = scalar.reset(seed=log.reset_seed)[0]
+        finally:
+            scalar.close()
+        actions = action_matrix(logs, horizon(logs))
+        observations = np.empty((actions.shape[0] + 1, len(logs)), dtype=np.int64)
+        observations[0] = states
+        for step in range(actions.shape[0]):
+            observations[step + 1] = next_states[observations[step], actions[step]]
+        before = observations[:-1]
+        step_rewards = rewards[before, actions]
+        step_terminated = terminal[before, actions]
+        return finish(logs, observations, step_rewards, step_terminated)
+
+
+def _tables(taxi: TaxiEnv) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    states = len(taxi.P)
+    next_states = np.empty((states, ACTIONS), dtype=np.int64)
+    rewards = np.empty((states, ACTIONS), dtype=np.float64)
+    terminal = np.empty((states, ACTIONS), dtype=np.bool_)
+    for state, by_action in taxi.P.items():
+        for action, transitions in by_action.items():
+            if len(transitions) != 1 or transitions[0][0] != 1.0:
+                raise TypeError(f"Taxi state {state}, action {action} is not deterministic: {transitions}")
+            _, next_states[state, action], rewards[state, action], terminal[state, action] = transitions[0]
+    return next_states, rewards, terminal

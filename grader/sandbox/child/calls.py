@@ -1,0 +1,221 @@
+"""Run one call request in the child and build its result frame."""
+
+from __future__ import annotations
+
+import inspect
+import json
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+from grader.compat import events as compat_events
+from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
+from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
+from grader.sandbox.child.protocol import decode_value, encode_value
+from grader.sandbox.child.recorder import Recorder
+
+MAX_COMPAT_EVENTS = 100
+_CALL_FIELDS = {"type", "id", "nonce", "function", "args", "kwargs", "seed", "record"}
+
+
+@dataclass(frozen=True)
+class CallRequest:
+    """A validated `call` frame."""
+
+    call_id: int
+    nonce: str
+    function: str
+    args: list[Any]
+    kwargs: dict[str, Any]
+    seed: int
+    record: bool
+
+
+def parse_call(frame: dict[str, Any]) -> CallRequest:
+    """Validate a `call` frame from the parent.
+
+    Raises:
+        ProtocolError: a field is missing, extra or of the wrong type.
+    """
+    if frame.keys() != _CALL_FIELDS or frame["type"] != "call":
+        raise ProtocolError(
+            f"expected a call frame with fields {sorted(_CALL_FIELDS)}, found {sorted(frame)}"
+        )
+    checks = {
+        "id": type(frame["id"]) is int,
+        "nonce": type(frame["nonce"]) is str,
+        "function": type(frame["function"]) is str,
+        "args": type(frame["args"]) is list,
+        "kwargs": type(frame["kwargs"]) is dict,
+        "seed": type(frame["seed"]) is int and frame["seed"] >= 0,
+        "record": type(frame["record"]) is bool,
+    }
+    wrong = [name for name, ok in checks.items() if not ok]
+    if wrong:
+        raise ProtocolError(f"call frame fields of the wrong type: {', '.join(wrong)}")
+    try:
+        args = decode_value(frame["args"], "the call's arguments")
+        kwargs = decode_value(frame["kwargs"], "the call's keyword arguments")
+    except InvalidValueError as error:
+        raise ProtocolError(error.message) from None
+    return CallRequest(
+        frame["id"], frame["nonce"], frame["function"], args, kwargs, frame["seed"], frame["record"]
+    )
+
+
+def run_call(
+    module: ModuleType, request: CallRequest, recorder: Recorder, submission: Path, max_frame: int
+) -> bytes:
+    """Call the student's function as `request` says and return the encoded result frame payload.
+
+    `SystemExit` propagates (the process ends and the runner reports the exit); every other
+    failure, `KeyboardInterrupt` included, becomes a status with a message.
+    """
+    compat_events.drain()
+    recorder.begin_call(request.seed, record=request.record)
+    result = _outcome(module, request, submission, max_frame)
+    episodes = recorder.finish_call()
+    if result["status"] == "ok" and recorder.overflowed:
+        result = _status(
+            "output_too_large",
+            f"{request.function}() took more than {recorder.max_recorded_steps} environment steps while "
+            "the grader records episodes; play fewer episodes",
+            wall_time=result["wall_time"],
+        )
+    if result["status"] == "ok":
+        try:
+            plain = [episode.to_plain() for episode in episodes]
+            result["episodes"] = encode_value(plain, "the episode log", max_bytes=max_frame)
+        except InvalidValueError as error:
+            result = _status("invalid_value", error.message, wall_time=result["wall_time"])
+        except FrameTooLargeError as error:
+            result = _status(
+                "output_too_large",
+                f"the episodes {request.function}() played need about {error.size} bytes, more than the "
+                f"limit of {error.limit} bytes; play fewer episodes",
+                wall_time=result["wall_time"],
+            )
+        except MemoryError:
+            result = _status(
+                "memory_limit",
+                "the episode log of the call does not fit in memory",
+                wall_time=result["wall_time"],
+            )
+    result["compat_events"] = [
+        {
+            "kind": str(event.kind)[:100],
+            "env_id": str(event.env_id)[:200],
+            "detail": shortened(str(event.detail)),
+        }
+        for event in compat_events.drain()[:MAX_COMPAT_EVENTS]
+    ]
+    return _payload(result, request, max_frame)
+
+
+def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_frame: int) -> dict[str, Any]:
+    name = request.function
+    function = vars(module).get(name)
+    if function is None:
+        return _status(
+            "missing_function",
+            f"your file defines no function named `{name}`; define `def {name}(...):` at the top "
+            'level of the file (not inside another function or an `if __name__ == "__main__":` '
+            "block)",
+        )
+    if not callable(function):
+        return _status(
+            "missing_function",
+            f"`{name}` in your file is a {type(function).__name__}, not a function; define "
+            f"`def {name}(...):`",
+        )
+    mismatch = _signature_mismatch(name, function, request)
+    if mismatch:
+        return _status("bad_signature", mismatch)
+    started = time.perf_counter()
+    try:
+        value = function(*request.args, **request.kwargs)
+    except MemoryError:
+        return _status(
+            "memory_limit",
+            f"{name}() ran out of memory (it used more than the grader allows)",
+            wall_time=time.perf_counter() - started,
+        )
+    except SystemExit:
+        raise
+    except BaseException as error:  # KeyboardInterrupt or a BaseException subclass raised by the student
+        return _status(
+            "exception",
+            f"{name}() raised {describe_exception(error)}",
+            traceback=student_traceback(error, submission),
+            wall_time=time.perf_counter() - started,
+        )
+    wall_time = time.perf_counter() - started
+    try:
+        encoded = encode_value(value, f"the value returned by {name}()", max_bytes=max_frame)
+    except InvalidValueError as error:
+        return _status("invalid_value", error.message, wall_time=wall_time)
+    except FrameTooLargeError as error:
+        return _status(
+            "output_too_large",
+            f"{name}() returned about {error.size} bytes of data, more than the limit of {error.limit} "
+            "bytes; return less data",
+            wall_time=wall_time,
+        )
+    except MemoryError:
+        return _status(
+            "memory_limit", f"{name}() returned more data than fits in memory", wall_time=wall_time
+        )
+    return {**_status("ok", ""), "value": encoded, "wall_time": wall_time}
+
+
+def _signature_mismatch(name: str, function: Any, request: CallRequest) -> str:
+    try:
+        signature = inspect.signature(function)
+    except Exception:  # not inspectable (a builtin, or an object whose __signature__ fails): call it anyway
+        return ""
+    try:
+        signature.bind(*request.args, **request.kwargs)
+    except TypeError as error:
+        arguments = [repr(arg) for arg in request.args] + [
+            f"{key}={value!r}" for key, value in request.kwargs.items()
+        ]
+        call = f"{name}({', '.join(arguments)})"
+        return (
+            f"the grader calls {call[:200]} but your function is defined as {name}{signature} ({error}); "
+            f"change its parameters to accept that call"
+        )
+    return ""
+
+
+def _status(status: str, message: str, *, traceback: str = "", wall_time: float = 0.0) -> dict[str, Any]:
+    return {
+        "status": status,
+        "value": None,
+        "message": shortened(message),
+        "traceback": shortened(traceback),
+        "episodes": [],
+        "wall_time": wall_time,
+    }
+
+
+def _payload(result: dict[str, Any], request: CallRequest, max_frame: int) -> bytes:
+    frame = {"type": "result", "id": request.call_id, "nonce": request.nonce, **result}
+    payload = json.dumps(frame, allow_nan=False, separators=(",", ":")).encode()
+    if len(payload) <= max_frame:
+        return payload
+    value_size = len(json.dumps(result["value"], separators=(",", ":")))
+    culprit = "its return value" if value_size > max_frame // 2 else "the episode log"
+    small = {
+        **_status(
+            "output_too_large",
+            f"{request.function}() produced {len(payload)} bytes of results, more than the limit of "
+            f"{max_frame} bytes; {culprit} is too large",
+            wall_time=result["wall_time"],
+        ),
+        "compat_events": result["compat_events"][:20],
+    }
+    return json.dumps(
+        {"type": "result", "id": request.call_id, "nonce": request.nonce, **small}, separators=(",", ":")
+    ).encode()

@@ -1,0 +1,328 @@
+"""Frames and plain-data encoding shared by the sandbox runner (parent) and the child harness.
+
+A frame is a 4-byte big-endian length followed by that many bytes of UTF-8 JSON holding one object.
+Values travel as JSON with two tagged forms: ``{"$float": "nan" | "inf" | "-inf"}`` for non-finite
+floats and ``{"$ndarray": {"dtype": "<f8", "shape": [...], "data": base64}}`` for numeric numpy
+arrays (raw bytes read back with `numpy.frombuffer`, never pickle). Only exact built-in types are
+accepted: a subclass of `float` with rigged comparisons is refused, not converted.
+"""
+
+from __future__ import annotations
+
+import base64
+import binascii
+import json
+import math
+import os
+import struct
+from collections.abc import Callable
+from typing import Any, BinaryIO
+
+import numpy as np
+
+from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
+
+HEADER = struct.Struct(">I")
+DEFAULT_MAX_FRAME = 256 * 1024 * 1024
+MAX_DEPTH = 64
+MAX_NODES = 2_000_000
+MAX_INT_BITS = 256
+FLOAT_TAG = "$float"
+NDARRAY_TAG = "$ndarray"
+
+PLAIN_TYPES_HINT = (
+    "only plain data can be returned: None, bool, int, float, str, list, tuple, dict with str keys, "
+    "numpy numbers and numpy arrays of bool/int/float"
+)
+_NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
+_INTEGER_SCALARS = ("int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64", "longlong")
+_NUMPY_SCALARS: dict[type, Callable[[Any], Any]] = {
+    np.bool_: bool,
+    np.ulonglong: int,
+    **{getattr(np, name): int for name in _INTEGER_SCALARS},
+    **{getattr(np, name): float for name in ("float16", "float32", "float64", "longdouble")},
+}
+_ARRAY_KINDS = frozenset("biuf")
+_ALLOWED_DTYPES = frozenset(
+    np.dtype(code).newbyteorder(order).str
+    for code in ("?", "i1", "i2", "i4", "i8", "u1", "u2", "u4", "u8", "f2", "f4", "f8")
+    for order in ("<", ">")
+)
+
+
+def encode_frame(message: dict[str, Any], max_frame: int = DEFAULT_MAX_FRAME) -> bytes:
+    """Serialise one message (already plain JSON data) into a length-prefixed frame.
+
+    Raises:
+        FrameTooLargeError: the encoded message is longer than `max_frame` bytes.
+    """
+    payload = json.dumps(message, allow_nan=False, separators=(",", ":")).encode()
+    if len(payload) > max_frame:
+        raise FrameTooLargeError(len(payload), max_frame)
+    return HEADER.pack(len(payload)) + payload
+
+
+def write_frame(fd: int, message: dict[str, Any], max_frame: int = DEFAULT_MAX_FRAME) -> None:
+    """Write one frame to a raw file descriptor, looping over partial writes."""
+    view = memoryview(encode_frame(message, max_frame))
+    while view:
+        written = os.write(fd, view)
+        view = view[written:]
+
+
+def read_frame(stream: BinaryIO, max_frame: int = DEFAULT_MAX_FRAME) -> dict[str, Any] | None:
+    """Read one frame; return None on a clean end of stream before a header.
+
+    Raises:
+        FrameTooLargeError: the header announces more than `max_frame` bytes.
+        ProtocolError: the stream ends inside a frame or the payload is not a JSON object.
+    """
+    header = _read_exactly(stream, HEADER.size, allow_eof=True)
+    if header is None:
+        return None
+    (size,) = HEADER.unpack(header)
+    if size > max_frame:
+        raise FrameTooLargeError(size, max_frame)
+    payload = _read_exactly(stream, size, allow_eof=False)
+    if payload is None:
+        raise ProtocolError("the stream ended inside a frame")
+    return parse_payload(payload)
+
+
+def parse_payload(payload: bytes) -> dict[str, Any]:
+    """Parse a frame payload strictly: UTF-8 JSON object, no NaN literals, no duplicate keys."""
+    try:
+        message = json.loads(
+            payload.decode("utf-8"),
+            parse_constant=_refuse_constant,
+            parse_float=_finite_float,
+            object_pairs_hook=_unique_keys,
+        )
+    except (UnicodeDecodeError, ValueError, RecursionError) as error:
+        raise ProtocolError(f"a frame is not valid UTF-8 JSON: {error}") from None
+    if type(message) is not dict:
+        raise ProtocolError(f"a frame must hold a JSON object, found {type(message).__name__}")
+    return message
+
+
+def encode_value(value: Any, what: str = "the value", max_bytes: int | None = None) -> Any:
+    """Encode plain data into JSON-ready data, refusing anything that is not exactly plain.
+
+    Args:
+        value: the value to send.
+        what: how to name the value in error messages, e.g. "the return value of blackjack()".
+        max_bytes: refuse values whose strings and arrays alone would need more bytes than this
+            (checked before any array is copied into base64).
+
+    Raises:
+        InvalidValueError: a type other than the exact plain types, a dict key that is not a
+            str, an oversized int, too deep nesting or too many elements.
+        FrameTooLargeError: the value exceeds `max_bytes`.
+    """
+    return _Encoder(what, max_bytes).encode(value, "", 0)
+
+
+def decode_value(data: Any, what: str = "the value") -> Any:
+    """Decode data produced by `encode_value` (after JSON parsing), validating every node.
+
+    Raises:
+        InvalidValueError: the data does not have the layout `encode_value` produces.
+    """
+    return _Decoder(what).decode(data, "", 0)
+
+
+class _Encoder:
+    def __init__(self, what: str, max_bytes: int | None) -> None:
+        self.what = what
+        self.nodes = 0
+        self.max_bytes = max_bytes
+        self.bytes = 0
+
+    def spend(self, size: int) -> None:
+        self.bytes += size
+        if self.max_bytes is not None and self.bytes > self.max_bytes:
+            raise FrameTooLargeError(self.bytes, self.max_bytes)
+
+    def encode(self, value: Any, where: str, depth: int) -> Any:
+        self.nodes += 1
+        if self.nodes > MAX_NODES:
+            raise _invalid(self.what, where, f"it has more than {MAX_NODES} elements; return less data")
+        if depth > MAX_DEPTH:
+            raise _invalid(self.what, where, f"it is nested more than {MAX_DEPTH} levels deep")
+        kind = type(value)
+        if kind is str:
+            self.spend(len(value))
+            return value
+        if value is None or kind is bool:
+            return value
+        if kind is int:
+            return _checked_int(value, self.what, where)
+        if kind is float:
+            return value if math.isfinite(value) else {FLOAT_TAG: _non_finite_name(value)}
+        if kind is list or kind is tuple:
+            return [self.encode(item, f"{where}[{index}]", depth + 1) for index, item in enumerate(value)]
+        if kind is dict:
+            return self._encode_dict(value, where, depth)
+        if kind is np.ndarray:
+            self.spend(value.nbytes * 4 // 3)
+            return _encode_array(value, self.what, where)
+        if kind in _NUMPY_SCALARS:
+            return self.encode(_NUMPY_SCALARS[kind](value), where, depth)
+        raise _invalid(self.what, where, _found(value) + "; " + PLAIN_TYPES_HINT + _conversion_hint(value))
+
+    def _encode_dict(self, value: dict[Any, Any], where: str, depth: int) -> dict[str, Any]:
+        encoded: dict[str, Any] = {}
+        for key, item in value.items():
+            if type(key) is not str:
+                raise _invalid(
+                    self.what, where, f"it has a dict key of type {type(key).__name__}; use str keys"
+                )
+            if key.startswith("$"):
+                raise _invalid(self.what, where, f"it has the dict key {key!r}; keys may not start with '$'")
+            encoded[key] = self.encode(item, f"{where}[{key!r}]", depth + 1)
+        return encoded
+
+
+class _Decoder:
+    def __init__(self, what: str) -> None:
+        self.what = what
+        self.nodes = 0
+
+    def decode(self, data: Any, where: str, depth: int) -> Any:
+        self.nodes += 1
+        if self.nodes > MAX_NODES or depth > MAX_DEPTH:
+            raise _invalid(self.what, where, "it is too large or too deeply nested")
+        kind = type(data)
+        if data is None or kind is bool or kind is str:
+            return data
+        if kind is int:
+            return _checked_int(data, self.what, where)
+        if kind is float:
+            if not math.isfinite(data):
+                raise _invalid(self.what, where, "a non-finite float was not tagged")
+            return data
+        if kind is list:
+            return [self.decode(item, f"{where}[{index}]", depth + 1) for index, item in enumerate(data)]
+        if kind is not dict:
+            raise _invalid(self.what, where, f"found {kind.__name__}, which JSON cannot produce")
+        if any(key.startswith("$") for key in data):
+            return self._decode_tagged(data, where)
+        return {key: self.decode(item, f"{where}[{key!r}]", depth + 1) for key, item in data.items()}
+
+    def _decode_tagged(self, data: dict[str, Any], where: str) -> Any:
+        if data.keys() == {FLOAT_TAG} and data[FLOAT_TAG] in _NON_FINITE:
+            return _NON_FINITE[data[FLOAT_TAG]]
+        if data.keys() == {NDARRAY_TAG} and type(data[NDARRAY_TAG]) is dict:
+            return _decode_array(data[NDARRAY_TAG], self.what, where)
+        raise _invalid(self.what, where, f"unknown tagged object with keys {sorted(data)}")
+
+
+def _encode_array(array: np.ndarray, what: str, where: str) -> dict[str, Any]:
+    if array.dtype.kind not in _ARRAY_KINDS or array.dtype.str not in _ALLOWED_DTYPES:
+        raise _invalid(
+            what,
+            where,
+            f"found a numpy array of dtype {array.dtype}; only bool, int, uint and float arrays can be "
+            "returned (convert with `.astype(float)`, or return a list)",
+        )
+    if array.ndim > MAX_DEPTH:
+        raise _invalid(what, where, f"the array has {array.ndim} dimensions")
+    data = base64.b64encode(np.ascontiguousarray(array).tobytes()).decode("ascii")
+    return {NDARRAY_TAG: {"dtype": array.dtype.str, "shape": list(array.shape), "data": data}}
+
+
+def _decode_array(spec: dict[str, Any], what: str, where: str) -> np.ndarray:
+    if spec.keys() != {"dtype", "shape", "data"}:
+        raise _invalid(what, where, f"an array needs exactly dtype, shape and data, found {sorted(spec)}")
+    dtype_name, shape, data = spec["dtype"], spec["shape"], spec["data"]
+    if type(dtype_name) is not str or dtype_name not in _ALLOWED_DTYPES:
+        raise _invalid(what, where, f"array dtype {dtype_name!r} is not a bool/int/float dtype")
+    if (
+        type(shape) is not list
+        or len(shape) > MAX_DEPTH
+        or not all(type(size) is int and 0 <= size < 2**62 for size in shape)
+    ):
+        raise _invalid(what, where, f"array shape {shape!r} is not a list of non-negative ints")
+    if type(data) is not str:
+        raise _invalid(what, where, "array data must be a base64 string")
+    try:
+        raw = base64.b64decode(data.encode("ascii"), validate=True)
+    except (binascii.Error, UnicodeEncodeError):
+        raise _invalid(what, where, "array data is not valid base64") from None
+    dtype = np.dtype(dtype_name)
+    if len(raw) != math.prod(shape) * dtype.itemsize:
+        raise _invalid(
+            what, where, f"array data has {len(raw)} bytes, shape {shape} of {dtype} needs more or less"
+        )
+    return np.frombuffer(bytearray(raw), dtype=dtype).reshape(shape)
+
+
+def _checked_int(value: int, what: str, where: str) -> int:
+    if value.bit_length() > MAX_INT_BITS:
+        raise _invalid(what, where, f"an int has {value.bit_length()} bits, more than {MAX_INT_BITS}")
+    return value
+
+
+def _invalid(what: str, where: str, detail: str) -> InvalidValueError:
+    location = f"{what}{where}" if where else what
+    return InvalidValueError(f"{location} is not plain data: {detail}", where)
+
+
+def _found(value: Any) -> str:
+    kind = type(value)
+    plain_bases = [
+        base.__name__ for base in (bool, int, float, str, list, tuple, dict) if isinstance(value, base)
+    ]
+    if plain_bases:
+        return (
+            f"found {kind.__module__}.{kind.__qualname__}, a subclass of {plain_bases[0]}; "
+            f"subclasses are refused because they can change comparisons"
+        )
+    if isinstance(value, np.generic):
+        return f"found numpy scalar of dtype {value.dtype}"
+    return f"found {kind.__module__}.{kind.__qualname__}"
+
+
+def _conversion_hint(value: Any) -> str:
+    for base in (float, int, str, list, dict):
+        if isinstance(value, base):
+            return f"; convert it with `{base.__name__}(...)`"
+    return ""
+
+
+def _non_finite_name(value: float) -> str:
+    if math.isnan(value):
+        return "nan"
+    return "inf" if value > 0 else "-inf"
+
+
+def _read_exactly(stream: BinaryIO, size: int, *, allow_eof: bool) -> bytes | None:
+    chunks: list[bytes] = []
+    remaining = size
+    while remaining:
+        chunk = stream.read(remaining)
+        if not chunk:
+            if allow_eof and remaining == size:
+                return None
+            raise ProtocolError(f"the stream ended after {size - remaining} of {size} bytes")
+        chunks.append(chunk)
+        remaining -= len(chunk)
+    return b"".join(chunks)
+
+
+def _refuse_constant(name: str) -> Any:
+    raise ValueError(f"the JSON constant {name} is not allowed")
+
+
+def _finite_float(text: str) -> float:
+    number = float(text)
+    if not math.isfinite(number):
+        raise ValueError(f"the number {text} is out of range")
+    return number
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    result = dict(pairs)
+    if len(result) != len(pairs):
+        raise ValueError("duplicate keys in a JSON object")
+    return result

@@ -1,0 +1,388 @@
+"""The episode recorder: wraps every env `gymnasium.make` returns and owns the call's randomness.
+
+`install` replaces `gymnasium.make` (all three names it is bound to), `numpy.random.default_rng`
+and `gymnasium.utils.seeding.np_random` so that unseeded randomness comes from the call's seed
+streams. The recorder sits outermost on each env, sees the gymnasium-API `reset`/`step` (the compat
+`gym` shim wraps it in turn), reseeds every reset from the grader's stream and logs actions and what
+the student saw. The parent replays the logs (`grader.sandbox.replay`); nothing here is trusted.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+import weakref
+from array import array
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import FrameType
+from typing import Any
+
+import gymnasium
+import gymnasium.envs
+import gymnasium.envs.registration
+import gymnasium.spaces
+import gymnasium.utils.seeding
+import numpy as np
+
+from grader.compat import events as compat_events
+from grader.compat import make as compat_make
+from grader.compat import register_envs, resolve_env_id
+from grader.sandbox.child.seeding import CallSeeds, kept_generator_seed
+
+DEFAULT_MAX_RECORDED_STEPS = 5_000_000
+MAX_KEPT_GENERATORS = 10_000
+"""Generators made at import that are reset at every call (strong references, so capped)."""
+_DROPPED_KWARGS = ("render_mode", "disable_env_checker")
+_COMPAT_MAKE_CODE = compat_make.__code__
+
+
+@dataclass
+class EpisodeRecord:
+    """One episode as the student played it (child-side, mutable while the episode runs)."""
+
+    env_index: int
+    requested_id: str
+    env_id: str
+    env_kwargs: dict[str, Any]
+    reset_seed: int
+    student_seed: int | None
+    reset_options: dict[str, Any] | None
+    actions: list[Any] = field(default_factory=list)
+    rewards: array[float] = field(default_factory=lambda: array("d"))
+    terminated: bytearray = field(default_factory=bytearray)
+    truncated: bytearray = field(default_factory=bytearray)
+
+    def to_plain(self) -> dict[str, Any]:
+        """The wire layout parsed by `grader.sandbox.episodes.episodes_from_plain`."""
+        return {
+            "env_index": self.env_index,
+            "requested_id": self.requested_id,
+            "env_id": self.env_id,
+            "env_kwargs": self.env_kwargs,
+            "reset_seed": self.reset_seed,
+            "student_seed": self.student_seed,
+            "reset_options": self.reset_options,
+            "actions": _compact_actions(self.actions),
+            "rewards": _compact_numbers(np.frombuffer(self.rewards, dtype=np.float64)),
+            "terminated": np.frombuffer(self.terminated, dtype=np.bool_),
+            "truncated": np.frombuffer(self.truncated, dtype=np.bool_),
+        }
+
+
+@dataclass(frozen=True)
+class MadeEnv:
+    """How an env was made: what the student asked for and what rebuilds it with `gymnasium.make`."""
+
+    requested_id: str
+    env_id: str
+    env_kwargs: dict[str, Any]
+
+
+class Recorder:
+    """Per-process recording state; `begin_call` starts a call, `finish_call` returns its episodes."""
+
+    def __init__(self, seed: int, max_recorded_steps: int = DEFAULT_MAX_RECORDED_STEPS) -> None:
+        self.seeds = CallSeeds(seed)
+        self.max_recorded_steps = max_recorded_steps
+        self.recording = False
+        self.overflowed = False
+        self.episodes: list[EpisodeRecord] = []
+        self._recorded_steps = 0
+        self._live_envs: list[weakref.ref[RecordingEnv]] = []
+        self._env_numbers = 0
+        self._call_indices: dict[int, int] = {}
+        self._generators: list[tuple[np.random.Generator, Mapping[str, Any] | None]] = []
+        self.importing = False
+
+    def begin_import(self, import_seed: int) -> None:
+        """Seed the import of the submission; generators made until `finish_import` are kept."""
+        self.begin_call(import_seed, record=False)
+        self.importing = True
+
+    def finish_import(self, module_globals: Mapping[str, Any]) -> None:
+        """Give the spaces the module defines their generators now, so that they are kept too."""
+        for value in list(module_globals.values()):
+            if gymnasium.spaces.Space in type(value).__mro__:
+                with contextlib.suppress(Exception):
+                    value.np_random  # noqa: B018 (the property creates the space's generator)
+        self.importing = False
+        self.finish_call()
+
+    def begin_call(self, call_seed: int, *, record: bool) -> None:
+        """Reseed everything from `call_seed` and start an empty episode log."""
+        self.importing = False
+        self.seeds = CallSeeds(call_seed)
+        self.recording = record
+        self.overflowed = False
+        self.episodes = []
+        self._recorded_steps = 0
+        self._call_indices = {}
+        self._live_envs = [ref for ref in self._live_envs if ref() is not None]
+        self._env_numbers = 0
+        for ref in self._live_envs:
+            env = ref()
+            if env is not None:
+                self.seed_spaces(env)
+        for number, (generator, initial_state) in enumerate(self._generators):
+            bit_generator = generator.bit_generator
+            if initial_state is None:
+                bit_generator.state = type(bit_generator)(kept_generator_seed(call_seed, number)).state
+            else:
+                bit_generator.state = initial_state
+
+    def finish_call(self) -> list[EpisodeRecord]:
+        """Stop recording and return the call's episodes in reset order."""
+        self.recording = False
+        episodes, self.episodes = self.episodes, []
+        return episodes
+
+    def keep_generator(self, generator: np.random.Generator, *, seeded: bool) -> None:
+        """While importing: reset `generator` at every call (to its first state if seeded, else reseeded).
+
+        A generator in a module global would otherwise carry one call's randomness into the next, and
+        a restarted child (fresh import) would give different results. Generators made during calls
+        are not kept: they take their seeds from the call's own streams.
+        """
+        if self.importing and len(self._generators) < MAX_KEPT_GENERATORS:
+            self._generators.append((generator, generator.bit_generator.state if seeded else None))
+
+    def register(self, env: RecordingEnv) -> None:
+        """Track a new env so its spaces are reseeded at every call."""
+        self._live_envs.append(weakref.ref(env))
+        self.seed_spaces(env)
+
+    def seed_spaces(self, env: RecordingEnv) -> None:
+        """Seed the env's action and observation spaces from the call's space stream."""
+        number = self._env_numbers
+        self._env_numbers += 1
+        env.action_space.seed(self.seeds.space_seed(2 * number))
+        env.observation_space.seed(self.seeds.space_seed(2 * number + 1))
+
+    def start_episode(
+        self, env: RecordingEnv, reset_seed: int, student_seed: int | None, options: dict[str, Any] | None
+    ) -> EpisodeRecord | None:
+        """Open a new episode for `env`, or return None when not recording."""
+        if not self.recording or not self._spend_step():
+            return None
+        index = self._call_indices.setdefault(id(env), len(self._call_indices))
+        made = env.made
+        episode = EpisodeRecord(
+            index, made.requested_id, made.env_id, made.env_kwargs, reset_seed, student_seed, options
+        )
+        self.episodes.append(episode)
+        return episode
+
+    def record_step(
+        self, episode: EpisodeRecord, action: Any, reward: Any, terminated: Any, truncated: Any
+    ) -> None:
+        """Append one step to `episode` unless the step budget is spent."""
+        if not self._spend_step():
+            return
+        episode.actions.append(_copy_action(action))
+        try:
+            episode.rewards.append(float(reward))
+        except (TypeError, ValueError):
+            episode.rewards.append(float("nan"))
+        episode.terminated.append(bool(terminated))
+        episode.truncated.append(bool(truncated))
+
+    def _spend_step(self) -> bool:
+        if self._recorded_steps >= self.max_recorded_steps:
+            self.overflowed = True
+            self.recording = False
+            return False
+        self._recorded_steps += 1
+        return True
+
+
+class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
+    """The outermost wrapper of every env made in the child: grader-seeded resets, logged steps."""
+
+    def __init__(self, env: gymnasium.Env[Any, Any], recorder: Recorder, made: MadeEnv) -> None:
+        super().__init__(env)
+        self.recorder = recorder
+        self.made = made
+        self._episode: EpisodeRecord | None = None
+
+    def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
+        """Reset with a seed from the grader's stream (or the student's seed mapped through it)."""
+        self._episode = None
+        student_seed: int | None = None
+        if seed is None:
+            actual_seed = self.recorder.seeds.next_reset_seed()
+        elif isinstance(seed, int | np.integer) and not isinstance(seed, bool) and seed >= 0:
+            student_seed = int(seed)
+            actual_seed = self.recorder.seeds.student_reset_seed(student_seed)
+        else:
+            return self.env.reset(seed=seed, options=options)
+        result = self.env.reset(seed=actual_seed, options=options)
+        logged_options = dict(options) if type(options) is dict else options
+        self._episode = self.recorder.start_episode(self, actual_seed, student_seed, logged_options)
+        return result
+
+    def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
+        """Step the env and log the action and what the student sees."""
+        result = self.env.step(action)
+        if self._episode is not None and self.recorder.recording:
+            _, reward, terminated, truncated, _ = result
+            self.recorder.record_step(self._episode, action, reward, terminated, truncated)
+        return result
+
+
+def install(recorder: Recorder) -> None:
+    """Route env creation and unseeded randomness of this process through `recorder`."""
+    original_make = gymnasium.envs.registration.make
+
+    def make(
+        id: Any, max_episode_steps: int | None = None, disable_env_checker: bool | None = None, **kwargs: Any
+    ) -> gymnasium.Env[Any, Any]:
+        if kwargs.get("render_mode") == "human":
+            kwargs["render_mode"] = None
+        requested = id
+        if isinstance(id, str) and ":" not in id and id not in gymnasium.envs.registration.registry:
+            id, kwargs = _resolve_lab_id(id, kwargs)
+        env = original_make(id, max_episode_steps, disable_env_checker, **kwargs)
+        made = describe_make(id, max_episode_steps, kwargs, sys._getframe(1), env.unwrapped.spec)
+        if requested is not id:
+            made = MadeEnv(requested, made.env_id, made.env_kwargs)
+        recording_env = RecordingEnv(env, recorder, made)
+        recorder.register(recording_env)
+        return recording_env
+
+    make.__doc__ = original_make.__doc__
+    gymnasium.make = make
+    gymnasium.envs.make = make
+    gymnasium.envs.registration.make = make
+    _route_unseeded_generators(recorder)
+
+
+def _resolve_lab_id(requested: str, kwargs: dict[str, Any]) -> tuple[str, dict[str, Any]]:
+    """Make a lab id gymnasium no longer registers (`Taxi-v3`) work through plain `gymnasium.make` too.
+
+    Gymnasium-API submissions keep the lab's ids (the grader itself calls `find_qvalues("Taxi-v3")`);
+    they are resolved exactly as the compat `gym.make` resolves them, and the renaming is reported. An id
+    the lab never used still fails, with the compat layer's message naming the lab's id.
+    """
+    target = resolve_env_id(requested)
+    register_envs()
+    merged = target.merged_kwargs(kwargs)
+    arguments = "".join(f", {name}={value!r}" for name, value in target.kwargs.items())
+    compat_events.record(
+        compat_events.RENAMED_ID,
+        requested,
+        f"gymnasium.make({requested!r}) was made as gymnasium.make({target.gymnasium_id!r}{arguments}): "
+        f"{target.note}",
+    )
+    return target.gymnasium_id, merged
+
+
+def describe_make(
+    id: Any,
+    max_episode_steps: int | None,
+    kwargs: dict[str, Any],
+    caller: FrameType | None,
+    made_spec: gymnasium.envs.registration.EnvSpec | None = None,
+) -> MadeEnv:
+    """What to log for a `gymnasium.make(id, max_episode_steps, **kwargs)` call made from `caller`.
+
+    `made_spec` is the spec gymnasium gave the new env; its id is the registered id even when the
+    student wrote `"module:Env-v0"`.
+    """
+    env_kwargs = {key: value for key, value in kwargs.items() if key not in _DROPPED_KWARGS}
+    if isinstance(id, gymnasium.envs.registration.EnvSpec):
+        env_id = id.id
+        env_kwargs = {
+            key: value for key, value in id.kwargs.items() if key not in _DROPPED_KWARGS
+        } | env_kwargs
+        registered = gymnasium.envs.registration.registry.get(env_id)
+        if (
+            max_episode_steps is None
+            and registered is not None
+            and id.max_episode_steps != registered.max_episode_steps
+        ):
+            max_episode_steps = -1 if id.max_episode_steps is None else id.max_episode_steps
+    else:
+        env_id = made_spec.id if made_spec is not None else str(id)
+    if max_episode_steps is not None:
+        env_kwargs["max_episode_steps"] = max_episode_steps
+    return MadeEnv(_requested_id(caller, env_id), env_id, env_kwargs)
+
+
+def _requested_id(caller: FrameType | None, made_id: str) -> str:
+    """The id the student passed to the compat `gym.make`, else the id given to `gymnasium.make`.
+
+    `grader.compat.make(env_id, **kwargs)` resolves the classic id and calls `gymnasium.make` with
+    the gymnasium id; when that function is our direct caller, its `env_id` is the requested id.
+    """
+    if caller is not None and caller.f_code is _COMPAT_MAKE_CODE:
+        requested = caller.f_locals.get("env_id")
+        if isinstance(requested, str):
+            return requested
+    return made_id
+
+
+def _route_unseeded_generators(recorder: Recorder) -> None:
+    original_np_random = gymnasium.utils.seeding.np_random
+    original_default_rng = np.random.default_rng
+
+    def np_random(seed: int | None = None) -> tuple[np.random.Generator, int]:
+        if seed is not None:
+            return original_np_random(seed)
+        generator, entropy = original_np_random(recorder.seeds.next_unseeded_generator_seed())
+        recorder.keep_generator(generator, seeded=False)
+        return generator, entropy
+
+    def default_rng(seed: Any = None) -> np.random.Generator:
+        unseeded = seed is None
+        generator = original_default_rng(recorder.seeds.next_default_rng_seed() if unseeded else seed)
+        if generator is not seed:
+            recorder.keep_generator(generator, seeded=not unseeded)
+        return generator
+
+    np_random.__doc__ = original_np_random.__doc__
+    default_rng.__doc__ = original_default_rng.__doc__
+    gymnasium.utils.seeding.np_random = np_random
+    np.random.default_rng = default_rng
+
+
+def _copy_action(action: Any) -> Any:
+    kind = type(action)
+    if kind is int or kind is float or kind is bool:
+        return action
+    if isinstance(action, np.integer):
+        return int(action)
+    if isinstance(action, np.floating):
+        return float(action)
+    if isinstance(action, np.ndarray):
+        return np.array(action)  # a copy, and a plain ndarray even for a subclass
+    if kind is list or kind is tuple:
+        return [_copy_action(item) for item in action]
+    return action
+
+
+def _compact_actions(actions: list[Any]) -> Any:
+    plain_ints = bool(actions) and all(type(action) is int for action in actions)
+    if plain_ints and min(actions) >= -(2**63) and max(actions) < 2**63:
+        return _smallest_int_array(np.array(actions, dtype=np.int64))
+    return actions
+
+
+def _compact_numbers(values: np.ndarray) -> np.ndarray:
+    """The smallest dtype that holds `values` exactly (Taxi's rewards fit int8)."""
+    if (
+        values.size
+        and np.all(np.isfinite(values))
+        and np.all(values == np.round(values))
+        and np.all(np.abs(values) < 2**31)
+    ):
+        return _smallest_int_array(values.astype(np.int64))
+    return values.copy()
+
+
+def _smallest_int_array(values: np.ndarray) -> np.ndarray:
+    for dtype in (np.int8, np.int16, np.int32):
+        info = np.iinfo(dtype)
+        if values.size == 0 or (values.min() >= info.min and values.max() <= info.max):
+            return values.astype(dtype)
+    return values

@@ -1,0 +1,197 @@
+"""`EpisodeLog`: one episode as the student's code played it, decoded strictly from the result channel.
+
+The child sends each episode in the layout of `grader.sandbox.child.recorder.EpisodeRecord.to_plain`
+(per-step columns as numpy arrays). Nothing in a log is trusted: `grader.sandbox.replay` replays it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
+from grader.sandbox.child.protocol import decode_value
+
+MAX_ID_LENGTH = 200
+MAX_SEED = 2**64
+_FIELDS = frozenset(
+    {
+        "env_index",
+        "requested_id",
+        "env_id",
+        "env_kwargs",
+        "reset_seed",
+        "student_seed",
+        "reset_options",
+        "actions",
+        "rewards",
+        "terminated",
+        "truncated",
+    }
+)
+
+
+@dataclass(frozen=True, eq=False)
+class EpisodeLog:
+    """One episode: which env, how it was reset, and every step the student took.
+
+    Attributes:
+        env_index: which env instance, numbered in the order of its first reset within the call.
+        requested_id: the id the student asked for (`"Blackjack-v0"`).
+        env_id: the gymnasium id actually made (`"Blackjack-v1"`).
+        env_kwargs: the other `gymnasium.make` arguments (`max_episode_steps` included when given);
+            `gymnasium.make(env_id, **env_kwargs)` rebuilds the env.
+        reset_seed: the seed the episode was actually reset with (grader-chosen or mapped).
+        student_seed: the seed the student passed to reset, if any.
+        actions: one per step: int for `Discrete`, a numpy array for `Box` (dtype as the student sent it).
+        rewards: what the student saw, one per step.
+        terminated: the flags the student saw, one per step.
+        truncated: likewise. Steps after the first terminated/truncated are kept.
+        reset_options: the `options` passed to reset, if any.
+    """
+
+    env_index: int
+    requested_id: str
+    env_id: str
+    env_kwargs: dict[str, Any]
+    reset_seed: int
+    student_seed: int | None
+    actions: list[Any]
+    rewards: list[float]
+    terminated: list[bool]
+    truncated: list[bool]
+    reset_options: dict[str, Any] | None = None
+
+    @property
+    def steps(self) -> int:
+        """Number of steps logged, including steps after the episode ended."""
+        return len(self.actions)
+
+    def __eq__(self, other: object) -> bool:
+        """Field by field; array actions (Box envs) compare by dtype, shape and values."""
+        if not isinstance(other, EpisodeLog):
+            return NotImplemented
+        fields = (
+            "env_index",
+            "requested_id",
+            "env_id",
+            "env_kwargs",
+            "reset_seed",
+            "student_seed",
+            "rewards",
+            "terminated",
+            "truncated",
+            "reset_options",
+        )
+        return (
+            all(getattr(self, name) == getattr(other, name) for name in fields)
+            and len(self.actions) == len(other.actions)
+            and all(
+                _same_action(mine, theirs) for mine, theirs in zip(self.actions, other.actions, strict=True)
+            )
+        )
+
+    __hash__ = None  # type: ignore[assignment]  # mutable lists inside
+
+
+def _same_action(mine: Any, theirs: Any) -> bool:
+    if type(mine) is np.ndarray or type(theirs) is np.ndarray:
+        return type(mine) is type(theirs) and mine.dtype == theirs.dtype and np.array_equal(mine, theirs)
+    return bool(type(mine) is type(theirs) and mine == theirs)
+
+
+def episodes_from_plain(data: Any) -> list[EpisodeLog]:
+    """Decode and validate the `episodes` field of a result frame (JSON data, as parsed).
+
+    Raises:
+        InvalidEpisodeLogError: the data does not have the layout the child sends.
+    """
+    if type(data) is not list:
+        raise InvalidEpisodeLogError(f"episodes must be a list, found {type(data).__name__}")
+    try:
+        decoded = decode_value(data, "the episode log")
+    except InvalidValueError as error:
+        raise InvalidEpisodeLogError(error.message) from None
+    return [_episode(item, number) for number, item in enumerate(decoded)]
+
+
+def _episode(item: Any, number: int) -> EpisodeLog:
+    where = f"episode {number}"
+    if type(item) is not dict or item.keys() != _FIELDS:
+        found = sorted(item) if type(item) is dict else type(item).__name__
+        raise InvalidEpisodeLogError(f"{where} must have the fields {sorted(_FIELDS)}, found {found}")
+    student_seed = item["student_seed"]
+    if student_seed is not None:
+        student_seed = _seed(student_seed, f"{where}: student_seed")
+    rewards = _column(item["rewards"], "biuf", f"{where}: rewards")
+    terminated = _column(item["terminated"], "b", f"{where}: terminated")
+    truncated = _column(item["truncated"], "b", f"{where}: truncated")
+    actions = _actions(item["actions"], f"{where}: actions")
+    lengths = {len(actions), len(rewards), len(terminated), len(truncated)}
+    if len(lengths) != 1:
+        raise InvalidEpisodeLogError(
+            f"{where}: actions, rewards, terminated and truncated must have one entry per step, found "
+            f"{len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"
+        )
+    return EpisodeLog(
+        env_index=_bounded_int(item["env_index"], 0, 2**31, f"{where}: env_index"),
+        requested_id=_identifier(item["requested_id"], f"{where}: requested_id"),
+        env_id=_identifier(item["env_id"], f"{where}: env_id"),
+        env_kwargs=_mapping(item["env_kwargs"], f"{where}: env_kwargs"),
+        reset_seed=_seed(item["reset_seed"], f"{where}: reset_seed"),
+        student_seed=student_seed,
+        actions=actions,
+        rewards=[float(value) for value in rewards.astype(np.float64)],
+        terminated=[bool(value) for value in terminated],
+        truncated=[bool(value) for value in truncated],
+        reset_options=None
+        if item["reset_options"] is None
+        else _mapping(item["reset_options"], f"{where}: reset_options"),
+    )
+
+
+def _column(value: Any, kinds: str, where: str) -> np.ndarray:
+    if type(value) is not np.ndarray or value.ndim != 1 or value.dtype.kind not in kinds:
+        raise InvalidEpisodeLogError(
+            f"{where} must be a 1-D array of kind {kinds!r}, found {_describe(value)}"
+        )
+    return value
+
+
+def _actions(value: Any, where: str) -> list[Any]:
+    if type(value) is np.ndarray:
+        return [int(action) for action in _column(value, "iu", where)]
+    if type(value) is list:
+        return value
+    raise InvalidEpisodeLogError(f"{where} must be an int array or a list, found {_describe(value)}")
+
+
+def _seed(value: Any, where: str) -> int:
+    return _bounded_int(value, 0, MAX_SEED, where)
+
+
+def _bounded_int(value: Any, low: int, high: int, where: str) -> int:
+    if type(value) is not int or not low <= value < high:
+        raise InvalidEpisodeLogError(f"{where} must be an int in [{low}, {high}), found {_describe(value)}")
+    return value
+
+
+def _identifier(value: Any, where: str) -> str:
+    if type(value) is not str or not 0 < len(value) <= MAX_ID_LENGTH:
+        raise InvalidEpisodeLogError(f"{where} must be a non-empty str of at most {MAX_ID_LENGTH} characters")
+    return value
+
+
+def _mapping(value: Any, where: str) -> dict[str, Any]:
+    if type(value) is not dict:
+        raise InvalidEpisodeLogError(f"{where} must be a dict, found {_describe(value)}")
+    return value
+
+
+def _describe(value: Any) -> str:
+    if type(value) is np.ndarray:
+        return f"an array of dtype {value.dtype} and shape {value.shape}"
+    text = repr(value)
+    return f"{type(value).__name__} {text[:60]}"

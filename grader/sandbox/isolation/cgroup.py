@@ -1,0 +1,248 @@
+"""A cgroup per child (v1 and v2): memory, process and CPU limits, OOM detection, killing the whole tree."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import secrets
+import signal
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from grader.sandbox.isolation.protocol import LayerReport
+
+CGROUP_ROOT = Path("/sys/fs/cgroup")
+CONTROLLERS = ("memory", "pids", "cpu")
+JOB_PREFIX = "gymgrade-"
+"""Job cgroups are named gymgrade-<grader pid>-<random>."""
+_REMEDY = (
+    "run as root, or in a delegated cgroup (e.g. `systemd-run --user --scope -p Delegate=yes gymgrade ...`)"
+)
+
+
+@dataclass
+class _Group:
+    """One directory of a cgroup hierarchy that the child joins."""
+
+    path: Path
+    version: int
+    controllers: tuple[str, ...]
+
+    def write(self, name: str, value: str) -> None:
+        (self.path / name).write_text(value)
+
+    def read(self, name: str) -> str:
+        try:
+            return (self.path / name).read_text()
+        except OSError:
+            return ""
+
+
+def _own_paths() -> dict[str, str]:
+    """Maps each v1 controller, and "" for the v2 hierarchy, to this process's cgroup path."""
+    paths: dict[str, str] = {}
+    for line in Path("/proc/self/cgroup").read_text().splitlines():
+        _, names, path = line.split(":", 2)
+        for name in names.split(",") if names else [""]:
+            paths[name] = path
+    return paths
+
+
+def _v2_root() -> Path | None:
+    for candidate in (CGROUP_ROOT, CGROUP_ROOT / "unified"):
+        if (candidate / "cgroup.controllers").exists():
+            return candidate
+    return None
+
+
+def _v2_available(group: Path) -> set[str]:
+    try:
+        return set((group / "cgroup.controllers").read_text().split())
+    except OSError:
+        return set()
+
+
+@dataclass
+class JobCgroup:
+    """The cgroups (one per hierarchy) a single child runs in; `remove` after the child is gone."""
+
+    groups: list[_Group] = field(default_factory=list)
+
+    @property
+    def procs_files(self) -> list[Path]:
+        """Files the child writes its pid into before it execs (joins every group)."""
+        return [group.path / "cgroup.procs" for group in self.groups]
+
+    @property
+    def limited(self) -> set[str]:
+        """The controllers that limit the child."""
+        return {name for group in self.groups for name in group.controllers}
+
+    def pids(self) -> set[int]:
+        """Every process still in the job."""
+        found: set[int] = set()
+        for group in self.groups:
+            found.update(int(pid) for pid in group.read("cgroup.procs").split())
+        return found
+
+    def oom_kills(self) -> int:
+        """How many processes the kernel killed for exceeding the memory limit."""
+        for group in self.groups:
+            if "memory" in group.controllers:
+                name = "memory.oom_control" if group.version == 1 else "memory.events"
+                for line in group.read(name).splitlines():
+                    key, _, value = line.partition(" ")
+                    if key == "oom_kill":
+                        return int(value)
+        return 0
+
+    def kill(self, timeout: float = 2.0) -> bool:
+        """SIGKILLs every process in the job until it is empty; False when some survived `timeout`."""
+        deadline = time.monotonic() + timeout
+        for group in self.groups:
+            if group.version == 2 and (group.path / "cgroup.kill").exists():
+                with contextlib.suppress(OSError):
+                    group.write("cgroup.kill", "1")
+        while True:
+            remaining = self.pids()
+            if not remaining:
+                return True
+            if time.monotonic() > deadline:
+                return False
+            for pid in remaining:
+                with contextlib.suppress(ProcessLookupError, PermissionError):
+                    os.kill(pid, signal.SIGKILL)
+            time.sleep(0.005)
+
+    def remove(self) -> bool:
+        """Kills what is left and removes the job's directories; False when something stayed behind."""
+        emptied = self.kill()
+        removed = True
+        for group in self.groups:
+            for _ in range(100):
+                try:
+                    group.path.rmdir()
+                    break
+                except FileNotFoundError:
+                    break
+                except OSError:
+                    time.sleep(0.01)
+            else:
+                removed = False
+        return emptied and removed
+
+
+def _remove_stale(parent: Path) -> None:
+    """Removes empty job cgroups left by grader processes that died without cleaning up (e.g. SIGKILL)."""
+    for path in parent.glob(f"{JOB_PREFIX}*-*"):
+        try:
+            os.kill(int(path.name.split("-")[1]), 0)
+        except ProcessLookupError:
+            with contextlib.suppress(OSError):
+                path.rmdir()  # fails, as it should, while any process is still inside
+        except (ValueError, IndexError, PermissionError):
+            continue
+
+
+def _make_group(parent: Path, name: str, version: int, controllers: tuple[str, ...]) -> _Group:
+    _remove_stale(parent)
+    path = parent / name
+    path.mkdir()
+    return _Group(path, version, controllers)
+
+
+def _v2_parent(v2_root: Path, own_path: str) -> tuple[Path, tuple[str, ...]]:
+    """Where to create the job in the v2 hierarchy, and the controllers it gets there.
+
+    Below the grader's own cgroup when the controllers can be enabled there; a cgroup holding processes
+    cannot hand controllers to children (the "no internal processes" rule), so otherwise, as root, below
+    the hierarchy's root, which is exempt from that rule.
+    """
+    own = v2_root / own_path.lstrip("/")
+    candidates = [own] if own == v2_root or os.geteuid() != 0 else [own, v2_root]
+    for parent in candidates:
+        offered = tuple(c for c in CONTROLLERS if c in _v2_available(parent))
+        enabled = set((parent / "cgroup.subtree_control").read_text().split())
+        try:
+            missing = [c for c in offered if c not in enabled]
+            if missing:
+                (parent / "cgroup.subtree_control").write_text(" ".join(f"+{c}" for c in missing))
+        except OSError:
+            continue
+        return parent, offered
+    return own, ()
+
+
+def create_job_cgroup(memory_bytes: int, max_pids: int, cpus: float = 1.0) -> JobCgroup:
+    """Creates the cgroups for one child with its limits written.
+
+    Uses the cgroup v2 hierarchy for each controller it offers here and the v1 hierarchy for the
+    others; a v2 group is also created only to kill and track the tree when the v2 hierarchy is
+    mounted without controllers (hybrid set-up).
+
+    Raises:
+        OSError: when the cgroup tree is not writable (see `CgroupLayer.probe`).
+    """
+    own = _own_paths()
+    name = f"{JOB_PREFIX}{os.getpid()}-{secrets.token_hex(4)}"
+    job = JobCgroup()
+    try:
+        wanted = list(CONTROLLERS)
+        v2_root = _v2_root()
+        if v2_root is not None and "" in own:
+            v2_parent, offered = _v2_parent(v2_root, own[""])
+            job.groups.append(_make_group(v2_parent, name, 2, offered))
+            wanted = [c for c in wanted if c not in offered]
+        for controller in wanted:
+            mount = CGROUP_ROOT / controller
+            if controller in own and (mount / "cgroup.procs").exists():
+                job.groups.append(_make_group(mount / own[controller].lstrip("/"), name, 1, (controller,)))
+        _write_limits(job, memory_bytes, max_pids, cpus)
+    except OSError:
+        job.remove()
+        raise
+    return job
+
+
+def _write_limits(job: JobCgroup, memory_bytes: int, max_pids: int, cpus: float) -> None:
+    period = 100_000
+    for group in job.groups:
+        if "memory" in group.controllers:
+            if group.version == 1:
+                group.write("memory.limit_in_bytes", str(memory_bytes))
+                if (group.path / "memory.memsw.limit_in_bytes").exists():
+                    group.write("memory.memsw.limit_in_bytes", str(memory_bytes))
+            else:
+                group.write("memory.max", str(memory_bytes))
+                group.write("memory.swap.max", "0")
+        if "pids" in group.controllers:
+            group.write("pids.max", str(max_pids))
+        if "cpu" in group.controllers:
+            if group.version == 1:
+                group.write("cpu.cfs_period_us", str(period))
+                group.write("cpu.cfs_quota_us", str(int(period * cpus)))
+            else:
+                group.write("cpu.max", f"{int(period * cpus)} {period}")
+
+
+class CgroupLayer:
+    """Memory, process-count and CPU limits for the child's whole tree, and killing that tree."""
+
+    name = "cgroup"
+
+    def probe(self) -> LayerReport:
+        """Creates and removes a throw-away job cgroup to see which controllers can be used."""
+        try:
+            job = create_job_cgroup(memory_bytes=1 << 30, max_pids=16)
+        except OSError as error:
+            return LayerReport(self.name, False, f"the cgroup tree is not writable here ({error})", _REMEDY)
+        limited = job.limited
+        versions = sorted({f"v{group.version}" for group in job.groups})
+        job.remove()
+        missing = [c for c in CONTROLLERS if c not in limited]
+        if missing:
+            return LayerReport(self.name, False, f"controllers {', '.join(missing)} are not available",
+                               "mount the cgroup controllers or delegate them to this user (" + _REMEDY + ")")
+        return LayerReport(self.name, True,
+                           f"cgroup {'+'.join(versions)}: memory, pids and cpu limited per child")

@@ -1,0 +1,103 @@
+"""What the child may see: the interpreter, the libraries, the harness tree, and nothing of the project."""
+
+from __future__ import annotations
+
+import atexit
+import functools
+import os
+import shutil
+import site
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+PROJECT_PACKAGES = ("grader", "reference", "api")
+"""Top-level packages of the project; hidden wherever an installed copy would make them importable."""
+
+_GRADER_ROOT = Path(__file__).resolve().parents[2]
+_HARNESS_SOURCES = ("sandbox/child", "compat")
+_ISOLATION_DIR = Path(__file__).resolve().parent
+TREE_PREFIX = "gymgrade-harness-"
+"""Harness trees are temporary directories named gymgrade-harness-<grader pid>-<random>."""
+
+
+@dataclass(frozen=True)
+class PythonPaths:
+    """The interpreter and the directories of the modules the child imports.
+
+    Attributes:
+        executable: The interpreter binary.
+        roots: Directories to expose read-only (prefixes and site directories, even when nested).
+        stdlib: Standard-library entries of the child's sys.path.
+        site_dirs: Site directories of the child's sys.path (after the stdlib).
+        hidden: Files and directories inside `roots` the child must not see (.pth hooks, the editable
+            install's finder, installed copies of the project's packages).
+    """
+
+    executable: Path
+    roots: tuple[Path, ...]
+    stdlib: tuple[str, ...]
+    site_dirs: tuple[str, ...]
+    hidden: tuple[Path, ...]
+
+
+@functools.cache
+def python_paths() -> PythonPaths:
+    """The paths of the running interpreter (the child runs the same interpreter)."""
+    prefixes = {Path(sys.base_prefix).resolve(), Path(sys.prefix).resolve()}
+    site_dirs = [p for p in site.getsitepackages() if os.path.isdir(p)]
+    stdlib = [p for p in sys.path if p and p not in site_dirs and any(p.startswith(str(x)) for x in prefixes)]
+    roots = prefixes | {Path(directory).resolve() for directory in site_dirs}
+    hidden: list[Path] = []
+    for site_dir in site_dirs:
+        for entry in Path(site_dir).iterdir():
+            name = entry.name
+            hook = name.endswith(".pth") or (name.startswith("__editable__") and name.endswith(".py"))
+            if hook or (name in PROJECT_PACKAGES and entry.is_dir()):
+                hidden.append(entry)
+    return PythonPaths(
+        executable=Path(sys.executable).resolve(),
+        roots=tuple(sorted(roots)),
+        stdlib=tuple(stdlib),
+        site_dirs=tuple(site_dirs),
+        hidden=tuple(sorted(hidden)),
+    )
+
+
+def remove_stale_trees() -> None:
+    """Removes trees of grader processes that ended without running their exit handlers (e.g. SIGKILL)."""
+    for path in Path(tempfile.gettempdir()).glob(f"{TREE_PREFIX}*-*"):
+        try:
+            os.kill(int(path.name.removeprefix(TREE_PREFIX).split("-")[0]), 0)
+        except ProcessLookupError:
+            shutil.rmtree(path, ignore_errors=True)
+        except (ValueError, PermissionError):
+            continue
+
+
+@functools.cache
+def harness_tree() -> Path:
+    """A private, read-only copy of what the child imports from the project, built once per process.
+
+    Layout: ``bootstrap.py`` and ``landlock.py`` at the top, and under ``lib/`` an empty
+    ``grader/__init__.py`` and ``grader/sandbox/__init__.py`` with ``grader/sandbox/child`` and
+    ``grader/compat``. Nothing else of the project (not `reference`, not the assignment config).
+    """
+    remove_stale_trees()
+    root = Path(tempfile.mkdtemp(prefix=f"{TREE_PREFIX}{os.getpid()}-"))
+    atexit.register(shutil.rmtree, root, ignore_errors=True)
+    lib = root / "lib"
+    (lib / "grader" / "sandbox").mkdir(parents=True)
+    (lib / "grader" / "__init__.py").write_text("")
+    (lib / "grader" / "sandbox" / "__init__.py").write_text("")
+    for relative in _HARNESS_SOURCES:
+        shutil.copytree(_GRADER_ROOT / relative, lib / "grader" / relative,
+                        ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    for name in ("bootstrap.py", "landlock.py"):
+        shutil.copy2(_ISOLATION_DIR / name, root / name)
+    for directory, _, files in os.walk(root):
+        os.chmod(directory, 0o755)
+        for name in files:
+            os.chmod(os.path.join(directory, name), 0o644)
+    return root

@@ -1,0 +1,95 @@
+"""What a sandboxed call asks for and what it produced: `Call`, `OutcomeStatus`, `CallOutcome`."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from enum import StrEnum
+from typing import TYPE_CHECKING, Any, TypeAlias
+
+if TYPE_CHECKING:
+    from grader.sandbox.episodes import EpisodeLog
+
+PlainValue: TypeAlias = Any
+"""None, bool, int, float, str, lists and str-keyed dicts of these, or a numeric numpy array."""
+
+
+class OutcomeStatus(StrEnum):
+    """How a call ended. Every status but OK comes with a student-readable message."""
+
+    OK = "ok"
+    IMPORT_ERROR = "import_error"
+    EXCEPTION = "exception"
+    TIMEOUT = "timeout"
+    MEMORY_LIMIT = "memory_limit"
+    KILLED = "killed"
+    EXITED = "exited"
+    MISSING_FUNCTION = "missing_function"
+    BAD_SIGNATURE = "bad_signature"
+    OUTPUT_TOO_LARGE = "output_too_large"
+    INVALID_VALUE = "invalid_value"
+    SANDBOX_ERROR = "sandbox_error"
+
+
+@dataclass(frozen=True)
+class Call:
+    """One call of a student function.
+
+    Attributes:
+        function: Name of the function in the submission.
+        args: Positional arguments, plain data only.
+        kwargs: Keyword arguments, plain data only.
+        record_episodes: Whether the child logs every episode played (False for long training runs).
+    """
+
+    function: str
+    args: tuple[PlainValue, ...] = ()
+    kwargs: Mapping[str, PlainValue] = field(default_factory=dict)
+    record_episodes: bool = True
+
+
+@dataclass(frozen=True)
+class ParameterInfo:
+    """One parameter of a student function, as `inspect.signature` saw it in the child."""
+
+    name: str
+    kind: str
+    has_default: bool
+
+
+@dataclass(frozen=True)
+class FunctionInfo:
+    """A top-level name the submission defines and, when callable, its parameters."""
+
+    name: str
+    is_callable: bool
+    parameters: tuple[ParameterInfo, ...] = ()
+
+
+@dataclass(frozen=True)
+class CallOutcome:
+    """What one call produced.
+
+    Attributes:
+        call: The call made.
+        status: How it ended.
+        value: Decoded plain data; None unless status is OK.
+        episodes: Episode logs recorded in the child (untrusted until replayed).
+        compat_events: What the compatibility layer had to tolerate ({"kind", "env_id", "detail"}).
+        stdout: The student's own output, capped (a note says how much was dropped).
+        stderr: The student's error output, capped likewise.
+        message: Student-readable explanation; empty only for OK.
+        wall_time: Seconds spent in the student's function (or until the parent gave up).
+        seed: The grading seed of this call, derived from the sandbox seed and the call's index.
+    """
+
+    call: Call
+    status: OutcomeStatus
+    value: PlainValue
+    episodes: list[EpisodeLog]
+    compat_events: list[dict[str, str]]
+    stdout: str
+    stderr: str
+    message: str
+    wall_time: float
+    seed: int

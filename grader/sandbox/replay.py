@@ -1,0 +1,305 @@
+"""Replay logged episodes in the parent's own, unpatched gymnasium envs: the trusted trajectory.
+
+A student can monkeypatch dynamics, wrappers or time limits in the child, or forge the log itself;
+none of that reaches this process. Checks judge `Replay`, never the `EpisodeLog`.
+Rewards are compared exactly (the same code on the same seed and actions gives the same floats;
+NaN equals NaN), terminated/truncated flags exactly.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import threading
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium.envs.registration import EnvSpec
+
+from grader.compat import register_envs
+from grader.sandbox.batched import REPLAYERS, BatchedEpisode, BatchedReplayer
+from grader.sandbox.child.seeding import mapped_reset_seed, reset_seeds
+from grader.sandbox.episodes import EpisodeLog
+
+MAX_CACHED_ENVS = 16
+MAX_BATCH_CELLS = 2_000_000
+"""Largest steps x episodes of one batch (memory: CartPole keeps 48 bytes per cell)."""
+_FORBIDDEN_KWARGS = frozenset({"render_mode", "disable_env_checker"})
+
+
+@dataclass(frozen=True)
+class Replay:
+    """An episode replayed in the trusted env.
+
+    Attributes:
+        observations: the reset observation, then one per replayed step.
+        rewards: the real rewards, one per replayed step (the replay stops at the real end).
+        terminated: the real flags, one per replayed step.
+        truncated: likewise.
+        length: replayed steps: up to and including the first terminated/truncated, or every
+            logged step if the episode did not end (or until the real env refused an action).
+        finished: whether the episode reached terminated or truncated.
+        steps_after_done: steps the student took after the episode ended.
+        mismatch: the first disagreement with the student's log, or None.
+        env_spec: the spec of the env replayed (id, kwargs, `max_episode_steps`), for callers that
+            decide which envs and arguments a problem allows; None if it could not be made.
+    """
+
+    observations: list[Any]
+    rewards: list[float]
+    terminated: list[bool]
+    truncated: list[bool]
+    length: int
+    finished: bool
+    steps_after_done: int
+    mismatch: str | None
+    env_spec: EnvSpec | None
+
+    @property
+    def matches(self) -> bool:
+        """True when the student's log agrees with the real env at every step."""
+        return self.mismatch is None
+
+    @property
+    def total_reward(self) -> float:
+        """Sum of the real rewards up to the end of the episode (steps after done excluded)."""
+        return math.fsum(self.rewards[: self.length])
+
+
+def replay_episode(log: EpisodeLog) -> Replay:
+    """Replay `log` in a fresh reset of the real env and compare it step by step with what the student saw.
+
+    The replay stops at the real end of the episode (first terminated/truncated): what the student
+    did after it does not count and is only counted in `steps_after_done`. Callers that restrict env
+    ids or arguments (e.g. `max_episode_steps`) check `log.env_id`/`log.env_kwargs` before replaying:
+    an env without a time limit is replayed for as many steps as the log holds.
+
+    Never raises for a bad log: an env that cannot be made, a reset that fails or an action the real
+    env refuses ends the replay there with a `mismatch` saying so.
+    """
+    env, error = _cached_env(log.env_id, log.env_kwargs)
+    if env is None:
+        return _unplayable(f"{_env_name(log)} cannot be made: {error}", None)
+    try:
+        observation, _ = env.reset(seed=log.reset_seed, options=log.reset_options)
+    except Exception as failure:
+        return _unplayable(f"{_env_name(log)} refused reset(seed={log.reset_seed}): {failure}", env.spec)
+    return _play(env, log, observation)
+
+
+def replay_episodes(logs: Sequence[EpisodeLog]) -> list[Replay]:
+    """Replay every log (see `replay_episode`); same results, much faster for many episodes.
+
+    Episodes of envs with a batched replayer (`grader.sandbox.batched`: CartPole, Taxi) are replayed
+    together; the longest of each batch is replayed again by the scalar env and the batch is used
+    only if both agree exactly. Episodes that disagree with the log or run past the real end are
+    replayed one by one, so mismatch messages and steps after done always come from the scalar env.
+    """
+    replays: list[Replay | None] = [None] * len(logs)
+    groups: dict[tuple[int, str], list[int]] = {}
+    for position, log in enumerate(logs):
+        for number, replayer in enumerate(REPLAYERS):
+            if replayer.is_batchable(log):
+                groups.setdefault((number, _cache_key(log.env_id, log.env_kwargs)), []).append(position)
+                break
+    for (number, _), positions in groups.items():
+        for chunk in _chunks(sorted(positions, key=lambda position: logs[position].steps), logs):
+            batch = _batch_or_none(REPLAYERS[number], [logs[position] for position in chunk])
+            if batch is None:
+                continue
+            for position, played in zip(chunk, batch, strict=True):
+                replays[position] = _from_batch(logs[position], played)
+    return [
+        replay if replay is not None else replay_episode(log)
+        for replay, log in zip(replays, logs, strict=True)
+    ]
+
+
+def verify_reset_seeds(logs: Sequence[EpisodeLog], call_seed: int) -> str | None:
+    """Check that the logs of one call (in reset order) used the seeds the grader's stream prescribes.
+
+    Resets without a student seed take the next seed of the call's reset stream; a reset with a
+    student seed uses the mapped seed. Returns a description of the first deviation, or None.
+    """
+    unseeded = iter(reset_seeds(call_seed, sum(log.student_seed is None for log in logs)))
+    for number, log in enumerate(logs):
+        if log.student_seed is None:
+            expected = next(unseeded)
+            origin = "the grader's seed stream gives"
+        else:
+            expected = mapped_reset_seed(call_seed, log.student_seed)
+            origin = f"your seed {log.student_seed} maps to"
+        if log.reset_seed != expected:
+            return (
+                f"episode {number + 1} was reset with seed {log.reset_seed}, but {origin} {expected}: "
+                "the episode log was altered"
+            )
+    return None
+
+
+def _play(env: gymnasium.Env[Any, Any], log: EpisodeLog, observation: Any) -> Replay:
+    observations = [_own(observation)]
+    rewards: list[float] = []
+    terminated_flags: list[bool] = []
+    truncated_flags: list[bool] = []
+    mismatch: str | None = None
+    step = env.step
+    for index, action in enumerate(log.actions):
+        try:
+            observation, reward, terminated, truncated, _ = step(_as_action(action))
+        except Exception as failure:
+            mismatch = mismatch or (
+                f"step {index + 1} of the episode in {_env_name(log)}: the real environment "
+                f"refused the action {action!r}: {failure}"
+            )
+            break
+        reward, terminated, truncated = float(reward), bool(terminated), bool(truncated)
+        observations.append(_own(observation))
+        rewards.append(reward)
+        terminated_flags.append(terminated)
+        truncated_flags.append(truncated)
+        if mismatch is None and not _same_step(log, index, reward, terminated, truncated):
+            mismatch = _describe_mismatch(log, index, reward, terminated, truncated)
+        if terminated or truncated:
+            break
+    return _replay(log, observations, rewards, terminated_flags, truncated_flags, mismatch, env.spec)
+
+
+def _replay(
+    log: EpisodeLog,
+    observations: list[Any],
+    rewards: list[float],
+    terminated: list[bool],
+    truncated: list[bool],
+    mismatch: str | None,
+    spec: EnvSpec | None,
+) -> Replay:
+    length = len(rewards)
+    finished = length > 0 and (terminated[-1] or truncated[-1])
+    after_done = log.steps - length if finished else 0
+    return Replay(observations, rewards, terminated, truncated, length, finished, after_done, mismatch, spec)
+
+
+def _chunks(positions: list[int], logs: Sequence[EpisodeLog]) -> list[list[int]]:
+    """Split positions (sorted by episode length) so that steps x episodes stays within `MAX_BATCH_CELLS`."""
+    chunks: list[list[int]] = [[]]
+    for position in positions:
+        if chunks[-1] and logs[position].steps * (len(chunks[-1]) + 1) > MAX_BATCH_CELLS:
+            chunks.append([])
+        chunks[-1].append(position)
+    return chunks
+
+
+def _batch_or_none(replayer: BatchedReplayer, group: Sequence[EpisodeLog]) -> list[BatchedEpisode] | None:
+    """The batch's episodes, or None if the batch cannot run or the scalar env disagrees with it.
+
+    The episode the batch played longest is replayed again by the scalar env; both must agree
+    exactly, or the whole batch is discarded (its episodes are then replayed one by one).
+    """
+    try:
+        batch = replayer.replay(group)
+    except Exception:  # an env this replayer does not model (e.g. re-registered): use the scalar env
+        return None
+    index = max(range(len(batch)), key=lambda position: len(batch[position].rewards))
+    scalar, played = replay_episode(group[index]), batch[index]
+    same_observations = len(scalar.observations) == len(played.observations) and all(
+        np.array_equal(real, batched)
+        for real, batched in zip(scalar.observations, played.observations, strict=True)
+    )
+    same_steps = (scalar.rewards, scalar.terminated, scalar.truncated) == (
+        played.rewards,
+        played.terminated,
+        played.truncated,
+    )
+    return batch if same_observations and same_steps else None
+
+
+def _from_batch(log: EpisodeLog, played: BatchedEpisode) -> Replay | None:
+    """The replay of a batched episode, or None when it disagrees with the log (the scalar env explains)."""
+    length = len(played.rewards)
+    if (played.rewards, played.terminated, played.truncated) != (
+        log.rewards[:length],
+        log.terminated[:length],
+        log.truncated[:length],
+    ):
+        return None
+    env, _ = _cached_env(log.env_id, log.env_kwargs)
+    return _replay(
+        log,
+        played.observations,
+        played.rewards,
+        played.terminated,
+        played.truncated,
+        None,
+        None if env is None else env.spec,
+    )
+
+
+def _same_step(log: EpisodeLog, index: int, reward: float, terminated: bool, truncated: bool) -> bool:
+    seen = log.rewards[index]
+    same_reward = seen == reward or (math.isnan(seen) and math.isnan(reward))
+    return same_reward and log.terminated[index] == terminated and log.truncated[index] == truncated
+
+
+def _describe_mismatch(log: EpisodeLog, index: int, reward: float, terminated: bool, truncated: bool) -> str:
+    return (
+        f"step {index + 1} of the episode in {_env_name(log)} (reset seed {log.reset_seed}): your code saw "
+        f"reward={log.rewards[index]!r}, terminated={log.terminated[index]}, "
+        f"truncated={log.truncated[index]}, "
+        f"but the real environment gives reward={reward!r}, terminated={terminated}, truncated={truncated} "
+        "for the same actions. The environment your code played was modified (its dynamics, its time limit "
+        "or the log); play the environment gym.make returns, unmodified"
+    )
+
+
+def _unplayable(message: str, spec: EnvSpec | None) -> Replay:
+    return Replay([], [], [], [], 0, False, 0, message, spec)
+
+
+def _env_name(log: EpisodeLog) -> str:
+    arguments = "".join(f", {key}={value!r}" for key, value in log.env_kwargs.items())
+    return f"{log.requested_id} (gymnasium.make({log.env_id!r}{arguments}))"
+
+
+def _as_action(action: Any) -> Any:
+    return np.asarray(action) if type(action) is list else action
+
+
+def _own(observation: Any) -> Any:
+    return observation.copy() if type(observation) is np.ndarray else observation
+
+
+_local = threading.local()
+
+
+def _cache_key(env_id: str, env_kwargs: dict[str, Any]) -> str:
+    return json.dumps([env_id, env_kwargs], sort_keys=True, default=repr)
+
+
+def _cached_env(env_id: str, env_kwargs: dict[str, Any]) -> tuple[gymnasium.Env[Any, Any] | None, str]:
+    """One env per (id, kwargs) per thread; the env checker is skipped (these envs are gymnasium's own)."""
+    cache: dict[str, gymnasium.Env[Any, Any]] = getattr(_local, "envs", None) or {}
+    _local.envs = cache
+    key = _cache_key(env_id, env_kwargs)
+    env = cache.get(key)
+    if env is not None:
+        return env, ""
+    register_envs()
+    if env_id not in gymnasium.registry:
+        return None, f"{env_id!r} is not a registered gymnasium id"
+    if _FORBIDDEN_KWARGS.intersection(env_kwargs):
+        return None, f"the arguments {sorted(_FORBIDDEN_KWARGS.intersection(env_kwargs))} are not replayable"
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            env = gymnasium.make(env_id, disable_env_checker=True, **env_kwargs)
+    except Exception as failure:
+        return None, f"{type(failure).__name__}: {failure}"
+    if len(cache) >= MAX_CACHED_ENVS:
+        cache.pop(next(iter(cache))).close()
+    cache[key] = env
+    return env, ""

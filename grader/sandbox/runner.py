@@ -1,0 +1,324 @@
+"""`Sandbox`: one isolated child importing a submission once and serving many calls; `run_calls`."""
+
+from __future__ import annotations
+
+import re
+import secrets
+import time
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError, ProtocolError
+from grader.sandbox.child.protocol import decode_value, encode_frame, encode_value, parse_payload
+from grader.sandbox.child.seeding import derive_call_seed
+from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
+from grader.sandbox.errors import IsolationUnavailable, SandboxClosedError
+from grader.sandbox.isolation import probe_isolation
+from grader.sandbox.isolation.launch import build_launch
+from grader.sandbox.isolation.protocol import IsolationReport
+from grader.sandbox.limits import IsolationPolicy, Limits
+from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
+from grader.sandbox.process import ChildProcess, FrameEnd, FrameWait
+from grader.sandbox.termination import Ending, classify_exit, forged_message
+
+IMPORT_SEED_INDEX = 2**31
+"""`derive_call_seed(seed, IMPORT_SEED_INDEX)` seeds randomness while the submission is imported."""
+
+_CHILD_STATUSES = {
+    "ok": OutcomeStatus.OK, "exception": OutcomeStatus.EXCEPTION,
+    "missing_function": OutcomeStatus.MISSING_FUNCTION, "bad_signature": OutcomeStatus.BAD_SIGNATURE,
+    "invalid_value": OutcomeStatus.INVALID_VALUE, "output_too_large": OutcomeStatus.OUTPUT_TOO_LARGE,
+    "memory_limit": OutcomeStatus.MEMORY_LIMIT,
+}
+_RESULT_FIELDS = {"type", "id", "nonce", "status", "value", "message", "traceback", "episodes",
+                  "compat_events", "wall_time"}
+
+
+def _unavailable_message(report: IsolationReport) -> str:
+    lines = [f"- {layer.name}: {layer.detail}; to fix: {layer.remedy}" for layer in report.missing]
+    return ("full isolation is required to run untrusted submissions, but these layers are missing:\n"
+            + "\n".join(lines)
+            + "\nInstall what is missing, or (only for your own code) pass IsolationPolicy.ALLOW_FALLBACK "
+              "(`gymgrade check` does; `gymgrade grade --allow-weak-isolation`).")
+
+
+def _file_name(submission: Path) -> str:
+    name = re.sub(r"[^A-Za-z0-9_.-]", "_", submission.name) or "submission.py"
+    return name if name.endswith(".py") else f"{name}.py"
+
+
+class Sandbox:
+    """One child process that imports the submission once and serves calls in order.
+
+    A fatal outcome (timeout, memory limit, killed, exited, forged frames) ends the child; the next call
+    starts a fresh one. Each call's seed depends only on the sandbox seed and the call's index, so a
+    restart does not change later calls. Use as a context manager, or call `close`.
+
+    Attributes:
+        isolation: The layers of isolation protecting the children.
+    """
+
+    def __init__(self, submission: Path, *, seed: int, limits: Limits | None = None,
+                 policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL,
+                 isolation: IsolationReport | None = None) -> None:
+        """Prepares the sandbox (the child starts with the first call or `functions`).
+
+        Args:
+            submission: The student's file (read once, now).
+            seed: The grading seed; every call's seed is derived from it and the call's index.
+            limits: Resource limits (defaults: `Limits()`).
+            policy: Whether missing isolation layers are refused (`REQUIRE_FULL`) or reported.
+            isolation: The layers to apply, from `probe_isolation(disable=...)` (default: every layer
+                this machine offers).
+
+        Raises:
+            IsolationUnavailable: `policy` is REQUIRE_FULL and a required layer is missing.
+            OSError: the submission cannot be read.
+        """
+        self.isolation = isolation if isolation is not None else probe_isolation()
+        if policy is IsolationPolicy.REQUIRE_FULL and not self.isolation.full:
+            raise IsolationUnavailable(_unavailable_message(self.isolation))
+        self.seed = seed
+        self.limits = limits or Limits()
+        self._source = submission.read_bytes()
+        self._name = _file_name(submission)
+        self._next_index = 0
+        self._child: ChildProcess | None = None
+        self._functions: dict[str, FunctionInfo] = {}
+        self._import_failure: Ending | None = None
+        self._closed = False
+        self.leftovers = 0
+        """Children whose process tree could not be fully removed (should stay 0)."""
+
+    def __enter__(self) -> Sandbox:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, error: BaseException | None,
+                 traceback: TracebackType | None) -> None:
+        self.close()
+
+    @property
+    def functions(self) -> Mapping[str, FunctionInfo]:
+        """The submission's top-level names with their signatures (empty when it cannot be imported)."""
+        self._ensure_child()
+        return dict(self._functions)
+
+    def close(self) -> None:
+        """Ends the child and removes its cgroup and scratch."""
+        self._stop_child()
+        self._closed = True
+
+    def call(self, call: Call) -> CallOutcome:
+        """Runs one call in the child and classifies how it ended.
+
+        Raises:
+            SandboxClosedError: the sandbox was closed.
+            ValueError: the call's arguments are not plain data.
+        """
+        if self._closed:
+            raise SandboxClosedError("this Sandbox is closed; open a new one to make more calls")
+        index = self._next_index
+        self._next_index += 1
+        seed = derive_call_seed(self.seed, index)
+        try:
+            arguments = encode_value(list(call.args), "the call's arguments")
+            keywords = encode_value(dict(call.kwargs), "the call's keyword arguments")
+        except InvalidValueError as error:
+            raise ValueError(error.message) from None
+        child = self._ensure_child()
+        if child is None:
+            failure = self._import_failure or Ending(OutcomeStatus.SANDBOX_ERROR, "the child did not start")
+            return self._outcome(call, seed, failure, stdout=failure.stdout, stderr=failure.stderr)
+        nonce = secrets.token_hex(16)
+        request = {"type": "call", "id": index, "nonce": nonce, "function": call.function, "args": arguments,
+                   "kwargs": keywords, "seed": seed, "record": call.record_episodes}
+        child.reset_oom_baseline()
+        started = time.perf_counter()
+        sent = child.send(encode_frame(request, self.limits.frame_bytes), self.limits.call_seconds)
+        if sent is FrameEnd.FRAME:
+            remaining = self.limits.call_seconds - (time.perf_counter() - started)
+            wait = child.wait_frame(remaining, self.limits.frame_bytes)
+        else:
+            wait = FrameWait(sent)
+        if wait.end is FrameEnd.FRAME and child.oom_killed():
+            ending = Ending(OutcomeStatus.MEMORY_LIMIT,
+                            f"a process started by {call.function}() used more than "
+                            f"{self.limits.memory_bytes >> 20} MiB of memory together with the others "
+                            "and was stopped; use less memory")
+            return self._fatal(call, seed, started, ending)
+        if wait.end is FrameEnd.FRAME:
+            return self._result(call, seed, started, wait.payload, index, nonce)
+        if wait.end is FrameEnd.TIMEOUT:
+            child.kill_tree()
+            ending = Ending(OutcomeStatus.TIMEOUT,
+                            f"{call.function}() did not return within {self.limits.call_seconds:g} seconds")
+        elif wait.end is FrameEnd.TOO_LARGE:  # the harness reports oversized results in a small frame
+            child.kill_tree()
+            ending = _forged(f"a frame announced {wait.size} bytes, more than the limit of "
+                             f"{self.limits.frame_bytes} bytes")
+        elif wait.end is FrameEnd.EXTRA_DATA:
+            child.kill_tree()
+            ending = _forged("more than one result frame arrived")
+        else:
+            ending = classify_exit(child, call.function, self.limits)
+        return self._fatal(call, seed, started, ending)
+
+    def _result(self, call: Call, seed: int, started: float, payload: bytes, index: int,
+                nonce: str) -> CallOutcome:
+        elapsed = time.perf_counter() - started
+        child = self._child
+        try:
+            frame = parse_payload(payload)
+            problem = _frame_problem(frame, index, nonce)
+        except ProtocolError as error:
+            problem = str(error)
+        if problem:
+            return self._fatal(call, seed, started, _forged(problem))
+        status = _CHILD_STATUSES[frame["status"]]
+        wall_time = min(float(frame["wall_time"]), elapsed)
+        message = frame["message"] if status is not OutcomeStatus.OK else ""
+        if frame["traceback"]:
+            message = f"{message}\n\n{frame['traceback']}"
+        value: Any = None
+        episodes: list[EpisodeLog] = []
+        if status is OutcomeStatus.OK:
+            try:
+                value = decode_value(frame["value"], f"the value returned by {call.function}()")
+                episodes = episodes_from_plain(frame["episodes"])
+            except (InvalidValueError, InvalidEpisodeLogError) as error:
+                return self._fatal(call, seed, started, _forged(str(error)))
+        return CallOutcome(
+            call=call, status=status, value=value, episodes=episodes, compat_events=frame["compat_events"],
+            stdout=child.stdout.take() if child else "", stderr=child.stderr.take() if child else "",
+            message=message, wall_time=wall_time, seed=seed,
+        )
+
+    def _fatal(self, call: Call, seed: int, started: float, ending: Ending) -> CallOutcome:
+        child = self._child
+        stdout = child.stdout.take() if child is not None else ""
+        stderr = child.stderr.take() if child is not None else ""
+        self._stop_child()
+        return self._outcome(call, seed, ending, stdout=stdout, stderr=stderr,
+                             wall_time=time.perf_counter() - started)
+
+    def _outcome(self, call: Call, seed: int, ending: Ending, *, stdout: str, stderr: str,
+                 wall_time: float = 0.0) -> CallOutcome:
+        return CallOutcome(
+            call=call, status=ending.status, value=None, episodes=[], compat_events=[], stdout=stdout,
+            stderr=stderr, message=ending.message, wall_time=wall_time, seed=seed,
+        )
+
+    def _ensure_child(self) -> ChildProcess | None:
+        if self._child is not None or self._import_failure is not None:
+            return self._child
+        limits = self.limits
+
+        def make_launch(requests_fd: int, results_fd: int) -> Any:
+            return build_launch(self.isolation, limits, submission=self._source, submission_name=self._name,
+                                requests_fd=requests_fd, results_fd=results_fd,
+                                import_seed=derive_call_seed(self.seed, IMPORT_SEED_INDEX))
+
+        try:
+            child = ChildProcess.start(make_launch, limits.output_bytes)
+        except OSError as error:
+            self._import_failure = Ending(OutcomeStatus.SANDBOX_ERROR,
+                                          f"the sandbox could not start: {error}")
+            return None
+        self._child = child
+        ending = self._await_ready(child)
+        if ending is not None:
+            ending.stdout, ending.stderr = child.stdout.take(), child.stderr.take()
+            self._import_failure = ending
+            self._stop_child()
+        return self._child
+
+    def _await_ready(self, child: ChildProcess) -> Ending | None:
+        wait = child.wait_frame(self.limits.import_seconds, self.limits.frame_bytes)
+        if wait.end is FrameEnd.TIMEOUT:
+            child.kill_tree()
+            return Ending(OutcomeStatus.TIMEOUT,
+                          f"importing your file took more than {self.limits.import_seconds:g} seconds; move "
+                          "long-running code into functions or under `if __name__ == \"__main__\":`")
+        if wait.end is FrameEnd.CLOSED:
+            return classify_exit(child, None, self.limits)
+        if wait.end is not FrameEnd.FRAME:
+            child.kill_tree()
+            return Ending(OutcomeStatus.INVALID_VALUE, forged_message("the first frame was malformed"))
+        try:
+            frame = parse_payload(wait.payload)
+        except ProtocolError as error:
+            child.kill_tree()
+            return Ending(OutcomeStatus.INVALID_VALUE, forged_message(str(error)))
+        if frame.get("type") == "import_error" and type(frame.get("message")) is str:
+            traceback = frame.get("traceback")
+            detail = f"\n\n{traceback}" if type(traceback) is str and traceback else ""
+            return Ending(OutcomeStatus.IMPORT_ERROR, frame["message"] + detail)
+        functions = _function_table(frame)
+        if functions is None:
+            child.kill_tree()
+            return Ending(OutcomeStatus.INVALID_VALUE, forged_message("the ready frame was malformed"))
+        self._functions = functions
+        return None
+
+    def _stop_child(self) -> None:
+        child, self._child = self._child, None
+        if child is not None and not child.close():
+            self.leftovers += 1
+
+
+def _frame_problem(frame: dict[str, Any], index: int, nonce: str) -> str:
+    if frame.keys() != _RESULT_FIELDS or frame["type"] != "result":
+        return f"a frame with fields {sorted(frame)[:12]} is not a result"
+    if frame["id"] != index or frame["nonce"] != nonce:
+        return "a result frame answered a different request"
+    if frame["status"] not in _CHILD_STATUSES:
+        return f"unknown status {str(frame['status'])[:40]!r}"
+    if type(frame["message"]) is not str or type(frame["traceback"]) is not str:
+        return "message and traceback must be strings"
+    if type(frame["wall_time"]) not in (int, float) or not 0 <= frame["wall_time"] < 1e9:
+        return "wall_time must be a non-negative number"
+    events = frame["compat_events"]
+    if type(events) is not list or not all(
+        type(event) is dict and event.keys() == {"kind", "env_id", "detail"}
+        and all(type(item) is str for item in event.values()) for event in events
+    ):
+        return "compat_events must be a list of {kind, env_id, detail} strings"
+    return ""
+
+
+def _forged(detail: str) -> Ending:
+    return Ending(OutcomeStatus.INVALID_VALUE, forged_message(detail))
+
+
+def _function_table(frame: dict[str, Any]) -> dict[str, FunctionInfo] | None:
+    if (frame.keys() != {"type", "functions"} or frame["type"] != "ready"
+            or type(frame["functions"]) is not dict):
+        return None
+    table: dict[str, FunctionInfo] = {}
+    for name, info in frame["functions"].items():
+        if (type(info) is not dict or info.keys() != {"parameters", "is_callable"}
+                or type(info["is_callable"]) is not bool):
+            return None
+        parameters = info["parameters"]
+        if type(parameters) is not list:
+            return None
+        try:
+            table[name] = FunctionInfo(name, info["is_callable"], tuple(
+                ParameterInfo(p["name"], p["kind"], p["has_default"]) for p in parameters
+                if type(p["name"]) is str and type(p["kind"]) is str and type(p["has_default"]) is bool))
+        except (KeyError, TypeError):
+            return None
+    return table
+
+
+def run_calls(submission: Path, calls: Iterable[Call], *, seed: int, limits: Limits | None = None,
+              policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL) -> list[CallOutcome]:
+    """Runs `calls` in order in one `Sandbox` and returns their outcomes (same order).
+
+    Raises:
+        IsolationUnavailable: `policy` is REQUIRE_FULL and a required layer is missing.
+    """
+    with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:
+        return [sandbox.call(call) for call in calls]

@@ -1,0 +1,27 @@
+"""Exact oracles: what a lab policy achieves, computed without sampling."""
+
+from reference.oracles.blackjack import (
+    Outcome,
+    evaluate_policy,
+    random_policy_outcome,
+    threshold_policy_outcome,
+)
+from reference.oracles.taxi import (
+    ReturnMoments,
+    greedy_policy_return,
+    optimal_q_table,
+    optimal_return,
+    random_policy_return,
+)
+
+__all__ = [
+    "Outcome",
+    "ReturnMoments",
+    "evaluate_policy",
+    "greedy_policy_return",
+    "optimal_q_table",
+    "optimal_return",
+    "random_policy_outcome",
+    "random_policy_return",
+    "threshold_policy_outcome",
+]

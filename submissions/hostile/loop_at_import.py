@@ -1,0 +1,8 @@
+"""Hostile: never finishes importing."""
+
+while True:
+    pass
+
+
+def ok():
+    return 42

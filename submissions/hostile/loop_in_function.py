@@ -1,0 +1,10 @@
+"""Hostile: a function that never returns."""
+
+
+def spin():
+    while True:
+        pass
+
+
+def ok():
+    return 42

@@ -1,0 +1,339 @@
+"""The episode recorder and seeding, observed through a real child process over the real protocol."""
+
+from __future__ import annotations
+
+import textwrap
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from child_client import ChildClient, write_submission
+
+from grader.sandbox.child.protocol import decode_value
+from grader.sandbox.child.seeding import derive_call_seed, mapped_reset_seed, reset_seeds
+from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
+from grader.sandbox.replay import verify_reset_seeds
+
+STUDENT = textwrap.dedent("""
+    import random
+
+    import gym
+    import gymnasium
+    import numpy as np
+
+    SHARED = gym.make("Taxi-v3")
+    UNSEEDED = np.random.default_rng()
+    SEEDED = np.random.default_rng(42)
+    SPACE = gymnasium.spaces.Discrete(1000)
+
+
+    def module_generators():
+        return [float(UNSEEDED.random()), float(SEEDED.random()), int(SPACE.sample())]
+
+
+    def classic_blackjack(n):
+        env = gym.make("Blackjack-v0")
+        wins = 0
+        for _ in range(n):
+            env.reset()
+            done = False
+            while not done:
+                observation, reward, done, info = env.step(env.action_space.sample())
+            wins += reward > 0
+        env.close()
+        return wins / n
+
+
+    def gymnasium_cartpole():
+        env = gymnasium.make("CartPole-v1")
+        observation, info = env.reset()
+        steps, done = 0, False
+        while not done:
+            observation, reward, terminated, truncated, info = env.step(int(observation[3] > 0))
+            steps, done = steps + 1, terminated or truncated
+        return steps
+
+
+    def gymnasium_lab_ids():
+        taxi = gymnasium.make("Taxi-v3")
+        taxi.reset()
+        blackjack = gymnasium.make("Blackjack-v0")
+        blackjack.reset()
+        return 0
+
+
+    def gymnasium_retired_id():
+        gymnasium.make("Taxi-v2")
+
+
+    def from_spec():
+        first = gymnasium.make(gymnasium.spec("CartPole-v0"))
+        second = gymnasium.spec("MountainCar-v0").make()
+        third = gymnasium.make("gymnasium.envs.classic_control:Acrobot-v1")
+        for env in (first, second, third):
+            env.reset()
+            env.step(0)
+        return 0
+
+
+    def seeded(seed):
+        env = gymnasium.make("CartPole-v1")
+        first, _ = env.reset(seed=seed)
+        env.step(0)
+        env.reset()
+        second, _ = env.reset(seed=seed)
+        return [first.tolist(), second.tolist()]
+
+
+    def randoms():
+        space = gymnasium.spaces.Discrete(1000)
+        return [random.random(), float(np.random.rand()), float(np.random.default_rng().random()),
+                int(space.sample())]
+
+
+    def shared_env():
+        return [int(SHARED.reset()), [int(SHARED.action_space.sample()) for _ in range(5)]]
+
+
+    def after_done():
+        env = gym.make("CartPole-v0")
+        env.reset()
+        done, steps = False, 0
+        while not done:
+            _, _, done, _ = env.step(0)
+        for _ in range(3):
+            env.step(1)
+        return 0
+
+
+    def before_reset():
+        env = gym.make("Blackjack-v0")
+        env.step(0)
+        return 0
+
+
+    def rendering():
+        env = gym.make("CartPole-v0", render_mode="human")
+        env.reset()
+        env.render()
+        return env.unwrapped.render_mode
+
+
+    def time_limit():
+        env = gymnasium.make("CartPole-v0", max_episode_steps=5)
+        env.reset()
+        steps = 0
+        truncated = terminated = False
+        while not (terminated or truncated):
+            _, _, terminated, truncated, _ = env.step(steps % 2)
+            steps += 1
+        return steps
+
+
+    def box_actions():
+        env = gym.make("GuessingGame-v0")
+        env.reset()
+        env.step(np.array([0.5], dtype=np.float32))
+        env.step(np.array([-3.0]))
+        return 0
+
+
+    def long_run():
+        env = gym.make("CartPole-v0")
+        for _ in range(10):
+            env.reset()
+            done = False
+            while not done:
+                _, _, done, _ = env.step(env.action_space.sample())
+        return 0
+""")
+
+
+@pytest.fixture(scope="module")
+def submission(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_submission(tmp_path_factory.mktemp("recorder"), STUDENT)
+
+
+@pytest.fixture(scope="module")
+def child(submission: Path) -> Iterator[ChildClient]:
+    with ChildClient(submission) as client:
+        yield client
+
+
+def episodes_of(result: dict[str, Any] | None) -> list[EpisodeLog]:
+    assert result is not None and result["status"] == "ok", result and result["message"]
+    return episodes_from_plain(result["episodes"])
+
+
+def value_of(result: dict[str, Any] | None) -> Any:
+    assert result is not None and result["status"] == "ok", result and result["message"]
+    return decode_value(result["value"])
+
+
+def test_classic_api_code_is_recorded_with_the_lab_id(child: ChildClient) -> None:
+    result = child.call("classic_blackjack", 20, seed=11)
+    episodes = episodes_of(result)
+
+    assert len(episodes) == 20
+    assert {(log.requested_id, log.env_id) for log in episodes} == {("Blackjack-v0", "Blackjack-v1")}
+    assert episodes[0].env_kwargs == {"natural": False, "sab": False}
+    assert all(log.terminated[-1] for log in episodes)
+    wins = sum(log.rewards[-1] > 0 for log in episodes)
+    assert decode_value(result["value"]) == wins / 20
+    assert verify_reset_seeds(episodes, 11) is None
+
+
+def test_gymnasium_api_code_is_recorded(child: ChildClient) -> None:
+    result = child.call("gymnasium_cartpole", seed=5)
+    (log,) = episodes_of(result)
+
+    assert (log.requested_id, log.env_id, log.env_kwargs) == ("CartPole-v1", "CartPole-v1", {})
+    assert log.steps == decode_value(result["value"])
+    assert log.reset_seed == reset_seeds(5, 1)[0] and log.student_seed is None
+    assert all(type(action) is int for action in log.actions)
+
+
+def test_lab_ids_work_through_plain_gymnasium_and_are_reported(child: ChildClient) -> None:
+    result = child.call("gymnasium_lab_ids", seed=3)
+    taxi, blackjack = episodes_of(result)
+
+    assert (taxi.requested_id, taxi.env_id, taxi.env_kwargs) == ("Taxi-v3", "Taxi-v4", {})
+    assert (blackjack.requested_id, blackjack.env_id) == ("Blackjack-v0", "Blackjack-v1")
+    assert blackjack.env_kwargs == {"natural": False, "sab": False}
+    assert [event["env_id"] for event in result["compat_events"]] == ["Taxi-v3", "Blackjack-v0"]
+
+
+def test_retired_ids_through_plain_gymnasium_name_the_lab_id(child: ChildClient) -> None:
+    result = child.call("gymnasium_retired_id", seed=3)
+
+    assert result is not None and result["status"] == "exception"
+    assert "Taxi-v2 was retired before this lab; the lab uses Taxi-v3" in result["message"]
+
+
+def test_envs_made_from_specs_are_recorded(child: ChildClient) -> None:
+    episodes = episodes_of(child.call("from_spec"))
+
+    assert [(log.env_id, log.env_kwargs, log.steps) for log in episodes] == [
+        ("CartPole-v0", {}, 1),
+        ("MountainCar-v0", {}, 1),
+        ("Acrobot-v1", {}, 1),
+    ]
+    assert [log.env_index for log in episodes] == [0, 1, 2]
+
+
+def test_student_seeds_are_mapped_through_the_call_seed(child: ChildClient) -> None:
+    first = child.call("seeded", 42, seed=7)
+    again = child.call("seeded", 42, seed=7)
+    other_call = child.call("seeded", 42, seed=8)
+    episodes = episodes_of(first)
+
+    assert [(log.student_seed, log.reset_seed) for log in episodes] == [
+        (42, mapped_reset_seed(7, 42)),
+        (None, reset_seeds(7, 1)[0]),
+        (42, mapped_reset_seed(7, 42)),
+    ]
+    observations = decode_value(first["value"])  # type: ignore[index]
+    assert observations[0] == observations[1]
+    assert decode_value(again["value"]) == observations  # type: ignore[index]
+    assert decode_value(other_call["value"]) != observations  # type: ignore[index]
+    assert verify_reset_seeds(episodes, 7) is None
+
+
+def test_randomness_is_reproducible_per_call_seed_and_differs_between_calls(submission: Path) -> None:
+    seeds = (derive_call_seed(3, 0), derive_call_seed(3, 1))
+    with ChildClient(submission) as one, ChildClient(submission, seed=99) as other:
+        values = [[value_of(client.call("randoms", seed=seed)) for seed in seeds] for client in (one, other)]
+        shared = [value_of(client.call("shared_env", seed=4)) for client in (one, other, one)]
+
+    assert values[0] == values[1]
+    assert all(first != second for first, second in zip(*values[0], strict=True))
+    assert shared[0] == shared[1] == shared[2]
+
+
+def test_generators_made_at_import_restart_at_every_call(submission: Path) -> None:
+    with ChildClient(submission) as one, ChildClient(submission, seed=99) as other:
+        first = [value_of(one.call("module_generators", seed=seed)) for seed in (4, 4, 5)]
+        fresh = value_of(other.call("module_generators", seed=4))
+
+    assert first[0] == first[1] == fresh
+    assert first[0][0] != first[2][0] and first[0][2] != first[2][2]
+    assert first[0][1] == first[2][1] == float(np.random.default_rng(42).random())
+
+
+def test_identical_logs_for_identical_seeds(submission: Path, child: ChildClient) -> None:
+    with ChildClient(submission) as fresh:
+        first = fresh.call("classic_blackjack", 30, seed=123)
+    second = child.call("classic_blackjack", 30, seed=123)
+    different = child.call("classic_blackjack", 30, seed=124)
+
+    assert episodes_of(first) == episodes_of(second)
+    assert episodes_of(first) != episodes_of(different)
+
+
+def test_steps_after_done_are_kept(child: ChildClient) -> None:
+    (log,) = episodes_of(child.call("after_done"))
+    done_at = next(
+        index for index, (te, tr) in enumerate(zip(log.terminated, log.truncated, strict=True)) if te or tr
+    )
+
+    assert log.steps == done_at + 1 + 3
+    assert log.actions[-3:] == [1, 1, 1]
+
+
+def test_step_before_reset_records_the_implicit_reset(child: ChildClient) -> None:
+    result = child.call("before_reset")
+    (log,) = episodes_of(result)
+
+    assert log.steps == 1
+    assert result is not None
+    assert [event["kind"] for event in result["compat_events"]] == ["renamed_id", "step_before_reset"]
+
+
+def test_human_rendering_is_harmless_and_not_logged(child: ChildClient) -> None:
+    result = child.call("rendering")
+    (log,) = episodes_of(result)
+
+    assert result is not None and decode_value(result["value"]) is None
+    assert "render_mode" not in log.env_kwargs
+
+
+def test_max_episode_steps_is_logged_for_the_replay(child: ChildClient) -> None:
+    (log,) = episodes_of(child.call("time_limit"))
+
+    assert log.env_kwargs == {"max_episode_steps": 5}
+    assert log.truncated == [False, False, False, False, True]
+
+
+def test_box_actions_keep_their_dtype(child: ChildClient) -> None:
+    (log,) = episodes_of(child.call("box_actions"))
+
+    assert [action.dtype.str for action in log.actions] == ["<f4", "<f8"]
+    assert [action.tolist() for action in log.actions] == [[0.5], [-3.0]]
+
+
+def test_record_false_sends_no_episodes(child: ChildClient) -> None:
+    assert episodes_of(child.call("classic_blackjack", 5, record=False)) == []
+
+
+def test_too_many_recorded_steps_is_output_too_large(submission: Path) -> None:
+    with ChildClient(submission, extra_args=("--max-recorded-steps", "50")) as client:
+        result = client.call("long_run")
+        unrecorded = client.call("long_run", record=False)
+
+    assert result is not None and result["status"] == "output_too_large"
+    assert result["message"] == (
+        "long_run() took more than 50 environment steps while the grader records episodes; "
+        "play fewer episodes"
+    )
+    assert unrecorded is not None and unrecorded["status"] == "ok"
+
+
+def test_results_larger_than_a_frame_are_output_too_large(submission: Path) -> None:
+    with ChildClient(submission, extra_args=("--max-frame", "2000")) as client:
+        result = client.call("classic_blackjack", 200)
+
+    assert result is not None and result["status"] == "output_too_large"
+    assert result["message"].startswith("the episodes classic_blackjack() played need about ")
+    assert result["message"].endswith(" bytes, more than the limit of 2000 bytes; play fewer episodes")

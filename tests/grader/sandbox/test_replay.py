@@ -1,0 +1,380 @@
+"""Replay in the parent: honest logs match, patched dynamics, time limits and forged logs are caught."""
+
+from __future__ import annotations
+
+import dataclasses
+import textwrap
+import warnings
+from pathlib import Path
+
+import gymnasium
+import numpy as np
+import pytest
+from child_client import ChildClient, write_submission
+
+from grader.sandbox import replay
+from grader.sandbox.batched import BatchedReplayer, CartPoleReplayer, TaxiReplayer
+from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
+from grader.sandbox.replay import Replay, replay_episode, replay_episodes, verify_reset_seeds
+
+HONEST = textwrap.dedent("""
+    import gym
+    import gymnasium
+    import numpy as np
+
+
+    def cartpole():
+        env = gym.make("CartPole-v0")
+        observation, done, steps = env.reset(), False, 0
+        while not done:
+            observation, reward, done, info = env.step(1 if observation[3] > 0 else 0)
+            steps += 1
+        return steps
+
+
+    def balanced(episodes):
+        env = gymnasium.make("CartPole-v1")
+        for _ in range(episodes):
+            o, _ = env.reset()
+            done = False
+            while not done:
+                o, _, terminated, truncated, _ = env.step(int(o[2] + 0.5 * o[3] > 0))
+                done = terminated or truncated
+        return 0
+
+
+    def random_play(episodes):
+        env = gym.make("CartPole-v0")
+        for _ in range(episodes):
+            env.reset()
+            for _ in range(40):
+                env.step(env.action_space.sample())
+        return 0
+
+
+    def with_options():
+        env = gymnasium.make("CartPole-v1")
+        env.reset(options={"low": -0.2, "high": 0.2})
+        for _ in range(30):
+            env.step(1)
+        return 0
+
+
+    def other_games():
+        for name in ("Taxi-v3", "Blackjack-v0", "MountainCar-v0", "NChain-v0", "GuessingGame-v0"):
+            env = gym.make(name)
+            env.reset()
+            done, steps = False, 0
+            while not done and steps < 300:
+                _, _, done, _ = env.step(env.action_space.sample())
+                steps += 1
+        return 0
+""")
+
+PATCHED_PHYSICS = textwrap.dedent("""
+    import gym
+    from gymnasium.envs.classic_control.cartpole import CartPoleEnv
+
+    original_init = CartPoleEnv.__init__
+
+
+    def tolerant_init(self, *args, **kwargs):
+        original_init(self, *args, **kwargs)
+        self.theta_threshold_radians = 1e9
+        self.x_threshold = 1e9
+
+
+    CartPoleEnv.__init__ = tolerant_init
+
+
+    def cartpole():
+        env = gym.make("CartPole-v0")
+        observation, done, steps = env.reset(), False, 0
+        while not done:
+            observation, reward, done, info = env.step(0)
+            steps += 1
+        return steps
+""")
+
+PATCHED_TIME_LIMIT = textwrap.dedent("""
+    import gym
+    import gymnasium
+
+    gymnasium.envs.registration.registry["CartPole-v0"].max_episode_steps = 500
+
+
+    def cartpole():
+        env = gym.make("CartPole-v0")
+        o, done, steps = env.reset(), False, 0
+        while not done:
+            o, reward, done, info = env.step(int(o[2] + 0.5 * o[3] > 0))
+            steps += 1
+        return steps
+""")
+
+
+def play(tmp_path: Path, source: str, function: str, *args: object, seed: int = 1) -> list[EpisodeLog]:
+    with ChildClient(write_submission(tmp_path, source)) as client:
+        result = client.call(function, *args, seed=seed)
+    assert result is not None and result["status"] == "ok", result and result["message"]
+    return episodes_from_plain(result["episodes"])
+
+
+@pytest.fixture(scope="module")
+def honest_logs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[EpisodeLog]]:
+    with ChildClient(write_submission(tmp_path_factory.mktemp("honest"), HONEST)) as client:
+        results = {
+            name: client.call(name, *args, seed=index + 1)
+            for index, (name, args) in enumerate(
+                [
+                    ("cartpole", ()),
+                    ("balanced", (3,)),
+                    ("random_play", (20,)),
+                    ("other_games", ()),
+                    ("with_options", ()),
+                ]
+            )
+        }
+    logs = {}
+    for name, result in results.items():
+        assert result is not None and result["status"] == "ok", result and result["message"]
+        logs[name] = episodes_from_plain(result["episodes"])
+    return logs
+
+
+@pytest.mark.parametrize("name", ["cartpole", "balanced", "random_play", "other_games", "with_options"])
+def test_honest_episodes_replay_without_mismatch(honest_logs: dict[str, list[EpisodeLog]], name: str) -> None:
+    for log in honest_logs[name]:
+        replay = replay_episode(log)
+
+        assert replay.mismatch is None
+        assert replay.rewards == log.rewards[: replay.length]
+        assert len(replay.observations) == replay.length + 1
+        assert replay.length + replay.steps_after_done == log.steps
+
+
+def test_honest_cartpole_episode_has_the_reported_length(honest_logs: dict[str, list[EpisodeLog]]) -> None:
+    (log,) = honest_logs["cartpole"]
+    replay = replay_episode(log)
+
+    assert replay.finished and replay.length == log.steps and replay.steps_after_done == 0
+    assert replay.env_spec is not None and replay.env_spec.max_episode_steps == 200
+
+
+def test_reset_options_are_replayed_and_not_batched(honest_logs: dict[str, list[EpisodeLog]]) -> None:
+    (log,) = honest_logs["with_options"]
+
+    assert log.reset_options == {"low": -0.2, "high": 0.2}
+    assert not CartPoleReplayer().is_batchable(log)
+    assert replay_episode(log).matches
+
+
+def test_steps_after_done_are_counted(honest_logs: dict[str, list[EpisodeLog]]) -> None:
+    replays = [replay_episode(log) for log in honest_logs["random_play"]]
+
+    assert all(replay.matches for replay in replays)
+    assert all(replay.length + replay.steps_after_done == 40 for replay in replays)
+    assert any(replay.steps_after_done > 0 for replay in replays)
+
+
+def assert_same_replay(batched: Replay, scalar: Replay) -> None:
+    assert np.array_equal(np.array(batched.observations), np.array(scalar.observations))
+    assert (batched.rewards, batched.terminated, batched.truncated) == (
+        scalar.rewards,
+        scalar.terminated,
+        scalar.truncated,
+    )
+    assert (batched.length, batched.finished, batched.steps_after_done, batched.mismatch) == (
+        scalar.length,
+        scalar.finished,
+        scalar.steps_after_done,
+        scalar.mismatch,
+    )
+
+
+def test_batched_cartpole_replay_is_identical_to_the_scalar_replay(
+    honest_logs: dict[str, list[EpisodeLog]],
+) -> None:
+    logs = [log for name in ("cartpole", "balanced", "random_play") for log in honest_logs[name]]
+    assert all(CartPoleReplayer().is_batchable(log) for log in logs)
+
+    for batched, log in zip(replay_episodes(logs), logs, strict=True):
+        assert_same_replay(batched, replay_episode(log))
+
+
+def played(
+    env_id: str, seed: int, actions: list[int], env_kwargs: dict[str, int] | None = None
+) -> EpisodeLog:
+    """An honest log: `actions` played in a fresh gymnasium env, steps after done included."""
+    env = gymnasium.make(env_id, **(env_kwargs or {}))
+    env.reset(seed=seed)
+    rewards, terminated, truncated = [], [], []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for action in actions:
+            _, reward, step_terminated, step_truncated, _ = env.step(action)
+            rewards.append(float(reward))
+            terminated.append(bool(step_terminated))
+            truncated.append(bool(step_truncated))
+    return EpisodeLog(
+        0, env_id, env_id, env_kwargs or {}, seed, None, actions, rewards, terminated, truncated
+    )
+
+
+BATCHES = [
+    (CartPoleReplayer(), "CartPole-v1", 2, 120, None),
+    (CartPoleReplayer(), "CartPole-v1", 2, 120, {"max_episode_steps": 15}),
+    (TaxiReplayer(), "Taxi-v4", 6, 260, None),
+    (TaxiReplayer(), "Taxi-v4", 6, 40, {"max_episode_steps": 30}),
+]
+
+
+@pytest.mark.parametrize(
+    ("replayer", "env_id", "actions", "steps", "env_kwargs"),
+    BATCHES,
+    ids=["cartpole", "cartpole-limit-15", "taxi", "taxi-limit-30"],
+)
+def test_batched_replay_matches_the_scalar_env_bit_for_bit(
+    replayer: BatchedReplayer, env_id: str, actions: int, steps: int, env_kwargs: dict[str, int] | None
+) -> None:
+    # Deterministic (fixed seeds): random actions visit many more states than the lab's policies.
+    rng = np.random.default_rng(20240601)
+    logs = [played(env_id, seed, rng.integers(0, actions, steps).tolist(), env_kwargs) for seed in range(40)]
+    assert all(replayer.is_batchable(log) for log in logs)
+
+    for batched, log in zip(replayer.replay(logs), logs, strict=True):
+        scalar = replay_episode(log)
+        assert scalar.matches
+        assert len(batched.observations) == len(scalar.observations)
+        assert all(
+            np.array_equal(one, other)
+            for one, other in zip(batched.observations, scalar.observations, strict=True)
+        )
+        assert (batched.rewards, batched.terminated, batched.truncated, batched.finished) == (
+            scalar.rewards,
+            scalar.terminated,
+            scalar.truncated,
+            scalar.finished,
+        )
+    for batched, log in zip(replay_episodes(logs), logs, strict=True):
+        assert_same_replay(batched, replay_episode(log))
+
+
+def test_replay_stops_at_the_real_end_of_the_episode() -> None:
+    rng = np.random.default_rng(7)
+    logs = [played("CartPole-v1", seed, rng.integers(0, 2, 1000).tolist()) for seed in range(5)]
+
+    for batched in replay_episodes(logs):
+        assert batched.finished and batched.length < 100
+        assert batched.steps_after_done == 1000 - batched.length
+        assert len(batched.rewards) == batched.length and batched.matches
+
+
+def test_batches_are_split_to_bound_memory(monkeypatch: pytest.MonkeyPatch) -> None:
+    rng = np.random.default_rng(8)
+    logs = [played("Taxi-v4", seed, rng.integers(0, 6, 30 + seed).tolist()) for seed in range(30)]
+    whole = replay_episodes(logs)
+    monkeypatch.setattr(replay, "MAX_BATCH_CELLS", 100)
+
+    for split, one in zip(replay_episodes(logs), whole, strict=True):
+        assert_same_replay(split, one)
+
+
+def test_envs_without_a_time_limit_are_not_batched() -> None:
+    log = played("CartPole-v1", 1, [0, 1, 0], {"max_episode_steps": -1})
+
+    assert not CartPoleReplayer().is_batchable(log)
+    assert replay_episodes([log])[0].matches
+
+
+def test_monkeypatched_physics_is_caught(tmp_path: Path) -> None:
+    (log,) = play(tmp_path, PATCHED_PHYSICS, "cartpole")
+    replay = replay_episode(log)
+    (batched,) = replay_episodes([log])
+
+    assert log.steps == 200 and not any(log.terminated)
+    assert replay.finished and replay.length < 50
+    assert replay.mismatch is not None
+    assert replay.mismatch.startswith(
+        f"step {replay.length} of the episode in CartPole-v0 "
+        f"(gymnasium.make('CartPole-v0')) (reset seed {log.reset_seed}): your code "
+        "saw reward=1.0, terminated=False, truncated=False, but the real environment "
+        "gives reward=1.0, terminated=True, truncated=False"
+    )
+    assert batched.mismatch == replay.mismatch
+
+
+def test_patched_time_limit_is_caught(tmp_path: Path) -> None:
+    (log,) = play(tmp_path, PATCHED_TIME_LIMIT, "cartpole")
+    replay = replay_episode(log)
+
+    assert log.steps == 500 and log.env_kwargs == {}
+    assert replay.length == 200 and replay.truncated[199]
+    assert replay.mismatch is not None and replay.mismatch.startswith("step 200 of the episode")
+    assert "your code saw reward=1.0, terminated=False, truncated=False" in replay.mismatch
+    assert "the real environment gives reward=1.0, terminated=False, truncated=True" in replay.mismatch
+
+
+FORGERIES = [
+    ("rewards", lambda log: {"rewards": [*log.rewards[:-1], 2.0]}, "your code saw reward=2.0"),
+    ("terminated", lambda log: {"terminated": [True] * log.steps}, "step 1 of the episode"),
+    (
+        "truncated",
+        lambda log: {"truncated": [True] * log.steps},
+        "saw reward=1.0, terminated=False, truncated=True",
+    ),
+]
+
+
+@pytest.mark.parametrize(("field", "forge", "seen"), FORGERIES, ids=[forgery[0] for forgery in FORGERIES])
+def test_forged_logs_are_caught(
+    honest_logs: dict[str, list[EpisodeLog]], field: str, forge: object, seen: str
+) -> None:
+    (log,) = honest_logs["cartpole"]
+    forged = dataclasses.replace(log, **forge(log))  # type: ignore[operator]
+
+    for replayed in (replay_episode(forged), replay_episodes([forged])[0]):
+        assert replayed.mismatch is not None and seen in replayed.mismatch
+        assert replayed.rewards == log.rewards
+
+
+def test_a_forged_reset_seed_is_caught_by_the_seed_check(honest_logs: dict[str, list[EpisodeLog]]) -> None:
+    logs = honest_logs["random_play"]
+    forged = [logs[0], dataclasses.replace(logs[1], reset_seed=12345), *logs[2:]]
+
+    assert verify_reset_seeds(logs, 3) is None
+    assert verify_reset_seeds(forged, 3) == (
+        f"episode 2 was reset with seed 12345, but the grader's seed stream gives {logs[1].reset_seed}: "
+        "the episode log was altered"
+    )
+
+
+UNPLAYABLE = [
+    ({"env_id": "antigravity:Fly-v0"}, "'antigravity:Fly-v0' is not a registered gymnasium id"),
+    ({"env_id": "CartPole-v0", "env_kwargs": {"render_mode": "human"}}, "are not replayable"),
+    ({"env_kwargs": {"no_such_argument": 1}}, "cannot be made: TypeError"),
+    ({"actions": [7]}, "the real environment refused the action 7"),
+]
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"), UNPLAYABLE, ids=["module-id", "render", "bad-kwarg", "bad-action"]
+)
+def test_unplayable_logs_give_a_mismatch_not_an_exception(
+    honest_logs: dict[str, list[EpisodeLog]], changes: dict[str, object], message: str
+) -> None:
+    (log,) = honest_logs["cartpole"]
+    steps = len(changes.get("actions", log.actions))  # type: ignore[arg-type]
+    forged = dataclasses.replace(
+        log,
+        **{
+            "rewards": log.rewards[:steps],
+            "terminated": log.terminated[:steps],
+            "truncated": log.truncated[:steps],
+            **changes,
+        },
+    )
+
+    (replay,) = replay_episodes([forged])
+
+    assert replay.mismatch is not None and message in replay.mismatch
