@@ -1,0 +1,59 @@
+"""Domain errors of the service; `api.handlers` maps each to its HTTP response in one place."""
+
+from __future__ import annotations
+
+
+class ServiceError(Exception):
+    """Root of every error the service reports to a client; the message is shown to them as is."""
+
+
+class NotAuthenticated(ServiceError):
+    """Raised when a request carries no token or a token that belongs to nobody."""
+
+
+class InstructorOnly(ServiceError):
+    """Raised when a student's token is used on an instructor's endpoint."""
+
+
+class StudentOnly(ServiceError):
+    """Raised when the instructor's token is used to upload (submissions belong to students)."""
+
+
+class SubmissionNotFound(ServiceError):
+    """Raised when a submission does not exist or belongs to another student."""
+
+
+class StudentNotFound(ServiceError):
+    """Raised when a named student does not exist."""
+
+
+class StudentExists(ServiceError):
+    """Raised when a student is created under a name that is already taken."""
+
+
+class InvalidStudentName(ServiceError):
+    """Raised when a student name is empty, too long or holds control characters."""
+
+
+class InvalidUpload(ServiceError):
+    """Raised when an uploaded file cannot be a submission (wrong name, empty, binary, not UTF-8)."""
+
+
+class UploadTooLarge(ServiceError):
+    """Raised when an upload exceeds GYMGRADE_MAX_UPLOAD_BYTES."""
+
+
+class LengthRequired(ServiceError):
+    """Raised when an upload does not say its size up front (no Content-Length header)."""
+
+
+class RateLimited(ServiceError):
+    """Raised when a student uploads more often than GYMGRADE_RATE_LIMIT_PER_MINUTE allows."""
+
+    def __init__(self, message: str, retry_after_seconds: int) -> None:
+        super().__init__(message)
+        self.retry_after_seconds = retry_after_seconds
+
+
+class GraderUnavailable(ServiceError):
+    """Raised when GYMGRADE_GRADER names nothing usable (reported at start-up or as the job's failure)."""

@@ -1,0 +1,97 @@
+"""The service's view of the grader: a small protocol and the adapter that calls the configured grader."""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+from api.errors import GraderUnavailable
+
+JsonObject = dict[str, Any]
+ProgressCallback = Callable[[JsonObject], None]
+
+
+class Grader(Protocol):
+    """Grades one file and returns the report as JSON data, reporting each problem as it finishes."""
+
+    def __call__(self, path: Path, *, seed: int, on_progress: ProgressCallback) -> JsonObject:
+        """Grade the file at ``path`` with ``seed``; call ``on_progress`` with each finished problem."""
+        ...
+
+
+@dataclass(frozen=True)
+class ImportedGrader:
+    """Calls a function with the signature of ``grader.grading.grade_submission``, imported by name.
+
+    Attributes:
+        target: ``module:function``, e.g. ``grader.grading:grade_submission``.
+        workers: Processes one grading may use (None: all cores).
+        allow_weak_isolation: Grade with the strongest available isolation instead of failing closed.
+    """
+
+    target: str
+    workers: int | None = None
+    allow_weak_isolation: bool = False
+
+    def __call__(self, path: Path, *, seed: int, on_progress: ProgressCallback) -> JsonObject:
+        """Grade the file at ``path``; see :class:`Grader`."""
+        grade_submission = load_function(self.target)
+        from grader.sandbox import IsolationPolicy  # the grader is heavy: import it only where grading runs
+
+        policy = IsolationPolicy.ALLOW_FALLBACK if self.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
+        report = grade_submission(
+            path,
+            seed=seed,
+            workers=self.workers,
+            policy=policy,
+            on_progress=lambda result: on_progress(result.model_dump(mode="json")),
+        )
+        dumped: JsonObject = report.model_dump(mode="json")
+        return dumped
+
+
+def check_grader_target(target: str) -> None:
+    """Check that ``module:function`` names an importable module without importing it (cheap, at start-up).
+
+    Raises:
+        GraderUnavailable: The target is malformed or its module cannot be found.
+    """
+    module_name, _, function_name = target.partition(":")
+    if not module_name or not function_name:
+        raise GraderUnavailable(f"GYMGRADE_GRADER must look like module:function, found {target!r}")
+    try:
+        found = importlib.util.find_spec(module_name) is not None
+    except (ImportError, ValueError):
+        found = False
+    if not found:
+        raise GraderUnavailable(
+            f"GYMGRADE_GRADER names module {module_name!r}, which is not installed; "
+            "expected e.g. grader.grading:grade_submission"
+        )
+
+
+def load_function(target: str) -> Callable[..., Any]:
+    """Import ``module:function``.
+
+    Raises:
+        GraderUnavailable: The target is malformed, or the module or function does not exist.
+    """
+    module_name, _, function_name = target.partition(":")
+    if not module_name or not function_name:
+        raise GraderUnavailable(f"GYMGRADE_GRADER must look like module:function, found {target!r}")
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as error:
+        raise GraderUnavailable(
+            f"GYMGRADE_GRADER names module {module_name!r}, which cannot be imported: {error}"
+        ) from error
+    function = getattr(module, function_name, None)
+    if not callable(function):
+        raise GraderUnavailable(
+            f"GYMGRADE_GRADER names {target!r}, but {module_name} has no function {function_name}"
+        )
+    return function  # type: ignore[no-any-return]

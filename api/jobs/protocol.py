@@ -1,0 +1,53 @@
+"""The job queue protocol: how workers claim gradings and report on them, whatever the backend."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+
+@dataclass(frozen=True)
+class ClaimedJob:
+    """A submission a worker holds the lease on and must grade."""
+
+    submission_id: int
+    filename: str
+    content: bytes
+    seed: int
+    attempt: int
+
+
+class JobQueue(Protocol):
+    """A queue of grading jobs with leases: a job whose worker stops renewing its lease is handed out again.
+
+    Every method that changes a job takes the worker's id and does nothing (returning False) when that
+    worker no longer holds the job's lease, so a worker presumed dead can never overwrite a newer result.
+    """
+
+    def claim(self, worker_id: str) -> ClaimedJob | None:
+        """Take the oldest queued job, or a running one whose lease expired; None when there is none."""
+        ...
+
+    def renew(self, submission_id: int, worker_id: str) -> bool:
+        """Extend the lease; False when the lease was lost (the worker must stop grading)."""
+        ...
+
+    def add_progress(self, submission_id: int, worker_id: str, problem: dict[str, Any]) -> bool:
+        """Record one finished problem of a running job (shown live)."""
+        ...
+
+    def complete(self, submission_id: int, worker_id: str, report: dict[str, Any]) -> bool:
+        """Store the report and mark the job done."""
+        ...
+
+    def fail(self, submission_id: int, worker_id: str, message: str) -> bool:
+        """Mark the job failed for a reason that retrying cannot fix."""
+        ...
+
+    def retry(self, submission_id: int, worker_id: str, message: str) -> bool:
+        """Put the job back in the queue after an interruption, or fail it once its attempts are used up."""
+        ...
+
+    def release(self, submission_id: int, worker_id: str) -> bool:
+        """Put the job back in the queue without counting the attempt (the worker is shutting down)."""
+        ...

@@ -1,0 +1,23 @@
+"""GET /healthz: the service is up and its database answers."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from api.deps import SessionDep
+from api.models import JobStatus
+from api.schemas import Health
+from api.submissions import count_by_status
+
+router = APIRouter(tags=["health"])
+
+
+@router.get("/healthz", response_model=Health)
+def get_health(session: SessionDep) -> Health:
+    """Liveness and queue depth."""
+    counts = count_by_status(session)
+    return Health(
+        database=session.get_bind().dialect.name,
+        queued=counts.get(JobStatus.QUEUED.value, 0),
+        running=counts.get(JobStatus.RUNNING.value, 0),
+    )

@@ -1,0 +1,28 @@
+"""POST /students: the instructor creates a student and receives their token."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from api.deps import InstructorDep, SessionDep
+from api.schemas import ErrorBody, StudentCreate, StudentCreated
+from api.students import create_student
+
+router = APIRouter(tags=["students"])
+
+
+@router.post(
+    "/students",
+    status_code=201,
+    response_model=StudentCreated,
+    responses={
+        401: {"model": ErrorBody},
+        403: {"model": ErrorBody},
+        409: {"model": ErrorBody},
+        422: {"model": ErrorBody},
+    },
+)
+def post_student(body: StudentCreate, session: SessionDep, _instructor: InstructorDep) -> StudentCreated:
+    """Create a student; the token in the response is shown only this once."""
+    student, token = create_student(session, body.name)
+    return StudentCreated(name=student.name, token=token)

@@ -1,0 +1,112 @@
+"""The web pages: sign in with a token, upload, watch the checks complete, read feedback and plots."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+from fastapi import APIRouter, File, Form, Request, UploadFile
+from fastapi.responses import RedirectResponse, Response
+
+from api.auth import Principal, authenticate
+from api.deps import SESSION_COOKIE, PageCallerDep, SessionDep, SettingsDep
+from api.errors import NotAuthenticated
+from api.gradebook import gradebook_csv
+from api.models import JobStatus
+from api.submissions import create_submission, detail, get_submission, list_submissions
+from api.uploads import check_upload
+from api.web import PAGE_HEADERS, templates
+
+router = APIRouter(include_in_schema=False)
+
+FINAL_STATUSES = frozenset({JobStatus.DONE.value, JobStatus.FAILED.value})
+
+
+def _page(request: Request, template: str, context: dict[str, Any], status_code: int = 200) -> Response:
+    return templates.TemplateResponse(
+        request, template, context, status_code=status_code, headers=PAGE_HEADERS
+    )
+
+
+def _signed_in(caller: Principal | None) -> Principal:
+    if caller is None:
+        raise NotAuthenticated("you are signed out; sign in with your token on the start page")
+    return caller
+
+
+@router.get("/")
+def home(request: Request, session: SessionDep, caller: PageCallerDep, settings: SettingsDep) -> Response:
+    """The start page: the sign-in form, or the caller's submissions and the upload form."""
+    if caller is None:
+        return _page(request, "signin.html", {})
+    submissions = list_submissions(session, caller)
+    return _page(
+        request,
+        "home.html",
+        {"caller": caller, "submissions": submissions, "max_upload_bytes": settings.max_upload_bytes},
+    )
+
+
+@router.post("/ui/sign-in")
+def sign_in(
+    request: Request, session: SessionDep, settings: SettingsDep, token: Annotated[str, Form()] = ""
+) -> Response:
+    """Check the token and keep it in an HttpOnly, SameSite=Strict cookie."""
+    try:
+        authenticate(session, settings, token.strip())
+    except NotAuthenticated as error:
+        return _page(request, "signin.html", {"error": str(error)}, status_code=401)
+    response = RedirectResponse("/", status_code=303)
+    response.set_cookie(
+        SESSION_COOKIE, token.strip(), httponly=True, samesite="strict", secure=request.url.scheme == "https"
+    )
+    return response
+
+
+@router.post("/ui/sign-out")
+def sign_out() -> Response:
+    """Forget the session cookie."""
+    response = RedirectResponse("/", status_code=303)
+    response.delete_cookie(SESSION_COOKIE)
+    return response
+
+
+@router.post("/ui/submissions")
+def upload(
+    session: SessionDep, settings: SettingsDep, caller: PageCallerDep, file: Annotated[UploadFile, File()]
+) -> Response:
+    """Upload from the form, then show the submission's page."""
+    student = _signed_in(caller).require_student()
+    content = file.file.read(settings.max_upload_bytes + 1)
+    submission = create_submission(
+        session, settings, student, check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
+    )
+    return RedirectResponse(f"/ui/submissions/{submission.id}", status_code=303)
+
+
+@router.get("/ui/submissions/{submission_id}")
+def submission_page(
+    request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep
+) -> Response:
+    """A submission's page; its live part is refreshed from the fragment below until grading ends."""
+    view = detail(get_submission(session, _signed_in(caller), submission_id))
+    return _page(request, "submission.html", {"submission": view, "final": view.status in FINAL_STATUSES})
+
+
+@router.get("/ui/submissions/{submission_id}/live")
+def submission_fragment(
+    request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep
+) -> Response:
+    """The live part of a submission's page: status, finished problems, report."""
+    view = detail(get_submission(session, _signed_in(caller), submission_id))
+    return _page(request, "_live.html", {"submission": view, "final": view.status in FINAL_STATUSES})
+
+
+@router.get("/ui/gradebook.csv")
+def gradebook_download(session: SessionDep, settings: SettingsDep, caller: PageCallerDep) -> Response:
+    """The gradebook for the signed-in instructor."""
+    _signed_in(caller).require_instructor()
+    return Response(
+        gradebook_csv(session, settings.gradebook_policy),
+        media_type="text/csv; charset=utf-8",
+        headers={"Content-Disposition": 'attachment; filename="gradebook.csv"'},
+    )

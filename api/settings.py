@@ -1,0 +1,139 @@
+"""The service's settings, read from ``GYMGRADE_*`` environment variables and validated once."""
+
+from __future__ import annotations
+
+from enum import StrEnum
+from pathlib import Path
+
+from pydantic import Field, SecretStr, model_validator
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+MIN_TOKEN_LENGTH = 24
+MIN_TOKEN_DISTINCT_CHARACTERS = 10
+
+
+class SeedPolicy(StrEnum):
+    """How the grading seed of a submission is chosen."""
+
+    FIXED = "fixed"
+    RANDOM = "random"
+
+
+class GradebookPolicy(StrEnum):
+    """Which of a student's graded submissions the gradebook shows."""
+
+    LATEST = "latest"
+    BEST = "best"
+
+
+class Settings(BaseSettings):
+    """Everything the service and its workers can be configured with (environment prefix ``GYMGRADE_``)."""
+
+    model_config = SettingsConfigDict(env_prefix="GYMGRADE_", extra="ignore", frozen=True)
+
+    data_dir: Path = Field(
+        default=Path("gymgrade-data"),
+        description="Directory holding the SQLite database (nothing executable is ever written there).",
+    )
+    database_url: str | None = Field(
+        default=None,
+        description="URL of a PostgreSQL database (postgresql+psycopg://...); unset: SQLite in DATA_DIR.",
+    )
+    instructor_token: SecretStr | None = Field(
+        default=None, description="Bearer token of the instructor; required unless DEVELOPMENT is set."
+    )
+    development: bool = Field(
+        default=False, description="Development mode: allows a missing or weak instructor token."
+    )
+    max_upload_bytes: int = Field(default=256 * 1024, gt=0, description="Largest accepted submission file.")
+    rate_limit_per_minute: int = Field(
+        default=6, gt=0, description="Uploads one student may make in any 60 seconds."
+    )
+    workers: int = Field(
+        default=1,
+        ge=0,
+        description="Gradings the server's worker pool runs at once (0: leave them to `gymgrade worker`).",
+    )
+    grading_workers: int | None = Field(
+        default=None, gt=0, description="Processes one grading spreads its checks over (default: all cores)."
+    )
+    seed_policy: SeedPolicy = Field(
+        default=SeedPolicy.FIXED,
+        description="fixed: every submission graded with SEED (same bytes, same grade); random: fresh seeds.",
+    )
+    seed: int = Field(default=0, ge=0, description="The grading seed under the fixed seed policy.")
+    gradebook_policy: GradebookPolicy = Field(
+        default=GradebookPolicy.LATEST, description="latest or best graded submission per student."
+    )
+    allow_weak_isolation: bool = Field(
+        default=False,
+        description="Grade even when the sandbox cannot enforce full isolation (never for real students).",
+    )
+    grader: str = Field(
+        default="grader.grading:grade_submission",
+        description="module:function with grade_submission's signature that grades one file.",
+    )
+    nice: int = Field(default=10, ge=0, le=19, description="Niceness added to grading processes.")
+    lease_seconds: float = Field(
+        default=60.0,
+        gt=0,
+        description="A running job whose worker stopped renewing it for this long is retried.",
+    )
+    poll_seconds: float = Field(
+        default=1.0, gt=0, description="How often an idle worker looks for queued jobs."
+    )
+    max_attempts: int = Field(
+        default=3, gt=0, description="Times a job is started before it is marked failed."
+    )
+    grading_timeout_seconds: float = Field(
+        default=1800.0,
+        gt=0,
+        description="A grading still running after this long is stopped and marked failed.",
+    )
+
+    @model_validator(mode="after")
+    def _refuse_unsafe_values(self) -> Settings:
+        if self.development:
+            return self
+        if self.instructor_token is None:
+            raise ValueError(
+                "GYMGRADE_INSTRUCTOR_TOKEN is not set; expected a long random token "
+                "(e.g. `python -c 'import secrets; print(secrets.token_urlsafe(32))'`), "
+                "or GYMGRADE_DEVELOPMENT=1 for local development"
+            )
+        problem = token_weakness(self.instructor_token.get_secret_value())
+        if problem is not None:
+            raise ValueError(f"GYMGRADE_INSTRUCTOR_TOKEN is weak: {problem}")
+        return self
+
+    @property
+    def sqlalchemy_url(self) -> str:
+        """The database URL in force: DATABASE_URL, or the SQLite file in DATA_DIR."""
+        if self.database_url:
+            return self.database_url
+        return f"sqlite:///{(self.data_dir / 'gymgrade.sqlite3').resolve()}"
+
+
+def token_weakness(token: str) -> str | None:
+    """Say why a token is too weak to guard the instructor's endpoints, or None when it is strong enough.
+
+    Args:
+        token: The candidate token.
+
+    Returns:
+        A sentence naming what was expected and what was found, or None.
+    """
+    if len(token) < MIN_TOKEN_LENGTH:
+        return f"expected at least {MIN_TOKEN_LENGTH} characters, found {len(token)}; generate a random one"
+    distinct = len(set(token))
+    if distinct < MIN_TOKEN_DISTINCT_CHARACTERS:
+        return (
+            f"expected at least {MIN_TOKEN_DISTINCT_CHARACTERS} distinct characters, found {distinct}; "
+            "generate a random one"
+        )
+    return None
+
+
+def load_settings() -> Settings:
+    """Read the settings from the environment (raises pydantic.ValidationError on unsafe values)."""
+    return Settings()

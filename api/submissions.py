@@ -1,0 +1,133 @@
+"""Storing uploads as queued jobs, and reading them back for their owner or the instructor."""
+
+from __future__ import annotations
+
+import math
+import secrets
+from datetime import timedelta
+
+from sqlalchemy import func, select
+from sqlalchemy.orm import Session, joinedload
+
+from api.auth import Principal
+from api.errors import RateLimited, SubmissionNotFound
+from api.models import JobStatus, Student, Submission, utcnow
+from api.schemas import SubmissionDetail, SubmissionSummary
+from api.settings import SeedPolicy, Settings
+from api.students import find_student
+from api.uploads import CheckedUpload
+
+RATE_WINDOW = timedelta(seconds=60)
+MAX_SEED = 2**31 - 1
+MAX_ID = 2**31 - 1  # the largest id every database's integer column holds
+
+
+def create_submission(
+    session: Session, settings: Settings, student: Student, upload: CheckedUpload
+) -> Submission:
+    """Store an upload as a queued grading job.
+
+    Args:
+        session: A database session (committed here).
+        settings: Service settings (rate limit, seed policy).
+        student: The uploading student.
+        upload: The checked file.
+
+    Returns:
+        The stored submission, status queued.
+
+    Raises:
+        RateLimited: The student already uploaded GYMGRADE_RATE_LIMIT_PER_MINUTE files in the last minute.
+    """
+    now = utcnow()
+    recent = session.execute(
+        select(func.count(Submission.id), func.min(Submission.created_at)).where(
+            Submission.student_id == student.id, Submission.created_at > now - RATE_WINDOW
+        )
+    ).one()
+    count, oldest = recent
+    if count >= settings.rate_limit_per_minute:
+        wait = math.ceil((oldest + RATE_WINDOW - now).total_seconds()) if oldest is not None else 60
+        raise RateLimited(
+            f"at most {settings.rate_limit_per_minute} uploads per minute; try again in {max(wait, 1)} s",
+            retry_after_seconds=max(wait, 1),
+        )
+    seed = settings.seed if settings.seed_policy is SeedPolicy.FIXED else secrets.randbelow(MAX_SEED)
+    submission = Submission(
+        student_id=student.id,
+        filename=upload.display_name,
+        sha256=upload.sha256,
+        content=upload.content,
+        size=len(upload.content),
+        seed=seed,
+        status=JobStatus.QUEUED.value,
+        created_at=now,
+        attempts=0,
+        progress=[],
+    )
+    session.add(submission)
+    session.commit()
+    return submission
+
+
+def get_submission(session: Session, caller: Principal, submission_id: int) -> Submission:
+    """The submission ``submission_id`` if the caller may see it.
+
+    Raises:
+        SubmissionNotFound: It does not exist, or it is another student's (indistinguishable on purpose).
+    """
+    in_range = 1 <= submission_id <= MAX_ID
+    submission = (
+        session.get(Submission, submission_id, options=[joinedload(Submission.student)]) if in_range else None
+    )
+    if submission is None or (caller.student is not None and submission.student_id != caller.student.id):
+        raise SubmissionNotFound(
+            f"no submission {submission_id} among yours; list them with GET /submissions"
+        )
+    return submission
+
+
+def list_submissions(
+    session: Session, caller: Principal, student_name: str | None = None
+) -> list[Submission]:
+    """The caller's submissions (all of them, or one student's, for the instructor), newest first."""
+    query = select(Submission).options(joinedload(Submission.student)).order_by(Submission.id.desc())
+    if caller.student is not None:
+        query = query.where(Submission.student_id == caller.student.id)
+    elif student_name is not None:
+        query = query.where(Submission.student_id == find_student(session, student_name).id)
+    return list(session.scalars(query))
+
+
+def count_by_status(session: Session) -> dict[str, int]:
+    """How many submissions are in each job status."""
+    rows = session.execute(select(Submission.status, func.count(Submission.id)).group_by(Submission.status))
+    return {status: count for status, count in rows}
+
+
+def summary(submission: Submission) -> SubmissionSummary:
+    """The listing view of a submission."""
+    return SubmissionSummary(
+        id=submission.id,
+        student=submission.student.name,
+        filename=submission.filename,
+        sha256=submission.sha256,
+        status=submission.status,  # type: ignore[arg-type]
+        score=submission.score,
+        max_score=submission.max_score,
+        created_at=submission.created_at,
+        finished_at=submission.finished_at,
+    )
+
+
+def detail(submission: Submission) -> SubmissionDetail:
+    """The full view of a submission: progress while running, the report once done."""
+    return SubmissionDetail(
+        **summary(submission).model_dump(),
+        seed=submission.seed,
+        started_at=submission.started_at,
+        attempts=submission.attempts,
+        progress=submission.progress,
+        report=submission.report if submission.status == JobStatus.DONE.value else None,
+        error=submission.error,
+    )

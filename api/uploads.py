@@ -1,0 +1,87 @@
+"""Checks an uploaded file before it is queued, and turns its client-chosen name into a safe display name."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+import unicodedata
+from dataclasses import dataclass
+
+from api.errors import InvalidUpload, UploadTooLarge
+
+MAX_DISPLAY_NAME_CHARS = 100
+_UNSAFE_NAME_CHARACTERS = re.compile(r"[^A-Za-z0-9._ -]+")
+_MODULE_STEM = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+GRADING_FALLBACK_NAME = "submission.py"
+
+
+@dataclass(frozen=True)
+class CheckedUpload:
+    """An upload that may be graded: its bytes, their SHA-256 and a display name that is safe anywhere."""
+
+    display_name: str
+    content: bytes
+    sha256: str
+
+
+def display_name(client_name: str | None) -> str:
+    """Reduce a client-supplied file name to a short, printable name (never used as a path).
+
+    Args:
+        client_name: The name the client sent, possibly with directories, control characters or worse.
+
+    Returns:
+        The last path component with every character outside ``[A-Za-z0-9._ -]`` replaced by ``_``,
+        no leading dots or spaces, at most 100 characters.
+    """
+    name = (client_name or "").replace("\\", "/").rsplit("/", 1)[-1]
+    name = unicodedata.normalize("NFKC", name)
+    name = _UNSAFE_NAME_CHARACTERS.sub("_", name).lstrip(". ").strip()
+    if len(name) <= MAX_DISPLAY_NAME_CHARS:
+        return name
+    suffix = ".py" if name.lower().endswith(".py") else ""
+    return name[: MAX_DISPLAY_NAME_CHARS - len(suffix)] + suffix
+
+
+def grading_file_name(name: str) -> str:
+    """The file name a submission is graded under: its display name when it is a valid module name."""
+    stem = name.removesuffix(".py")
+    return name if name.endswith(".py") and _MODULE_STEM.fullmatch(stem) else GRADING_FALLBACK_NAME
+
+
+def check_upload(client_name: str | None, content: bytes, *, max_bytes: int) -> CheckedUpload:
+    """Accept a Python source file or say precisely why it cannot be graded.
+
+    Args:
+        client_name: The file name the client sent.
+        content: The file's bytes (at most ``max_bytes + 1`` were read).
+        max_bytes: GYMGRADE_MAX_UPLOAD_BYTES.
+
+    Returns:
+        The checked upload.
+
+    Raises:
+        UploadTooLarge: More than ``max_bytes`` bytes.
+        InvalidUpload: Not a ``.py`` name, empty, binary (NUL bytes) or not UTF-8.
+    """
+    if len(content) > max_bytes:
+        raise UploadTooLarge(
+            f"the file is larger than the limit of {max_bytes} bytes; upload only your opengym.py source"
+        )
+    name = display_name(client_name)
+    if not name.lower().endswith(".py") or name.lower() == ".py":
+        raise InvalidUpload(
+            f"expected a Python file named like opengym.py, found the name {name or '(none)'!r}"
+        )
+    if not content.strip():
+        raise InvalidUpload(f"{name} is empty; upload the file with your functions in it")
+    if b"\x00" in content:
+        raise InvalidUpload(f"{name} holds binary data (NUL bytes); expected Python source text")
+    try:
+        content.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise InvalidUpload(
+            f"{name} is not UTF-8 text (byte {error.start} is 0x{content[error.start]:02x}); "
+            "save it as UTF-8 and upload it again"
+        ) from None
+    return CheckedUpload(display_name=name, content=content, sha256=hashlib.sha256(content).hexdigest())

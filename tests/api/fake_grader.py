@@ -1,0 +1,105 @@
+"""A fast stand-in for grader.grading.grade_submission whose behaviour the uploaded file itself chooses.
+
+Directives in the file (one per line):
+    ``# fake-grader: sleep=SECONDS``  wait this long before each problem finishes;
+    ``# fake-grader: crash``          kill the grading process (as a crash would);
+    ``# fake-grader: fail``           raise, as a broken grader would.
+A problem passes when the file defines its function, and is missing otherwise; a file that does not
+compile gets a ``submission_error``, as the real grader's validation gives.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from pydantic import JsonValue
+
+from grader.report import ProblemResult, Report
+
+PROBLEMS = (
+    ("random_blackjack", "Random blackjack"),
+    ("blackjack", "Threshold blackjack"),
+    ("cartpole", "CartPole"),
+)
+POINTS = 1.0
+CURVE: list[JsonValue] = [
+    {"n": n, "student": 0.30 + 0.01 * n, "exact": 0.31 + 0.01 * n} for n in range(4, 21, 4)
+]
+
+
+def _directive(source: str, name: str) -> str | None:
+    match = re.search(rf"^# fake-grader: {name}(?:=(\S+))?\s*$", source, flags=re.MULTILINE)
+    if match is None:
+        return None
+    return match.group(1) or ""
+
+
+def grade_submission(
+    path: Path,
+    *,
+    seed: int = 0,
+    workers: int | None = None,
+    only: Sequence[str] | None = None,
+    policy: Any = None,
+    on_progress: Callable[[ProblemResult], None] | None = None,
+) -> Report:
+    """Grade ``path`` the fake way (see the module docstring)."""
+    data = path.read_bytes()
+    source = data.decode("utf-8")
+    sha256 = hashlib.sha256(data).hexdigest()
+    if _directive(source, "crash") is not None:
+        os._exit(3)
+    if _directive(source, "fail") is not None:
+        raise RuntimeError("the fake grader was told to fail")
+    try:
+        compile(source, path.name, "exec")
+    except SyntaxError as error:
+        return Report(
+            submission=path.name,
+            sha256=sha256,
+            seed=seed,
+            gymnasium_version="fake",
+            grader_version="fake",
+            score=0.0,
+            max_score=POINTS * len(PROBLEMS),
+            submission_error=f"{path.name} is not valid Python: line {error.lineno}: {error.msg}",
+        )
+    delay = float(_directive(source, "sleep") or 0.0)
+    problems = []
+    for problem_id, title in PROBLEMS:
+        time.sleep(delay)
+        defined = re.search(rf"^def {problem_id}\(", source, flags=re.MULTILINE) is not None
+        result = ProblemResult(
+            id=problem_id,
+            title=title,
+            status="passed" if defined else "missing",
+            score=POINTS if defined else 0.0,
+            max_score=POINTS,
+            feedback=f"{problem_id} is defined."
+            if defined
+            else f"expected a function {problem_id}; found none",
+            measurements={"curve": CURVE}
+            if problem_id == "blackjack"
+            else {"policy": str(policy), "workers": workers},
+            output=f"<output of {problem_id}>",
+            seed=seed,
+        )
+        problems.append(result)
+        if on_progress is not None:
+            on_progress(result)
+    return Report(
+        submission=path.name,
+        sha256=sha256,
+        seed=seed,
+        gymnasium_version="fake",
+        grader_version="fake",
+        score=sum(p.score for p in problems),
+        max_score=POINTS * len(problems),
+        problems=problems,
+    )

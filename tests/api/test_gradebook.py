@@ -1,0 +1,83 @@
+"""The gradebook CSV: one row per student, their latest or best graded submission, a column per problem."""
+
+from __future__ import annotations
+
+import csv
+import io
+
+import pytest
+from api_testing import SettingsFactory, add_student, bearer, instructor_headers
+from fastapi.testclient import TestClient
+
+from api.main import create_app
+
+
+def _graded(client: TestClient, token: str, scores: dict[str, float]) -> int:
+    response = client.post("/submissions", files={"file": ("opengym.py", b"x = 1\n")}, headers=bearer(token))
+    submission_id: int = response.json()["id"]
+    jobs = client.app.state.context.jobs  # type: ignore[attr-defined]
+    job = jobs.claim("test-worker")
+    assert job is not None and job.submission_id == submission_id
+    problems = [{"id": name, "score": score, "max_score": 1.0} for name, score in scores.items()]
+    report = {"score": sum(scores.values()), "max_score": float(len(scores)), "problems": problems}
+    assert jobs.complete(submission_id, "test-worker", report)
+    return submission_id
+
+
+def _rows(client: TestClient) -> list[dict[str, str]]:
+    response = client.get("/gradebook.csv", headers=instructor_headers())
+    assert response.status_code == 200
+    assert response.headers["content-type"].startswith("text/csv")
+    return list(csv.DictReader(io.StringIO(response.text)))
+
+
+@pytest.mark.parametrize("database_url", ["sqlite", "postgresql"], indirect=True)
+@pytest.mark.parametrize(
+    ("policy", "expected_cartpole", "expected_total"),
+    [("latest", "0", "1"), ("best", "1", "2")],
+    ids=["latest", "best"],
+)
+def test_one_row_per_student_by_policy(
+    make_settings: SettingsFactory, policy: str, expected_cartpole: str, expected_total: str
+) -> None:
+    with TestClient(create_app(make_settings(gradebook_policy=policy), run_workers=False)) as client:
+        ada, bob = add_student(client, "ada"), add_student(client, "bob")
+        add_student(client, "=cmd|' /C calc'!A0")
+        best = _graded(client, ada, {"random_blackjack": 1.0, "cartpole": 1.0})
+        latest = _graded(client, ada, {"random_blackjack": 1.0, "cartpole": 0.0})
+        _graded(client, bob, {"random_blackjack": 0.0, "cartpole": 0.0})
+        rows = _rows(client)
+    assert [row["student"] for row in rows] == ["'=cmd|' /C calc'!A0", "ada", "bob"]
+    ada_row = rows[1]
+    assert ada_row["submission_id"] == str(best if policy == "best" else latest)
+    assert (ada_row["cartpole"], ada_row["score"], ada_row["max_score"]) == (
+        expected_cartpole,
+        expected_total,
+        "2",
+    )
+    assert rows[0]["score"] == "", "a student without a graded submission has empty cells"
+    assert list(rows[0]) == [
+        "student",
+        "submission_id",
+        "submitted_at",
+        "sha256",
+        "random_blackjack",
+        "cartpole",
+        "score",
+        "max_score",
+    ]
+
+
+def test_ungraded_submissions_are_not_in_the_gradebook(client: TestClient) -> None:
+    ada = add_student(client, "ada")
+    client.post("/submissions", files={"file": ("opengym.py", b"x = 1\n")}, headers=bearer(ada))
+    assert _rows(client) == [
+        {
+            "student": "ada",
+            "submission_id": "",
+            "submitted_at": "",
+            "sha256": "",
+            "score": "",
+            "max_score": "",
+        }
+    ]

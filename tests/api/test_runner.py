@@ -1,0 +1,150 @@
+"""Grading one claimed job in a child process: progress, report, grader failures, crashes, shutdown."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterator
+
+import pytest
+from api_testing import SettingsFactory
+from sqlalchemy import select
+from sqlalchemy.orm import Session, sessionmaker
+
+from api.database import make_engine, make_session_factory, migrate
+from api.jobs.local import DatabaseQueue
+from api.jobs.runner import run_job
+from api.models import Student, Submission, utcnow
+from api.settings import Settings
+
+SOLUTION = b"def random_blackjack(n):\n    return 0.3\n\ndef blackjack(n=11):\n    return 0.4\n"
+
+
+@pytest.fixture
+def settings(make_settings: SettingsFactory) -> Settings:
+    return make_settings(max_attempts=2)
+
+
+@pytest.fixture
+def sessions(settings: Settings) -> Iterator[sessionmaker[Session]]:
+    engine = make_engine(settings)
+    migrate(engine)
+    yield make_session_factory(engine)
+    engine.dispose()
+
+
+def _grade(
+    sessions: sessionmaker[Session],
+    settings: Settings,
+    content: bytes,
+    *,
+    filename: str = "opengym.py",
+    stop: bool = False,
+) -> Submission:
+    with sessions() as session:
+        student = session.scalars(select(Student)).first()
+        if student is None:
+            student = Student(name="ada", token_sha256="a" * 64)
+            session.add(student)
+            session.flush()
+        row = Submission(
+            student_id=student.id,
+            filename=filename,
+            sha256="0" * 64,
+            content=content,
+            size=len(content),
+            seed=11,
+            status="queued",
+            created_at=utcnow(),
+            attempts=0,
+            progress=[],
+        )
+        session.add(row)
+        session.commit()
+        submission_id = row.id
+    queue = DatabaseQueue(sessions, lease_seconds=settings.lease_seconds, max_attempts=settings.max_attempts)
+    job = queue.claim("worker")
+    assert job is not None
+    stop_event = threading.Event()
+    if stop:
+        stop_event.set()
+    run_job(job, queue, "worker", settings, stop_event)
+    with sessions() as session:
+        return session.get_one(Submission, submission_id)
+
+
+def test_a_graded_job_stores_the_report_with_its_seed(
+    sessions: sessionmaker[Session], settings: Settings
+) -> None:
+    row = _grade(sessions, settings, SOLUTION)
+    assert row.status == "done", row.error
+    assert row.report is not None
+    assert (row.score, row.max_score, row.report["seed"]) == (2.0, 3.0, 11)
+    assert [problem["status"] for problem in row.progress] == ["passed", "passed", "missing"]
+
+
+@pytest.mark.parametrize(
+    ("overrides", "policy", "workers"),
+    [({}, "require_full", None), ({"allow_weak_isolation": True, "grading_workers": 2}, "allow_fallback", 2)],
+    ids=["strict-by-default", "weak-isolation-allowed"],
+)
+def test_the_grader_gets_the_isolation_policy_and_workers_of_the_settings(
+    sessions: sessionmaker[Session],
+    make_settings: SettingsFactory,
+    overrides: dict[str, object],
+    policy: str,
+    workers: int | None,
+) -> None:
+    row = _grade(sessions, make_settings(**overrides), SOLUTION)
+    assert row.report is not None
+    assert row.report["problems"][0]["measurements"] == {"policy": policy, "workers": workers}
+
+
+def test_a_syntax_error_is_a_stored_verdict(sessions: sessionmaker[Session], settings: Settings) -> None:
+    row = _grade(sessions, settings, b"def broken(:\n")
+    assert row.status == "done"
+    assert row.report is not None and row.report["submission_error"].startswith(
+        "opengym.py is not valid Python"
+    )
+
+
+@pytest.mark.parametrize(
+    ("content", "status", "error"),
+    [
+        (
+            b"# fake-grader: fail\n",
+            "failed",
+            "the grader failed: RuntimeError: the fake grader was told to fail",
+        ),
+        (b"# fake-grader: crash\n", "queued", "the grading process ended unexpectedly (exit status 3)"),
+    ],
+    ids=["grader-raises", "grading-process-crashes"],
+)
+def test_grader_failures_are_stored_not_raised(
+    sessions: sessionmaker[Session], settings: Settings, content: bytes, status: str, error: str
+) -> None:
+    row = _grade(sessions, settings, content)
+    assert (row.status, row.error) == (status, error)
+
+
+def test_an_unknown_grader_fails_the_job_with_the_setting_named(
+    sessions: sessionmaker[Session], make_settings: SettingsFactory
+) -> None:
+    settings = make_settings(grader="no_such_module:grade")
+    row = _grade(sessions, settings, SOLUTION)
+    assert row.status == "failed"
+    assert row.error is not None and row.error.startswith("GYMGRADE_GRADER names module 'no_such_module'")
+
+
+def test_a_stopping_worker_puts_its_job_back(sessions: sessionmaker[Session], settings: Settings) -> None:
+    row = _grade(sessions, settings, b"# fake-grader: sleep=5\n" + SOLUTION, stop=True)
+    assert (row.status, row.attempts, row.lease_owner) == ("queued", 0, None)
+
+
+def test_a_submission_named_like_a_module_cannot_shadow_the_grading_process(
+    sessions: sessionmaker[Session], settings: Settings
+) -> None:
+    hostile = b"raise SystemExit('imported outside the sandbox')\n"
+    for name in ("json.py", "fake_grader.py", "api.py"):
+        row = _grade(sessions, settings, hostile, filename=name)
+        assert row.status == "done", (name, row.error)
+        assert row.report is not None and row.report["submission"] == name

@@ -1,0 +1,87 @@
+"""Settings refuse to start the service without a strong instructor token, outside development."""
+
+from __future__ import annotations
+
+import pytest
+from pydantic import ValidationError
+
+from api.settings import GradebookPolicy, SeedPolicy, Settings, token_weakness
+
+STRONG = "Zq3-vK9_pL2xR7mN4tB8wY6c"
+
+
+@pytest.mark.parametrize(
+    ("environment", "message"),
+    [
+        ({}, "GYMGRADE_INSTRUCTOR_TOKEN is not set; expected a long random token"),
+        (
+            {"GYMGRADE_INSTRUCTOR_TOKEN": "secret"},
+            "GYMGRADE_INSTRUCTOR_TOKEN is weak: expected at least 24 "
+            "characters, found 6; generate a random one",
+        ),
+        (
+            {"GYMGRADE_INSTRUCTOR_TOKEN": "ab" * 20},
+            "GYMGRADE_INSTRUCTOR_TOKEN is weak: expected at least 10 "
+            "distinct characters, found 2; generate a random one",
+        ),
+    ],
+    ids=["missing", "short", "repetitive"],
+)
+def test_unsafe_tokens_are_refused_outside_development(
+    monkeypatch: pytest.MonkeyPatch, environment: dict[str, str], message: str
+) -> None:
+    monkeypatch.delenv("GYMGRADE_INSTRUCTOR_TOKEN", raising=False)
+    monkeypatch.delenv("GYMGRADE_DEVELOPMENT", raising=False)
+    for name, value in environment.items():
+        monkeypatch.setenv(name, value)
+    with pytest.raises(ValidationError) as raised:
+        Settings()
+    assert message in str(raised.value)
+
+
+@pytest.mark.parametrize("token", [None, "dev"], ids=["missing", "weak"])
+def test_development_allows_a_missing_or_weak_token(
+    monkeypatch: pytest.MonkeyPatch, token: str | None
+) -> None:
+    monkeypatch.setenv("GYMGRADE_DEVELOPMENT", "1")
+    if token is None:
+        monkeypatch.delenv("GYMGRADE_INSTRUCTOR_TOKEN", raising=False)
+    else:
+        monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", token)
+    assert Settings().development
+
+
+def test_environment_variables_are_read_with_the_prefix(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: object
+) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.setenv("GYMGRADE_DATA_DIR", str(tmp_path))
+    monkeypatch.setenv("GYMGRADE_MAX_UPLOAD_BYTES", "1000")
+    monkeypatch.setenv("GYMGRADE_GRADEBOOK_POLICY", "best")
+    monkeypatch.setenv("GYMGRADE_SEED_POLICY", "random")
+    monkeypatch.setenv("GYMGRADE_ALLOW_WEAK_ISOLATION", "true")
+    settings = Settings()
+    assert settings.instructor_token is not None and settings.instructor_token.get_secret_value() == STRONG
+    assert (settings.max_upload_bytes, settings.gradebook_policy, settings.seed_policy) == (
+        1000,
+        GradebookPolicy.BEST,
+        SeedPolicy.RANDOM,
+    )
+    assert settings.allow_weak_isolation
+    assert settings.sqlalchemy_url == f"sqlite:///{tmp_path}/gymgrade.sqlite3"
+
+
+def test_database_url_takes_precedence(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.setenv("GYMGRADE_DATABASE_URL", "postgresql+psycopg://u@127.0.0.1/db")
+    assert Settings().sqlalchemy_url == "postgresql+psycopg://u@127.0.0.1/db"
+
+
+def test_isolation_is_strict_by_default(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.delenv("GYMGRADE_ALLOW_WEAK_ISOLATION", raising=False)
+    assert not Settings().allow_weak_isolation
+
+
+def test_a_generated_token_is_strong() -> None:
+    assert token_weakness(STRONG) is None
