@@ -57,3 +57,7 @@ class RateLimited(ServiceError):
 
 class GraderUnavailable(ServiceError):
     """Raised when GYMGRADE_GRADER names nothing usable (reported at start-up or as the job's failure)."""
+
+
+class GraderFailed(ServiceError):
+    """Raised when the grader reports a failure of its own on a submission (stored as the job's failure)."""

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from api.errors import GraderUnavailable
+from api.errors import GraderFailed, GraderUnavailable
 
 JsonObject = dict[str, Any]
 ProgressCallback = Callable[[JsonObject], None]
@@ -50,6 +50,9 @@ class ImportedGrader:
             policy=policy,
             on_progress=lambda result: on_progress(result.model_dump(mode="json")),
         )
+        if report.grader_errors:
+            failures = "; ".join(report.grader_errors)
+            raise GraderFailed(f"the grader failed on this submission (not the student's fault): {failures}")
         dumped: JsonObject = report.model_dump(mode="json")
         return dumped
 

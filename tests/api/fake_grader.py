@@ -3,7 +3,8 @@
 Directives in the file (one per line):
     ``# fake-grader: sleep=SECONDS``  wait this long before each problem finishes;
     ``# fake-grader: crash``          kill the grading process (as a crash would);
-    ``# fake-grader: fail``           raise, as a broken grader would.
+    ``# fake-grader: fail``           raise, as a broken grader would;
+    ``# fake-grader: internal-error`` return a report that lists a failure of the grader itself.
 A problem passes when the file defines its function, and is missing otherwise; a file that does not
 compile gets a ``submission_error``, as the real grader's validation gives.
 """
@@ -102,4 +103,7 @@ def grade_submission(
         score=sum(p.score for p in problems),
         max_score=POINTS * len(problems),
         problems=problems,
+        grader_errors=["cartpole: the fake grader crashed"]
+        if _directive(source, "internal-error") is not None
+        else [],
     )

@@ -116,8 +116,13 @@ def test_a_syntax_error_is_a_stored_verdict(sessions: sessionmaker[Session], set
             "the grader failed: RuntimeError: the fake grader was told to fail",
         ),
         (b"# fake-grader: crash\n", "queued", "the grading process ended unexpectedly (exit status 3)"),
+        (
+            b"# fake-grader: internal-error\n",
+            "failed",
+            "the grader failed on this submission (not the student's fault): cartpole: the fake grader crashed",
+        ),
     ],
-    ids=["grader-raises", "grading-process-crashes"],
+    ids=["grader-raises", "grading-process-crashes", "grader-reports-its-own-failure"],
 )
 def test_grader_failures_are_stored_not_raised(
     sessions: sessionmaker[Session], settings: Settings, content: bytes, status: str, error: str

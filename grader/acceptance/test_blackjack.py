@@ -1,0 +1,11 @@
+"""Problem 2: blackjack(n) follows 'draw while sum <= n' and wins as often as that policy does."""
+
+from grader.plugin import GradeCase, ProblemCase
+from grader.problems import ProblemId
+
+PROBLEM: ProblemId = "blackjack"
+
+
+def test_blackjack(problem_case: ProblemCase, grade: GradeCase) -> None:
+    result = grade(problem_case)
+    assert result.id == PROBLEM

@@ -1,0 +1,11 @@
+"""Problem 3: cartpole() balances long enough; every returned length is its replayed episode's."""
+
+from grader.plugin import GradeCase, ProblemCase
+from grader.problems import ProblemId
+
+PROBLEM: ProblemId = "cartpole"
+
+
+def test_cartpole(problem_case: ProblemCase, grade: GradeCase) -> None:
+    result = grade(problem_case)
+    assert result.id == PROBLEM

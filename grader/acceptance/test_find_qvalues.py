@@ -1,0 +1,11 @@
+"""The lab-provided find_qvalues(env): it trains, and its greedy policy's exact return is reported."""
+
+from grader.plugin import GradeCase, ProblemCase
+from grader.problems import ProblemId
+
+PROBLEM: ProblemId = "find_qvalues"
+
+
+def test_find_qvalues(problem_case: ProblemCase, grade: GradeCase) -> None:
+    result = grade(problem_case)
+    assert result.id == PROBLEM

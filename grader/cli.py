@@ -1,0 +1,247 @@
+"""The `gymgrade` command line: `check` one file (students), `grade` a batch (instructors), and plugins."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+from collections.abc import Callable, Sequence
+from importlib.metadata import entry_points
+from pathlib import Path
+from typing import Any
+
+from grader.errors import GraderError
+from grader.problems import PROBLEM_IDS
+from grader.progress import ProgressBar, result_line
+from grader.report import ProblemResult, Report
+from grader.sandbox import IsolationPolicy
+from grader.sandbox.errors import SandboxError
+
+COMMAND_GROUP = "gymgrade.commands"
+EXIT_FULL_MARKS, EXIT_NOT_FULL, EXIT_ERROR = 0, 1, 2
+EXIT_INTERRUPTED = 130
+
+Handler = Callable[[argparse.Namespace], int]
+
+
+def _problem_ids(text: str) -> list[str]:
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in PROBLEM_IDS]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(
+            f"unknown problem {', '.join(unknown) or '(none)'}; expected ids among {', '.join(PROBLEM_IDS)}"
+        )
+    return names
+
+
+def _positive(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive number of workers, found {value}")
+    return value
+
+
+def _add_common(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--seed", type=int, default=0, help="grading seed (same file + seed = same verdicts)")
+    parser.add_argument(
+        "--workers", type=_positive, default=None, help="parallel workers (default: all cores)"
+    )
+    parser.add_argument(
+        "--only",
+        type=_problem_ids,
+        default=None,
+        metavar="ID[,ID...]",
+        help=f"grade only these problems ({', '.join(PROBLEM_IDS)})",
+    )
+    parser.add_argument(
+        "--config",
+        type=Path,
+        default=None,
+        metavar="PATH",
+        help="assignment configuration TOML (default: the bundled one)",
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser, including subcommands registered under the `gymgrade.commands` entry points."""
+    parser = argparse.ArgumentParser(prog="gymgrade", description="Grade OpenGym AI lab submissions.")
+    subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    check = subparsers.add_parser("check", help="grade one file and explain every verdict (for students)")
+    check.add_argument("file", type=Path, metavar="FILE")
+    _add_common(check)
+    check.add_argument("--json", action="store_true", help="print exactly the report JSON on stdout")
+    check.add_argument(
+        "--output", type=Path, default=None, metavar="PATH", help="also write the report JSON here"
+    )
+    check.set_defaults(handler=run_check)
+
+    grade = subparsers.add_parser(
+        "grade", help="grade many files: a report each and grades.csv (instructors)"
+    )
+    grade.add_argument("targets", type=Path, nargs="+", metavar="DIR|FILE")
+    grade.add_argument(
+        "--out", type=Path, required=True, metavar="DIR", help="directory for reports + grades.csv"
+    )
+    _add_common(grade)
+    grade.add_argument(
+        "--allow-weak-isolation",
+        action="store_true",
+        help="grade even where the sandbox cannot enforce every isolation layer",
+    )
+    grade.set_defaults(handler=run_grade)
+
+    for entry_point in entry_points(group=COMMAND_GROUP):
+        try:
+            entry_point.load()(subparsers)
+        except Exception as error:
+            broken = subparsers.add_parser(entry_point.name, help=f"(unavailable: {type(error).__name__})")
+            broken.set_defaults(handler=_unavailable(entry_point.name, error))
+    return parser
+
+
+def _unavailable(name: str, error: Exception) -> Handler:
+    def handler(_args: argparse.Namespace) -> int:
+        print(
+            f"gymgrade {name}: the command could not be loaded ({type(error).__name__}: {error}); "
+            "install the package providing it.",
+            file=sys.stderr,
+        )
+        return EXIT_ERROR
+
+    return handler
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run `gymgrade` and return its exit code.
+
+    0: full marks (check) or success (grade); 1: not full marks; 2: usage or grader error; 130: interrupted.
+    """
+    args = build_parser().parse_args(argv)
+    handler: Handler = args.handler
+    # A terminated run unwinds like Ctrl-C, so the grading processes it started are ended too.
+    previous = signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        return handler(args)
+    except (GraderError, SandboxError, ValueError, OSError) as error:
+        print(f"gymgrade {args.command}: {error}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        print(f"gymgrade {args.command}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _interrupt(signum: int, _frame: object) -> None:
+    raise KeyboardInterrupt(signal.Signals(signum).name)
+
+
+def run_check(args: argparse.Namespace) -> int:
+    """`gymgrade check`: grade one file with live progress, summarise, exit 0 only at full marks."""
+    from grader.grading import grade_submission
+
+    if not args.file.is_file():
+        print(f"gymgrade check: {args.file} is not a file: pass the path of your .py file", file=sys.stderr)
+        return EXIT_ERROR
+    progress = sys.stderr if args.json else sys.stdout
+
+    def show(result: ProblemResult) -> None:
+        print(result_line(result), file=progress, flush=True)
+
+    if not args.json:
+        print(f"Checking {args.file.name} (seed {args.seed})...", flush=True)
+    report = grade_submission(
+        args.file,
+        seed=args.seed,
+        workers=args.workers,
+        only=args.only,
+        policy=IsolationPolicy.ALLOW_FALLBACK,
+        on_progress=show,
+        config=args.config,
+    )
+    if args.output is not None:
+        args.output.write_text(report.to_json() + "\n", encoding="utf-8")
+    if args.json:
+        sys.stdout.write(report.to_json() + "\n")
+    else:
+        print(summary(report))
+    if report.grader_errors:
+        return EXIT_ERROR
+    return EXIT_FULL_MARKS if report.full_marks else EXIT_NOT_FULL
+
+
+def summary(report: Report) -> str:
+    """The readable end of `gymgrade check`: every verdict's feedback, the total, the isolation."""
+    lines = [""]
+    if report.submission_error is not None:
+        lines.append(report.submission_error)
+    else:
+        for result in report.problems:
+            lines += [f"{result.title}: {result.status}", f"  {result.feedback}"]
+    lines.append(
+        f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
+    )
+    lines += isolation_lines(report.isolation)
+    lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
+    return "\n".join(lines)
+
+
+def isolation_lines(isolation: dict[str, Any]) -> list[str]:
+    """How the student's code was isolated: one line when fully, else each missing layer and its remedy."""
+    layers = isolation.get("layers")
+    if not isinstance(layers, list):
+        return []
+    if isolation.get("full"):
+        names = ", ".join(str(layer["name"]) for layer in layers if layer.get("active"))
+        return [f"Sandbox: full isolation ({names})."]
+    lines = [
+        "Sandbox: weaker isolation on this machine (fine for checking your own code; instructors grade "
+        "with full isolation). Missing:"
+    ]
+    lines += [
+        f"  - {layer['name']}: {layer['detail']}"
+        + (f" (to fix: {layer['remedy']})" if layer.get("remedy") else "")
+        for layer in layers
+        if layer.get("required") and not layer.get("active")
+    ]
+    return lines
+
+
+def run_grade(args: argparse.Namespace) -> int:
+    """`gymgrade grade`: grade every file, write reports + grades.csv, show a progress bar."""
+    from grader.batch import collect_submissions, grade_many
+    from grader.grading import GradingPlan
+
+    paths = collect_submissions(args.targets)
+    if not paths:
+        print("gymgrade grade: no .py files found in the given targets", file=sys.stderr)
+        return EXIT_ERROR
+    problems = GradingPlan.load(args.config, args.only).problems
+    bar = ProgressBar(total=len(paths) * len(problems))
+
+    def advance(path: Path, result: ProblemResult) -> None:
+        bar.advance(f"{path.name}: {result.id} {result.status}")
+
+    policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
+    reports = grade_many(
+        paths,
+        args.out,
+        seed=args.seed,
+        workers=args.workers,
+        only=args.only,
+        policy=policy,
+        config=args.config,
+        on_result=advance,
+    )
+    errors = sum(1 for report in reports if report.grader_errors)
+    print(
+        f"Graded {len(reports)} submissions into {args.out} (grades.csv)"
+        + (f"; {errors} with grader errors" if errors else ""),
+        file=sys.stderr,
+    )
+    return EXIT_ERROR if errors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

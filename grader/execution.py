@@ -1,0 +1,130 @@
+"""Grade one problem of one submission: sandboxed calls, trusted replays, the check's verdict."""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from pydantic import JsonValue
+
+from grader.checks import CHECKS
+from grader.checks.base import CallRecord
+from grader.config import AssignmentConfig
+from grader.problems import ProblemId
+from grader.report import ProblemResult, ProblemRun, Timings, cap_output, plain_json
+from grader.sandbox import CallOutcome, IsolationPolicy, IsolationReport, Sandbox
+from grader.sandbox.replay import Replay, replay_episodes, verify_reset_seeds
+
+MAX_COMPAT_EVENTS = 20
+"""Distinct compatibility events kept per problem: enough to explain, bounded for 100-call problems."""
+
+
+def problem_seed(grading_seed: int, problem: str) -> int:
+    """The sandbox seed of one problem: a stable hash of (grading seed, problem id), 63 bits.
+
+    Independent of the worker, the order of the tests and the other problems, so a problem gets the same
+    calls and episodes whether it is graded alone, under xdist or in a batch.
+    """
+    digest = hashlib.sha256(f"gymgrade:{grading_seed}:{problem}".encode()).digest()
+    return int.from_bytes(digest[:8], "big") >> 1
+
+
+def isolation_summary(isolation: IsolationReport) -> dict[str, JsonValue]:
+    """The sandbox's isolation report as plain JSON data: ``full``, ``layers`` and a readable ``summary``."""
+    summary = plain_json(isolation.to_dict())
+    if not isinstance(summary, dict):
+        raise TypeError(f"IsolationReport.to_dict() must give a dict; found {type(summary).__name__}")
+    summary["summary"] = isolation.summary()
+    return summary
+
+
+def run_problem(
+    submission: Path,
+    problem: ProblemId,
+    *,
+    config: AssignmentConfig,
+    grading_seed: int,
+    policy: IsolationPolicy,
+) -> ProblemRun:
+    """Run one problem's planned calls in a fresh sandbox, replay every episode and judge.
+
+    A student's failure (import error, crash, timeout, wrong values) is part of the returned result;
+    only a failure of the grader itself raises.
+
+    Args:
+        submission: The student's file.
+        problem: Which problem to grade.
+        config: The assignment configuration.
+        grading_seed: The grading seed; the problem's sandbox seed derives from it and the problem id.
+        policy: Whether weaker isolation than full is acceptable.
+
+    Returns:
+        The problem's result and the sandbox's isolation report.
+
+    Raises:
+        grader.sandbox.errors.IsolationUnavailable: Full isolation was required and is not available.
+    """
+    started = time.perf_counter()
+    check = CHECKS[problem]
+    settings = config.problem(problem)
+    seed = problem_seed(grading_seed, problem)
+    limits = config.sandbox.to_limits(settings.call_seconds)
+    with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:
+        calls = check.plan(settings, sandbox.functions)
+        outcomes = [sandbox.call(call) for call in calls]
+        isolation = isolation_summary(sandbox.isolation)
+    records = [CallRecord(outcome, trusted_replays(outcome)) for outcome in outcomes]
+    verdict = check.judge(settings, records)
+    wall_seconds = time.perf_counter() - started
+    student_seconds = sum(outcome.wall_time for outcome in outcomes)
+    fraction = min(max(verdict.fraction, 0.0), 1.0)
+    measurements = plain_json(verdict.measurements)
+    result = ProblemResult(
+        id=problem,
+        title=settings.title,
+        status=verdict.status,
+        score=round(settings.points * fraction, 6),
+        max_score=settings.points,
+        feedback=verdict.feedback,
+        measurements=measurements if isinstance(measurements, dict) else {"value": measurements},
+        output=cap_output(student_output(outcomes)),
+        compat_events=_distinct_events(outcomes),
+        seed=seed,
+        timings=Timings(
+            wall_seconds=wall_seconds,
+            student_seconds=student_seconds,
+            overhead_seconds=max(wall_seconds - student_seconds, 0.0),
+        ),
+    )
+    return ProblemRun(submission=str(submission), result=result, isolation=isolation)
+
+
+def trusted_replays(outcome: CallOutcome) -> list[Replay]:
+    """Replay a call's episodes in the grader's own environments and check their reset seeds.
+
+    Replay alone would accept a forged log that names seeds of its own choosing (favourable starts), so
+    the seeds are checked against the stream the grader derives from the call's seed; a deviation marks
+    every episode of the call as not replaying, which fails any check that relies on them.
+    """
+    replays = replay_episodes(outcome.episodes)
+    altered = verify_reset_seeds(outcome.episodes, outcome.seed)
+    if altered is None:
+        return replays
+    return [dataclasses.replace(replay, mismatch=replay.mismatch or altered) for replay in replays]
+
+
+def student_output(outcomes: Sequence[CallOutcome]) -> str:
+    """Everything the student's calls printed, stdout then stderr per call, in call order."""
+    return "".join(outcome.stdout + outcome.stderr for outcome in outcomes)
+
+
+def _distinct_events(outcomes: Sequence[CallOutcome]) -> list[dict[str, str]]:
+    seen: dict[tuple[str, str, str], dict[str, str]] = {}
+    for outcome in outcomes:
+        for event in outcome.compat_events:
+            key = (event.get("kind", ""), event.get("env_id", ""), event.get("detail", ""))
+            seen.setdefault(key, dict(event))
+    return list(seen.values())[:MAX_COMPAT_EVENTS]

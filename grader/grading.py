@@ -1,0 +1,415 @@
+"""Grade submissions: validate the file, run the acceptance tests under pytest-xdist, build the report."""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from importlib.metadata import version
+from pathlib import Path
+
+import grader
+from grader.config import load_config
+from grader.execution import problem_seed
+from grader.problems import PROBLEM_IDS, ProblemId
+from grader.progress import ResultsFollower
+from grader.report import GradingTimings, ProblemResult, ProblemRun, Report
+from grader.sandbox import IsolationPolicy
+from grader.sandbox.errors import IsolationUnavailable
+from grader.validation import FileVerdict, check_source
+
+ACCEPTANCE_DIR = Path(__file__).with_name("acceptance")
+_POLL_SECONDS = 0.1
+_PYTEST_ARGS = "-p grader.plugin -p xdist.plugin -p no:cacheprovider -q"
+_ISOLATION_ERROR = IsolationUnavailable.__name__ + ": "
+
+
+@dataclass(frozen=True)
+class GradingPlan:
+    """What one grading run covers: the selected problems, their points and titles."""
+
+    problems: tuple[ProblemId, ...]
+    points: dict[ProblemId, float]
+    titles: dict[ProblemId, str]
+    config: Path | None
+
+    @classmethod
+    def load(cls, config: Path | None, only: Sequence[str] | None) -> GradingPlan:
+        """The enabled problems (restricted to ``only``) of an assignment configuration.
+
+        Raises:
+            ValueError: ``only`` names a problem that does not exist.
+            grader.errors.ConfigError: The configuration is invalid.
+        """
+        unknown = sorted(set(only or ()) - set(PROBLEM_IDS))
+        if unknown:
+            raise ValueError(
+                f"unknown problem {', '.join(unknown)}; expected ids among {', '.join(PROBLEM_IDS)}"
+            )
+        assignment = load_config(config)
+        problems = tuple(
+            problem
+            for problem in PROBLEM_IDS
+            if assignment.problem(problem).enabled and (not only or problem in only)
+        )
+        return cls(
+            problems=problems,
+            points={problem: assignment.problem(problem).points for problem in problems},
+            titles={problem: assignment.problem(problem).title for problem in problems},
+            config=config,
+        )
+
+
+def default_workers() -> int:
+    """The cores this process may run on."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def grade_submission(
+    path: Path,
+    *,
+    seed: int = 0,
+    workers: int | None = None,
+    only: Sequence[str] | None = None,
+    policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL,
+    on_progress: Callable[[ProblemResult], None] | None = None,
+    config: Path | None = None,
+) -> Report:
+    """Grade one submission file.
+
+    A file that is empty, not UTF-8, not Python or too large gets a report saying so; a student's crash,
+    timeout or wrong answer is a verdict in the report. Neither raises.
+
+    Args:
+        path: The student's ``.py`` file.
+        seed: Grading seed: the same bytes and seed give the same statuses, scores and measurements.
+        workers: Parallel pytest-xdist workers; the machine's cores when None.
+        only: Problem ids to grade; all enabled problems when None.
+        policy: ``REQUIRE_FULL`` (instructors, the service) refuses to run without full isolation;
+            ``ALLOW_FALLBACK`` (a student's own check) runs with what the machine offers.
+        on_progress: Called with each problem's result as soon as its check finishes.
+        config: Assignment configuration TOML; the bundled one when None.
+
+    Returns:
+        The report. ``report.grader_errors`` lists failures of the grader itself (the affected problems
+        are marked ``error`` with a message saying it is not the student's fault).
+
+    Raises:
+        grader.sandbox.errors.IsolationUnavailable: ``REQUIRE_FULL`` and this machine cannot isolate.
+        grader.errors.ConfigError: The configuration is invalid.
+        ValueError: ``only`` names an unknown problem.
+    """
+    plan = GradingPlan.load(config, only)
+    callback = (lambda _path, result: on_progress(result)) if on_progress is not None else None
+    return grade_files([path], plan, seed=seed, workers=workers, policy=policy, on_result=callback)[0]
+
+
+def grade_files(
+    paths: Sequence[Path],
+    plan: GradingPlan,
+    *,
+    seed: int,
+    workers: int | None,
+    policy: IsolationPolicy,
+    on_result: Callable[[Path, ProblemResult], None] | None = None,
+) -> list[Report]:
+    """Grade several files in one pytest-xdist run (work spread over all workers), a report per file.
+
+    Args:
+        paths: Submission files; invalid ones are reported without running anything.
+        plan: The problems to grade.
+        seed: Grading seed.
+        workers: Parallel workers; the machine's cores when None.
+        policy: Isolation policy (see ``grade_submission``).
+        on_result: Called with (file, result) as each check finishes.
+
+    Returns:
+        One report per path, in the order given.
+    """
+    started = time.perf_counter()
+    contents = {path: _read(path) for path in paths}
+    rejected: dict[Path, Report] = {}
+    for path, data in contents.items():
+        verdict = _file_verdict(path, data)
+        if verdict is not None:
+            rejected[path] = _rejected_report(path, data or b"", plan, seed, verdict)
+            _announce(on_result, path, rejected[path].problems)
+    runnable = [path for path in paths if path not in rejected]
+    worker_count = min(workers or default_workers(), max(len(runnable) * len(plan.problems), 1))
+    runs: dict[str, list[ProblemRun]] = {}
+    if runnable and plan.problems:
+        runs = run_acceptance(
+            runnable, plan, seed=seed, workers=worker_count, policy=policy, on_result=on_result
+        )
+    elapsed = time.perf_counter() - started
+    return [
+        rejected.get(path)
+        or build_report(
+            path, contents[path] or b"", seed, runs.get(str(path), []), plan, elapsed, worker_count
+        )
+        for path in paths
+    ]
+
+
+def build_report(
+    path: Path,
+    data: bytes,
+    seed: int,
+    runs: Sequence[ProblemRun],
+    plan: GradingPlan,
+    elapsed: float,
+    workers: int,
+) -> Report:
+    """Assemble the report of a file from its problems' runs (problems in the lab's order)."""
+    by_problem = {run.result.id: run for run in runs}
+    results: list[ProblemResult] = []
+    errors: list[str] = []
+    for problem in plan.problems:
+        run = by_problem.get(problem)
+        if run is None:
+            detail = "the grading run ended without a result for this problem"
+            run = _internal_error_run(path, problem, plan, seed, detail)
+        if run.internal_error is not None:
+            errors.append(f"{problem}: {run.internal_error}")
+        results.append(run.result)
+    isolation = next((run.isolation for run in runs if run.isolation), {})
+    timings = [result.timings for result in results if result.timings is not None]
+    check_seconds = sum(timing.wall_seconds for timing in timings)
+    student_seconds = sum(timing.student_seconds for timing in timings)
+    return Report(
+        submission=path.name,
+        sha256=hashlib.sha256(data).hexdigest(),
+        seed=seed,
+        gymnasium_version=version("gymnasium"),
+        grader_version=grader.__version__,
+        isolation=isolation,
+        score=round(sum(result.score for result in results), 6),
+        max_score=sum(result.max_score for result in results),
+        problems=results,
+        grader_errors=errors,
+        execution_time=elapsed,
+        timings=GradingTimings(
+            elapsed_seconds=elapsed,
+            workers=workers,
+            check_seconds=check_seconds,
+            student_seconds=student_seconds,
+            overhead_seconds=max(check_seconds - student_seconds, 0.0),
+        ),
+    )
+
+
+def _announce(
+    on_result: Callable[[Path, ProblemResult], None] | None, path: Path, results: Sequence[ProblemResult]
+) -> None:
+    if on_result is not None:
+        for result in results:
+            on_result(path, result)
+
+
+def _file_verdict(path: Path, data: bytes | None) -> FileVerdict | None:
+    if data is None:
+        return FileVerdict(
+            "error", f"{path.name} could not be read: check that the file exists and is readable."
+        )
+    return check_source(data, path.name)
+
+
+def _rejected_report(path: Path, data: bytes, plan: GradingPlan, seed: int, verdict: FileVerdict) -> Report:
+    results = [
+        ProblemResult(
+            id=problem,
+            title=plan.titles[problem],
+            status=verdict.status,
+            score=0.0,
+            max_score=plan.points[problem],
+            feedback=verdict.message,
+            seed=problem_seed(seed, problem),
+        )
+        for problem in plan.problems
+    ]
+    return Report(
+        submission=path.name,
+        sha256=hashlib.sha256(data).hexdigest(),
+        seed=seed,
+        gymnasium_version=version("gymnasium"),
+        grader_version=grader.__version__,
+        score=0.0,
+        max_score=sum(plan.points.values()),
+        submission_error=verdict.message,
+        problems=results,
+    )
+
+
+def _internal_error_run(
+    path: Path, problem: ProblemId, plan: GradingPlan, seed: int, detail: str
+) -> ProblemRun:
+    return ProblemRun.grader_failure(
+        str(path),
+        problem,
+        title=plan.titles[problem],
+        points=plan.points[problem],
+        seed=problem_seed(seed, problem),
+        detail=detail,
+    )
+
+
+def _read(path: Path) -> bytes | None:
+    try:
+        return path.read_bytes()
+    except OSError:
+        return None
+
+
+def run_acceptance(
+    paths: Sequence[Path],
+    plan: GradingPlan,
+    *,
+    seed: int,
+    workers: int,
+    policy: IsolationPolicy,
+    on_result: Callable[[Path, ProblemResult], None] | None,
+) -> dict[str, list[ProblemRun]]:
+    """Run the acceptance tests of valid files in one pytest run; the runs per file path, as given.
+
+    Problems the run ended without a result for (pytest or a worker died) get an internal-error run.
+
+    Raises:
+        grader.sandbox.errors.IsolationUnavailable: ``REQUIRE_FULL`` and this machine cannot isolate.
+    """
+    runs: dict[str, list[ProblemRun]] = {str(path): [] for path in paths}
+    resolved = {str(path.resolve()): path for path in paths}
+    with tempfile.TemporaryDirectory(prefix="gymgrade-") as scratch:
+        results_file = Path(scratch) / "results.jsonl"
+        log_file = Path(scratch) / "pytest.log"
+        command = acceptance_command(
+            paths, plan, seed=seed, workers=workers, policy=policy, results=results_file
+        )
+        follower = ResultsFollower(results_file)
+        with log_file.open("wb") as log:
+            # Its own process group, so that abandoning the run also ends the xdist workers.
+            process = subprocess.Popen(
+                command,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                cwd=scratch,
+                env=acceptance_environment(),
+                start_new_session=True,
+            )
+            try:
+                complete = _follow(
+                    process, follower, resolved, runs, on_result, len(paths) * len(plan.problems)
+                )
+            finally:
+                _stop(process)
+        if not complete and process.returncode not in (0, 1):
+            log_text = log_file.read_text(errors="replace")
+            _fill_missing(runs, paths, plan, seed, log_text, process.returncode, on_result)
+    return runs
+
+
+def _follow(
+    process: subprocess.Popen[bytes],
+    follower: ResultsFollower,
+    resolved: dict[str, Path],
+    runs: dict[str, list[ProblemRun]],
+    on_result: Callable[[Path, ProblemResult], None] | None,
+    expected: int,
+) -> bool:
+    """Hand every result over as soon as the controller writes it, until the run ends.
+
+    Returns True as soon as all ``expected`` results are in: the run's remaining work is only pytest and
+    its workers shutting down (about two seconds), which the caller need not wait for.
+    """
+    received = 0
+    while True:
+        finished = process.poll() is not None
+        for run in follower.poll():
+            received += 1
+            path = resolved.get(run.submission, Path(run.submission))
+            runs.setdefault(str(path), []).append(run)
+            if run.internal_error is not None and run.internal_error.startswith(_ISOLATION_ERROR):
+                raise IsolationUnavailable(run.internal_error.removeprefix(_ISOLATION_ERROR))
+            if on_result is not None:
+                on_result(path, run.result)
+        if received >= expected or finished:
+            return received >= expected
+        time.sleep(_POLL_SECONDS)
+
+
+def acceptance_command(
+    paths: Sequence[Path],
+    plan: GradingPlan,
+    *,
+    seed: int,
+    workers: int,
+    policy: IsolationPolicy,
+    results: Path,
+) -> list[str]:
+    """The pytest command line that runs the acceptance tests of ``paths`` (writing to ``results``)."""
+    command = [sys.executable, "-m", "pytest", *_PYTEST_ARGS.split(), str(ACCEPTANCE_DIR)]
+    command += ["-c", str(ACCEPTANCE_DIR / "pytest.ini"), "--rootdir", str(ACCEPTANCE_DIR)]
+    command += [
+        "--grading-seed",
+        str(seed),
+        "--results-file",
+        str(results),
+        "--isolation-policy",
+        policy.value,
+    ]
+    command += ["--only", ",".join(plan.problems), "-n", str(workers if workers > 1 else 0)]
+    for path in paths:
+        command += ["--submission", str(path.resolve())]
+    if plan.config is not None:
+        command += ["--assignment-config", str(plan.config.resolve())]
+    return command
+
+
+def _stop(process: subprocess.Popen[bytes]) -> None:
+    """End what is left of a run: nothing once it exited by itself; otherwise its whole process group.
+
+    A run is cut short when its results are all in (only pytest's shutdown remains) or when we abandon
+    it (an error or Ctrl-C on our side); the workers' sandboxes die with them (bubblewrap's
+    --die-with-parent, cgroup clean-up).
+    """
+    if process.poll() is None:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+
+
+def _fill_missing(
+    runs: dict[str, list[ProblemRun]],
+    paths: Sequence[Path],
+    plan: GradingPlan,
+    seed: int,
+    log_text: str,
+    returncode: int,
+    on_result: Callable[[Path, ProblemResult], None] | None,
+) -> None:
+    tail = " | ".join(line for line in log_text.strip().splitlines()[-5:] if line.strip())
+    detail = f"the grading run stopped (pytest exit code {returncode}): {tail}"
+    for path in paths:
+        done = {run.result.id for run in runs[str(path)]}
+        for problem in plan.problems:
+            if problem not in done:
+                run = _internal_error_run(path, problem, plan, seed, detail)
+                runs[str(path)].append(run)
+                if on_result is not None:
+                    on_result(path, run.result)
+
+
+def acceptance_environment() -> dict[str, str]:
+    """The environment of the pytest run: no plugin autoloading (only ours and xdist), this grader first."""
+    environment = dict(os.environ)
+    environment["PYTEST_DISABLE_PLUGIN_AUTOLOAD"] = "1"
+    environment["PYTHONDONTWRITEBYTECODE"] = "1"
+    source_root = str(Path(grader.__file__).resolve().parents[1])
+    environment["PYTHONPATH"] = os.pathsep.join(filter(None, [source_root, environment.get("PYTHONPATH")]))
+    return environment

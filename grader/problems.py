@@ -1,0 +1,14 @@
+"""The problem identifiers of the lab, in the order the lab poses them."""
+
+from typing import Literal
+
+ProblemId = Literal["random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues"]
+
+PROBLEM_IDS: tuple[ProblemId, ...] = (
+    "random_blackjack",
+    "blackjack",
+    "cartpole",
+    "car",
+    "taxi",
+    "find_qvalues",
+)

@@ -1,0 +1,183 @@
+"""The grade report: what a submission earned per problem, why, and how the grading ran."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, JsonValue
+
+Status = Literal["passed", "failed", "error", "timeout", "missing"]
+
+REPORT_FORMAT = 1
+OUTPUT_CAP_CHARS = 8_000
+"""Student output kept per problem in the report; the rest is replaced by a note saying how much was cut."""
+
+TIMING_FIELDS: frozenset[str] = frozenset({"execution_time", "timings"})
+"""Fields that measure time and so differ between runs; everything else is a function of (bytes, seed)."""
+
+
+class Timings(BaseModel):
+    """Where the wall time of a check (or of the whole grading) went. Differs between runs by nature."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    wall_seconds: float = Field(description="Elapsed time from the start to the end of the check.")
+    student_seconds: float = Field(description="Time spent inside the student's own functions.")
+    overhead_seconds: float = Field(
+        description="Everything else: sandbox start-up, import, data transfer, replay, judging."
+    )
+
+
+class GradingTimings(BaseModel):
+    """Where a whole grading's time went. Differs between runs by nature."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    elapsed_seconds: float = Field(description="Wall time from start to report (same as execution_time).")
+    workers: int = Field(description="Parallel workers the checks ran on.")
+    check_seconds: float = Field(
+        description="Sum of the checks' wall times (what the workers were busy with)."
+    )
+    student_seconds: float = Field(description="Sum of the time spent inside the student's functions.")
+    overhead_seconds: float = Field(
+        description="check_seconds - student_seconds: sandbox start-up, import, transfer, replay, judging."
+    )
+
+
+class ProblemResult(BaseModel):
+    """The verdict on one problem of one submission."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    id: str = Field(description="Problem id: random_blackjack, blackjack, cartpole, car, taxi, find_qvalues.")
+    title: str = Field(description="The problem's title in the lab.")
+    status: Status = Field(description="passed, failed, error, timeout or missing.")
+    score: float = Field(description="Points earned.")
+    max_score: float = Field(description="Points available.")
+    feedback: str = Field(description="What was expected, what was measured, the likely cause.")
+    measurements: dict[str, JsonValue] = Field(
+        default_factory=dict, description="The numbers behind the verdict (deterministic for bytes + seed)."
+    )
+    output: str = Field(default="", description="The student's captured stdout/stderr, capped.")
+    compat_events: list[dict[str, str]] = Field(
+        default_factory=list,
+        description="What the lab-compatibility layer had to tolerate (e.g. steps after the episode ended).",
+    )
+    seed: int = Field(default=0, description="The sandbox seed this problem ran with.")
+    timings: Timings | None = Field(
+        default=None, description="Where the check's time went (not deterministic)."
+    )
+
+
+class ProblemRun(BaseModel):
+    """What one acceptance test hands to the controller: the result plus how it was isolated."""
+
+    submission: str = Field(description="The submission path exactly as given to the plugin.")
+    result: ProblemResult
+    isolation: dict[str, JsonValue] = Field(default_factory=dict, description="What the sandbox enforced.")
+    internal_error: str | None = Field(
+        default=None, description="'ExceptionType: message' when the grader itself failed on this problem."
+    )
+
+    @classmethod
+    def grader_failure(
+        cls, submission: str, problem: str, *, title: str, points: float, seed: int, detail: str
+    ) -> ProblemRun:
+        """The run of a problem the grader failed on: an ``error`` the student is told is not theirs."""
+        result = ProblemResult(
+            id=problem,
+            title=title,
+            status="error",
+            score=0.0,
+            max_score=points,
+            feedback=f"The grader failed while checking this problem (not your code's fault): {detail}. "
+            "Please report this to your instructor.",
+            seed=seed,
+        )
+        return cls(submission=submission, result=result, internal_error=detail)
+
+
+class Report(BaseModel):
+    """The whole grade of one submission, serialised as the JSON the CLI prints and the service stores."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    format: int = Field(default=REPORT_FORMAT, description="Version of this report layout.")
+    submission: str = Field(description="The submission's file name (never a path).")
+    sha256: str = Field(description="SHA-256 of the submission's bytes.")
+    seed: int = Field(description="The grading seed; the same bytes and seed give the same verdicts.")
+    gymnasium_version: str = Field(description="Gymnasium version the episodes were replayed with.")
+    grader_version: str = Field(description="gymgrade version.")
+    isolation: dict[str, JsonValue] = Field(
+        default_factory=dict, description="What the sandbox could enforce for this grading."
+    )
+    score: float = Field(description="Points earned over all problems.")
+    max_score: float = Field(description="Points available over all graded problems.")
+    submission_error: str | None = Field(
+        default=None, description="Why the file could not be graded at all (empty, not UTF-8, not Python...)."
+    )
+    problems: list[ProblemResult] = Field(default_factory=list, description="One result per graded problem.")
+    grader_errors: list[str] = Field(
+        default_factory=list, description="Failures of the grader itself (not the student's); normally empty."
+    )
+    execution_time: float = Field(
+        default=0.0, description="Wall time of the whole grading (not deterministic)."
+    )
+    timings: GradingTimings | None = Field(
+        default=None, description="Where the grading's time went (not deterministic)."
+    )
+
+    @property
+    def full_marks(self) -> bool:
+        """True when every graded problem passed and the file itself was gradable."""
+        return self.submission_error is None and all(problem.status == "passed" for problem in self.problems)
+
+    def to_json(self) -> str:
+        """The report as indented JSON, fields in declaration order (stable for identical reports)."""
+        return self.model_dump_json(indent=2)
+
+    def graded_view(self) -> dict[str, Any]:
+        """The report without its timing fields: identical for identical bytes and seed."""
+        data = self.model_dump(exclude=set(TIMING_FIELDS))
+        for problem in data["problems"]:
+            problem.pop("timings", None)
+        return data
+
+
+def plain_json(value: object) -> JsonValue:
+    """Convert a measurement into JSON-safe data: numpy to Python, non-finite floats to strings.
+
+    Args:
+        value: A number, string, list, dict or numpy value produced by a check.
+
+    Returns:
+        The same data made of ``None``, ``bool``, ``int``, finite ``float``, ``str``, lists and dicts.
+
+    Raises:
+        TypeError: The value holds something that is not plain data (a check bug, not a student's).
+    """
+    if isinstance(value, np.ndarray):
+        return plain_json(value.tolist())
+    if isinstance(value, np.generic):
+        return plain_json(value.item())
+    if value is None or isinstance(value, bool | int | str):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else str(value)
+    if isinstance(value, Mapping):
+        return {str(key): plain_json(item) for key, item in value.items()}
+    if isinstance(value, Sequence):
+        return [plain_json(item) for item in value]
+    raise TypeError(
+        f"a measurement must be plain data (numbers, strings, lists, dicts); found {type(value).__name__}"
+    )
+
+
+def cap_output(text: str, limit: int = OUTPUT_CAP_CHARS) -> str:
+    """Keep the start of a student's output and say how much was dropped."""
+    if len(text) <= limit:
+        return text
+    return text[:limit] + f"\n[... {len(text) - limit} more characters of output not shown]"

@@ -1,0 +1,231 @@
+"""Tests of grader/cli.py: exit codes, --json exactness, batch output, entry-point subcommands."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pytest
+from grading_support import CLASSIC_COMPLETE, FAST_OVERRIDES, SUBMISSIONS, write_config
+
+from grader import cli
+from grader.report import Report
+
+
+@pytest.fixture(scope="module")
+def fast_config(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_config(tmp_path_factory.mktemp("config") / "assignment.toml", FAST_OVERRIDES)
+
+
+def test_check_json_prints_exactly_the_report_and_exits_0_at_full_marks(
+    fast_config: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    output = tmp_path / "report.json"
+    argv = [
+        "check",
+        str(CLASSIC_COMPLETE),
+        "--only",
+        "car",
+        "--config",
+        str(fast_config),
+        "--seed",
+        "4",
+        "--json",
+        "--output",
+        str(output),
+    ]
+    assert cli.main(argv) == cli.EXIT_FULL_MARKS
+    captured = capsys.readouterr()
+    report = Report.model_validate_json(captured.out)
+    assert captured.out == report.to_json() + "\n"
+    assert output.read_text() == captured.out
+    assert "[   PASS] Problem 4: MountainCar (1/1)" in captured.err, "progress goes to stderr with --json"
+
+
+def test_check_explains_what_is_missing_and_exits_1(
+    fast_config: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["check", str(SUBMISSIONS / "template.py"), "--only", "car", "--config", str(fast_config)]
+    assert cli.main(argv) == cli.EXIT_NOT_FULL
+    out = capsys.readouterr().out
+    assert "[MISSING] Problem 4: MountainCar (0/1)" in out
+    assert "car() raised NotImplementedError: not attempted yet." in out
+    assert "Score: 0 / 1" in out
+
+
+@pytest.fixture
+def without_bubblewrap(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A machine like a student's laptop: `bwrap` (and `setpriv`) cannot be found on PATH."""
+    empty = tmp_path / "bin"
+    empty.mkdir()
+    monkeypatch.setenv("PATH", str(empty))
+
+
+@pytest.mark.usefixtures("without_bubblewrap")
+def test_check_runs_with_weaker_isolation_and_says_so(
+    fast_config: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["check", str(CLASSIC_COMPLETE), "--only", "car", "--config", str(fast_config)]
+    assert cli.main(argv) == cli.EXIT_FULL_MARKS
+    out = capsys.readouterr().out
+    assert "Sandbox: weaker isolation on this machine" in out
+    assert "  - bubblewrap: bubblewrap (bwrap) is not installed" in out
+
+
+@pytest.mark.usefixtures("without_bubblewrap")
+def test_grade_refuses_weaker_isolation_unless_allowed(
+    fast_config: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["grade", str(CLASSIC_COMPLETE), "--out", str(tmp_path / "out"), "--only", "car"]
+    assert cli.main([*argv, "--config", str(fast_config)]) == cli.EXIT_ERROR
+    err = capsys.readouterr().err
+    assert "full isolation is required to run untrusted submissions" in err
+    assert "`gymgrade grade --allow-weak-isolation`" in err
+    assert not (tmp_path / "out" / "grades.csv").exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["check", "no/such/file.py"], "no/such/file.py is not a file"),
+        (
+            ["check", str(CLASSIC_COMPLETE), "--config", "no/such/config.toml"],
+            "no/such/config.toml not found",
+        ),
+        (["grade", "no/such/dir", "--out", "out"], "no/such/dir does not exist"),
+    ],
+    ids=["missing-file", "missing-config", "missing-batch-target"],
+)
+def test_usage_errors_exit_2_with_a_message(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert cli.main(argv) == cli.EXIT_ERROR
+    assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["check", str(CLASSIC_COMPLETE), "--only", "blackjak"], "unknown problem blackjak"),
+        (
+            ["check", str(CLASSIC_COMPLETE), "--workers", "0"],
+            "expected a positive number of workers, found 0",
+        ),
+        (["grade", str(CLASSIC_COMPLETE)], "the following arguments are required: --out"),
+        ([], "the following arguments are required: COMMAND"),
+    ],
+    ids=["unknown-problem", "zero-workers", "grade-without-out", "no-command"],
+)
+def test_argument_errors_exit_2(argv: list[str], message: str, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(argv)
+    assert exit_info.value.code == cli.EXIT_ERROR
+    assert message in capsys.readouterr().err
+
+
+def test_grade_writes_reports_and_grades_csv_with_plain_progress(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    inputs = tmp_path / "inputs"
+    inputs.mkdir()
+    (inputs / "alice.py").write_bytes(b"")
+    (inputs / "bob.py").write_bytes(b"def car(:\n")
+    out = tmp_path / "out"
+    assert cli.main(["grade", str(inputs), "--out", str(out), "--only", "car,taxi"]) == 0
+    err = capsys.readouterr().err
+    assert "1/4 alice.py: car missing\n" in err and "4/4 bob.py: taxi error\n" in err
+    rows = list(csv.DictReader((out / "grades.csv").open()))
+    assert [(row["submission"], row["car"], row["taxi"], row["total"]) for row in rows] == [
+        ("alice", "0", "0", "0"),
+        ("bob", "0", "0", "0"),
+    ]
+    assert sorted(path.name for path in out.iterdir()) == ["alice.json", "bob.json", "grades.csv"]
+
+
+@dataclass
+class FakeEntryPoint:
+    """Stands in for an installed `gymgrade.commands` entry point."""
+
+    name: str
+    target: Any
+
+    def load(self) -> Any:
+        if isinstance(self.target, Exception):
+            raise self.target
+        return self.target
+
+
+def _add_hello(subparsers: Any) -> None:
+    hello = subparsers.add_parser("hello", help="say hello")
+    hello.add_argument("--times", type=int, default=1)
+    hello.set_defaults(handler=lambda args: 40 + args.times)
+
+
+@pytest.mark.parametrize(
+    ("entry_point", "argv", "code", "message"),
+    [
+        (FakeEntryPoint("hello", _add_hello), ["hello", "--times", "2"], 42, ""),
+        (
+            FakeEntryPoint("serve", ImportError("No module named 'uvicorn'")),
+            ["serve"],
+            cli.EXIT_ERROR,
+            "gymgrade serve: the command could not be loaded (ImportError: No module named 'uvicorn')",
+        ),
+    ],
+    ids=["registered", "broken"],
+)
+def test_entry_point_commands(
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    entry_point: FakeEntryPoint,
+    argv: list[str],
+    code: int,
+    message: str,
+) -> None:
+    monkeypatch.setattr(
+        cli, "entry_points", lambda group: [entry_point] if group == cli.COMMAND_GROUP else []
+    )
+    assert cli.main(argv) == code
+    assert message in capsys.readouterr().err
+
+
+def _layer(name: str, active: bool, required: bool = True, remedy: str = "") -> dict[str, Any]:
+    return {
+        "name": name,
+        "active": active,
+        "required": required,
+        "detail": f"{name} detail",
+        "remedy": remedy,
+    }
+
+
+@pytest.mark.parametrize(
+    ("isolation", "expected"),
+    [
+        (
+            {"full": True, "layers": [_layer("bubblewrap", True), _layer("landlock", False, required=False)]},
+            ["Sandbox: full isolation (bubblewrap)."],
+        ),
+        (
+            {
+                "full": False,
+                "layers": [
+                    _layer("bubblewrap", False, remedy="apt-get install bubblewrap"),
+                    _layer("rlimits", True),
+                    _layer("landlock", False, required=False),
+                ],
+            },
+            [
+                "Sandbox: weaker isolation on this machine (fine for checking your own code; "
+                "instructors grade with full isolation). Missing:",
+                "  - bubblewrap: bubblewrap detail (to fix: apt-get install bubblewrap)",
+            ],
+        ),
+        ({}, []),
+    ],
+    ids=["full", "laptop-fallback", "file-never-ran"],
+)
+def test_check_says_how_the_code_was_isolated(isolation: dict[str, Any], expected: list[str]) -> None:
+    assert cli.isolation_lines(isolation) == expected

@@ -1,0 +1,117 @@
+"""Tests of grader/report.py: JSON round trip, the deterministic view, plain-data conversion."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from grader.report import (
+    OUTPUT_CAP_CHARS,
+    GradingTimings,
+    ProblemResult,
+    Report,
+    Timings,
+    cap_output,
+    plain_json,
+)
+
+
+def _report(wall: float) -> Report:
+    problem = ProblemResult(
+        id="cartpole",
+        title="Problem 3: CartPole",
+        status="failed",
+        score=0.0,
+        max_score=1.0,
+        feedback="expected a mean of at least 170 steps; measured 95.2",
+        output="step 1\n",
+        measurements={"mean_steps": 95.2, "lengths": [90, 101], "replayed": {"mismatches": 0}},
+        compat_events=[{"kind": "step_after_done", "env_id": "CartPole-v0", "detail": "1 step"}],
+        seed=12345,
+        timings=Timings(wall_seconds=wall, student_seconds=wall / 2, overhead_seconds=wall / 2),
+    )
+    return Report(
+        submission="opengym.py",
+        sha256="ab" * 32,
+        seed=7,
+        gymnasium_version="1.4.0",
+        grader_version="0.1.0",
+        isolation={"summary": "full", "layers": ["bubblewrap", "cgroup"]},
+        score=0.0,
+        max_score=1.0,
+        problems=[problem],
+        execution_time=wall,
+        timings=GradingTimings(
+            elapsed_seconds=wall,
+            workers=2,
+            check_seconds=wall,
+            student_seconds=wall / 2,
+            overhead_seconds=wall / 2,
+        ),
+    )
+
+
+def test_json_round_trip_is_exact() -> None:
+    report = _report(3.5)
+    again = Report.model_validate_json(report.to_json())
+    assert again == report
+    assert again.to_json() == report.to_json()
+
+
+def test_graded_view_ignores_only_the_timings() -> None:
+    fast, slow = _report(1.0), _report(9.0)
+    assert fast.to_json() != slow.to_json()
+    assert fast.graded_view() == slow.graded_view()
+    assert "execution_time" not in fast.graded_view()
+    assert "timings" not in fast.graded_view()["problems"][0]
+
+
+@pytest.mark.parametrize(
+    ("statuses", "submission_error", "full"),
+    [
+        (["passed", "passed"], None, True),
+        (["passed", "failed"], None, False),
+        (["passed", "timeout"], None, False),
+        ([], "opengym.py is empty", False),
+    ],
+    ids=["all-passed", "one-failed", "one-timeout", "unreadable-file"],
+)
+def test_full_marks(statuses: list[str], submission_error: str | None, full: bool) -> None:
+    problems = [
+        ProblemResult(id="car", title="car", status=status, score=0.0, max_score=1.0, feedback="")  # type: ignore[arg-type]
+        for status in statuses
+    ]
+    report = _report(1.0).model_copy(update={"problems": problems, "submission_error": submission_error})
+    assert report.full_marks is full
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        (np.float64(0.25), 0.25),
+        (np.int64(3), 3),
+        (np.array([[1, 2], [3, 4]]), [[1, 2], [3, 4]]),
+        (math.nan, "nan"),
+        (-math.inf, "-inf"),
+        ((1, "a", None, True), [1, "a", None, True]),
+        ({"n": {1: np.bool_(True)}}, {"n": {"1": True}}),
+    ],
+    ids=["numpy-float", "numpy-int", "numpy-array", "nan", "minus-inf", "tuple", "nested-dict"],
+)
+def test_plain_json(value: object, expected: object) -> None:
+    assert plain_json(value) == expected
+
+
+def test_plain_json_refuses_objects() -> None:
+    with pytest.raises(TypeError, match="found object"):
+        plain_json(object())
+
+
+def test_cap_output_keeps_the_start_and_says_how_much_was_cut() -> None:
+    text = "x" * (OUTPUT_CAP_CHARS + 25)
+    capped = cap_output(text)
+    assert capped.startswith("x" * OUTPUT_CAP_CHARS)
+    assert capped.endswith("[... 25 more characters of output not shown]")
+    assert cap_output("short") == "short"
