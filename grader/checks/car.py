@@ -1,0 +1,68 @@
+"""Problem 4: `car()` drives MountainCar-v0 to the flag and returns the steps it took."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
+from grader.checks.episodes import MOUNTAIN_CAR
+from grader.checks.lengths import judge_lengths
+from grader.config import CarConfig, ProblemConfig
+from grader.errors import PlanError
+from grader.sandbox.outcome import Call, FunctionInfo
+
+
+def _settings(config: ProblemConfig) -> CarConfig:
+    if not isinstance(config, CarConfig):
+        raise PlanError(f"expected the car settings, found {type(config).__name__}")
+    return config
+
+
+@dataclass
+class CarCheck:
+    """car() called many times: each return is its replayed length, every run reaches the goal, mean < bar."""
+
+    id: ProblemId = "car"
+    title: str = "Problem 4: MountainCar"
+
+    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+        """The configured number of car() calls."""
+        return [Call("car") for _ in range(_settings(config).calls)]
+
+    @paused_gc
+    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+        """Judge the returned lengths against the replays, then the goal and the mean against the bar."""
+        settings = _settings(config)
+        runs = judge_lengths("car", MOUNTAIN_CAR, records)
+        if isinstance(runs, Verdict):
+            return runs
+        measurements = runs.measurements()
+        stuck = sum(1 for episode in runs.episodes if not episode.reached_terminal)
+        measurements["runs_reaching_goal"] = len(runs.episodes) - stuck
+        bar = (
+            f"the lab asks for every run to reach the flag in fewer than {settings.max_mean_steps:g} steps "
+            f"on average"
+        )
+        measured = (
+            f"{len(runs.episodes) - stuck} of your {len(runs.episodes)} replayed runs reached the flag, "
+            f"taking {runs.mean:.1f} steps on average"
+        )
+        if stuck:
+            return Verdict(
+                "failed",
+                0.0,
+                f"car(): {bar}; {measured}, and {stuck} ran out of time (200 steps) short of it. Build "
+                "momentum: "
+                f"push (action 2 right, 0 left) in the direction the car is already moving (observation[1]).",
+                measurements,
+            )
+        if runs.mean >= settings.max_mean_steps:
+            return Verdict(
+                "failed",
+                0.0,
+                f"car(): {bar}; {measured}. Push in the direction of the velocity on every step to swing up "
+                "faster.",
+                measurements,
+            )
+        return Verdict("passed", 1.0, f"car(): {measured}; {bar}.", measurements)

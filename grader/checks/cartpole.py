@@ -1,0 +1,59 @@
+"""Problem 3: `cartpole()` balances CartPole-v0 with the pole tip's velocity and returns the steps lasted."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
+from grader.checks.episodes import CARTPOLE
+from grader.checks.lengths import judge_lengths
+from grader.config import CartpoleConfig, ProblemConfig
+from grader.errors import PlanError
+from grader.sandbox.outcome import Call, FunctionInfo
+
+
+def _settings(config: ProblemConfig) -> CartpoleConfig:
+    if not isinstance(config, CartpoleConfig):
+        raise PlanError(f"expected the cartpole settings, found {type(config).__name__}")
+    return config
+
+
+@dataclass
+class CartpoleCheck:
+    """cartpole() called many times: each return is its replayed episode's length; the lab's bar holds."""
+
+    id: ProblemId = "cartpole"
+    title: str = "Problem 3: CartPole"
+
+    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+        """The configured number of cartpole() calls."""
+        return [Call("cartpole") for _ in range(_settings(config).calls)]
+
+    @paused_gc
+    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+        """Judge the returned lengths against the replays, then mean and minimum against the bar."""
+        settings = _settings(config)
+        runs = judge_lengths("cartpole", CARTPOLE, records)
+        if isinstance(runs, Verdict):
+            return runs
+        measurements = runs.measurements()
+        shortest = min(runs.lengths)
+        bar = (
+            f"the lab asks for at least {settings.min_steps} steps in every run and about 180 on average "
+            f"(graded: mean >= {settings.min_mean_steps:g} and every run >= {settings.min_steps})"
+        )
+        measured = (
+            f"your {len(runs.lengths)} replayed runs lasted {runs.mean:.1f} steps on average, "
+            f"the shortest {shortest}"
+        )
+        if runs.mean < settings.min_mean_steps or shortest < settings.min_steps:
+            return Verdict(
+                "failed",
+                0.0,
+                f"cartpole(): {bar}; {measured}. Push the cart the way the tip of the pole is moving: action "
+                "1 "
+                f"(right) when the pole's angular velocity observation[3] is positive, else 0.",
+                measurements,
+            )
+        return Verdict("passed", 1.0, f"cartpole(): {measured}; {bar}.", measurements)

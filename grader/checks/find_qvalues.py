@@ -1,0 +1,77 @@
+"""The lab-provided `find_qvalues(env)`: validate the returned Q-table and report its exact greedy return."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
+from grader.checks.values import describe
+from grader.config import FindQvaluesConfig, ProblemConfig
+from grader.errors import PlanError
+from grader.sandbox.outcome import Call, FunctionInfo
+from reference.oracles import greedy_policy_return, optimal_return
+
+TAXI_SHAPE = (500, 6)
+
+
+def _settings(config: ProblemConfig) -> FindQvaluesConfig:
+    if not isinstance(config, FindQvaluesConfig):
+        raise PlanError(f"expected the find_qvalues settings, found {type(config).__name__}")
+    return config
+
+
+@dataclass
+class FindQvaluesCheck:
+    """find_qvalues("Taxi-v3"): a finite (500, 6) table; its greedy policy's exact return is reported."""
+
+    id: ProblemId = "find_qvalues"
+    title: str = "find_qvalues (provided by the lab)"
+
+    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+        """One unrecorded call (100 000 training episodes are not worth logging)."""
+        return [Call("find_qvalues", (_settings(config).env_id,), record_episodes=False)]
+
+    @paused_gc
+    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+        """Validate the table and report the exact expected return of acting greedily on it."""
+        _settings(config)
+        early = outcome_verdict(records)
+        if early is not None:
+            return early
+        value = records[0].outcome.value
+        table = np.asarray(value) if isinstance(value, np.ndarray | list) else None
+        if (
+            table is None
+            or table.shape != TAXI_SHAPE
+            or table.dtype.kind not in "iuf"
+            or not np.isfinite(table).all()
+        ):
+            found = (
+                f"an array of shape {table.shape} and dtype {table.dtype}"
+                if table is not None
+                else describe(value)
+            )
+            return Verdict(
+                "failed",
+                0.0,
+                f"find_qvalues('Taxi-v3') must return a finite {TAXI_SHAPE[0]} x {TAXI_SHAPE[1]} array of "
+                "numbers "
+                f"(one row per state, one column per action); it returned {found}.",
+                {},
+            )
+        greedy = greedy_policy_return(table.astype(np.float64))
+        optimal = optimal_return()
+        return Verdict(
+            "passed",
+            1.0,
+            f"Acting greedily on your table earns {greedy.mean:.3f} per Taxi episode on average (exact, over "
+            f"all start states); the optimal policy earns {optimal.mean:.3f}.",
+            {
+                "greedy_mean_return": greedy.mean,
+                "greedy_return_std": greedy.std,
+                "optimal_mean_return": optimal.mean,
+            },
+        )

@@ -1,0 +1,268 @@
+"""In-process stand-in for the sandbox: run student-like functions on gymnasium and build CallRecords.
+
+Calibration (bench/calibrate.py) and the checks' tests use it to judge thousands of regrades without
+starting processes. Episodes are logged with the fields and seeds the sandbox's recorder logs; their
+replays are either recomputed for real with `grader.sandbox.replay.replay_episode` or taken from the
+trajectory as played (identical for unmodified gymnasium, and twice as fast).
+
+With ``fast=True`` gymnasium's Blackjack draws its cards with Python's `random.Random.choice` instead of
+numpy's `Generator.choice` (same uniform draw from the same 13-card deck, 20 times faster): the game
+code is gymnasium's, only the random stream differs, so such episodes are judged as played.
+"""
+
+from __future__ import annotations
+
+import inspect
+import operator
+import random
+import time
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import gymnasium
+import numpy as np
+
+from grader.checks.base import CallRecord
+from grader.compat import resolve_env_id
+from grader.sandbox.child.seeding import SeedStream, Stream, mapped_reset_seed, space_seed
+from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
+from grader.sandbox.replay import Replay, replay_episode
+
+StudentFunction = Callable[..., Any]
+"""A simulated student function: called as ``function(lab, *call.args, **call.kwargs)``."""
+
+
+class _FastCards:
+    """Stands in for Blackjack's numpy generator: only `choice` is used by gymnasium's Blackjack."""
+
+    def __init__(self, seed: int) -> None:
+        self._random = random.Random(seed)
+
+    def choice(self, deck: Sequence[int]) -> int:
+        return self._random.choice(deck)
+
+
+@dataclass
+class _Episode:
+    env_index: int
+    requested_id: str
+    env_id: str
+    env_kwargs: dict[str, Any]
+    reset_seed: int
+    student_seed: int | None
+    observations: list[Any]
+    actions: list[Any] = field(default_factory=list)
+    rewards: list[float] = field(default_factory=list)
+    terminated: list[bool] = field(default_factory=list)
+    truncated: list[bool] = field(default_factory=list)
+    ended: bool = False
+
+    def log(self) -> EpisodeLog:
+        return EpisodeLog(
+            env_index=self.env_index,
+            requested_id=self.requested_id,
+            env_id=self.env_id,
+            env_kwargs=dict(self.env_kwargs),
+            reset_seed=self.reset_seed,
+            student_seed=self.student_seed,
+            actions=list(self.actions),
+            rewards=list(self.rewards),
+            terminated=list(self.terminated),
+            truncated=list(self.truncated),
+        )
+
+    def replay_as_played(self) -> Replay:
+        ends = [step for step, end in enumerate(map(operator.or_, self.terminated, self.truncated)) if end]
+        finished = bool(ends)
+        length = ends[0] + 1 if finished else len(self.actions)
+        return Replay(
+            observations=self.observations,
+            rewards=self.rewards,
+            terminated=self.terminated,
+            truncated=self.truncated,
+            length=length,
+            finished=finished,
+            steps_after_done=len(self.actions) - length if finished else 0,
+            mismatch=None,
+            env_spec=None,
+        )
+
+
+class LabEnv:
+    """A gymnasium env (5-tuple API) that logs its episodes like the sandbox's recorder."""
+
+    def __init__(self, lab: Lab, requested_id: str, kwargs: dict[str, Any]) -> None:
+        target = resolve_env_id(requested_id)
+        self._lab = lab
+        self._requested_id = requested_id
+        self._env_id = target.gymnasium_id
+        self._kwargs = target.merged_kwargs(kwargs)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            self._env = gymnasium.make(self._env_id, disable_env_checker=True, **self._kwargs)
+        self._index = len(lab.envs)
+        lab.envs.append(self)
+        self.action_space = self._env.action_space
+        self.action_space.seed(space_seed(lab.call_seed, self._index))
+        self.observation_space = self._env.observation_space
+        self._episode: _Episode | None = None
+        self._fast = lab.fast and self._env_id.startswith("Blackjack")
+        if self._fast:
+            self._env.reset(seed=0)
+            self._env.unwrapped._np_random = _FastCards(lab.call_seed)  # type: ignore[attr-defined,assignment]
+
+    def reset(self, *, seed: int | None = None) -> tuple[Any, dict[str, Any]]:
+        """Start a new episode; a student seed is mapped like the sandbox maps it."""
+        reset_seed = self._lab.reset_seed(seed)
+        observation, info = self._env.reset() if self._fast else self._env.reset(seed=reset_seed)
+        self._episode = _Episode(
+            self._index, self._requested_id, self._env_id, dict(self._kwargs), reset_seed, seed, [observation]
+        )
+        self._lab.episodes.append(self._episode)
+        return observation, info
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Step the env and log the step (steps after the end are logged too)."""
+        if self._episode is None:
+            raise RuntimeError("reset() before step()")
+        episode = self._episode
+        if episode.terminated and (episode.terminated[-1] or episode.truncated[-1] or episode.ended):
+            episode.ended = True
+            with warnings.catch_warnings():  # gymnasium warns about stepping after the end; the log says it
+                warnings.simplefilter("ignore")
+                observation, reward, terminated, truncated, info = self._env.step(action)
+        else:
+            observation, reward, terminated, truncated, info = self._env.step(action)
+        episode.observations.append(observation)
+        episode.actions.append(action if not isinstance(action, np.integer) else int(action))
+        episode.rewards.append(float(reward))
+        episode.terminated.append(bool(terminated))
+        episode.truncated.append(bool(truncated))
+        return observation, float(reward), bool(terminated), bool(truncated), info
+
+
+class Lab:
+    """What a simulated student function works with: ``make`` and randomness seeded by the call."""
+
+    def __init__(self, call_seed: int, *, fast: bool = False) -> None:
+        self.fast = fast
+        self.random = random.Random(call_seed)
+        self._resets = SeedStream(call_seed, Stream.RESETS)
+        self.call_seed = call_seed
+        self.envs: list[LabEnv] = []
+        self.episodes: list[_Episode] = []
+
+    def make(self, env_id: str, **kwargs: Any) -> LabEnv:
+        """Make a logged env; the lab's ids resolve as in the sandbox (`Taxi-v2` raises)."""
+        return LabEnv(self, env_id, kwargs)
+
+    def reset_seed(self, student_seed: int | None) -> int:
+        """The seed a reset uses: the next grader seed, or the student's seed mapped through the call seed."""
+        if student_seed is None:
+            return self._resets.next()
+        return mapped_reset_seed(self.call_seed, int(student_seed))
+
+
+def simulate_call(
+    call: Call, function: StudentFunction, call_seed: int, *, replay: bool = False, fast: bool = False
+) -> CallRecord:
+    """Run one simulated call and build its record as the sandbox and the replay would.
+
+    Args:
+        call: The call the check planned.
+        function: The simulated student function.
+        call_seed: The call's seed (episodes and the student's randomness derive from it).
+        replay: Replay every episode for real (True) or take the played trajectory as its replay.
+        fast: Draw Blackjack cards with Python's generator (see the module docstring); implies no replay.
+    """
+    if fast and replay:
+        raise ValueError(
+            "fast Blackjack episodes cannot be replayed from their seeds; use fast=False to replay"
+        )
+    lab = Lab(call_seed, fast=fast)
+    started = time.perf_counter()
+    try:
+        value = function(lab, *call.args, **dict(call.kwargs))
+    except Exception as error:
+        outcome = CallOutcome(
+            call,
+            OutcomeStatus.EXCEPTION,
+            None,
+            [],
+            [],
+            "",
+            "",
+            f"{call.function}() raised {type(error).__name__}: {error}",
+            time.perf_counter() - started,
+            call_seed,
+        )
+        return CallRecord(outcome, [])
+    wall_time = time.perf_counter() - started
+    episodes = lab.episodes if call.record_episodes else []
+    logs = [episode.log() for episode in episodes]
+    outcome = CallOutcome(call, OutcomeStatus.OK, value, logs, [], "", "", "", wall_time, call_seed)
+    replays = (
+        [replay_episode(log) for log in logs]
+        if replay
+        else [episode.replay_as_played() for episode in episodes]
+    )
+    return CallRecord(outcome, replays)
+
+
+def simulate_calls(
+    calls: Sequence[Call],
+    functions: dict[str, StudentFunction],
+    seed: int,
+    *,
+    replay: bool = False,
+    fast: bool = False,
+) -> list[CallRecord]:
+    """Run planned calls against simulated functions; a function not in `functions` is missing.
+
+    Args:
+        calls: The planned calls.
+        functions: Simulated student functions by name.
+        seed: The regrade's seed; call k uses a seed derived from (seed, k).
+        replay: See `simulate_call`.
+        fast: See `simulate_call`.
+    """
+    records = []
+    for index, call in enumerate(calls):
+        call_seed = int(np.random.SeedSequence(seed, spawn_key=(index,)).generate_state(1, np.uint64)[0] >> 1)
+        function = functions.get(call.function)
+        if function is None:
+            outcome = CallOutcome(
+                call,
+                OutcomeStatus.MISSING_FUNCTION,
+                None,
+                [],
+                [],
+                "",
+                "",
+                f"your file defines no function named `{call.function}`",
+                0.0,
+                call_seed,
+            )
+            records.append(CallRecord(outcome, []))
+        else:
+            records.append(simulate_call(call, function, call_seed, replay=replay, fast=fast))
+    return records
+
+
+def function_infos(functions: dict[str, StudentFunction]) -> dict[str, FunctionInfo]:
+    """What the sandbox's `ready` frame would say about simulated functions (the `lab` parameter hidden)."""
+    infos = {}
+    for name, function in functions.items():
+        parameters = list(inspect.signature(function).parameters.values())[1:]
+        infos[name] = FunctionInfo(
+            name,
+            True,
+            tuple(
+                ParameterInfo(p.name, p.kind.name, p.default is not inspect.Parameter.empty)
+                for p in parameters
+            ),
+        )
+    return infos

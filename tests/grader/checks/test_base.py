@@ -1,0 +1,86 @@
+"""The outcome mapping every check shares: sandbox statuses to verdicts."""
+
+import pytest
+
+from grader.checks.base import CallRecord, outcome_verdict
+from grader.sandbox.outcome import Call, CallOutcome, OutcomeStatus
+
+
+def _record(status: OutcomeStatus, message: str = "", function: str = "car") -> CallRecord:
+    outcome = CallOutcome(
+        Call(function), status, 1 if status is OutcomeStatus.OK else None, [], [], "", "", message, 0.0, 7
+    )
+    return CallRecord(outcome, [])
+
+
+@pytest.mark.parametrize(
+    ("status", "message", "expected_status", "feedback"),
+    [
+        (
+            OutcomeStatus.MISSING_FUNCTION,
+            "your file defines no function named `car`",
+            "missing",
+            "your file defines no function named `car`",
+        ),
+        (
+            OutcomeStatus.EXCEPTION,
+            "car() raised NotImplementedError: Problem 4 Incomplete",
+            "missing",
+            "car() raised NotImplementedError: not attempted yet. Replace the `raise NotImplementedError` "
+            "with your "
+            "solution.",
+        ),
+        (
+            OutcomeStatus.TIMEOUT,
+            "car() did not return within 30 s",
+            "timeout",
+            "car(): car() did not return within 30 s",
+        ),
+        (
+            OutcomeStatus.EXCEPTION,
+            "car() raised ZeroDivisionError: division by zero",
+            "error",
+            "car(): car() raised ZeroDivisionError: division by zero",
+        ),
+        (
+            OutcomeStatus.IMPORT_ERROR,
+            "your file failed to import: NameError",
+            "error",
+            "car(): your file failed to import: NameError",
+        ),
+        (
+            OutcomeStatus.INVALID_VALUE,
+            "car() returned a MagicFloat, expected a number",
+            "error",
+            "car(): car() returned a MagicFloat, expected a number",
+        ),
+        (OutcomeStatus.MEMORY_LIMIT, "car() ran out of memory", "error", "car(): car() ran out of memory"),
+    ],
+    ids=[
+        "missing-function",
+        "not-implemented",
+        "timeout",
+        "exception",
+        "import-error",
+        "invalid-value",
+        "memory",
+    ],
+)
+def test_non_ok_outcome_maps_to_a_zero_verdict(
+    status: OutcomeStatus, message: str, expected_status: str, feedback: str
+) -> None:
+    verdict = outcome_verdict([_record(OutcomeStatus.OK), _record(status, message)])
+    assert verdict is not None
+    assert (verdict.status, verdict.fraction, verdict.feedback) == (expected_status, 0.0, feedback)
+    assert verdict.measurements == {"calls": 2, "calls_ok": 1, "outcome": status.value}
+
+
+def test_missing_wins_over_an_earlier_error() -> None:
+    verdict = outcome_verdict(
+        [_record(OutcomeStatus.TIMEOUT, "slow"), _record(OutcomeStatus.MISSING_FUNCTION, "no car")]
+    )
+    assert verdict is not None and verdict.status == "missing"
+
+
+def test_all_ok_leaves_judging_to_the_check() -> None:
+    assert outcome_verdict([_record(OutcomeStatus.OK)] * 3) is None

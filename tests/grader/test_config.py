@@ -1,0 +1,172 @@
+"""The assignment configuration: the bundled file, its validation errors, and the power analysis behind it."""
+
+from pathlib import Path
+
+import pytest
+from pydantic import BaseModel
+
+from grader import config as config_module
+from grader.config import AssignmentConfig, ConfigError, load_config
+from grader.problems import PROBLEM_IDS
+from grader.sandbox.limits import Limits
+from grader.stats import binomial_acceptance, mean_tolerance
+from reference.oracles import random_policy_outcome, random_policy_return, threshold_policy_outcome
+
+BUNDLED = config_module.DEFAULT_CONFIG_PATH.read_text(encoding="utf-8")
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "assignment.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_bundled_configuration_loads_with_every_problem() -> None:
+    config = load_config()
+    assert tuple(config.problems) == PROBLEM_IDS
+    assert {config.problems[problem].points for problem in PROBLEM_IDS[:5]} == {1.0}
+    assert config.problems["find_qvalues"].points == 0.0
+
+
+def _models() -> list[type[BaseModel]]:
+    return [
+        AssignmentConfig,
+        config_module.AssignmentFile,
+        config_module.ProblemTable,
+        config_module.SandboxConfig,
+        *config_module._PROBLEM_CLASSES.values(),
+    ]
+
+
+@pytest.mark.parametrize("model", _models(), ids=lambda model: model.__name__)
+def test_every_field_is_described(model: type[BaseModel]) -> None:
+    undescribed = [
+        name for name, field in model.model_fields.items() if name != "kind" and not field.description
+    ]
+    assert undescribed == []
+
+
+def test_sandbox_settings_become_limits() -> None:
+    limits = load_config().sandbox.to_limits(12.5)
+    assert isinstance(limits, Limits)
+    assert limits.call_seconds == 12.5
+    assert limits.memory_bytes == 2 * 2**30
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            "points = 1.0\nenabled = true\ncall_seconds = 60.0\nexpected_seconds = 2.0",
+            "points = -1.0\nenabled = true\ncall_seconds = 60.0\nexpected_seconds = 2.0",
+            "problems.random_blackjack.points: Input should be greater than or equal to 0 (found -1.0)",
+        ),
+        (
+            "thresholds = [12, 13, 14, 20]",
+            "thresholds = [12, 22]",
+            "problems.blackjack.thresholds.1: Input should be less than or equal to 21 (found 22)",
+        ),
+        (
+            "thresholds = [12, 13, 14, 20]",
+            "thresholds = [12, 12]",
+            "problems.blackjack.thresholds: Value error, expected distinct values of n, found [12, 12]",
+        ),
+        (
+            "min_steps = 120",
+            "min_steps = 120\nlaps = 3",
+            "problems.cartpole.laps: Extra inputs are not permitted (found 3)",
+        ),
+        (
+            "win_rate_alpha = 1e-6",
+            "win_rate_alpha = 1.5",
+            "problems.random_blackjack.win_rate_alpha: Input should be less than 1 (found 1.5)",
+        ),
+        (
+            "memory_bytes = 2147483648",
+            "memory_bytes = 1048576",
+            "sandbox.memory_bytes: Input should be greater than or equal to 1610612736 (found 1048576)",
+        ),
+        (
+            "[problems.find_qvalues]",
+            "[problems.find_q]",
+            "problems.find_qvalues: Field required (add it to the file)",
+        ),
+    ],
+    ids=[
+        "negative-points",
+        "threshold-above-21",
+        "duplicate-thresholds",
+        "unknown-field",
+        "alpha-above-one",
+        "memory-too-small",
+        "missing-problem",
+    ],
+)
+def test_invalid_fields_are_named_with_what_was_found(
+    tmp_path: Path, old: str, new: str, message: str
+) -> None:
+    assert old in BUNDLED
+    with pytest.raises(ConfigError) as raised:
+        load_config(_write(tmp_path, BUNDLED.replace(old, new, 1)))
+    assert message in str(raised.value)
+    assert "invalid assignment configuration" in str(raised.value)
+
+
+def test_no_points_at_all_is_refused(tmp_path: Path) -> None:
+    text = BUNDLED.replace("points = 1.0", "points = 0.0")
+    with pytest.raises(ConfigError, match="expected at least one enabled problem worth points; found none"):
+        load_config(_write(tmp_path, text))
+
+
+def test_missing_file_says_so(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match=r"nothing\.toml not found: pass an existing TOML file"):
+        load_config(tmp_path / "nothing.toml")
+
+
+def test_not_toml_says_so(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="is not valid UTF-8 TOML"):
+        load_config(_write(tmp_path, "[problems\n"))
+
+
+# The power analysis of grader/ASSIGNMENT.md, pinned: exact binomial probabilities and exact Taxi moments.
+
+
+def test_random_blackjack_sample_size_detects_a_shifted_win_rate() -> None:
+    settings = load_config().problems["random_blackjack"]
+    exact = random_policy_outcome().win
+    acceptance = binomial_acceptance(settings.games, exact, settings.win_rate_alpha)  # type: ignore[attr-defined]
+    assert acceptance.false_fail <= 1e-6
+    assert acceptance.pass_probability(exact - 0.04) < 1e-3
+    assert acceptance.pass_probability(exact + 0.04) < 1e-3
+
+
+def test_random_blackjack_hit_test_detects_a_biased_coin() -> None:
+    settings = load_config().problems["random_blackjack"]
+    # At least 1.3 decisions per game (measured 1.37): every game has one, and half of the first draws go on.
+    decisions = int(1.3 * settings.games)  # type: ignore[attr-defined]
+    tolerance = mean_tolerance(0.5, 0.25, decisions, settings.action_alpha)  # type: ignore[attr-defined]
+    assert tolerance.pass_probability(0.45) < 1e-3
+    assert tolerance.pass_probability(0.55) < 1e-3
+
+
+def test_blackjack_thresholds_include_the_best_n_and_both_its_sides() -> None:
+    thresholds = load_config().problems["blackjack"].thresholds  # type: ignore[attr-defined]
+    wins = {n: threshold_policy_outcome(n).win for n in range(22)}
+    best = max(wins, key=wins.__getitem__)
+    assert {best - 1, best, best + 1} <= set(thresholds)
+    # n = 21 (always draw) never wins; among the others `<` versus `<=` matters most at:
+    largest_gap = max(range(1, 21), key=lambda n: abs(wins[n] - wins[n - 1]))
+    assert largest_gap in thresholds
+
+
+def test_taxi_random_mean_tolerance() -> None:
+    settings = load_config().problems["taxi"]
+    moments = random_policy_return()
+    tolerance = mean_tolerance(
+        moments.mean,
+        moments.variance,
+        settings.episodes_per_scenario,  # type: ignore[attr-defined]
+        settings.mean_alpha,
+    )  # type: ignore[attr-defined]
+    assert tolerance.half_width < 5.0
+    assert tolerance.pass_probability(moments.mean + 10.0) < 1e-6
