@@ -7,9 +7,10 @@ student's own run time is the sum of the calls' `wall_time` (time inside the stu
 recorder included). The replay cost is the time `replay_episodes` takes on the 100 logs (batched),
 and, for comparison, replaying them one at a time with `replay_episode`. Medians and minima over
 `--rounds` rounds; each round's replay time is the best of 3 repeats. A second table does the same
-for one call playing `--taxi-episodes` random Taxi episodes (the lab's problem 5 plays 10 000).
+for one call playing `--taxi-episodes` random Taxi episodes (the lab's problem 5 plays 10 000), a third
+for one call of the lab's `blackjack(11)` playing `--blackjack-games` games (problem 2 plays 10 000).
 
-    python bench/replay.py [--rounds 7] [--taxi-episodes 500]
+    python bench/replay.py [--rounds 7] [--taxi-episodes 500] [--blackjack-games 10000]
 """
 
 from __future__ import annotations
@@ -61,6 +62,18 @@ LAB_SUBMISSION = textwrap.dedent("""
                 _, reward, done, _ = env.step(env.action_space.sample())
                 total += reward
         return total / episodes
+
+
+    def blackjack(n, games):
+        env = gym.make("Blackjack-v0")
+        wins = 0
+        for _ in range(games):
+            observation = env.reset()
+            done = False
+            while not done:
+                observation, reward, done, _ = env.step(1 if observation[0] <= n else 0)
+            wins += reward > 0
+        return wins / games
 """)
 
 
@@ -214,6 +227,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--taxi-episodes", type=int, default=500)
+    parser.add_argument("--blackjack-games", type=int, default=10_000)
     arguments = parser.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
     _print(
@@ -225,6 +239,10 @@ def main() -> None:
         max(1, arguments.rounds // 2), function="random_taxi", args=[arguments.taxi_episodes], calls=1
     )
     _print(f"1 call playing {arguments.taxi_episodes} random Taxi episodes", taxi)
+    blackjack = measure_replay_cost(
+        max(1, arguments.rounds // 2), function="blackjack", args=[11, arguments.blackjack_games], calls=1
+    )
+    _print(f"1 call of the lab's blackjack(11) playing {arguments.blackjack_games} games", blackjack)
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 
 

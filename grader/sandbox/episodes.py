@@ -1,21 +1,27 @@
 """`EpisodeLog`: one episode as the student's code played it, decoded strictly from the result channel.
 
 The child sends each episode in the layout of `grader.sandbox.child.recorder.EpisodeRecord.to_plain`
-(per-step columns as numpy arrays). Nothing in a log is trusted: `grader.sandbox.replay` replays it.
+(per-step columns as numpy arrays, or plain lists for short episodes). Nothing in a log is trusted:
+`grader.sandbox.replay` replays it.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
-from grader.sandbox.child.protocol import decode_value
+from grader.sandbox.child.protocol import MAX_INT_BITS, decode_value, paused_gc
 
 MAX_ID_LENGTH = 200
 MAX_SEED = 2**64
+_LARGEST_INT = 2**MAX_INT_BITS
+_NUMBER_TYPES = frozenset({int, float})
+_INT_TYPE = frozenset({int})
+_BOOL_TYPE = frozenset({bool})
 _FIELDS = frozenset(
     {
         "env_index",
@@ -105,36 +111,36 @@ def _same_action(mine: Any, theirs: Any) -> bool:
 def episodes_from_plain(data: Any) -> list[EpisodeLog]:
     """Decode and validate the `episodes` field of a result frame (JSON data, as parsed).
 
+    Each per-step column is either a tagged numpy array or, for short episodes, a plain list.
+
     Raises:
         InvalidEpisodeLogError: the data does not have the layout the child sends.
     """
     if type(data) is not list:
         raise InvalidEpisodeLogError(f"episodes must be a list, found {type(data).__name__}")
-    try:
-        decoded = decode_value(data, "the episode log")
-    except InvalidValueError as error:
-        raise InvalidEpisodeLogError(error.message) from None
-    return [_episode(item, number) for number, item in enumerate(decoded)]
+    with paused_gc():
+        return [_episode(item, number) for number, item in enumerate(data)]
 
 
 def _episode(item: Any, number: int) -> EpisodeLog:
     where = f"episode {number}"
     if type(item) is not dict or item.keys() != _FIELDS:
+        item = _decoded(item, where)
         found = sorted(item) if type(item) is dict else type(item).__name__
         raise InvalidEpisodeLogError(f"{where} must have the fields {sorted(_FIELDS)}, found {found}")
     student_seed = item["student_seed"]
     if student_seed is not None:
         student_seed = _seed(student_seed, f"{where}: student_seed")
-    rewards = _column(item["rewards"], "biuf", f"{where}: rewards")
-    terminated = _column(item["terminated"], "b", f"{where}: terminated")
-    truncated = _column(item["truncated"], "b", f"{where}: truncated")
+    rewards = _rewards(item["rewards"], f"{where}: rewards")
+    terminated = _flags(item["terminated"], f"{where}: terminated")
+    truncated = _flags(item["truncated"], f"{where}: truncated")
     actions = _actions(item["actions"], f"{where}: actions")
-    lengths = {len(actions), len(rewards), len(terminated), len(truncated)}
-    if len(lengths) != 1:
+    if not len(actions) == len(rewards) == len(terminated) == len(truncated):
         raise InvalidEpisodeLogError(
             f"{where}: actions, rewards, terminated and truncated must have one entry per step, found "
             f"{len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"
         )
+    reset_options = item["reset_options"]
     return EpisodeLog(
         env_index=_bounded_int(item["env_index"], 0, 2**31, f"{where}: env_index"),
         requested_id=_identifier(item["requested_id"], f"{where}: requested_id"),
@@ -143,28 +149,66 @@ def _episode(item: Any, number: int) -> EpisodeLog:
         reset_seed=_seed(item["reset_seed"], f"{where}: reset_seed"),
         student_seed=student_seed,
         actions=actions,
-        rewards=[float(value) for value in rewards.astype(np.float64)],
-        terminated=[bool(value) for value in terminated],
-        truncated=[bool(value) for value in truncated],
-        reset_options=None
-        if item["reset_options"] is None
-        else _mapping(item["reset_options"], f"{where}: reset_options"),
+        rewards=rewards,
+        terminated=terminated,
+        truncated=truncated,
+        reset_options=None if reset_options is None else _mapping(reset_options, f"{where}: reset_options"),
     )
 
 
-def _column(value: Any, kinds: str, where: str) -> np.ndarray:
-    if type(value) is not np.ndarray or value.ndim != 1 or value.dtype.kind not in kinds:
+def _decoded(value: Any, where: str) -> Any:
+    """`decode_value` for one field of the log, its errors as `InvalidEpisodeLogError`."""
+    try:
+        return decode_value(value, f"the episode log ({where})")
+    except InvalidValueError as error:
+        raise InvalidEpisodeLogError(error.message) from None
+
+
+def _array(value: Any, kinds: str, where: str) -> np.ndarray:
+    array = _decoded(value, where) if type(value) is dict else value
+    if type(array) is not np.ndarray or array.ndim != 1 or array.dtype.kind not in kinds:
         raise InvalidEpisodeLogError(
-            f"{where} must be a 1-D array of kind {kinds!r}, found {_describe(value)}"
+            f"{where} must be a 1-D array of kind {kinds!r} or a list, found {_describe(array)}"
         )
-    return value
+    return array
+
+
+def _rewards(value: Any, where: str) -> list[float]:
+    if type(value) is not list:
+        return _array(value, "biuf", where).astype(np.float64).tolist()  # type: ignore[no-any-return]
+    numbers = value if _plain_numbers(value) else _decoded(value, where)
+    if not _plain_numbers(numbers):
+        raise InvalidEpisodeLogError(f"{where} must hold only numbers, found {_describe(value)}")
+    rewards = [float(number) for number in numbers]
+    if not all(map(math.isfinite, rewards)) and numbers is value:
+        _decoded(value, where)  # an untagged non-finite float: the protocol's own error
+    return rewards
+
+
+def _plain_numbers(values: list[Any]) -> bool:
+    """Only floats and ints small enough for a float (what `decode_value` accepts untagged)."""
+    return set(map(type, values)) <= _NUMBER_TYPES and all(
+        type(value) is float or -_LARGEST_INT < value < _LARGEST_INT for value in values
+    )
+
+
+def _flags(value: Any, where: str) -> list[bool]:
+    if type(value) is not list:
+        return _array(value, "b", where).tolist()  # type: ignore[no-any-return]
+    if not set(map(type, value)) <= _BOOL_TYPE:
+        raise InvalidEpisodeLogError(f"{where} must hold only bools, found {_describe(value)}")
+    return list(value)
 
 
 def _actions(value: Any, where: str) -> list[Any]:
-    if type(value) is np.ndarray:
-        return [int(action) for action in _column(value, "iu", where)]
     if type(value) is list:
-        return value
+        if set(map(type, value)) <= _INT_TYPE and all(
+            -_LARGEST_INT < action < _LARGEST_INT for action in value
+        ):
+            return list(value)
+        return _decoded(value, where)  # type: ignore[no-any-return]
+    if type(value) is dict:
+        return _array(value, "iu", where).tolist()  # type: ignore[no-any-return]
     raise InvalidEpisodeLogError(f"{where} must be an int array or a list, found {_describe(value)}")
 
 
@@ -187,7 +231,7 @@ def _identifier(value: Any, where: str) -> str:
 def _mapping(value: Any, where: str) -> dict[str, Any]:
     if type(value) is not dict:
         raise InvalidEpisodeLogError(f"{where} must be a dict, found {_describe(value)}")
-    return value
+    return _decoded(value, where)  # type: ignore[no-any-return]
 
 
 def _describe(value: Any) -> str:

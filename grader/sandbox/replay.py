@@ -22,6 +22,7 @@ from gymnasium.envs.registration import EnvSpec
 
 from grader.compat import register_envs
 from grader.sandbox.batched import REPLAYERS, BatchedEpisode, BatchedReplayer
+from grader.sandbox.child.protocol import paused_gc
 from grader.sandbox.child.seeding import mapped_reset_seed, reset_seeds
 from grader.sandbox.episodes import EpisodeLog
 
@@ -94,11 +95,16 @@ def replay_episode(log: EpisodeLog) -> Replay:
 def replay_episodes(logs: Sequence[EpisodeLog]) -> list[Replay]:
     """Replay every log (see `replay_episode`); same results, much faster for many episodes.
 
-    Episodes of envs with a batched replayer (`grader.sandbox.batched`: CartPole, Taxi) are replayed
-    together; the longest of each batch is replayed again by the scalar env and the batch is used
-    only if both agree exactly. Episodes that disagree with the log or run past the real end are
-    replayed one by one, so mismatch messages and steps after done always come from the scalar env.
+    Episodes of envs with a batched replayer (`grader.sandbox.batched`: CartPole, Taxi, Blackjack) are
+    replayed together; the longest, first and last of each batch are replayed again by the scalar env
+    and the batch is used only if they agree exactly. Episodes that disagree with the log are replayed
+    one by one, so mismatch messages always come from the scalar env.
     """
+    with paused_gc():
+        return _replay_all(logs)
+
+
+def _replay_all(logs: Sequence[EpisodeLog]) -> list[Replay]:
     replays: list[Replay | None] = [None] * len(logs)
     groups: dict[tuple[int, str], list[int]] = {}
     for position, log in enumerate(logs):
@@ -107,12 +113,15 @@ def replay_episodes(logs: Sequence[EpisodeLog]) -> list[Replay]:
                 groups.setdefault((number, _cache_key(log.env_id, log.env_kwargs)), []).append(position)
                 break
     for (number, _), positions in groups.items():
+        first = logs[positions[0]]
+        env, _ = _cached_env(first.env_id, first.env_kwargs)
+        spec = None if env is None else env.spec
         for chunk in _chunks(sorted(positions, key=lambda position: logs[position].steps), logs):
             batch = _batch_or_none(REPLAYERS[number], [logs[position] for position in chunk])
             if batch is None:
                 continue
             for position, played in zip(chunk, batch, strict=True):
-                replays[position] = _from_batch(logs[position], played)
+                replays[position] = _from_batch(logs[position], played, spec)
     return [
         replay if replay is not None else replay_episode(log)
         for replay, log in zip(replays, logs, strict=True)
@@ -197,15 +206,22 @@ def _chunks(positions: list[int], logs: Sequence[EpisodeLog]) -> list[list[int]]
 def _batch_or_none(replayer: BatchedReplayer, group: Sequence[EpisodeLog]) -> list[BatchedEpisode] | None:
     """The batch's episodes, or None if the batch cannot run or the scalar env disagrees with it.
 
-    The episode the batch played longest is replayed again by the scalar env; both must agree
-    exactly, or the whole batch is discarded (its episodes are then replayed one by one).
+    The episode the batch played longest, the first and the last are replayed again by the scalar
+    env; they must agree exactly, or the whole batch is discarded (its episodes are then replayed
+    one by one).
     """
     try:
         batch = replayer.replay(group)
     except Exception:  # an env this replayer does not model (e.g. re-registered): use the scalar env
         return None
-    index = max(range(len(batch)), key=lambda position: len(batch[position].rewards))
-    scalar, played = replay_episode(group[index]), batch[index]
+    longest = max(range(len(batch)), key=lambda position: len(batch[position].rewards))
+    witnesses = sorted({longest, 0, len(batch) - 1})
+    if all(_same_trajectory(replay_episode(group[index]), batch[index]) for index in witnesses):
+        return batch
+    return None
+
+
+def _same_trajectory(scalar: Replay, played: BatchedEpisode) -> bool:
     same_observations = len(scalar.observations) == len(played.observations) and all(
         np.array_equal(real, batched)
         for real, batched in zip(scalar.observations, played.observations, strict=True)
@@ -215,10 +231,10 @@ def _batch_or_none(replayer: BatchedReplayer, group: Sequence[EpisodeLog]) -> li
         played.terminated,
         played.truncated,
     )
-    return batch if same_observations and same_steps else None
+    return same_observations and same_steps
 
 
-def _from_batch(log: EpisodeLog, played: BatchedEpisode) -> Replay | None:
+def _from_batch(log: EpisodeLog, played: BatchedEpisode, spec: EnvSpec | None) -> Replay | None:
     """The replay of a batched episode, or None when it disagrees with the log (the scalar env explains)."""
     length = len(played.rewards)
     if (played.rewards, played.terminated, played.truncated) != (
@@ -227,16 +243,7 @@ def _from_batch(log: EpisodeLog, played: BatchedEpisode) -> Replay | None:
         log.truncated[:length],
     ):
         return None
-    env, _ = _cached_env(log.env_id, log.env_kwargs)
-    return _replay(
-        log,
-        played.observations,
-        played.rewards,
-        played.terminated,
-        played.truncated,
-        None,
-        None if env is None else env.spec,
-    )
+    return _replay(log, played.observations, played.rewards, played.terminated, played.truncated, None, spec)
 
 
 def _same_step(log: EpisodeLog, index: int, reward: float, terminated: bool, truncated: bool) -> bool:

@@ -119,7 +119,8 @@ def test_a_syntax_error_is_a_stored_verdict(sessions: sessionmaker[Session], set
         (
             b"# fake-grader: internal-error\n",
             "failed",
-            "the grader failed on this submission (not the student's fault): cartpole: the fake grader crashed",
+            "the grader failed on this submission (not the student's fault): "
+            "cartpole: the fake grader crashed",
         ),
     ],
     ids=["grader-raises", "grading-process-crashes", "grader-reports-its-own-failure"],

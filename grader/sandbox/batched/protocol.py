@@ -110,22 +110,32 @@ def finish(
     steps = terminated.shape[0]
     truncated_at = np.arange(1, steps + 1) >= time_limit(logs[0])
     done = terminated | truncated_at[:, None]
+    truncated_flags = truncated_at.tolist()
+    # One conversion per matrix, then list slices: per-episode numpy calls cost more than the episodes.
+    observation_columns = _columns(observations)
+    reward_columns = rewards.T.tolist()
+    terminated_columns = terminated.T.tolist()
+    ended: list[bool] = np.any(done, axis=0).tolist()
+    first_end: list[int] = done.argmax(axis=0).tolist()
     episodes = []
     for column, log in enumerate(logs):
-        ends = np.flatnonzero(done[: log.steps, column])
-        end = int(ends[0]) + 1 if ends.size else min(log.steps, steps)
+        played = min(log.steps, steps)
+        finished = ended[column] and first_end[column] < played
+        end = first_end[column] + 1 if finished else played
         episodes.append(
             BatchedEpisode(
-                observations=_rows(observations[: end + 1, column]),
-                rewards=rewards[:end, column].tolist(),
-                terminated=terminated[:end, column].tolist(),
-                truncated=truncated_at[:end].tolist(),
-                finished=bool(ends.size),
+                observations=observation_columns[column][: end + 1],
+                rewards=reward_columns[column][:end],
+                terminated=terminated_columns[column][:end],
+                truncated=truncated_flags[:end],
+                finished=finished,
             )
         )
     return episodes
 
 
-def _rows(observations: np.ndarray) -> list[Any]:
-    """Python scalars for scalar observations (Taxi's ints), array rows otherwise (CartPole's)."""
-    return observations.tolist() if observations.ndim == 1 else list(observations)
+def _columns(observations: np.ndarray) -> list[list[Any]]:
+    """Per episode: Python scalars for scalar observations (Taxi's ints), else array rows (CartPole's)."""
+    if observations.ndim == 2:
+        return observations.T.tolist()  # type: ignore[no-any-return]
+    return [list(observations[:, column]) for column in range(observations.shape[1])]

@@ -4,9 +4,9 @@
 terminated)`; with default arguments (no rain, no fickle passenger) every list holds one transition
 of probability 1.0, so the random draw `step` makes cannot change the outcome and an episode is
 a chain of table lookups. Here the parent's own env provides the table (checked to be deterministic)
-and the initial states (its own `reset(seed)`); all episodes advance in lockstep, one array lookup
-per step. `grader.sandbox.replay` checks every batch against the scalar env, which stays the
-authority for every mismatch.
+and the initial-state distribution, sampled as its `reset(seed)` does (`SeededDraws`); all episodes
+advance in lockstep, one array lookup per step. `grader.sandbox.replay` checks every batch against
+the scalar env, which stays the authority for every mismatch.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 from gymnasium.envs.toy_text.taxi import TaxiEnv
 
+from grader.sandbox.batched.draws import SeededDraws
 from grader.sandbox.batched.protocol import (
     BatchedEpisode,
     action_matrix,
@@ -50,9 +51,7 @@ class TaxiReplayer:
             raise TypeError(f"{logs[0].env_id} is not gymnasium's TaxiEnv")
         try:
             next_states, rewards, terminal = _tables(taxi)
-            states = np.empty(len(logs), dtype=np.int64)
-            for column, log in enumerate(logs):
-                states[column] = scalar.reset(seed=log.reset_seed)[0]
+            states = _initial_states(taxi, logs)
         finally:
             scalar.close()
         actions = action_matrix(logs, horizon(logs))
@@ -64,6 +63,17 @@ class TaxiReplayer:
         step_rewards = rewards[before, actions]
         step_terminated = terminal[before, actions]
         return finish(logs, observations, step_rewards, step_terminated)
+
+
+def _initial_states(taxi: TaxiEnv, logs: Sequence[EpisodeLog]) -> np.ndarray:
+    """What `TaxiEnv.reset(seed)` draws: `categorical_sample(initial_state_distrib, np_random)`.
+
+    That is `argmax(cumsum(distribution) > np_random.random())`, the first draw of each seed's generator.
+    """
+    cumulative = np.cumsum(np.asarray(taxi.initial_state_distrib))
+    uniforms = np.array([SeededDraws(log.reset_seed).random() for log in logs])
+    states: np.ndarray = np.argmax(cumulative[None, :] > uniforms[:, None], axis=1).astype(np.int64)
+    return states
 
 
 def _tables(taxi: TaxiEnv) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -11,11 +11,13 @@ from __future__ import annotations
 
 import base64
 import binascii
+import contextlib
+import gc
 import json
 import math
 import os
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any, BinaryIO
 
 import numpy as np
@@ -50,13 +52,31 @@ _ALLOWED_DTYPES = frozenset(
 )
 
 
+@contextlib.contextmanager
+def paused_gc() -> Iterator[None]:
+    """Pause the cyclic garbage collector for the block (restored afterwards, even if it was off).
+
+    Encoding, parsing and decoding a frame of episode logs builds millions of small objects that form
+    no cycles; every automatic collection meanwhile rescans all of them (and every other live
+    object), which made parsing a 2-million-step Taxi log 6x slower. Nothing is lost by collecting later.
+    """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
 def encode_frame(message: dict[str, Any], max_frame: int = DEFAULT_MAX_FRAME) -> bytes:
     """Serialise one message (already plain JSON data) into a length-prefixed frame.
 
     Raises:
         FrameTooLargeError: the encoded message is longer than `max_frame` bytes.
     """
-    payload = json.dumps(message, allow_nan=False, separators=(",", ":")).encode()
+    with paused_gc():
+        payload = json.dumps(message, allow_nan=False, separators=(",", ":")).encode()
     if len(payload) > max_frame:
         raise FrameTooLargeError(len(payload), max_frame)
     return HEADER.pack(len(payload)) + payload
@@ -92,12 +112,13 @@ def read_frame(stream: BinaryIO, max_frame: int = DEFAULT_MAX_FRAME) -> dict[str
 def parse_payload(payload: bytes) -> dict[str, Any]:
     """Parse a frame payload strictly: UTF-8 JSON object, no NaN literals, no duplicate keys."""
     try:
-        message = json.loads(
-            payload.decode("utf-8"),
-            parse_constant=_refuse_constant,
-            parse_float=_finite_float,
-            object_pairs_hook=_unique_keys,
-        )
+        with paused_gc():
+            message = json.loads(
+                payload.decode("utf-8"),
+                parse_constant=_refuse_constant,
+                parse_float=_finite_float,
+                object_pairs_hook=_unique_keys,
+            )
     except (UnicodeDecodeError, ValueError, RecursionError) as error:
         raise ProtocolError(f"a frame is not valid UTF-8 JSON: {error}") from None
     if type(message) is not dict:
@@ -119,7 +140,8 @@ def encode_value(value: Any, what: str = "the value", max_bytes: int | None = No
             str, an oversized int, too deep nesting or too many elements.
         FrameTooLargeError: the value exceeds `max_bytes`.
     """
-    return _Encoder(what, max_bytes).encode(value, "", 0)
+    with paused_gc():
+        return _Encoder(what, max_bytes).encode(value, "", 0)
 
 
 def decode_value(data: Any, what: str = "the value") -> Any:
@@ -128,7 +150,8 @@ def decode_value(data: Any, what: str = "the value") -> Any:
     Raises:
         InvalidValueError: the data does not have the layout `encode_value` produces.
     """
-    return _Decoder(what).decode(data, "", 0)
+    with paused_gc():
+        return _Decoder(what).decode(data, "", 0)
 
 
 class _Encoder:

@@ -28,13 +28,21 @@ import numpy as np
 from grader.compat import events as compat_events
 from grader.compat import make as compat_make
 from grader.compat import register_envs, resolve_env_id
+from grader.sandbox.child.protocol import MAX_NODES
 from grader.sandbox.child.seeding import CallSeeds, kept_generator_seed
 
 DEFAULT_MAX_RECORDED_STEPS = 5_000_000
+SHORT_EPISODE_STEPS = 16
+"""Episodes up to this many steps send their columns as lists, longer ones as numpy arrays."""
+LIST_NODE_BUDGET = MAX_NODES // 2
+"""Most elements a call's episode log may take with list columns; beyond it all columns are arrays."""
+EPISODE_NODES = 16
+"""Elements of one encoded episode besides its columns' entries and its env arguments (a bound)."""
 MAX_KEPT_GENERATORS = 10_000
 """Generators made at import that are reset at every call (strong references, so capped)."""
 _DROPPED_KWARGS = ("render_mode", "disable_env_checker")
 _COMPAT_MAKE_CODE = compat_make.__code__
+_EXACT_INTS = 2**53
 
 
 @dataclass
@@ -52,10 +60,16 @@ class EpisodeRecord:
     rewards: array[float] = field(default_factory=lambda: array("d"))
     terminated: bytearray = field(default_factory=bytearray)
     truncated: bytearray = field(default_factory=bytearray)
+    short_as_lists: bool = True
 
     def to_plain(self) -> dict[str, Any]:
-        """The wire layout parsed by `grader.sandbox.episodes.episodes_from_plain`."""
-        return {
+        """The wire layout parsed by `grader.sandbox.episodes.episodes_from_plain`.
+
+        Per-step columns are compact numpy arrays, or plain lists for episodes of at most
+        `SHORT_EPISODE_STEPS` steps (a Blackjack game), where four arrays would cost more to encode and
+        decode than the steps themselves (unless `short_as_lists` was turned off, see `finish_call`).
+        """
+        plain: dict[str, Any] = {
             "env_index": self.env_index,
             "requested_id": self.requested_id,
             "env_id": self.env_id,
@@ -63,11 +77,22 @@ class EpisodeRecord:
             "reset_seed": self.reset_seed,
             "student_seed": self.student_seed,
             "reset_options": self.reset_options,
-            "actions": _compact_actions(self.actions),
-            "rewards": _compact_numbers(np.frombuffer(self.rewards, dtype=np.float64)),
-            "terminated": np.frombuffer(self.terminated, dtype=np.bool_),
-            "truncated": np.frombuffer(self.truncated, dtype=np.bool_),
         }
+        if self.short_as_lists and len(self.actions) <= SHORT_EPISODE_STEPS:
+            plain["actions"] = list(self.actions)
+            # Integral rewards travel as ints: JSON parses ints without a Python callback per number.
+            plain["rewards"] = [
+                int(reward) if reward.is_integer() and -_EXACT_INTS <= reward <= _EXACT_INTS else reward
+                for reward in self.rewards
+            ]
+            plain["terminated"] = list(map(bool, self.terminated))
+            plain["truncated"] = list(map(bool, self.truncated))
+            return plain
+        plain["actions"] = _compact_actions(self.actions)
+        plain["rewards"] = _compact_numbers(np.frombuffer(self.rewards, dtype=np.float64))
+        plain["terminated"] = np.frombuffer(self.terminated, dtype=np.bool_)
+        plain["truncated"] = np.frombuffer(self.truncated, dtype=np.bool_)
+        return plain
 
 
 @dataclass(frozen=True)
@@ -132,9 +157,21 @@ class Recorder:
                 bit_generator.state = initial_state
 
     def finish_call(self) -> list[EpisodeRecord]:
-        """Stop recording and return the call's episodes in reset order."""
+        """Stop recording and return the call's episodes in reset order.
+
+        Short episodes send their columns as lists unless that would take the call's log past
+        `LIST_NODE_BUDGET` elements; then every episode sends arrays (an element count that grows with
+        the episodes, not with their steps, as `grader.sandbox.child.protocol.MAX_NODES` requires).
+        """
         self.recording = False
         episodes, self.episodes = self.episodes, []
+        list_nodes = sum(
+            EPISODE_NODES + len(episode.env_kwargs) + 4 * _list_entries(len(episode.actions))
+            for episode in episodes
+        )
+        if list_nodes > LIST_NODE_BUDGET:
+            for episode in episodes:
+                episode.short_as_lists = False
         return episodes
 
     def keep_generator(self, generator: np.random.Generator, *, seeded: bool) -> None:
@@ -361,28 +398,33 @@ def _copy_action(action: Any) -> Any:
     return action
 
 
+def _list_entries(steps: int) -> int:
+    """Entries per column as sent: one per step in list form, one array otherwise."""
+    return steps if steps <= SHORT_EPISODE_STEPS else 1
+
+
 def _compact_actions(actions: list[Any]) -> Any:
-    plain_ints = bool(actions) and all(type(action) is int for action in actions)
-    if plain_ints and min(actions) >= -(2**63) and max(actions) < 2**63:
-        return _smallest_int_array(np.array(actions, dtype=np.int64))
+    if actions and set(map(type, actions)) == {int}:
+        try:
+            return _smallest_int_array(np.array(actions, dtype=np.int64))
+        except OverflowError:
+            return actions
     return actions
 
 
 def _compact_numbers(values: np.ndarray) -> np.ndarray:
     """The smallest dtype that holds `values` exactly (Taxi's rewards fit int8)."""
-    if (
-        values.size
-        and np.all(np.isfinite(values))
-        and np.all(values == np.round(values))
-        and np.all(np.abs(values) < 2**31)
-    ):
+    if values.size and np.all(np.abs(values) < 2**31) and np.all(values == np.trunc(values)):
         return _smallest_int_array(values.astype(np.int64))
     return values.copy()
 
 
 def _smallest_int_array(values: np.ndarray) -> np.ndarray:
+    if values.size == 0:
+        return values.astype(np.int8)
+    low, high = int(values.min()), int(values.max())
     for dtype in (np.int8, np.int16, np.int32):
         info = np.iinfo(dtype)
-        if values.size == 0 or (values.min() >= info.min and values.max() <= info.max):
+        if info.min <= low and high <= info.max:
             return values.astype(dtype)
     return values

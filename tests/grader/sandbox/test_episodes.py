@@ -2,20 +2,25 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 import pytest
 
 from grader.sandbox.child.errors import InvalidEpisodeLogError
-from grader.sandbox.child.protocol import encode_value
-from grader.sandbox.child.recorder import EpisodeRecord
+from grader.sandbox.child.protocol import encode_frame, encode_value, parse_payload
+from grader.sandbox.child.recorder import SHORT_EPISODE_STEPS, EpisodeRecord
 from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
 
+STEPS = [(1, -1.0), (4, -10.0), (5, 20.0)]
+LONG = SHORT_EPISODE_STEPS + 1
+"""Steps of an episode long enough to send its columns as arrays."""
 
-def recorded() -> EpisodeRecord:
+
+def recorded(repeats: int = 1) -> EpisodeRecord:
     record = EpisodeRecord(0, "Taxi-v3", "Taxi-v4", {}, 12, None, None)
-    for action, reward in [(1, -1.0), (4, -10.0), (5, 20.0)]:
+    for action, reward in STEPS * repeats:
         record.actions.append(action)
         record.rewards.append(reward)
         record.terminated.append(reward == 20.0)
@@ -28,8 +33,9 @@ def wire(**changes: Any) -> Any:
     return encode_value([plain])
 
 
-def test_the_childs_layout_decodes_to_episode_logs() -> None:
-    (log,) = episodes_from_plain(wire())
+@pytest.mark.parametrize("repeats", [1, LONG], ids=["short-lists", "long-arrays"])
+def test_the_childs_layout_decodes_to_episode_logs(repeats: int) -> None:
+    (log,) = episodes_from_plain(encode_value([recorded(repeats).to_plain()]))
 
     assert log == EpisodeLog(
         0,
@@ -38,18 +44,52 @@ def test_the_childs_layout_decodes_to_episode_logs() -> None:
         {},
         12,
         None,
-        [1, 4, 5],
-        [-1.0, -10.0, 20.0],
-        [False, False, True],
-        [False, False, False],
+        [1, 4, 5] * repeats,
+        [-1.0, -10.0, 20.0] * repeats,
+        [False, False, True] * repeats,
+        [False, False, False] * repeats,
     )
     assert all(type(reward) is float for reward in log.rewards)
+    assert all(type(action) is int for action in log.actions)
+    assert all(type(flag) is bool for flag in log.terminated + log.truncated)
 
 
-def test_compact_columns_use_small_dtypes() -> None:
-    plain = recorded().to_plain()
+def test_long_episodes_use_small_dtypes() -> None:
+    plain = recorded(LONG).to_plain()
 
     assert (plain["actions"].dtype, plain["rewards"].dtype) == (np.int8, np.int8)
+
+
+def test_short_episodes_use_lists_with_integral_rewards_as_ints() -> None:
+    plain = recorded().to_plain()
+
+    assert (plain["actions"], plain["rewards"], plain["terminated"]) == (
+        [1, 4, 5],
+        [-1, -10, 20],
+        [False, False, True],
+    )
+    assert [type(reward) for reward in plain["rewards"]] == [int, int, int]
+
+
+@pytest.mark.parametrize(
+    "reward",
+    [0.5, -0.0, 2.0**60, float("nan"), float("inf"), float("-inf")],
+    ids=["fraction", "negative-zero", "huge", "nan", "inf", "minus-inf"],
+)
+def test_short_episode_rewards_survive_the_wire(reward: float) -> None:
+    record = EpisodeRecord(0, "Taxi-v3", "Taxi-v4", {}, 12, None, None)
+    record.actions.append(0)
+    record.rewards.append(reward)
+    record.terminated.append(False)
+    record.truncated.append(True)
+
+    (log,) = episodes_from_plain(
+        parse_payload(encode_frame({"e": encode_value([record.to_plain()])})[4:])["e"]
+    )
+
+    assert type(log.rewards[0]) is float
+    assert log.rewards[0] == reward or (math.isnan(reward) and math.isnan(log.rewards[0]))
+    assert (log.terminated, log.truncated) == ([False], [True])
 
 
 def test_an_empty_episode_decodes() -> None:
@@ -68,7 +108,12 @@ REFUSED = [
     ({"requested_id": "x" * 201}, "requested_id must be a non-empty str of at most 200"),
     ({"env_kwargs": [1]}, "env_kwargs must be a dict, found list"),
     ({"rewards": np.array([1.0, 2.0])}, "must have one entry per step, found 3, 2, 3 and 3"),
-    ({"rewards": [1.0, 2.0, 3.0]}, "rewards must be a 1-D array of kind 'biuf', found list"),
+    ({"rewards": [1.0, 2.0, "3"]}, "rewards must hold only numbers"),
+    ({"rewards": [1.0, 2.0, True]}, "rewards must hold only numbers"),
+    ({"rewards": [1.0, 2.0]}, "must have one entry per step, found 3, 2, 3 and 3"),
+    ({"terminated": [False, 0, True]}, "terminated must hold only bools"),
+    ({"truncated": [False, False]}, "must have one entry per step, found 3, 3, 3 and 2"),
+    ({"actions": [1, 2]}, "must have one entry per step, found 2, 3, 3 and 3"),
     ({"terminated": np.array([1, 0, 0])}, "terminated must be a 1-D array of kind 'b'"),
     ({"truncated": np.zeros((3, 1), dtype=bool)}, "truncated must be a 1-D array"),
     ({"actions": np.array([0.5, 1.0, 2.0])}, "actions must be a 1-D array of kind 'iu'"),
@@ -88,6 +133,23 @@ def test_malformed_episodes_are_refused(changes: dict[str, Any], message: str) -
         episodes_from_plain(wire(**changes))
 
     assert message in str(caught.value)
+
+
+@pytest.mark.parametrize(
+    ("rewards", "message"),
+    [
+        ([0, float("nan"), 1], "a non-finite float was not tagged"),
+        ([0, 2**300, 1], "an int has 301 bits"),
+        ([0, {"$float": "nan?"}, 1], "unknown tagged object"),
+    ],
+    ids=["untagged-nan", "huge-int", "bad-tag"],
+)
+def test_list_rewards_are_decoded_as_strictly_as_any_value(rewards: list[Any], message: str) -> None:
+    (plain,) = wire()
+    plain["rewards"] = rewards
+
+    with pytest.raises(InvalidEpisodeLogError, match=message):
+        episodes_from_plain([plain])
 
 
 @pytest.mark.parametrize(

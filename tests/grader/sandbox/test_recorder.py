@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 from child_client import ChildClient, write_submission
 
-from grader.sandbox.child.protocol import decode_value
+from grader.sandbox.child.protocol import MAX_NODES, decode_value, encode_value
+from grader.sandbox.child.recorder import SHORT_EPISODE_STEPS, EpisodeRecord, Recorder
 from grader.sandbox.child.seeding import derive_call_seed, mapped_reset_seed, reset_seeds
 from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
 from grader.sandbox.replay import verify_reset_seeds
@@ -337,3 +338,32 @@ def test_results_larger_than_a_frame_are_output_too_large(submission: Path) -> N
     assert result is not None and result["status"] == "output_too_large"
     assert result["message"].startswith("the episodes classic_blackjack() played need about ")
     assert result["message"].endswith(" bytes, more than the limit of 2000 bytes; play fewer episodes")
+
+
+def short_episodes(count: int) -> Recorder:
+    recorder = Recorder(seed=3)
+    for number in range(count):
+        episode = EpisodeRecord(
+            0, "Blackjack-v0", "Blackjack-v1", {"natural": False, "sab": False}, number, None, None
+        )
+        for _ in range(SHORT_EPISODE_STEPS):
+            episode.actions.append(1)
+            episode.rewards.append(0.0)
+            episode.terminated.append(False)
+            episode.truncated.append(False)
+        recorder.episodes.append(episode)
+    return recorder
+
+
+@pytest.mark.parametrize(
+    ("count", "lists"),
+    [(100, True), (MAX_NODES // (4 * SHORT_EPISODE_STEPS), False)],
+    ids=["within-budget-lists", "over-budget-arrays"],
+)
+def test_short_episodes_use_lists_only_within_the_element_budget(count: int, lists: bool) -> None:
+    episodes = short_episodes(count).finish_call()
+
+    plain = [episode.to_plain() for episode in episodes]
+    assert {type(episode["actions"]) for episode in plain} == {list if lists else np.ndarray}
+    encoded = encode_value(plain, "the episode log")  # as lists, the second case would pass MAX_NODES
+    assert len(episodes_from_plain(encoded)) == count

@@ -13,7 +13,9 @@ import pytest
 from child_client import ChildClient, write_submission
 
 from grader.sandbox import replay
-from grader.sandbox.batched import BatchedReplayer, CartPoleReplayer, TaxiReplayer
+from grader.sandbox.batched import BatchedReplayer, BlackjackReplayer, CartPoleReplayer, TaxiReplayer
+from grader.sandbox.batched.draws import SeededDraws
+from grader.sandbox.child.seeding import reset_seeds
 from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
 from grader.sandbox.replay import Replay, replay_episode, replay_episodes, verify_reset_seeds
 
@@ -203,7 +205,7 @@ def test_batched_cartpole_replay_is_identical_to_the_scalar_replay(
 
 
 def played(
-    env_id: str, seed: int, actions: list[int], env_kwargs: dict[str, int] | None = None
+    env_id: str, seed: int, actions: list[int], env_kwargs: dict[str, int | bool] | None = None
 ) -> EpisodeLog:
     """An honest log: `actions` played in a fresh gymnasium env, steps after done included."""
     env = gymnasium.make(env_id, **(env_kwargs or {}))
@@ -226,16 +228,31 @@ BATCHES = [
     (CartPoleReplayer(), "CartPole-v1", 2, 120, {"max_episode_steps": 15}),
     (TaxiReplayer(), "Taxi-v4", 6, 260, None),
     (TaxiReplayer(), "Taxi-v4", 6, 40, {"max_episode_steps": 30}),
+    (BlackjackReplayer(), "Blackjack-v1", 2, 6, {"natural": False, "sab": False}),
+    (BlackjackReplayer(), "Blackjack-v1", 2, 6, {"natural": True, "sab": False}),
+    (BlackjackReplayer(), "Blackjack-v1", 2, 6, {}),
 ]
 
 
 @pytest.mark.parametrize(
     ("replayer", "env_id", "actions", "steps", "env_kwargs"),
     BATCHES,
-    ids=["cartpole", "cartpole-limit-15", "taxi", "taxi-limit-30"],
+    ids=[
+        "cartpole",
+        "cartpole-limit-15",
+        "taxi",
+        "taxi-limit-30",
+        "blackjack-lab",
+        "blackjack-natural",
+        "blackjack-sab",
+    ],
 )
 def test_batched_replay_matches_the_scalar_env_bit_for_bit(
-    replayer: BatchedReplayer, env_id: str, actions: int, steps: int, env_kwargs: dict[str, int] | None
+    replayer: BatchedReplayer,
+    env_id: str,
+    actions: int,
+    steps: int,
+    env_kwargs: dict[str, int | bool] | None,
 ) -> None:
     # Deterministic (fixed seeds): random actions visit many more states than the lab's policies.
     rng = np.random.default_rng(20240601)
@@ -258,6 +275,103 @@ def test_batched_replay_matches_the_scalar_env_bit_for_bit(
         )
     for batched, log in zip(replay_episodes(logs), logs, strict=True):
         assert_same_replay(batched, replay_episode(log))
+
+
+BOUNDED_COUNTS = [1, 2, 3, 4, 13, 3 * 2**30, 2**31 + 1, 2**32 - 5, 2**32]
+
+
+@pytest.mark.parametrize("count", BOUNDED_COUNTS, ids=[str(count) for count in BOUNDED_COUNTS])
+def test_card_draws_are_numpys_bounded_draws(count: int) -> None:
+    # Counts near 2**32 reject about a third of the draws, so Lemire's rejection loop is exercised.
+    for seed in (0, 1, 2**40 + 7, 2**63 - 1):
+        generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
+        draws = SeededDraws(seed)
+
+        assert [draws.bounded(count) for _ in range(50)] == [
+            int(generator.integers(0, count)) for _ in range(50)
+        ]
+
+
+@pytest.mark.parametrize(
+    "sequence",
+    [[1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 10, 10, 10], ["C", "D", "H", "S"], ["J", "Q", "K"]],
+    ids=["deck", "suits", "faces"],
+)
+def test_card_draws_choose_as_generator_choice_does(sequence: list[object]) -> None:
+    generator, _ = gymnasium.utils.seeding.np_random(2024)
+    draws = SeededDraws(2024)
+
+    assert [draws.choice(sequence) for _ in range(100)] == [
+        generator.choice(sequence).item() for _ in range(100)
+    ]
+
+
+def test_seeded_draws_interleave_doubles_and_bounded_draws_as_numpy_does() -> None:
+    # A double takes a whole 64-bit output; the high half of an earlier 32-bit draw stays kept.
+    operations = [13, "random", 13, 4, "random", "random", 3, 13, 13, 13, "random", 2**32 - 5] * 5
+    for seed in (0, 5, 2**62 + 3):
+        generator, _ = gymnasium.utils.seeding.np_random(seed)
+        draws = SeededDraws(seed)
+
+        expected = [
+            generator.random() if op == "random" else int(generator.integers(0, op)) for op in operations
+        ]
+        assert [draws.random() if op == "random" else draws.bounded(op) for op in operations] == expected
+
+
+def test_batched_blackjack_matches_gymnasiums_env_over_many_seeds() -> None:
+    # Deterministic: 3000 grader-stream seeds, random hit/stick sequences (long ones run past the end).
+    rng = np.random.default_rng(4096)
+    kwargs = {"natural": False, "sab": False}
+    seeds = reset_seeds(77, 3000)
+    logs = [played("Blackjack-v1", seed, rng.integers(0, 2, 1 + seed % 7).tolist(), kwargs) for seed in seeds]
+    env = gymnasium.make("Blackjack-v1", **kwargs)
+
+    for batched, log in zip(BlackjackReplayer().replay(logs), logs, strict=True):
+        observations = [env.reset(seed=log.reset_seed)[0]]
+        rewards, terminated = [], []
+        for action in log.actions:
+            observation, reward, ended, _, _ = env.step(action)
+            observations.append(observation)
+            rewards.append(float(reward))
+            terminated.append(ended)
+            if ended:
+                break
+        assert (batched.observations, batched.rewards, batched.terminated) == (
+            observations,
+            rewards,
+            terminated,
+        )
+        assert batched.finished == terminated[-1]
+
+
+def test_a_wrong_batched_blackjack_is_discarded_for_the_scalar_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    rng = np.random.default_rng(99)
+    logs = [
+        played("Blackjack-v1", seed, rng.integers(0, 2, 3).tolist(), {"natural": False, "sab": False})
+        for seed in range(50)
+    ]
+    expected = [replay_episode(log) for log in logs]
+    monkeypatch.setattr(SeededDraws, "bounded", lambda self, count: 0)
+
+    assert replay._batch_or_none(BlackjackReplayer(), logs) is None
+    for batched, scalar in zip(replay_episodes(logs), expected, strict=True):
+        assert_same_replay(batched, scalar)
+        assert batched.matches
+
+
+def test_forged_blackjack_rewards_are_caught_in_a_batch() -> None:
+    rng = np.random.default_rng(5)
+    kwargs = {"natural": False, "sab": False}
+    logs = [played("Blackjack-v1", seed, rng.integers(0, 2, 2).tolist(), kwargs) for seed in range(30)]
+    forged = dataclasses.replace(logs[7], rewards=[1.0] * logs[7].steps)
+    assert forged.rewards != logs[7].rewards
+
+    replays = replay_episodes([*logs[:7], forged, *logs[8:]])
+
+    assert [replayed.matches for replayed in replays] == [index != 7 for index in range(30)]
+    assert replays[7].mismatch == replay_episode(forged).mismatch
+    assert replays[7].mismatch is not None and "your code saw reward=1.0" in replays[7].mismatch
 
 
 def test_replay_stops_at_the_real_end_of_the_episode() -> None:
