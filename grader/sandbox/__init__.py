@@ -10,7 +10,23 @@ from grader.sandbox.replay import Replay, replay_episode
 from grader.sandbox.runner import Sandbox, run_calls
 
 __all__ = [
-    "Call", "CallOutcome", "EpisodeLog", "FunctionInfo", "IsolationPolicy", "IsolationReport",
-    "IsolationUnavailable", "LayerReport", "Limits", "OutcomeStatus", "ParameterInfo", "PlainValue", "Replay",
-    "Sandbox", "SandboxClosedError", "SandboxError", "probe_isolation", "replay_episode", "run_calls",
+    "Call",
+    "CallOutcome",
+    "EpisodeLog",
+    "FunctionInfo",
+    "IsolationPolicy",
+    "IsolationReport",
+    "IsolationUnavailable",
+    "LayerReport",
+    "Limits",
+    "OutcomeStatus",
+    "ParameterInfo",
+    "PlainValue",
+    "Replay",
+    "Sandbox",
+    "SandboxClosedError",
+    "SandboxError",
+    "probe_isolation",
+    "replay_episode",
+    "run_calls",
 ]

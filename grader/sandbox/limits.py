@@ -53,7 +53,16 @@ class Limits:
                 f"memory_bytes must be at least 1.5 GiB (numpy and gymnasium need that much address space); "
                 f"found {self.memory_bytes} bytes: raise the limit"
             )
-        for name in ("call_seconds", "import_seconds", "cpu_seconds", "max_pids", "output_bytes",
-                     "scratch_bytes", "file_bytes", "open_files", "frame_bytes"):
+        for name in (
+            "call_seconds",
+            "import_seconds",
+            "cpu_seconds",
+            "max_pids",
+            "output_bytes",
+            "scratch_bytes",
+            "file_bytes",
+            "open_files",
+            "frame_bytes",
+        ):
             if getattr(self, name) <= 0:
                 raise ValueError(f"{name} must be positive; found {getattr(self, name)}")

@@ -39,7 +39,7 @@ class CappedOutput:
     def add(self, data: bytes) -> None:
         """Appends `data`, keeping at most `cap` bytes in total."""
         room = self.cap - len(self.head)
-        self.head += data[:max(room, 0)]
+        self.head += data[: max(room, 0)]
         self.dropped += max(len(data) - max(room, 0), 0)
 
     def take(self) -> str:
@@ -98,9 +98,15 @@ class ChildProcess:
         try:
             launch = make_launch(requests_read, results_write)
             process = subprocess.Popen(
-                launch.argv, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                pass_fds=(requests_read, results_write, *launch.pass_fds), env=launch.env,
-                start_new_session=True, close_fds=True, cwd=launch.cwd,
+                launch.argv,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                pass_fds=(requests_read, results_write, *launch.pass_fds),
+                env=launch.env,
+                start_new_session=True,
+                close_fds=True,
+                cwd=launch.cwd,
             )
         except BaseException:
             for descriptor in (requests_write, results_read):
@@ -114,12 +120,21 @@ class ChildProcess:
         launch.close_descriptors()
         if process.stdout is None or process.stderr is None:
             raise OSError("the child's output pipes were not created")
-        child = cls(launch, process, requests_write, results_read, CappedOutput(output_bytes),
-                    CappedOutput(output_bytes))
+        child = cls(
+            launch,
+            process,
+            requests_write,
+            results_read,
+            CappedOutput(output_bytes),
+            CappedOutput(output_bytes),
+        )
         if launch.cgroup is not None:
             child.oom_kills_at_start = launch.cgroup.oom_kills()
-        child._open = {process.stdout.fileno(): child.stdout, process.stderr.fileno(): child.stderr,
-                       results_read: None}
+        child._open = {
+            process.stdout.fileno(): child.stdout,
+            process.stderr.fileno(): child.stderr,
+            results_read: None,
+        }
         for descriptor in (*child._open, requests_write):
             os.set_blocking(descriptor, False)
         _RUNNING.add(child)
@@ -137,7 +152,7 @@ class ChildProcess:
             selector.register(self.requests_fd, selectors.EVENT_WRITE)
             while view:
                 try:
-                    view = view[os.write(self.requests_fd, view):]
+                    view = view[os.write(self.requests_fd, view) :]
                     continue
                 except BlockingIOError:
                     pass
@@ -175,7 +190,7 @@ class ChildProcess:
     def _frame_state(self, max_frame: int) -> FrameWait | None:
         if len(self._pending) < HEADER.size:
             return None
-        (size,) = HEADER.unpack(self._pending[:HEADER.size])
+        (size,) = HEADER.unpack(self._pending[: HEADER.size])
         if size > max_frame:
             return FrameWait(FrameEnd.TOO_LARGE, size=size)
         end = HEADER.size + size
@@ -184,7 +199,7 @@ class ChildProcess:
         self.drain_output()
         if len(self._pending) > end:
             return FrameWait(FrameEnd.EXTRA_DATA, size=size)
-        payload = bytes(self._pending[HEADER.size:end])
+        payload = bytes(self._pending[HEADER.size : end])
         del self._pending[:end]
         return FrameWait(FrameEnd.FRAME, payload)
 
@@ -275,5 +290,3 @@ class ChildProcess:
         """Kills processes the child left behind after its main process exited (daemons)."""
         if self.launch.cgroup is not None:
             self.launch.cgroup.kill()
-
-

@@ -27,21 +27,36 @@ IMPORT_SEED_INDEX = 2**31
 """`derive_call_seed(seed, IMPORT_SEED_INDEX)` seeds randomness while the submission is imported."""
 
 _CHILD_STATUSES = {
-    "ok": OutcomeStatus.OK, "exception": OutcomeStatus.EXCEPTION,
-    "missing_function": OutcomeStatus.MISSING_FUNCTION, "bad_signature": OutcomeStatus.BAD_SIGNATURE,
-    "invalid_value": OutcomeStatus.INVALID_VALUE, "output_too_large": OutcomeStatus.OUTPUT_TOO_LARGE,
+    "ok": OutcomeStatus.OK,
+    "exception": OutcomeStatus.EXCEPTION,
+    "missing_function": OutcomeStatus.MISSING_FUNCTION,
+    "bad_signature": OutcomeStatus.BAD_SIGNATURE,
+    "invalid_value": OutcomeStatus.INVALID_VALUE,
+    "output_too_large": OutcomeStatus.OUTPUT_TOO_LARGE,
     "memory_limit": OutcomeStatus.MEMORY_LIMIT,
 }
-_RESULT_FIELDS = {"type", "id", "nonce", "status", "value", "message", "traceback", "episodes",
-                  "compat_events", "wall_time"}
+_RESULT_FIELDS = {
+    "type",
+    "id",
+    "nonce",
+    "status",
+    "value",
+    "message",
+    "traceback",
+    "episodes",
+    "compat_events",
+    "wall_time",
+}
 
 
 def _unavailable_message(report: IsolationReport) -> str:
     lines = [f"- {layer.name}: {layer.detail}; to fix: {layer.remedy}" for layer in report.missing]
-    return ("full isolation is required to run untrusted submissions, but these layers are missing:\n"
-            + "\n".join(lines)
-            + "\nInstall what is missing, or (only for your own code) pass IsolationPolicy.ALLOW_FALLBACK "
-              "(`gymgrade check` does; `gymgrade grade --allow-weak-isolation`).")
+    return (
+        "full isolation is required to run untrusted submissions, but these layers are missing:\n"
+        + "\n".join(lines)
+        + "\nInstall what is missing, or (only for your own code) pass IsolationPolicy.ALLOW_FALLBACK "
+        "(`gymgrade check` does; `gymgrade grade --allow-weak-isolation`)."
+    )
 
 
 def _file_name(submission: Path) -> str:
@@ -60,9 +75,15 @@ class Sandbox:
         isolation: The layers of isolation protecting the children.
     """
 
-    def __init__(self, submission: Path, *, seed: int, limits: Limits | None = None,
-                 policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL,
-                 isolation: IsolationReport | None = None) -> None:
+    def __init__(
+        self,
+        submission: Path,
+        *,
+        seed: int,
+        limits: Limits | None = None,
+        policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL,
+        isolation: IsolationReport | None = None,
+    ) -> None:
         """Prepares the sandbox (the child starts with the first call or `functions`).
 
         Args:
@@ -95,8 +116,9 @@ class Sandbox:
     def __enter__(self) -> Sandbox:
         return self
 
-    def __exit__(self, kind: type[BaseException] | None, error: BaseException | None,
-                 traceback: TracebackType | None) -> None:
+    def __exit__(
+        self, kind: type[BaseException] | None, error: BaseException | None, traceback: TracebackType | None
+    ) -> None:
         self.close()
 
     @property
@@ -132,8 +154,16 @@ class Sandbox:
             failure = self._import_failure or Ending(OutcomeStatus.SANDBOX_ERROR, "the child did not start")
             return self._outcome(call, seed, failure, stdout=failure.stdout, stderr=failure.stderr)
         nonce = secrets.token_hex(16)
-        request = {"type": "call", "id": index, "nonce": nonce, "function": call.function, "args": arguments,
-                   "kwargs": keywords, "seed": seed, "record": call.record_episodes}
+        request = {
+            "type": "call",
+            "id": index,
+            "nonce": nonce,
+            "function": call.function,
+            "args": arguments,
+            "kwargs": keywords,
+            "seed": seed,
+            "record": call.record_episodes,
+        }
         child.reset_oom_baseline()
         started = time.perf_counter()
         sent = child.send(encode_frame(request, self.limits.frame_bytes), self.limits.call_seconds)
@@ -143,21 +173,26 @@ class Sandbox:
         else:
             wait = FrameWait(sent)
         if wait.end is FrameEnd.FRAME and child.oom_killed():
-            ending = Ending(OutcomeStatus.MEMORY_LIMIT,
-                            f"a process started by {call.function}() used more than "
-                            f"{self.limits.memory_bytes >> 20} MiB of memory together with the others "
-                            "and was stopped; use less memory")
+            ending = Ending(
+                OutcomeStatus.MEMORY_LIMIT,
+                f"a process started by {call.function}() used more than "
+                f"{self.limits.memory_bytes >> 20} MiB of memory together with the others "
+                "and was stopped; use less memory",
+            )
             return self._fatal(call, seed, started, ending)
         if wait.end is FrameEnd.FRAME:
             return self._result(call, seed, started, wait.payload, index, nonce)
         if wait.end is FrameEnd.TIMEOUT:
             child.kill_tree()
-            ending = Ending(OutcomeStatus.TIMEOUT,
-                            f"{call.function}() did not return within {self.limits.call_seconds:g} seconds")
+            ending = Ending(
+                OutcomeStatus.TIMEOUT,
+                f"{call.function}() did not return within {self.limits.call_seconds:g} seconds",
+            )
         elif wait.end is FrameEnd.TOO_LARGE:  # the harness reports oversized results in a small frame
             child.kill_tree()
-            ending = _forged(f"a frame announced {wait.size} bytes, more than the limit of "
-                             f"{self.limits.frame_bytes} bytes")
+            ending = _forged(
+                f"a frame announced {wait.size} bytes, more than the limit of {self.limits.frame_bytes} bytes"
+            )
         elif wait.end is FrameEnd.EXTRA_DATA:
             child.kill_tree()
             ending = _forged("more than one result frame arrived")
@@ -165,8 +200,9 @@ class Sandbox:
             ending = classify_exit(child, call.function, self.limits)
         return self._fatal(call, seed, started, ending)
 
-    def _result(self, call: Call, seed: int, started: float, payload: bytes, index: int,
-                nonce: str) -> CallOutcome:
+    def _result(
+        self, call: Call, seed: int, started: float, payload: bytes, index: int, nonce: str
+    ) -> CallOutcome:
         elapsed = time.perf_counter() - started
         child = self._child
         try:
@@ -190,9 +226,16 @@ class Sandbox:
             except (InvalidValueError, InvalidEpisodeLogError) as error:
                 return self._fatal(call, seed, started, _forged(str(error)))
         return CallOutcome(
-            call=call, status=status, value=value, episodes=episodes, compat_events=frame["compat_events"],
-            stdout=child.stdout.take() if child else "", stderr=child.stderr.take() if child else "",
-            message=message, wall_time=wall_time, seed=seed,
+            call=call,
+            status=status,
+            value=value,
+            episodes=episodes,
+            compat_events=frame["compat_events"],
+            stdout=child.stdout.take() if child else "",
+            stderr=child.stderr.take() if child else "",
+            message=message,
+            wall_time=wall_time,
+            seed=seed,
         )
 
     def _fatal(self, call: Call, seed: int, started: float, ending: Ending) -> CallOutcome:
@@ -200,14 +243,24 @@ class Sandbox:
         stdout = child.stdout.take() if child is not None else ""
         stderr = child.stderr.take() if child is not None else ""
         self._stop_child()
-        return self._outcome(call, seed, ending, stdout=stdout, stderr=stderr,
-                             wall_time=time.perf_counter() - started)
+        return self._outcome(
+            call, seed, ending, stdout=stdout, stderr=stderr, wall_time=time.perf_counter() - started
+        )
 
-    def _outcome(self, call: Call, seed: int, ending: Ending, *, stdout: str, stderr: str,
-                 wall_time: float = 0.0) -> CallOutcome:
+    def _outcome(
+        self, call: Call, seed: int, ending: Ending, *, stdout: str, stderr: str, wall_time: float = 0.0
+    ) -> CallOutcome:
         return CallOutcome(
-            call=call, status=ending.status, value=None, episodes=[], compat_events=[], stdout=stdout,
-            stderr=stderr, message=ending.message, wall_time=wall_time, seed=seed,
+            call=call,
+            status=ending.status,
+            value=None,
+            episodes=[],
+            compat_events=[],
+            stdout=stdout,
+            stderr=stderr,
+            message=ending.message,
+            wall_time=wall_time,
+            seed=seed,
         )
 
     def _ensure_child(self) -> ChildProcess | None:
@@ -216,15 +269,22 @@ class Sandbox:
         limits = self.limits
 
         def make_launch(requests_fd: int, results_fd: int) -> Any:
-            return build_launch(self.isolation, limits, submission=self._source, submission_name=self._name,
-                                requests_fd=requests_fd, results_fd=results_fd,
-                                import_seed=derive_call_seed(self.seed, IMPORT_SEED_INDEX))
+            return build_launch(
+                self.isolation,
+                limits,
+                submission=self._source,
+                submission_name=self._name,
+                requests_fd=requests_fd,
+                results_fd=results_fd,
+                import_seed=derive_call_seed(self.seed, IMPORT_SEED_INDEX),
+            )
 
         try:
             child = ChildProcess.start(make_launch, limits.output_bytes)
         except OSError as error:
-            self._import_failure = Ending(OutcomeStatus.SANDBOX_ERROR,
-                                          f"the sandbox could not start: {error}")
+            self._import_failure = Ending(
+                OutcomeStatus.SANDBOX_ERROR, f"the sandbox could not start: {error}"
+            )
             return None
         self._child = child
         ending = self._await_ready(child)
@@ -238,9 +298,11 @@ class Sandbox:
         wait = child.wait_frame(self.limits.import_seconds, self.limits.frame_bytes)
         if wait.end is FrameEnd.TIMEOUT:
             child.kill_tree()
-            return Ending(OutcomeStatus.TIMEOUT,
-                          f"importing your file took more than {self.limits.import_seconds:g} seconds; move "
-                          "long-running code into functions or under `if __name__ == \"__main__\":`")
+            return Ending(
+                OutcomeStatus.TIMEOUT,
+                f"importing your file took more than {self.limits.import_seconds:g} seconds; move "
+                'long-running code into functions or under `if __name__ == "__main__":`',
+            )
         if wait.end is FrameEnd.CLOSED:
             return classify_exit(child, None, self.limits)
         if wait.end is not FrameEnd.FRAME:
@@ -281,8 +343,10 @@ def _frame_problem(frame: dict[str, Any], index: int, nonce: str) -> str:
         return "wall_time must be a non-negative number"
     events = frame["compat_events"]
     if type(events) is not list or not all(
-        type(event) is dict and event.keys() == {"kind", "env_id", "detail"}
-        and all(type(item) is str for item in event.values()) for event in events
+        type(event) is dict
+        and event.keys() == {"kind", "env_id", "detail"}
+        and all(type(item) is str for item in event.values())
+        for event in events
     ):
         return "compat_events must be a list of {kind, env_id, detail} strings"
     return ""
@@ -293,28 +357,46 @@ def _forged(detail: str) -> Ending:
 
 
 def _function_table(frame: dict[str, Any]) -> dict[str, FunctionInfo] | None:
-    if (frame.keys() != {"type", "functions"} or frame["type"] != "ready"
-            or type(frame["functions"]) is not dict):
+    if (
+        frame.keys() != {"type", "functions"}
+        or frame["type"] != "ready"
+        or type(frame["functions"]) is not dict
+    ):
         return None
     table: dict[str, FunctionInfo] = {}
     for name, info in frame["functions"].items():
-        if (type(info) is not dict or info.keys() != {"parameters", "is_callable"}
-                or type(info["is_callable"]) is not bool):
+        if (
+            type(info) is not dict
+            or info.keys() != {"parameters", "is_callable"}
+            or type(info["is_callable"]) is not bool
+        ):
             return None
         parameters = info["parameters"]
         if type(parameters) is not list:
             return None
         try:
-            table[name] = FunctionInfo(name, info["is_callable"], tuple(
-                ParameterInfo(p["name"], p["kind"], p["has_default"]) for p in parameters
-                if type(p["name"]) is str and type(p["kind"]) is str and type(p["has_default"]) is bool))
+            table[name] = FunctionInfo(
+                name,
+                info["is_callable"],
+                tuple(
+                    ParameterInfo(p["name"], p["kind"], p["has_default"])
+                    for p in parameters
+                    if type(p["name"]) is str and type(p["kind"]) is str and type(p["has_default"]) is bool
+                ),
+            )
         except (KeyError, TypeError):
             return None
     return table
 
 
-def run_calls(submission: Path, calls: Iterable[Call], *, seed: int, limits: Limits | None = None,
-              policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL) -> list[CallOutcome]:
+def run_calls(
+    submission: Path,
+    calls: Iterable[Call],
+    *,
+    seed: int,
+    limits: Limits | None = None,
+    policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL,
+) -> list[CallOutcome]:
     """Runs `calls` in order in one `Sandbox` and returns their outcomes (same order).
 
     Raises:

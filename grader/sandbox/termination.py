@@ -26,8 +26,10 @@ class Ending:
 
 def forged_message(detail: str) -> str:
     """The message for data on the result channel that the harness did not send."""
-    return (f"the result channel carried data the harness did not send ({detail}); do not write to the "
-            "grader's file descriptors or imitate its messages: return your result from the function")
+    return (
+        f"the result channel carried data the harness did not send ({detail}); do not write to the "
+        "grader's file descriptors or imitate its messages: return your result from the function"
+    )
 
 
 def _signal_name(number: int) -> str:
@@ -52,37 +54,51 @@ def classify_exit(child: ChildProcess, function: str | None, limits: Limits) -> 
     code = child.wait_exit()
     if code is None:
         child.kill_tree()
-        return Ending(OutcomeStatus.INVALID_VALUE,
-                      forged_message(f"{_during(function)} closed the grader's result channel"))
+        return Ending(
+            OutcomeStatus.INVALID_VALUE,
+            forged_message(f"{_during(function)} closed the grader's result channel"),
+        )
     if child.oom_killed():
-        return Ending(OutcomeStatus.MEMORY_LIMIT,
-                      f"{_during(function)} used more than {limits.memory_bytes // (1 << 20)} MiB of memory "
-                      "and was stopped; use less memory (smaller arrays, fewer stored episodes)")
+        return Ending(
+            OutcomeStatus.MEMORY_LIMIT,
+            f"{_during(function)} used more than {limits.memory_bytes // (1 << 20)} MiB of memory "
+            "and was stopped; use less memory (smaller arrays, fewer stored episodes)",
+        )
     uses_signal_codes = child.launch.uses_bubblewrap
     number = -code if code < 0 else 0
     if uses_signal_codes and _SIGNAL_BASE < code < _SIGNAL_BASE + 64:
         number = code - _SIGNAL_BASE
     if function is None and code in (1, JOIN_FAILED_EXIT) and _looks_like_sandbox_failure(child):
-        return Ending(OutcomeStatus.SANDBOX_ERROR, "the sandbox failed to start; this is not your fault: "
-                      "tell the instructor")
+        return Ending(
+            OutcomeStatus.SANDBOX_ERROR,
+            "the sandbox failed to start; this is not your fault: tell the instructor",
+        )
     if number == signal.SIGXCPU:
-        return Ending(OutcomeStatus.TIMEOUT, f"{_during(function)} used more than {limits.cpu_seconds} "
-                      "seconds of CPU time and was stopped")
+        return Ending(
+            OutcomeStatus.TIMEOUT,
+            f"{_during(function)} used more than {limits.cpu_seconds} seconds of CPU time and was stopped",
+        )
     if number:
         if number == signal.SIGKILL and child.launch.cgroup is None:
             hint = " (possibly for using too much memory)"
         else:
             hint = ""
-        return Ending(OutcomeStatus.KILLED,
-                      f"{_during(function)} was killed by {_signal_name(number)}{hint}; "
-                      "a signal ended the process before it returned")
+        return Ending(
+            OutcomeStatus.KILLED,
+            f"{_during(function)} was killed by {_signal_name(number)}{hint}; "
+            "a signal ended the process before it returned",
+        )
     what = "your file" if function is None else f"{function}()"
     where = "while being imported" if function is None else "before returning"
-    fix = ("move that code under `if __name__ == \"__main__\":`" if function is None
-           else "return a value instead of calling sys.exit(), exit() or os._exit()")
-    return Ending(OutcomeStatus.EXITED,
-                  f"{what} ended the process with exit status {code} {where} (sys.exit(), exit() or "
-                  f"os._exit()); {fix}")
+    fix = (
+        'move that code under `if __name__ == "__main__":`'
+        if function is None
+        else "return a value instead of calling sys.exit(), exit() or os._exit()"
+    )
+    return Ending(
+        OutcomeStatus.EXITED,
+        f"{what} ended the process with exit status {code} {where} (sys.exit(), exit() or os._exit()); {fix}",
+    )
 
 
 def _looks_like_sandbox_failure(child: ChildProcess) -> bool:

@@ -26,4 +26,3 @@ def test_problem_seeds_are_distinct_63_bit_numbers() -> None:
     seeds = {problem_seed(grading_seed, problem) for grading_seed in range(50) for problem in PROBLEM_IDS}
     assert len(seeds) == 50 * len(PROBLEM_IDS)
     assert all(0 <= seed < 2**63 for seed in seeds)
-

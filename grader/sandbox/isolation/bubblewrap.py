@@ -89,8 +89,17 @@ def bwrap_argv(
         else:
             argv += ["--ro-bind", "/dev/null", str(hidden)]
     argv += ["--ro-bind", str(harness_tree), HARNESS_DIR]
-    argv += ["--perms", "0755", "--dir", SUBMISSION_DIR,
-             "--perms", "0444", "--ro-bind-data", str(submission_fd), f"{SUBMISSION_DIR}/{submission_name}"]
+    argv += [
+        "--perms",
+        "0755",
+        "--dir",
+        SUBMISSION_DIR,
+        "--perms",
+        "0444",
+        "--ro-bind-data",
+        str(submission_fd),
+        f"{SUBMISSION_DIR}/{submission_name}",
+    ]
     argv += ["--proc", "/proc", "--dev", "/dev"]
     argv += [*_scratch(scratch_bytes), "--chdir", SCRATCH_DIR]
     for name, value in env.items():
@@ -119,6 +128,9 @@ class BubblewrapLayer:
             return LayerReport(self.name, False, f"bwrap could not run ({error})", _REMEDY)
         if result.returncode != 0:
             return LayerReport(self.name, False, f"bwrap failed: {result.stderr.strip()}", _REMEDY)
-        return LayerReport(self.name, True,
-                           "all namespaces unshared (no network, own PID space), read-only minimal file "
-                           "system, size-limited scratch tmpfs, die-with-parent, cleared environment")
+        return LayerReport(
+            self.name,
+            True,
+            "all namespaces unshared (no network, own PID space), read-only minimal file "
+            "system, size-limited scratch tmpfs, die-with-parent, cleared environment",
+        )

@@ -242,7 +242,12 @@ class CgroupLayer:
         job.remove()
         missing = [c for c in CONTROLLERS if c not in limited]
         if missing:
-            return LayerReport(self.name, False, f"controllers {', '.join(missing)} are not available",
-                               "mount the cgroup controllers or delegate them to this user (" + _REMEDY + ")")
-        return LayerReport(self.name, True,
-                           f"cgroup {'+'.join(versions)}: memory, pids and cpu limited per child")
+            return LayerReport(
+                self.name,
+                False,
+                f"controllers {', '.join(missing)} are not available",
+                "mount the cgroup controllers or delegate them to this user (" + _REMEDY + ")",
+            )
+        return LayerReport(
+            self.name, True, f"cgroup {'+'.join(versions)}: memory, pids and cpu limited per child"
+        )

@@ -92,8 +92,11 @@ def harness_tree() -> Path:
     (lib / "grader" / "__init__.py").write_text("")
     (lib / "grader" / "sandbox" / "__init__.py").write_text("")
     for relative in _HARNESS_SOURCES:
-        shutil.copytree(_GRADER_ROOT / relative, lib / "grader" / relative,
-                        ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        shutil.copytree(
+            _GRADER_ROOT / relative,
+            lib / "grader" / relative,
+            ignore=shutil.ignore_patterns("__pycache__", "*.pyc"),
+        )
     for name in ("bootstrap.py", "landlock.py"):
         shutil.copy2(_ISOLATION_DIR / name, root / name)
     for directory, _, files in os.walk(root):

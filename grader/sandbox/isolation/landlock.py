@@ -37,8 +37,9 @@ def abi_version() -> int:
     """The Landlock ABI of the running kernel, 0 when Landlock is unavailable (or not Linux x86-64/arm64)."""
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "aarch64"):
         return 0
-    result = _libc().syscall(_SYSCALLS["create_ruleset"], None, ctypes.c_size_t(0),
-                             ctypes.c_uint32(_CREATE_RULESET_VERSION))
+    result = _libc().syscall(
+        _SYSCALLS["create_ruleset"], None, ctypes.c_size_t(0), ctypes.c_uint32(_CREATE_RULESET_VERSION)
+    )
     return max(int(result), 0)
 
 
@@ -69,8 +70,9 @@ def restrict_self(read_paths: list[str], write_paths: list[str]) -> int:
     handled = _handled(abi)
     attr = _RulesetAttr(handled, _NET_BIND_TCP | _NET_CONNECT_TCP if abi >= 4 else 0)
     size = ctypes.sizeof(_RulesetAttr) if abi >= 4 else ctypes.sizeof(ctypes.c_uint64)
-    ruleset = libc.syscall(_SYSCALLS["create_ruleset"], ctypes.byref(attr), ctypes.c_size_t(size),
-                           ctypes.c_uint32(0))
+    ruleset = libc.syscall(
+        _SYSCALLS["create_ruleset"], ctypes.byref(attr), ctypes.c_size_t(size), ctypes.c_uint32(0)
+    )
     if ruleset < 0:
         raise OSError(ctypes.get_errno(), "landlock_create_ruleset failed")
     try:
@@ -96,8 +98,12 @@ def _add_rule(libc: ctypes.CDLL, ruleset: int, path: str, access: int) -> None:
         if not os.path.isdir(path):
             access &= EXECUTE | WRITE_FILE | READ_FILE | _TRUNCATE
         rule = _PathBeneathAttr(access, descriptor)
-        if libc.syscall(_SYSCALLS["add_rule"], ruleset, _RULE_PATH_BENEATH, ctypes.byref(rule),
-                        ctypes.c_uint32(0)) != 0:
+        if (
+            libc.syscall(
+                _SYSCALLS["add_rule"], ruleset, _RULE_PATH_BENEATH, ctypes.byref(rule), ctypes.c_uint32(0)
+            )
+            != 0
+        ):
             raise OSError(ctypes.get_errno(), f"landlock_add_rule failed for {path}")
     finally:
         os.close(descriptor)

@@ -63,8 +63,13 @@ class Launch:
 
 def _child_env(scratch: str) -> dict[str, str]:
     return {
-        "PATH": "/usr/bin:/bin", "HOME": scratch, "TMPDIR": scratch, "LANG": "C.UTF-8",
-        "PYTHONHASHSEED": "0", "PYTHONDONTWRITEBYTECODE": "1", "MPLCONFIGDIR": f"{scratch}/.matplotlib",
+        "PATH": "/usr/bin:/bin",
+        "HOME": scratch,
+        "TMPDIR": scratch,
+        "LANG": "C.UTF-8",
+        "PYTHONHASHSEED": "0",
+        "PYTHONDONTWRITEBYTECODE": "1",
+        "MPLCONFIGDIR": f"{scratch}/.matplotlib",
     }
 
 
@@ -105,8 +110,13 @@ def build_launch(
             submission_path = f"{bubblewrap.SUBMISSION_DIR}/{submission_name}"
             launch.env = {}
             outer = bubblewrap.bwrap_argv(
-                paths, tree, submission_fd=submission_fd, submission_name=submission_name,
-                seccomp_fd=seccomp_fd, scratch_bytes=limits.scratch_bytes, env=_child_env(scratch),
+                paths,
+                tree,
+                submission_fd=submission_fd,
+                submission_name=submission_name,
+                seccomp_fd=seccomp_fd,
+                scratch_bytes=limits.scratch_bytes,
+                env=_child_env(scratch),
             )
             bootstrap_seccomp = None
         else:
@@ -124,24 +134,46 @@ def build_launch(
             bootstrap_seccomp = seccomp_fd
         landlock = None
         if report.is_active("landlock") and not use_bwrap:
-            read = [*map(str, paths.roots), *bubblewrap.SYSTEM_DIRS, str(tree), "/dev/null", "/dev/urandom",
-                    "/proc/self", "/etc/ld.so.cache", "/etc/localtime"]
+            read = [
+                *map(str, paths.roots),
+                *bubblewrap.SYSTEM_DIRS,
+                str(tree),
+                "/dev/null",
+                "/dev/urandom",
+                "/proc/self",
+                "/etc/ld.so.cache",
+                "/etc/localtime",
+            ]
             landlock = {"read": read, "write": [scratch]}
         config = {
             "sys_path": [f"{harness_dir}/lib", *paths.stdlib, *paths.site_dirs],
-            "rlimits": rlimit_table(limits, dropped_uid=drop_uid,
-                                    own_user_namespace=use_bwrap and not privileges.running_as_root()),
+            "rlimits": rlimit_table(
+                limits,
+                dropped_uid=drop_uid,
+                own_user_namespace=use_bwrap and not privileges.running_as_root(),
+            ),
             "landlock": landlock,
             "seccomp_fd": bootstrap_seccomp,
             "harness_argv": [
-                "--submission", submission_path, "--requests", str(requests_fd), "--results", str(results_fd),
-                "--max-frame", str(limits.frame_bytes), "--seed", str(import_seed),
+                "--submission",
+                submission_path,
+                "--requests",
+                str(requests_fd),
+                "--results",
+                str(results_fd),
+                "--max-frame",
+                str(limits.frame_bytes),
+                "--seed",
+                str(import_seed),
             ],
         }
         inner = [str(paths.executable), "-S", "-B", f"{harness_dir}/bootstrap.py", json.dumps(config)]
         drop = privileges.drop_argv() if drop_uid else []
-        join = (["/bin/sh", "-c", _JOIN_CGROUPS, "gymgrade-join", *map(str, launch.cgroup.procs_files), "--"]
-                if launch.cgroup is not None else [])
+        join = (
+            ["/bin/sh", "-c", _JOIN_CGROUPS, "gymgrade-join", *map(str, launch.cgroup.procs_files), "--"]
+            if launch.cgroup is not None
+            else []
+        )
         launch.argv = [*join, *outer, *drop, *inner]
     except BaseException:
         launch.cleanup()

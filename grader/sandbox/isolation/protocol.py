@@ -80,8 +80,13 @@ class IsolationReport:
         return {
             "full": self.full,
             "layers": [
-                {"name": layer.name, "active": layer.active, "required": layer.required,
-                 "detail": layer.detail, "remedy": layer.remedy}
+                {
+                    "name": layer.name,
+                    "active": layer.active,
+                    "required": layer.required,
+                    "detail": layer.detail,
+                    "remedy": layer.remedy,
+                }
                 for layer in self.layers
             ],
         }

@@ -46,6 +46,10 @@ class RlimitsLayer:
         table = rlimit_table(Limits(), dropped_uid=True, own_user_namespace=False)
         missing = [name for name, _, _ in table if not hasattr(resource, name)]
         if missing:
-            return LayerReport(self.name, False, f"this system lacks {', '.join(missing)}",
-                               "grade on Linux, where every limit exists")
+            return LayerReport(
+                self.name,
+                False,
+                f"this system lacks {', '.join(missing)}",
+                "grade on Linux, where every limit exists",
+            )
         return LayerReport(self.name, True, "CPU time, address space, file size, open files, no core dumps")

@@ -19,14 +19,51 @@ _REMEDY = (
 AF_UNIX = 1
 CLONE_NEWUSER = 0x10000000
 DENIED_SYSCALLS = (
-    "ptrace", "process_vm_readv", "process_vm_writev", "kcmp",
-    "mount", "umount2", "pivot_root", "chroot", "move_mount", "open_tree", "fsopen", "fsmount", "fsconfig",
-    "fspick", "mount_setattr", "unshare", "setns",
-    "kexec_load", "kexec_file_load", "reboot", "init_module", "finit_module", "delete_module",
-    "bpf", "perf_event_open", "userfaultfd", "keyctl", "add_key", "request_key",
-    "personality", "acct", "swapon", "swapoff", "syslog", "quotactl", "lookup_dcookie",
-    "settimeofday", "clock_settime", "clock_adjtime", "adjtimex",
-    "iopl", "ioperm", "open_by_handle_at", "name_to_handle_at", "io_uring_setup",
+    "ptrace",
+    "process_vm_readv",
+    "process_vm_writev",
+    "kcmp",
+    "mount",
+    "umount2",
+    "pivot_root",
+    "chroot",
+    "move_mount",
+    "open_tree",
+    "fsopen",
+    "fsmount",
+    "fsconfig",
+    "fspick",
+    "mount_setattr",
+    "unshare",
+    "setns",
+    "kexec_load",
+    "kexec_file_load",
+    "reboot",
+    "init_module",
+    "finit_module",
+    "delete_module",
+    "bpf",
+    "perf_event_open",
+    "userfaultfd",
+    "keyctl",
+    "add_key",
+    "request_key",
+    "personality",
+    "acct",
+    "swapon",
+    "swapoff",
+    "syslog",
+    "quotactl",
+    "lookup_dcookie",
+    "settimeofday",
+    "clock_settime",
+    "clock_adjtime",
+    "adjtimex",
+    "iopl",
+    "ioperm",
+    "open_by_handle_at",
+    "name_to_handle_at",
+    "io_uring_setup",
 )
 """Denied with EPERM: nothing a grading child needs, and each is a known escape or kernel attack surface."""
 
@@ -67,9 +104,7 @@ def compile_filter() -> int:
     syscall_filter.add_rule(
         bindings.ERRNO(errno.EAFNOSUPPORT), "socket", bindings.Arg(0, bindings.NE, AF_UNIX)
     )
-    syscall_filter.add_rule(
-        deny, "clone", bindings.Arg(0, bindings.MASKED_EQ, CLONE_NEWUSER, CLONE_NEWUSER)
-    )
+    syscall_filter.add_rule(deny, "clone", bindings.Arg(0, bindings.MASKED_EQ, CLONE_NEWUSER, CLONE_NEWUSER))
     # clone3 passes its flags in memory a filter cannot read; glibc falls back to clone on ENOSYS.
     syscall_filter.add_rule(bindings.ERRNO(errno.ENOSYS), "clone3")
     descriptor = os.memfd_create("gymgrade-seccomp", 0)
@@ -89,10 +124,12 @@ class SeccompLayer:
         try:
             os.close(compile_filter())
         except OSError as error:
-            return LayerReport(self.name, False, f"cannot build the syscall filter ({error.strerror})",
-                               _REMEDY)
+            return LayerReport(
+                self.name, False, f"cannot build the syscall filter ({error.strerror})", _REMEDY
+            )
         return LayerReport(
-            self.name, True,
+            self.name,
+            True,
             f"{len(DENIED_SYSCALLS)} syscalls denied (ptrace, mount, namespaces, bpf, keyctl, ...), "
             "sockets limited to AF_UNIX",
         )
