@@ -144,12 +144,17 @@ class BlackjackCheck:
         student_curve: dict[str, PlainValue] = {}
         measurements["curve"] = student_curve
         passed_lines = []
+        first_failure: str | None = None
         grouped = episodes_per_call(records, episodes)
+        # Every call is judged, even after a failure, so the report shows the student's whole curve.
         for n, record, call_episodes in zip(settings.thresholds, records, grouped, strict=True):
             failure, line = self._judge_call(settings, n, record, call_episodes, student_curve)
             if failure:
-                return Verdict("failed", 0.0, failure, measurements)
-            passed_lines.append(line)
+                first_failure = first_failure or failure
+            else:
+                passed_lines.append(line)
+        if first_failure:
+            return Verdict("failed", 0.0, first_failure, measurements)
         peak = max(student_curve, key=lambda n: float(student_curve[n] or 0.0))  # type: ignore[arg-type]
         return Verdict(
             "passed",

@@ -121,3 +121,13 @@ def test_measurements_hold_both_curves(seed: int) -> None:
     assert set(verdict.measurements["curve"]) == {"12", "13", "14", "20"}  # type: ignore[arg-type]
     assert verdict.measurements["exact_best_n"] == 13
     assert len(verdict.measurements["exact_curve"]) == 22  # type: ignore[arg-type]
+
+
+def test_a_failing_student_still_gets_the_whole_curve(seed: int) -> None:
+    from grader.checks.behaviours import MISTAKES
+
+    (less_than,) = [mistake for mistake in MISTAKES if mistake.name == "blackjack_less_than"]
+    verdict = grade("blackjack", less_than.functions, seed)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith("blackjack(12) returned")
+    assert set(verdict.measurements["curve"]) == {"12", "13", "14", "20"}  # type: ignore[arg-type]
