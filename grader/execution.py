@@ -10,12 +10,12 @@ from pathlib import Path
 from pydantic import JsonValue
 
 from grader.checks import CHECKS
-from grader.checks.base import CallRecord
+from grader.checks.base import CallRecord, Verdict
+from grader.checks.episodes import replay_call, settled_by
 from grader.config import AssignmentConfig
 from grader.problems import ProblemId
 from grader.report import ProblemResult, ProblemRun, Timings, cap_output, plain_json
 from grader.sandbox import CallOutcome, IsolationPolicy, IsolationReport, Sandbox
-from grader.sandbox.replay import replay_episodes
 
 MAX_COMPAT_EVENTS = 20
 """Distinct compatibility events kept per problem: enough to explain, bounded for 100-call problems."""
@@ -71,12 +71,20 @@ def run_problem(
     settings = config.problem(problem)
     seed = problem_seed(grading_seed, problem)
     limits = config.sandbox.to_limits(settings.call_seconds)
+    records: list[CallRecord] = []
+    stopped: str | None = None
     with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:
         calls = check.plan(settings, sandbox.functions)
-        outcomes = [sandbox.call(call) for call in calls]
+        for call in calls:
+            records.append(replay_call(sandbox.call(call), check.games))
+            stopped = settled_by(records[-1], check.games)
+            if stopped is not None:
+                break
         isolation = isolation_summary(sandbox.isolation)
-    records = [CallRecord(outcome, replay_episodes(outcome.episodes)) for outcome in outcomes]
+    outcomes = [record.outcome for record in records]
     verdict = check.judge(settings, records)
+    if stopped is not None and len(records) < len(calls):
+        verdict = _stopped_early(verdict, stopped, len(records), len(calls))
     wall_seconds = time.perf_counter() - started
     student_seconds = sum(outcome.wall_time for outcome in outcomes)
     fraction = min(max(verdict.fraction, 0.0), 1.0)
@@ -99,6 +107,16 @@ def run_problem(
         ),
     )
     return ProblemRun(submission=str(submission), result=result, isolation=isolation)
+
+
+def _stopped_early(verdict: Verdict, reason: str, made: int, planned: int) -> Verdict:
+    """The verdict of a problem whose calls stopped once it could no longer change, saying so."""
+    measurements = {**verdict.measurements, "calls_planned": planned, "calls_made": made}
+    note = (
+        f" Grading stopped after call {made} of {planned}: {reason}, so no later call could change the "
+        "verdict."
+    )
+    return Verdict(verdict.status, verdict.fraction, verdict.feedback + note, measurements)
 
 
 def student_output(outcomes: Sequence[CallOutcome]) -> str:

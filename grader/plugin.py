@@ -247,7 +247,7 @@ class ResultsWriter:
             seed=problem_seed(self.options.seed, problem),
             detail=detail,
         )
-        self._write(report.nodeid, run.model_dump_json())
+        self._write(report.nodeid, run.to_json())
 
     def _write(self, nodeid: str, line: str) -> None:
         self.written.add(nodeid)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 from typing import Any, Literal
 
@@ -99,6 +100,27 @@ class ProblemRun(BaseModel):
         )
         return cls(submission=submission, result=result, internal_error=detail)
 
+    def to_json(self) -> str:
+        """This run as one JSON line, whatever strings the student's code put into it.
+
+        Strings from the child are cleaned where they enter (`grader.sandbox`); should one still not
+        encode (a lone surrogate, say), the run is written with every unencodable character replaced and
+        the problem marked ``error`` with a note, instead of aborting the grading.
+        """
+        try:
+            return self.model_dump_json()
+        except ValueError as error:
+            cleaned = ProblemRun.model_validate(_encodable(self.model_dump(mode="python")))
+            result = cleaned.result
+            result.status = "error"
+            result.score = 0.0
+            result.feedback = (
+                f"{result.feedback}\n\nYour code's output or values held text that cannot be stored "
+                f"({type(error).__name__}); unencodable characters were replaced and this problem scored 0. "
+                "Print and return plain text only."
+            )
+            return cleaned.model_dump_json()
+
 
 class Report(BaseModel):
     """The whole grade of one submission, serialised as the JSON the CLI prints and the service stores."""
@@ -174,6 +196,20 @@ def plain_json(value: object) -> JsonValue:
     raise TypeError(
         f"a measurement must be plain data (numbers, strings, lists, dicts); found {type(value).__name__}"
     )
+
+
+_SURROGATES = re.compile("[\ud800-\udfff]")
+
+
+def _encodable(value: object) -> object:
+    """`value` with every string made UTF-8 encodable (lone surrogates become U+FFFD)."""
+    if isinstance(value, str):
+        return _SURROGATES.sub("\ufffd", value)
+    if isinstance(value, dict):
+        return {_encodable(key): _encodable(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_encodable(item) for item in value]
+    return value
 
 
 def cap_output(text: str, limit: int = OUTPUT_CAP_CHARS) -> str:

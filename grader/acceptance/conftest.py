@@ -22,10 +22,11 @@ def grade(request: pytest.FixtureRequest, record_property: Callable[[str, object
     def grade_case(case: ProblemCase) -> ProblemResult:
         try:
             run = session.run(case)
+            line = run.to_json()
         except Exception as error:
             record_property(ERROR_PROPERTY, f"{type(error).__name__}: {error}")
             raise
-        record_property(RESULT_PROPERTY, run.model_dump_json())
+        record_property(RESULT_PROPERTY, line)
         return run.result
 
     return grade_case

@@ -186,12 +186,60 @@ def _never_reaches(lab: Lab) -> int:
     return _episode_length(lab.make("MountainCar-v0"), lambda _observation: 2)
 
 
+def _reset_after_make(lab: Lab) -> int:
+    # A real pattern: the lab's "initialize, then reset" before the function's own reset.
+    env = lab.make("CartPole-v0")
+    env.reset()
+    return _episode_length(env, velocity_policy)
+
+
+def _reset_at_loop_end(lab: Lab, n: int) -> float:
+    # A real pattern: reset before the loop and again at the end of every game (the last one unplayed).
+    env = lab.make("Blackjack-v0")
+    env.reset()
+    wins = 0
+    for _ in range(n):
+        done, reward = False, 0.0
+        while not done:
+            _, reward, terminated, truncated, _ = env.step(int(env.action_space.sample()))
+            done = terminated or truncated
+        wins += reward > 0
+        env.reset()
+    return wins / n
+
+
+def _scouting(lab: Lab) -> int:
+    # Resets until the car starts far left (more room to swing), then one blind tape of pushes.
+    env = lab.make("MountainCar-v0")
+    observation, _ = env.reset()
+    while observation[0] > -0.55:
+        observation, _ = env.reset()
+    steps, done = 0, False
+    for action in [0] * 30 + [2] * 170:
+        _, _, terminated, truncated, _ = env.step(action)
+        steps, done = steps + 1, terminated or truncated
+        if done:
+            break
+    return steps
+
+
+def _chosen_start(lab: Lab) -> int:
+    env = lab.make("MountainCar-v0")
+    env.reset(options={"low": 0.55, "high": 0.55})
+    steps, done = 0, False
+    while not done:
+        _, _, terminated, truncated, _ = env.step(2)
+        steps, done = steps + 1, terminated or truncated
+    return steps
+
+
 @dataclass(frozen=True)
 class Behaviour:
     """A simulated student for one problem.
 
     Attributes:
-        name: Identifier (the matching sample is ``submissions/mistakes/<name>.py`` for mistakes).
+        name: Identifier (the matching sample is ``submissions/mistakes/<name>.py`` for most mistakes;
+            the reset patterns and attacks of issue 8 have theirs in ``submissions/hostile/``).
         problem: The problem it is about.
         functions: Simulated functions by name.
         status: The status the checks must give it.
@@ -255,6 +303,15 @@ MISTAKES: tuple[Behaviour, ...] = (
         "after the game was over",
     ),
     Behaviour("car_never_reaches_goal", "car", {"car": _never_reaches}, "failed", "ran out of time"),
+    Behaviour("cartpole_reset_after_make", "cartpole", {"cartpole": _reset_after_make}, "passed"),
+    Behaviour(
+        "random_blackjack_reset_at_loop_end",
+        "random_blackjack",
+        {"random_blackjack": _reset_at_loop_end},
+        "passed",
+    ),
+    Behaviour("car_scouting", "car", {"car": _scouting}, "failed", "games unplayed"),
+    Behaviour("car_reset_options", "car", {"car": _chosen_start}, "failed", "call reset() without options"),
     Behaviour("taxi_final_reward", "taxi", {"taxi": partial(taxi, final_only=True)}, "failed", "LAST reward"),
     Behaviour("taxi_v2", "taxi", {"taxi": partial(taxi, env_id="Taxi-v2")}, "error", "Taxi-v3"),
 )

@@ -8,11 +8,13 @@ from functools import cache
 from typing import TYPE_CHECKING, NamedTuple
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
-from grader.checks.blackjack_games import HIT, count_games, player_sum
+from grader.checks.blackjack_games import GAME_STEPS, HIT, count_games, player_sum
 from grader.checks.episodes import (
     BLACKJACK,
     Episode,
+    GameRules,
     episodes_per_call,
+    games_budget,
     integrity_problem,
     played_episodes,
     repeated_seed_problem,
@@ -118,10 +120,13 @@ class BlackjackCheck:
 
     id: ProblemId = "blackjack"
     title: str = "Problem 2: threshold Blackjack"
+    games: GameRules | None = BLACKJACK
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """One call blackjack(n) per configured n."""
-        return [Call("blackjack", (n,)) for n in _settings(config).thresholds]
+        settings = _settings(config)
+        budget = games_budget(settings.games_per_call, GAME_STEPS)
+        return [Call("blackjack", (n,), budget=budget) for n in settings.thresholds]
 
     @paused_gc
     def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:

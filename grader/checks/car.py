@@ -6,11 +6,14 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
-from grader.checks.episodes import MOUNTAIN_CAR
+from grader.checks.episodes import MOUNTAIN_CAR, GameRules, games_budget
 from grader.checks.lengths import judge_lengths
 from grader.config import CarConfig, ProblemConfig
 from grader.errors import PlanError
 from grader.sandbox.outcome import Call, FunctionInfo
+
+EPISODE_STEPS = 1_000
+"""Steps recorded per game: MountainCar-v0 ends at 200; room for steps after the end to be diagnosed."""
 
 
 def _settings(config: ProblemConfig) -> CarConfig:
@@ -25,10 +28,12 @@ class CarCheck:
 
     id: ProblemId = "car"
     title: str = "Problem 4: MountainCar"
+    games: GameRules | None = MOUNTAIN_CAR
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of car() calls."""
-        return [Call("car") for _ in range(_settings(config).calls)]
+        budget = games_budget(1, EPISODE_STEPS)
+        return [Call("car", budget=budget) for _ in range(_settings(config).calls)]
 
     @paused_gc
     def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:

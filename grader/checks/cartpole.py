@@ -6,11 +6,14 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
-from grader.checks.episodes import CARTPOLE
+from grader.checks.episodes import CARTPOLE, GameRules, games_budget
 from grader.checks.lengths import judge_lengths
 from grader.config import CartpoleConfig, ProblemConfig
 from grader.errors import PlanError
 from grader.sandbox.outcome import Call, FunctionInfo
+
+EPISODE_STEPS = 1_000
+"""Steps recorded per game: CartPole-v0 ends at 200 (v1 at 500); room for steps after the end."""
 
 
 def _settings(config: ProblemConfig) -> CartpoleConfig:
@@ -25,10 +28,12 @@ class CartpoleCheck:
 
     id: ProblemId = "cartpole"
     title: str = "Problem 3: CartPole"
+    games: GameRules | None = CARTPOLE
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of cartpole() calls."""
-        return [Call("cartpole") for _ in range(_settings(config).calls)]
+        budget = games_budget(1, EPISODE_STEPS)
+        return [Call("cartpole", budget=budget) for _ in range(_settings(config).calls)]
 
     @paused_gc
     def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:

@@ -13,11 +13,16 @@ import gymnasium
 from gymnasium.envs.registration import load_env_creator
 
 from grader.checks.base import CallRecord
-from grader.sandbox.replay import verify_reset_seeds
+from grader.sandbox.outcome import CallBudget
+from grader.sandbox.replay import not_replayed, replay_episodes, verify_reset_seeds
 
 if TYPE_CHECKING:
     from grader.sandbox.episodes import EpisodeLog
+    from grader.sandbox.outcome import CallOutcome
     from grader.sandbox.replay import Replay
+
+RESET_SLACK = 8
+"""Resets beyond the planned games a call may record, so that extra resets get a diagnosis, not a cut-off."""
 
 # Constructor arguments that never change a game's rules.
 _HARMLESS_KWARGS = frozenset({"render_mode"})
@@ -106,6 +111,15 @@ def episodes_per_call(records: Sequence[CallRecord], episodes: Sequence[Episode]
     return grouped
 
 
+def all_resets(records: Sequence[CallRecord]) -> list[Episode]:
+    """Every reset of the records, played or not, in reset order (``position``: index among the call's)."""
+    return [
+        Episode(call_index, position, log, replay)
+        for call_index, record in enumerate(records)
+        for position, (log, replay) in enumerate(zip(record.outcome.episodes, record.replays, strict=True))
+    ]
+
+
 @dataclass(frozen=True)
 class GameRules:
     """Which environment a problem must be played in.
@@ -163,6 +177,119 @@ MOUNTAIN_CAR = GameRules("MountainCar-v0", ("MountainCar-v0",))
 TAXI = GameRules("Taxi-v3", ("Taxi-v4", "Taxi-v3"), {"is_rainy": False, "fickle_passenger": False})
 
 
+def games_budget(games: int, steps_per_game: int) -> CallBudget:
+    """What a call that plays `games` games of at most `steps_per_game` steps each may record.
+
+    Twice the games in resets (every unplayed reset is then diagnosed by `scouting_problem`, not cut
+    off), and the steps of the games plus a few more (`RESET_SLACK`). Beyond it the child stops recording
+    and the call fails, so the grader never replays more than this.
+    """
+    return CallBudget(2 * games + RESET_SLACK, (games + RESET_SLACK) * steps_per_game)
+
+
+NO_EPISODES = CallBudget(0, 0)
+"""The budget of a call that records no episodes."""
+
+
+def settled_by(record: CallRecord, rules: GameRules | None) -> str | None:
+    """Why a problem's verdict can no longer change after this call, or None.
+
+    A call that did not return normally scores the problem 0 (`outcome_verdict`); episodes that are not
+    the problem's game, resets with options and unplayed resets fail it (`integrity_problem`). Either way
+    more calls cannot change the verdict and are not made.
+    """
+    status = record.outcome.status.value
+    if status == "timeout":
+        return "it did not return in time"
+    if status != "ok":
+        return f"it ended with {status.replace('_', ' ')}"
+    if _replay_refusal(record.outcome.episodes, rules) is not None or scouting_problem([record]) is not None:
+        return "it broke a rule of the game"
+    return None
+
+
+def replay_call(outcome: CallOutcome, rules: GameRules | None) -> CallRecord:
+    """A call's record: its logs replayed, unless they may not be (then none is, and each says why).
+
+    Whether an episode may be replayed is decided from the log before any env is built: its env id and
+    arguments must be the problem's game (`rules`; None: the problem plays no episodes) and its reset
+    must have no ``options``. Nothing else the student passed reaches an env constructor here.
+    """
+    logs = outcome.episodes
+    refusal = _replay_refusal(logs, rules)
+    if refusal is not None:
+        return CallRecord(outcome, [not_replayed(refusal)] * len(logs))
+    return CallRecord(outcome, replay_episodes(logs))
+
+
+def _replay_refusal(logs: Sequence[EpisodeLog], rules: GameRules | None) -> str | None:
+    if not logs:
+        return None
+    if rules is None:
+        return f"this problem plays no episodes, but the call logged {len(logs)}"
+    environments = {(log.env_id, log.requested_id, repr(sorted(log.env_kwargs.items()))): log for log in logs}
+    for log in environments.values():
+        problem = rules.problem_with(log)
+        if problem:
+            return problem
+    return options_problem(logs)
+
+
+def options_problem(logs: Sequence[EpisodeLog]) -> str | None:
+    """Why resets that passed ``options`` cannot count, or None when none did."""
+    chosen = [number for number, log in enumerate(logs) if log.reset_options]
+    if not chosen:
+        return None
+    options = logs[chosen[0]].reset_options or {}
+    shown = ", ".join(f"{name!r}: {value!r}" for name, value in list(options.items())[:4])[:200]
+    return (
+        f"{len(chosen)} reset(s) passed options (e.g. reset {chosen[0] + 1}: options={{{shown}}}), which "
+        "choose the start of the game instead of letting the environment deal it. Every start must be the "
+        "grader's: call reset() without options"
+    )
+
+
+def scouting_problem(records: Sequence[CallRecord]) -> str | None:
+    """Why some call reset an environment without playing the game it dealt, or None.
+
+    Every reset deals a game the grader counts. A reset that is not played abandons that game; resetting
+    until the start looks easy and playing only that one ("scouting") would choose the starts the
+    statistics rely on. The lab's code needs no such reset, so per environment a call may only leave
+    unplayed its first reset when another reset of that environment follows (the reset right after
+    ``gym.make``, or the one the classic API needed before the first step) and its last reset when an
+    earlier one was played (a reset at the end of the game loop).
+    """
+    for call_index, record in enumerate(records):
+        resets: dict[int, list[int]] = {}
+        for position, log in enumerate(record.outcome.episodes):
+            resets.setdefault(log.env_index, []).append(position)
+        unplayed = [
+            position
+            for positions in resets.values()
+            for order, position in enumerate(positions)
+            if not _tolerated_unplayed(record.outcome.episodes, positions, order)
+        ]
+        if unplayed:
+            total = len(record.outcome.episodes)
+            shown = ", ".join(str(position + 1) for position in unplayed[:5])
+            more = ", ..." if len(unplayed) > 5 else ""
+            return (
+                f"call {call_index + 1} reset its environment {total} times and left {len(unplayed)} "
+                f"of those games unplayed (resets {shown}{more} took no step before the next reset): "
+                "every reset deals a game that counts, and resetting until the start looks easy chooses "
+                "the games. Reset once per game and play every game you reset until `done` is True"
+            )
+    return None
+
+
+def _tolerated_unplayed(logs: Sequence[EpisodeLog], positions: list[int], order: int) -> bool:
+    if logs[positions[order]].steps > 0:
+        return True
+    first_then_more = order == 0 and len(positions) > 1
+    last_after_played = order == len(positions) - 1 and any(logs[p].steps > 0 for p in positions[:order])
+    return first_then_more or last_after_played
+
+
 def seed_problem(records: Sequence[CallRecord]) -> str | None:
     """Why some call's episodes did not start from the seeds the grader's stream prescribes, or None."""
     for record in records:
@@ -177,14 +304,29 @@ def integrity_problem(
 ) -> str | None:
     """The first reason the episodes cannot be trusted or are not the lab's game, or None.
 
-    Checks, in order: a reset seed differs from the grader's stream (an altered log); the replay
-    disagrees with the student's log; the environment or its arguments
-    differ from the lab's game; steps were taken after an episode ended; an episode was abandoned
-    before it ended (reset in the middle of a game, or stopped early).
+    Checks every reset, played or not, in order: a reset seed differs from the grader's stream (an
+    altered log); the environment or its arguments differ from the lab's game; a reset passed
+    ``options``; a reset was left unplayed (`scouting_problem`); the replay disagrees with the student's
+    log; steps were taken after an episode ended; an episode was abandoned before it ended (reset in the
+    middle of a game, or stopped early).
     """
     altered = seed_problem(records)
     if altered:
         return altered
+    resets = all_resets(records)
+    environments = {
+        (e.log.env_id, e.log.requested_id, repr(sorted(e.log.env_kwargs.items()))): e for e in resets
+    }
+    for episode in environments.values():
+        problem = rules.problem_with(episode.log)
+        if problem:
+            return problem
+    chosen = options_problem([episode.log for episode in resets])
+    if chosen:
+        return chosen
+    scouted = scouting_problem(records)
+    if scouted:
+        return scouted
     for episode in episodes:
         if episode.replay.mismatch:
             return (
@@ -192,13 +334,6 @@ def integrity_problem(
                 "every "
                 f"episode in its own environment; results that the real game does not produce cannot count"
             )
-    environments = {
-        (e.log.env_id, e.log.requested_id, repr(sorted(e.log.env_kwargs.items()))): e for e in episodes
-    }
-    for episode in environments.values():
-        problem = rules.problem_with(episode.log)
-        if problem:
-            return problem
     after_done = [episode for episode in episodes if episode.replay.steps_after_done > 0]
     if after_done:
         first = after_done[0]

@@ -10,6 +10,7 @@ from grader.checks.base import CallRecord, Verdict, outcome_verdict
 from grader.checks.episodes import (
     Episode,
     GameRules,
+    all_resets,
     episodes_per_call,
     integrity_problem,
     played_episodes,
@@ -65,7 +66,7 @@ def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]
         return early
     episodes = played_episodes(records)
     problem = integrity_problem(records, episodes, rules) or repeated_seed_problem(
-        episodes, across_calls=True
+        all_resets(records), across_calls=True
     )
     if problem:
         return Verdict("failed", 0.0, f"{function}(): {problem}.", {})

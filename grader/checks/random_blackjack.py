@@ -7,8 +7,16 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
-from grader.checks.blackjack_games import count_games, hits_by_sum
-from grader.checks.episodes import BLACKJACK, integrity_problem, played_episodes, repeated_seed_problem
+from grader.checks.blackjack_games import GAME_STEPS, count_games, hits_by_sum
+from grader.checks.episodes import (
+    BLACKJACK,
+    GameRules,
+    all_resets,
+    games_budget,
+    integrity_problem,
+    played_episodes,
+    repeated_seed_problem,
+)
 from grader.checks.values import as_number, chance_text, describe, rate_mismatch_cause, read_rate
 from grader.config import ProblemConfig, RandomBlackjackConfig
 from grader.errors import PlanError
@@ -32,10 +40,12 @@ class RandomBlackjackCheck:
 
     id: ProblemId = "random_blackjack"
     title: str = "Problem 1: random Blackjack"
+    games: GameRules | None = BLACKJACK
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """One call, random_blackjack(games)."""
-        return [Call("random_blackjack", (_settings(config).games,))]
+        games = _settings(config).games
+        return [Call("random_blackjack", (games,), budget=games_budget(games, GAME_STEPS))]
 
     @paused_gc
     def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
@@ -52,7 +62,7 @@ class RandomBlackjackCheck:
             )
         episodes = played_episodes(records)
         problem = integrity_problem(records, episodes, BLACKJACK) or repeated_seed_problem(
-            episodes, across_calls=False
+            all_resets(records), across_calls=False
         )
         if problem:
             return _fail(f"{call}: {problem}.")

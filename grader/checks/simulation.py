@@ -26,7 +26,7 @@ import numpy as np
 
 from grader.checks.base import CallRecord
 from grader.compat import resolve_env_id
-from grader.sandbox.child.seeding import SeedStream, Stream, mapped_reset_seed, space_seed
+from grader.sandbox.child.seeding import SeedStream, Stream, space_seed
 from grader.sandbox.episodes import EpisodeLog
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
 from grader.sandbox.replay import Replay, replay_episode
@@ -59,6 +59,7 @@ class _Episode:
     terminated: list[bool] = field(default_factory=list)
     truncated: list[bool] = field(default_factory=list)
     ended: bool = False
+    reset_options: dict[str, Any] | None = None
 
     def log(self) -> EpisodeLog:
         return EpisodeLog(
@@ -72,6 +73,7 @@ class _Episode:
             rewards=list(self.rewards),
             terminated=list(self.terminated),
             truncated=list(self.truncated),
+            reset_options=self.reset_options,
         )
 
     def replay_as_played(self) -> Replay:
@@ -114,12 +116,24 @@ class LabEnv:
             self._env.reset(seed=0)
             self._env.unwrapped._np_random = _FastCards(lab.call_seed)  # type: ignore[attr-defined,assignment]
 
-    def reset(self, *, seed: int | None = None) -> tuple[Any, dict[str, Any]]:
-        """Start a new episode; a student seed is mapped like the sandbox maps it."""
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        """Start a new episode; a student seed is mapped like the sandbox maps it; options are logged."""
         reset_seed = self._lab.reset_seed(seed)
-        observation, info = self._env.reset() if self._fast else self._env.reset(seed=reset_seed)
+        if self._fast:
+            observation, info = self._env.reset()
+        else:
+            observation, info = self._env.reset(seed=reset_seed, options=options)
         self._episode = _Episode(
-            self._index, self._requested_id, self._env_id, dict(self._kwargs), reset_seed, seed, [observation]
+            self._index,
+            self._requested_id,
+            self._env_id,
+            dict(self._kwargs),
+            reset_seed,
+            seed,
+            [observation],
+            reset_options=options,
         )
         self._lab.episodes.append(self._episode)
         return observation, info
@@ -160,10 +174,8 @@ class Lab:
         return LabEnv(self, env_id, kwargs)
 
     def reset_seed(self, student_seed: int | None) -> int:
-        """The seed a reset uses: the next grader seed, or the student's seed mapped through the call seed."""
-        if student_seed is None:
-            return self._resets.next()
-        return mapped_reset_seed(self.call_seed, int(student_seed))
+        """The seed a reset uses: the next grader seed (a student's seed is replaced, as in the sandbox)."""
+        return self._resets.next()
 
 
 def simulate_call(

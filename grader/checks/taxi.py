@@ -10,11 +10,20 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
-from grader.checks.episodes import TAXI, Episode, integrity_problem, played_episodes, repeated_seed_problem
+from grader.checks.episodes import (
+    TAXI,
+    Episode,
+    GameRules,
+    all_resets,
+    games_budget,
+    integrity_problem,
+    played_episodes,
+    repeated_seed_problem,
+)
 from grader.checks.values import as_number, describe, same_number
 from grader.config import ProblemConfig, TaxiConfig
 from grader.errors import PlanError
-from grader.sandbox.outcome import Call, FunctionInfo
+from grader.sandbox.outcome import Call, CallBudget, FunctionInfo
 from grader.stats import goodness_of_fit, mean_tolerance
 from reference.oracles import greedy_policy_return, optimal_q_table, optimal_return, random_policy_return
 
@@ -22,6 +31,12 @@ if TYPE_CHECKING:
     from grader.sandbox.outcome import PlainValue
 
 ACTIONS = 6
+EPISODE_STEPS = 250
+"""Steps recorded per game: Taxi-v3 ends at 200; room for steps after the end to be diagnosed."""
+TRAINING_EPISODES = 100_000
+"""Episodes the lab's find_qvalues trains for, played inside a taxi() that trains its own table."""
+TRAINING_STEPS = 4_000_000
+"""Steps those training episodes may take (the lab's Q-learning took 1.59 million, measured: 2.5x room)."""
 _POSITIONAL = frozenset({"POSITIONAL_ONLY", "POSITIONAL_OR_KEYWORD", "VAR_POSITIONAL"})
 
 
@@ -102,13 +117,19 @@ class TaxiCheck:
 
     id: ProblemId = "taxi"
     title: str = "Problem 5: Taxi"
+    games: GameRules | None = TAXI
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """taxi(optimal Q-table) when taxi takes a parameter, else taxi()."""
         settings = _settings(config)
+        games = 2 * settings.episodes_per_scenario
+        evaluation = games_budget(games, EPISODE_STEPS)
         if takes_q_table(functions):
-            return [Call("taxi", (optimal_q_table(settings.gamma),))]
-        return [Call("taxi")]
+            return [Call("taxi", (optimal_q_table(settings.gamma),), budget=evaluation)]
+        budget = CallBudget(
+            evaluation.max_episodes + 2 * TRAINING_EPISODES, evaluation.max_steps + TRAINING_STEPS
+        )
+        return [Call("taxi", budget=budget)]
 
     @paused_gc
     def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
@@ -127,7 +148,7 @@ class TaxiCheck:
         random_mean, greedy_mean = float(means[0]), float(means[1])  # type: ignore[arg-type]
         episodes = played_episodes(records)
         problem = integrity_problem(records, episodes, TAXI) or repeated_seed_problem(
-            episodes, across_calls=False
+            all_resets(records), across_calls=False
         )
         if problem:
             return _fail(f"taxi: {problem}.")

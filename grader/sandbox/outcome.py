@@ -32,6 +32,14 @@ class OutcomeStatus(StrEnum):
 
 
 @dataclass(frozen=True)
+class CallBudget:
+    """What one call may record: resets (played or not) and steps summed over its episodes."""
+
+    max_episodes: int
+    max_steps: int
+
+
+@dataclass(frozen=True)
 class Call:
     """One call of a student function.
 
@@ -40,12 +48,14 @@ class Call:
         args: Positional arguments, plain data only.
         kwargs: Keyword arguments, plain data only.
         record_episodes: Whether the child logs every episode played (False for long training runs).
+        budget: The most the call may record (None: the sandbox's global limits).
     """
 
     function: str
     args: tuple[PlainValue, ...] = ()
     kwargs: Mapping[str, PlainValue] = field(default_factory=dict)
     record_episodes: bool = True
+    budget: CallBudget | None = None
 
 
 @dataclass(frozen=True)

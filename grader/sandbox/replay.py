@@ -23,7 +23,7 @@ from gymnasium.envs.registration import EnvSpec
 from grader.compat import register_envs
 from grader.sandbox.batched import REPLAYERS, BatchedEpisode, BatchedReplayer
 from grader.sandbox.child.protocol import paused_gc
-from grader.sandbox.child.seeding import mapped_reset_seed, reset_seeds
+from grader.sandbox.child.seeding import reset_seeds
 from grader.sandbox.episodes import EpisodeLog
 
 MAX_CACHED_ENVS = 16
@@ -128,24 +128,22 @@ def _replay_all(logs: Sequence[EpisodeLog]) -> list[Replay]:
     ]
 
 
+def not_replayed(reason: str) -> Replay:
+    """The `Replay` of a log the grader refused to replay (its env is not the problem's game, ...)."""
+    return _unplayable(f"not replayed: {reason}", None)
+
+
 def verify_reset_seeds(logs: Sequence[EpisodeLog], call_seed: int) -> str | None:
     """Check that the logs of one call (in reset order) used the seeds the grader's stream prescribes.
 
-    Resets without a student seed take the next seed of the call's reset stream; a reset with a
-    student seed uses the mapped seed. Returns a description of the first deviation, or None.
+    Every reset takes the next seed of the call's reset stream (a student's own seed is replaced).
+    Returns a description of the first deviation, or None.
     """
-    unseeded = iter(reset_seeds(call_seed, sum(log.student_seed is None for log in logs)))
-    for number, log in enumerate(logs):
-        if log.student_seed is None:
-            expected = next(unseeded)
-            origin = "the grader's seed stream gives"
-        else:
-            expected = mapped_reset_seed(call_seed, log.student_seed)
-            origin = f"your seed {log.student_seed} maps to"
+    for number, (log, expected) in enumerate(zip(logs, reset_seeds(call_seed, len(logs)), strict=True)):
         if log.reset_seed != expected:
             return (
-                f"episode {number + 1} was reset with seed {log.reset_seed}, but {origin} {expected}: "
-                "the episode log was altered"
+                f"episode {number + 1} was reset with seed {log.reset_seed}, but the grader's seed stream "
+                f"gives {expected}: the episode log was altered"
             )
     return None
 

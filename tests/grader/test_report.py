@@ -11,6 +11,7 @@ from grader.report import (
     OUTPUT_CAP_CHARS,
     GradingTimings,
     ProblemResult,
+    ProblemRun,
     Report,
     Timings,
     cap_output,
@@ -115,3 +116,22 @@ def test_cap_output_keeps_the_start_and_says_how_much_was_cut() -> None:
     assert capped.startswith("x" * OUTPUT_CAP_CHARS)
     assert capped.endswith("[... 25 more characters of output not shown]")
     assert cap_output("short") == "short"
+
+
+def test_a_run_holding_a_lone_surrogate_still_serialises_as_that_problem_s_error() -> None:
+    result = ProblemResult(
+        id="car",
+        title="Problem 4",
+        status="passed",
+        score=1.0,
+        max_score=1.0,
+        feedback="ok",
+        seed=1,
+        output="printed \ud800 by the student",
+    )
+    line = ProblemRun(submission="s.py", result=result).to_json()
+    parsed = ProblemRun.model_validate_json(line)
+    assert parsed.result.status == "error"
+    assert parsed.result.score == 0.0
+    assert parsed.result.output == "printed \ufffd by the student"
+    assert "cannot be stored" in parsed.result.feedback

@@ -24,6 +24,7 @@ from grader.report import Report
 from grader.sandbox import IsolationPolicy
 
 VERDICTS = SUBMISSIONS / "verdicts.toml"
+HOSTILE_OUTCOMES = SUBMISSIONS / "hostile" / "outcomes.toml"
 SEED = 20261122
 CONCURRENT_RUNS = 3
 
@@ -34,6 +35,8 @@ SAMPLE_OVERRIDES: dict[str, dict[str, Any]] = {
     # n = 12 shows both blackjack mistakes in the replayed decisions (standing on exactly 12; a first
     # decision taken on the previous game's hand); the complete solutions pass at any n.
     "blackjack": {"thresholds": [12]},
+    # Honest car() calls take milliseconds; a shorter limit keeps the endless sample's timeout cheap.
+    "car": {"call_seconds": 5.0},
 }
 
 
@@ -56,6 +59,7 @@ class Sample:
 
 def _samples() -> list[Sample]:
     entries = tomllib.loads(VERDICTS.read_text(encoding="utf-8"))["sample"]
+    entries += tomllib.loads(HOSTILE_OUTCOMES.read_text(encoding="utf-8"))["verdict"]
     return [Sample(entry["file"], entry["status"], entry.get("feedback", {})) for entry in entries]
 
 

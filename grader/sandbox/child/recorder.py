@@ -243,16 +243,23 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         self._episode: EpisodeRecord | None = None
 
     def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
-        """Reset with a seed from the grader's stream (or the student's seed mapped through it)."""
+        """Reset with the next seed of the grader's stream, whatever seed the student passed.
+
+        A student's seed cannot choose the start (it could be searched for an easy one): it is replaced,
+        noted as a compat event, and logged as `student_seed` when it is a plain non-negative int (the
+        checks diagnose a seed repeated over games, which outside the grader replays the same game).
+        """
         self._episode = None
-        student_seed: int | None = None
-        if seed is None:
-            actual_seed = self.recorder.seeds.next_reset_seed()
-        elif isinstance(seed, int | np.integer) and not isinstance(seed, bool) and seed >= 0:
-            student_seed = int(seed)
-            actual_seed = self.recorder.seeds.student_reset_seed(student_seed)
-        else:
-            return self.env.reset(seed=seed, options=options)
+        actual_seed = self.recorder.seeds.next_reset_seed()
+        student_seed = _plain_seed(seed)
+        if seed is not None:
+            shown = repr(seed) if type(seed) in (int, bool, float) else f"of type {type(seed).__name__}"
+            compat_events.record(
+                compat_events.SEED_REPLACED,
+                self.made.requested_id,
+                f"reset(seed=...) with your seed {shown[:40]} was given the grader's next seed instead: "
+                "the grader deals every start, so results do not depend on seeds you choose",
+            )
         result = self.env.reset(seed=actual_seed, options=options)
         logged_options = dict(options) if type(options) is dict else options
         self._episode = self.recorder.start_episode(self, actual_seed, student_seed, logged_options)
@@ -381,6 +388,13 @@ def _route_unseeded_generators(recorder: Recorder) -> None:
     default_rng.__doc__ = original_default_rng.__doc__
     gymnasium.utils.seeding.np_random = np_random
     np.random.default_rng = default_rng
+
+
+def _plain_seed(seed: Any) -> int | None:
+    """The student's seed as logged: a plain non-negative int below 2**64, else None."""
+    if isinstance(seed, int | np.integer) and not isinstance(seed, bool | np.bool_) and 0 <= seed < 2**64:
+        return int(seed)
+    return None
 
 
 def _copy_action(action: Any) -> Any:

@@ -1,7 +1,8 @@
 """The grader's randomness: every seed a call uses derives from the call's seed alone.
 
-Pure functions (`derive_call_seed`, `reset_seeds`, `mapped_reset_seed`) let the parent recompute the
-seeds a call must have used; `CallSeeds` is the child's stateful view of the same streams.
+Pure functions (`derive_call_seed`, `reset_seeds`) let the parent recompute the seeds a call must have
+used (every reset takes the next seed of the call's reset stream, whatever seed the student passed);
+`CallSeeds` is the child's stateful view of the same streams.
 Streams are numpy `SeedSequence` children keyed by purpose, so adding a draw to one stream never
 shifts another.
 """
@@ -26,7 +27,7 @@ class Stream(IntEnum):
     DEFAULT_RNG = 3
     SPACES = 4
     RESETS = 5
-    STUDENT_SEEDS = 6
+    STUDENT_SEEDS = 6  # no longer drawn from: student seeds are replaced, not mapped
     UNSEEDED_GENERATORS = 7
     KEPT_GENERATORS = 8
 
@@ -39,12 +40,6 @@ def derive_call_seed(session_seed: int, call_index: int) -> int:
 def reset_seeds(call_seed: int, count: int) -> list[int]:
     """The first `count` seeds given to resets without a student seed, in reset order."""
     return _draws(_stream(call_seed, Stream.RESETS), count)
-
-
-def mapped_reset_seed(call_seed: int, student_seed: int) -> int:
-    """The seed actually used when the student resets with `student_seed` (a non-negative int)."""
-    sequence = np.random.SeedSequence(call_seed, spawn_key=(Stream.STUDENT_SEEDS, student_seed))
-    return _draws(sequence, 1)[0]
 
 
 def space_seed(call_seed: int, env_number: int) -> int:
@@ -89,12 +84,8 @@ class CallSeeds:
         self._unseeded = SeedStream(call_seed, Stream.UNSEEDED_GENERATORS)
 
     def next_reset_seed(self) -> int:
-        """The seed for the next reset the student makes without a seed."""
+        """The seed for the next reset (the student's own seed, if any, is replaced by it)."""
         return self._resets.next()
-
-    def student_reset_seed(self, student_seed: int) -> int:
-        """The seed used for a reset where the student passed `student_seed`."""
-        return mapped_reset_seed(self.call_seed, student_seed)
 
     def space_seed(self, env_number: int) -> int:
         """The seed for the spaces of the `env_number`-th live environment."""

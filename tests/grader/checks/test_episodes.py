@@ -2,13 +2,25 @@
 
 import dataclasses
 
+import numpy as np
 import pytest
 
 from grader.checks import CHECKS
 from grader.checks.base import CallRecord
 from grader.checks.behaviours import cartpole, velocity_policy
-from grader.checks.episodes import BLACKJACK, CARTPOLE, TAXI, GameRules, integrity_problem, played_episodes
+from grader.checks.episodes import (
+    BLACKJACK,
+    CARTPOLE,
+    TAXI,
+    GameRules,
+    games_budget,
+    integrity_problem,
+    played_episodes,
+    replay_call,
+    settled_by,
+)
 from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.outcome import CallBudget
 from grader.sandbox.replay import replay_episode
 
 from .support import grade, simulate, small_config
@@ -152,3 +164,124 @@ def test_plans_name_the_functions() -> None:
     calls = CHECKS["cartpole"].plan(small_config("cartpole"), {})
     assert [call.function for call in calls] == ["cartpole"] * 100
     assert velocity_policy([0, 0, 0, 0.1]) == 1
+
+
+def _velocity_run(env) -> int:  # type: ignore[no-untyped-def]
+    observation, _ = env.reset()
+    steps, done = 0, False
+    while not done:
+        observation, _, terminated, truncated, _ = env.step(velocity_policy(observation))
+        steps, done = steps + 1, terminated or truncated
+    return steps
+
+
+def _honest_reset_patterns():  # type: ignore[no-untyped-def]
+    def reset_after_make(lab):  # type: ignore[no-untyped-def]
+        env = lab.make("CartPole-v0")
+        env.reset()  # the lab's "reset right after make"
+        return _velocity_run(env)
+
+    def reset_at_loop_end(lab):  # type: ignore[no-untyped-def]
+        env = lab.make("CartPole-v0")
+        steps = _velocity_run(env)
+        env.reset()  # a reset at the end of the game loop, never played
+        return steps
+
+    def both(lab):  # type: ignore[no-untyped-def]
+        env = lab.make("CartPole-v0")
+        env.reset()
+        steps = _velocity_run(env)
+        env.reset()
+        return steps
+
+    return {"reset after make": reset_after_make, "reset at loop end": reset_at_loop_end, "both": both}
+
+
+@pytest.mark.parametrize("pattern", list(_honest_reset_patterns()))
+def test_the_lab_s_unplayed_resets_are_tolerated(pattern: str, seed: int) -> None:
+    function = _honest_reset_patterns()[pattern]
+    verdict = grade("cartpole", {"cartpole": function}, seed, small_config("cartpole", calls=5))
+    assert verdict.status == "passed", verdict.feedback
+
+
+def _scouting(lab):  # type: ignore[no-untyped-def]
+    env = lab.make("CartPole-v0")
+    observation, _ = env.reset()
+    while abs(observation[2]) > 0.01:  # reset until the pole starts nearly upright
+        observation, _ = env.reset()
+    steps, done = 0, False
+    while not done:
+        observation, _, terminated, truncated, _ = env.step(velocity_policy(observation))
+        steps, done = steps + 1, terminated or truncated
+    return steps
+
+
+def _scouting_many_envs(lab):  # type: ignore[no-untyped-def]
+    envs = [lab.make("CartPole-v0") for _ in range(5)]
+    starts = [abs(env.reset()[0][2]) for env in envs]
+    env = envs[starts.index(min(starts))]
+    return _velocity_run(env)
+
+
+def _double_reset(lab):  # type: ignore[no-untyped-def]
+    env = lab.make("CartPole-v0")
+    steps = _velocity_run(env)
+    env.reset()
+    env.reset()
+    return steps
+
+
+@pytest.mark.parametrize(
+    "function", [_scouting, _scouting_many_envs, _double_reset], ids=["scouting", "many envs", "double reset"]
+)
+def test_unplayed_resets_fail_as_scouting(function, seed: int) -> None:  # type: ignore[no-untyped-def]
+    verdict = grade("cartpole", {"cartpole": function}, seed, small_config("cartpole", calls=5))
+    assert verdict.status == "failed"
+    assert "games unplayed" in verdict.feedback
+    assert "Reset once per game and play every game you reset" in verdict.feedback
+
+
+def test_reset_options_fail_whatever_they_choose(seed: int) -> None:
+    def pinned(lab):  # type: ignore[no-untyped-def]
+        env = lab.make("CartPole-v0")
+        env.reset(options={"low": 0, "high": 0})
+        steps, done, observation = 0, False, np.zeros(4)
+        while not done:
+            observation, _, terminated, truncated, _ = env.step(velocity_policy(observation))
+            steps, done = steps + 1, terminated or truncated
+        return steps
+
+    verdict = grade("cartpole", {"cartpole": pinned}, seed, small_config("cartpole", calls=3))
+    assert verdict.status == "failed"
+    assert "3 reset(s) passed options (e.g. reset 1: options={'low': 0, 'high': 0})" in verdict.feedback
+    assert verdict.feedback.endswith("call reset() without options.")
+
+
+def test_an_episode_of_another_game_is_not_replayed(seed: int) -> None:
+    records = simulate("cartpole", {"cartpole": cartpole}, seed, replay=False)
+    outcome = records[0].outcome
+    acrobot = dataclasses.replace(
+        outcome.episodes[0], env_id="Acrobot-v1", requested_id="Acrobot-v1", actions=[0] * 100_000
+    )
+    record = replay_call(dataclasses.replace(outcome, episodes=[acrobot]), CARTPOLE)
+    assert record.replays[0].mismatch is not None
+    assert record.replays[0].mismatch.startswith("not replayed: the episodes must be played in CartPole-v0")
+    assert record.replays[0].length == 0
+    assert settled_by(record, CARTPOLE) is not None
+
+
+def test_a_call_with_episodes_where_none_are_planned_is_not_replayed(seed: int) -> None:
+    records = simulate("cartpole", {"cartpole": cartpole}, seed, replay=False)
+    record = replay_call(records[0].outcome, None)
+    assert record.replays[0].mismatch == "not replayed: this problem plays no episodes, but the call logged 1"
+
+
+def test_an_honest_call_does_not_settle_the_verdict(seed: int) -> None:
+    records = simulate("cartpole", {"cartpole": cartpole}, seed, replay=False)
+    assert settled_by(replay_call(records[0].outcome, CARTPOLE), CARTPOLE) is None
+
+
+def test_budgets_leave_room_for_diagnoses() -> None:
+    assert games_budget(1, 1_000) == CallBudget(max_episodes=10, max_steps=9_000)
+    calls = CHECKS["car"].plan(small_config("car"), {})
+    assert {call.budget for call in calls} == {games_budget(1, 1_000)}

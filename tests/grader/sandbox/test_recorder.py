@@ -13,7 +13,7 @@ from child_client import ChildClient, write_submission
 
 from grader.sandbox.child.protocol import MAX_NODES, decode_value, encode_value
 from grader.sandbox.child.recorder import SHORT_EPISODE_STEPS, EpisodeRecord, Recorder
-from grader.sandbox.child.seeding import derive_call_seed, mapped_reset_seed, reset_seeds
+from grader.sandbox.child.seeding import derive_call_seed, reset_seeds
 from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
 from grader.sandbox.replay import verify_reset_seeds
 
@@ -86,6 +86,17 @@ STUDENT = textwrap.dedent("""
         env.reset()
         second, _ = env.reset(seed=seed)
         return [first.tolist(), second.tolist()]
+
+
+    def seeded_once(seed):
+        if seed == "numpy 5":
+            seed = np.int64(5)
+        elif seed == "object":
+            seed = object()
+        env = gymnasium.make("CartPole-v1")
+        env.reset(seed=seed)
+        env.step(0)
+        return 1
 
 
     def randoms():
@@ -224,22 +235,35 @@ def test_envs_made_from_specs_are_recorded(child: ChildClient) -> None:
     assert [log.env_index for log in episodes] == [0, 1, 2]
 
 
-def test_student_seeds_are_mapped_through_the_call_seed(child: ChildClient) -> None:
+def test_student_seeds_are_replaced_by_the_grader_s_next_seeds(child: ChildClient) -> None:
     first = child.call("seeded", 42, seed=7)
     again = child.call("seeded", 42, seed=7)
-    other_call = child.call("seeded", 42, seed=8)
     episodes = episodes_of(first)
 
     assert [(log.student_seed, log.reset_seed) for log in episodes] == [
-        (42, mapped_reset_seed(7, 42)),
-        (None, reset_seeds(7, 1)[0]),
-        (42, mapped_reset_seed(7, 42)),
+        (42, reset_seeds(7, 3)[0]),
+        (None, reset_seeds(7, 3)[1]),
+        (42, reset_seeds(7, 3)[2]),
     ]
     observations = decode_value(first["value"])  # type: ignore[index]
-    assert observations[0] == observations[1]
+    assert observations[0] != observations[1]  # the same student seed no longer picks the same start
     assert decode_value(again["value"]) == observations  # type: ignore[index]
-    assert decode_value(other_call["value"]) != observations  # type: ignore[index]
     assert verify_reset_seeds(episodes, 7) is None
+    (event,) = [event for event in first["compat_events"] if event["kind"] == "seed_replaced"]  # type: ignore[union-attr]
+    assert event["detail"].startswith("reset(seed=...) with your seed 42 was given the grader's next seed")
+
+
+@pytest.mark.parametrize(
+    ("seed", "logged"),
+    [(True, None), (2.5, None), (-3, None), (2**70, None), ("7", None), ("numpy 5", 5), ("object", None)],
+    ids=["True", "float", "negative", "huge", "str", "numpy int", "object"],
+)
+def test_every_seed_value_is_recorded_and_replaced(
+    child: ChildClient, seed: object, logged: int | None
+) -> None:
+    result = child.call("seeded_once", seed, seed=7)
+    (log,) = episodes_of(result)
+    assert (log.student_seed, log.reset_seed) == (logged, reset_seeds(7, 1)[0])
 
 
 def test_randomness_is_reproducible_per_call_seed_and_differs_between_calls(submission: Path) -> None:
