@@ -10,6 +10,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
+from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError, ProtocolError
 from grader.sandbox.child.protocol import decode_value, encode_frame, encode_value, parse_payload
 from grader.sandbox.child.seeding import derive_call_seed
@@ -34,6 +35,7 @@ _CHILD_STATUSES = {
     "invalid_value": OutcomeStatus.INVALID_VALUE,
     "output_too_large": OutcomeStatus.OUTPUT_TOO_LARGE,
     "memory_limit": OutcomeStatus.MEMORY_LIMIT,
+    "episode_limit": OutcomeStatus.EPISODE_LIMIT,
 }
 _RESULT_FIELDS = {
     "type",
@@ -154,6 +156,8 @@ class Sandbox:
             failure = self._import_failure or Ending(OutcomeStatus.SANDBOX_ERROR, "the child did not start")
             return self._outcome(call, seed, failure, stdout=failure.stdout, stderr=failure.stderr)
         nonce = secrets.token_hex(16)
+        budget = None if call.budget is None else WireBudget(call.budget.max_episodes, call.budget.max_steps)
+        frame_limit = frame_limits(budget, record=call.record_episodes, max_frame=self.limits.frame_bytes)
         request = {
             "type": "call",
             "id": index,
@@ -163,13 +167,14 @@ class Sandbox:
             "kwargs": keywords,
             "seed": seed,
             "record": call.record_episodes,
+            "budget": None if budget is None else budget.to_plain(),
         }
         child.reset_oom_baseline()
         started = time.perf_counter()
         sent = child.send(encode_frame(request, self.limits.frame_bytes), self.limits.call_seconds)
         if sent is FrameEnd.FRAME:
             remaining = self.limits.call_seconds - (time.perf_counter() - started)
-            wait = child.wait_frame(remaining, self.limits.frame_bytes)
+            wait = child.wait_frame(remaining, frame_limit.max_bytes)
         else:
             wait = FrameWait(sent)
         if wait.end is FrameEnd.FRAME and child.oom_killed():
@@ -181,7 +186,7 @@ class Sandbox:
             )
             return self._fatal(call, seed, started, ending)
         if wait.end is FrameEnd.FRAME:
-            return self._result(call, seed, started, wait.payload, index, nonce)
+            return self._result(call, seed, started, wait.payload, index, nonce, frame_limit)
         if wait.end is FrameEnd.TIMEOUT:
             child.kill_tree()
             ending = Ending(
@@ -191,7 +196,8 @@ class Sandbox:
         elif wait.end is FrameEnd.TOO_LARGE:  # the harness reports oversized results in a small frame
             child.kill_tree()
             ending = _forged(
-                f"a frame announced {wait.size} bytes, more than the limit of {self.limits.frame_bytes} bytes"
+                f"a frame announced {wait.size:,} bytes, more than this call's limit of "
+                f"{frame_limit.max_bytes:,} bytes"
             )
         elif wait.end is FrameEnd.EXTRA_DATA:
             child.kill_tree()
@@ -201,13 +207,22 @@ class Sandbox:
         return self._fatal(call, seed, started, ending)
 
     def _result(
-        self, call: Call, seed: int, started: float, payload: bytes, index: int, nonce: str
+        self,
+        call: Call,
+        seed: int,
+        started: float,
+        payload: bytes,
+        index: int,
+        nonce: str,
+        frame_limit: FrameLimits,
     ) -> CallOutcome:
         elapsed = time.perf_counter() - started
         child = self._child
+        # Sized and counted before any Python object is built: a forged frame costs what an honest may.
+        problem = frame_limit.excess(payload)
         try:
-            frame = parse_payload(payload)
-            problem = _frame_problem(frame, index, nonce)
+            frame = {} if problem else parse_payload(payload)
+            problem = problem or _frame_problem(frame, index, nonce)
         except ProtocolError as error:
             problem = str(error)
         if problem:
@@ -222,7 +237,7 @@ class Sandbox:
         if status is OutcomeStatus.OK:
             try:
                 value = decode_value(frame["value"], f"the value returned by {call.function}()")
-                episodes = episodes_from_plain(frame["episodes"])
+                episodes = episodes_from_plain(frame["episodes"], call.budget)
             except (InvalidValueError, InvalidEpisodeLogError) as error:
                 return self._fatal(call, seed, started, _forged(str(error)))
         return CallOutcome(

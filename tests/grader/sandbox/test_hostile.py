@@ -15,7 +15,7 @@ from typing import Any
 
 import pytest
 
-from grader.sandbox import Call, IsolationPolicy, Limits, OutcomeStatus, Sandbox, probe_isolation
+from grader.sandbox import Call, CallBudget, IsolationPolicy, Limits, OutcomeStatus, Sandbox, probe_isolation
 from grader.sandbox.replay import replay_episode
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -130,7 +130,10 @@ def test_hostile_sample_gets_its_outcome_and_leaves_the_host_unaffected(
 
     limits = replace(LIMITS, call_seconds=sample.get("call_seconds", LIMITS.call_seconds))
     with Sandbox(submission, seed=7, limits=limits, policy=IsolationPolicy.REQUIRE_FULL) as sandbox:
-        outcome = sandbox.call(Call(function or "ok", _arguments(sample, loopback.port, marker)))
+        budget = CallBudget(**sample["budget"]) if "budget" in sample else None
+        outcome = sandbox.call(
+            Call(function or "ok", _arguments(sample, loopback.port, marker), budget=budget)
+        )
         following = sandbox.call(Call("ok"))
 
     assert outcome.status == OutcomeStatus(sample["status"]), outcome.message + outcome.stderr[-2000:]
