@@ -16,6 +16,7 @@ import numpy as np
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
 from grader.sandbox.child.protocol import MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
 from grader.sandbox.outcome import CallBudget
+from grader.sandbox.text import clean_plain, clean_text
 
 MAX_ID_LENGTH = 200
 MAX_SEED = 2**64
@@ -260,13 +261,13 @@ def _bounded_int(value: Any, low: int, high: int, where: str) -> int:
 def _identifier(value: Any, where: str) -> str:
     if type(value) is not str or not 0 < len(value) <= MAX_ID_LENGTH:
         raise InvalidEpisodeLogError(f"{where} must be a non-empty str of at most {MAX_ID_LENGTH} characters")
-    return value
+    return clean_text(value, MAX_ID_LENGTH)
 
 
 def _mapping(value: Any, where: str) -> dict[str, Any]:
     if type(value) is not dict:
         raise InvalidEpisodeLogError(f"{where} must be a dict, found {_describe(value)}")
-    return _decoded(value, where)  # type: ignore[no-any-return]
+    return clean_plain(_decoded(value, where))  # type: ignore[no-any-return]
 
 
 def _describe(value: Any) -> str:

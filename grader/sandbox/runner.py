@@ -12,6 +12,7 @@ from typing import Any
 
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError, ProtocolError
+from grader.sandbox.child.importer import MAX_LISTED_NAMES, MAX_LISTED_PARAMETERS
 from grader.sandbox.child.protocol import decode_value, encode_frame, encode_value, parse_payload
 from grader.sandbox.child.seeding import derive_call_seed
 from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
@@ -23,7 +24,10 @@ from grader.sandbox.limits import IsolationPolicy, Limits
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
 from grader.sandbox.process import ChildProcess, FrameEnd, FrameWait
 from grader.sandbox.termination import Ending, classify_exit, forged_message
+from grader.sandbox.text import EVENT_CHARS, MESSAGE_CHARS, NAME_CHARS, clean_plain, clean_text
 
+READY_FRAME_LIMITS = FrameLimits(max_bytes=16 << 20, max_nodes=200_000)
+"""The `ready` frame lists at most `MAX_LISTED_NAMES` names of `MAX_LISTED_PARAMETERS` parameters each."""
 IMPORT_SEED_INDEX = 2**31
 """`derive_call_seed(seed, IMPORT_SEED_INDEX)` seeds randomness while the submission is imported."""
 
@@ -229,14 +233,14 @@ class Sandbox:
             return self._fatal(call, seed, started, _forged(problem))
         status = _CHILD_STATUSES[frame["status"]]
         wall_time = min(float(frame["wall_time"]), elapsed)
-        message = frame["message"] if status is not OutcomeStatus.OK else ""
+        message = clean_text(frame["message"], MESSAGE_CHARS) if status is not OutcomeStatus.OK else ""
         if frame["traceback"]:
-            message = f"{message}\n\n{frame['traceback']}"
+            message = f"{message}\n\n{clean_text(frame['traceback'], MESSAGE_CHARS)}"
         value: Any = None
         episodes: list[EpisodeLog] = []
         if status is OutcomeStatus.OK:
             try:
-                value = decode_value(frame["value"], f"the value returned by {call.function}()")
+                value = clean_plain(decode_value(frame["value"], f"the value returned by {call.function}()"))
                 episodes = episodes_from_plain(frame["episodes"], call.budget)
             except (InvalidValueError, InvalidEpisodeLogError) as error:
                 return self._fatal(call, seed, started, _forged(str(error)))
@@ -245,7 +249,10 @@ class Sandbox:
             status=status,
             value=value,
             episodes=episodes,
-            compat_events=frame["compat_events"],
+            compat_events=[
+                {name: clean_text(text, EVENT_CHARS) for name, text in event.items()}
+                for event in frame["compat_events"]
+            ],
             stdout=child.stdout.take() if child else "",
             stderr=child.stderr.take() if child else "",
             message=message,
@@ -310,7 +317,7 @@ class Sandbox:
         return self._child
 
     def _await_ready(self, child: ChildProcess) -> Ending | None:
-        wait = child.wait_frame(self.limits.import_seconds, self.limits.frame_bytes)
+        wait = child.wait_frame(self.limits.import_seconds, READY_FRAME_LIMITS.max_bytes)
         if wait.end is FrameEnd.TIMEOUT:
             child.kill_tree()
             return Ending(
@@ -324,14 +331,19 @@ class Sandbox:
             child.kill_tree()
             return Ending(OutcomeStatus.INVALID_VALUE, forged_message("the first frame was malformed"))
         try:
-            frame = parse_payload(wait.payload)
+            problem = READY_FRAME_LIMITS.excess(wait.payload)
+            frame = {} if problem else parse_payload(wait.payload)
         except ProtocolError as error:
+            problem = str(error)
+        if problem:
             child.kill_tree()
-            return Ending(OutcomeStatus.INVALID_VALUE, forged_message(str(error)))
+            return Ending(OutcomeStatus.INVALID_VALUE, forged_message(problem))
         if frame.get("type") == "import_error" and type(frame.get("message")) is str:
             traceback = frame.get("traceback")
-            detail = f"\n\n{traceback}" if type(traceback) is str and traceback else ""
-            return Ending(OutcomeStatus.IMPORT_ERROR, frame["message"] + detail)
+            detail = (
+                f"\n\n{clean_text(traceback, MESSAGE_CHARS)}" if type(traceback) is str and traceback else ""
+            )
+            return Ending(OutcomeStatus.IMPORT_ERROR, clean_text(frame["message"], MESSAGE_CHARS) + detail)
         functions = _function_table(frame)
         if functions is None:
             child.kill_tree()
@@ -379,7 +391,10 @@ def _function_table(frame: dict[str, Any]) -> dict[str, FunctionInfo] | None:
     ):
         return None
     table: dict[str, FunctionInfo] = {}
-    for name, info in frame["functions"].items():
+    if len(frame["functions"]) > MAX_LISTED_NAMES:
+        return None
+    for raw_name, info in frame["functions"].items():
+        name = clean_text(raw_name, NAME_CHARS)
         if (
             type(info) is not dict
             or info.keys() != {"parameters", "is_callable"}
@@ -387,14 +402,16 @@ def _function_table(frame: dict[str, Any]) -> dict[str, FunctionInfo] | None:
         ):
             return None
         parameters = info["parameters"]
-        if type(parameters) is not list:
+        if type(parameters) is not list or len(parameters) > MAX_LISTED_PARAMETERS:
             return None
         try:
             table[name] = FunctionInfo(
                 name,
                 info["is_callable"],
                 tuple(
-                    ParameterInfo(p["name"], p["kind"], p["has_default"])
+                    ParameterInfo(
+                        clean_text(p["name"], NAME_CHARS), clean_text(p["kind"], NAME_CHARS), p["has_default"]
+                    )
                     for p in parameters
                     if type(p["name"]) is str and type(p["kind"]) is str and type(p["has_default"]) is bool
                 ),

@@ -1,5 +1,6 @@
-"""Hostile: forges a result frame with the right id and nonce, found in the harness's own frames, whose
-value is millions of empty objects, so that the grader builds them all when it parses the frame."""
+"""Hostile: forges result frames with the right id and nonce, found in the harness's own frames: one whose
+value is millions of empty objects, so that the grader builds them all when it parses the frame, and
+one whose strings (compat events, value) hold escaped lone surrogates and NULs."""
 
 import os
 import sys
@@ -31,12 +32,11 @@ def _results_fd():
     raise RuntimeError("the result channel was not found")
 
 
-def bomb(megabytes):
+def _forge(value, events="[]"):
     request = _request()
-    value = "[" + ",".join(["{}"] * (megabytes * (1 << 20) // 3)) + "]"
     frame = (
         '{"type":"result","id":%d,"nonce":"%s","status":"ok","value":%s,"message":"","traceback":"",'
-        '"episodes":[],"compat_events":[],"wall_time":0.1}' % (request.call_id, request.nonce, value)
+        '"episodes":[],"compat_events":%s,"wall_time":0.1}' % (request.call_id, request.nonce, value, events)
     ).encode()
     descriptor = _results_fd()
     view = memoryview(len(frame).to_bytes(4, "big") + frame)
@@ -47,6 +47,16 @@ def bomb(megabytes):
         return 0
     time.sleep(60)  # no frame of the harness's own follows: the grader must parse this one
     return 0
+
+
+def bomb(megabytes):
+    return _forge("[" + ",".join(["{}"] * (megabytes * (1 << 20) // 3)) + "]")
+
+
+def forge_strings():
+    bad = "\\ud800 \\u0000 " + "x" * 5000
+    event = '{"kind":"%s","env_id":"%s","detail":"%s"}' % (bad, bad, bad)
+    return _forge('"%s"' % bad, "[" + event + "]")
 
 
 def ok():
