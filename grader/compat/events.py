@@ -10,8 +10,17 @@ NUMPY_ACTION = "numpy_action"
 RENDER_WITHOUT_MODE = "render_without_mode"
 LEGACY_SEED_CALL = "legacy_seed_call"
 RENAMED_ID = "renamed_id"
+API_DETECTED = "api_detected"
 
-KINDS = (STEP_BEFORE_RESET, STEP_AFTER_DONE, NUMPY_ACTION, RENDER_WITHOUT_MODE, LEGACY_SEED_CALL, RENAMED_ID)
+KINDS = (
+    STEP_BEFORE_RESET,
+    STEP_AFTER_DONE,
+    NUMPY_ACTION,
+    RENDER_WITHOUT_MODE,
+    LEGACY_SEED_CALL,
+    RENAMED_ID,
+    API_DETECTED,
+)
 
 
 @dataclass(frozen=True)
@@ -32,6 +41,7 @@ class CompatEvent:
 # One entry per (kind, env_id), the first detail and how many times it happened: code that steps
 # millions of times with numpy actions must not grow this without bound.
 _pending: dict[tuple[str, str], tuple[str, int]] = {}
+_drains = 0
 
 
 def record(kind: str, env_id: str, detail: str) -> None:
@@ -62,4 +72,11 @@ def drain() -> list[CompatEvent]:
         for (kind, env_id), (detail, count) in _pending.items()
     ]
     _pending.clear()
+    global _drains
+    _drains += 1
     return drained
+
+
+def generation() -> int:
+    """How many times the events were drained: what is reported once per drain re-records when it changes."""
+    return _drains
