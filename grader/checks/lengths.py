@@ -62,12 +62,18 @@ class LengthRuns:
         """The feedback sentence on a counting slip ("" when every count was right)."""
         if not self.uncounted_steps:
             return ""
-        steps = "one step" if self.uncounted_steps == 1 else f"{self.uncounted_steps} steps"
+        if self.uncounted_steps == 1:
+            short, uncounted = (
+                "one step",
+                "the step taken before the counted loop (e.g. a random step after reset) was",
+            )
+        else:
+            short = f"{self.uncounted_steps} steps"
+            uncounted = f"the {short} taken before the counted loop were"
         cost = f" ({deduction:.0%} of the points deducted)" if deduction else ""
         return (
-            f" Note: every count {function}() returned is {steps} short of its replayed episode: the "
-            f"{steps} taken before the counted loop (e.g. one random step after reset) were not counted. "
-            f"The verdict follows the replayed episodes{cost}; count every env.step() call"
+            f" Note: every count {function}() returned is {short} short of its replayed episode: {uncounted} "
+            f"not counted. The verdict follows the replayed episodes{cost}; count every env.step() call."
         )
 
 

@@ -39,8 +39,8 @@ CASES = [
         ["Blackjack-v0"],
         _log("Blackjack-v1", "Blackjack-v1"),
         "Blackjack-v0 is played with sab=False, but your environment had sab=True, which changes the game: "
-        "this assignment accepts Blackjack-v0; make the environment with gym.make('Blackjack-v0') and no extra "
-        "arguments",
+        "this assignment accepts Blackjack-v0; make the environment with gym.make('Blackjack-v0') and no "
+        "extra arguments",
     ),
     ("cartpole-v1", "cartpole", None, _log("CartPole-v1", "CartPole-v1"), None),
     (
@@ -57,7 +57,8 @@ CASES = [
         None,
         _log("CartPole-v0", "CartPole-v0", max_episode_steps=500),
         "you made 'CartPole-v0' with max_episode_steps=500, which changes the game: this assignment accepts "
-        "CartPole-v0 or CartPole-v1; make the environment with gym.make('CartPole-v0') and no extra arguments",
+        "CartPole-v0 or CartPole-v1; make the environment with gym.make('CartPole-v0') and no extra "
+        "arguments",
     ),
     ("render-mode", "cartpole", None, _log("CartPole-v0", "CartPole-v0", render_mode="human"), None),
     ("taxi", "taxi", None, _log("Taxi-v4", "Taxi-v3"), None),
@@ -67,7 +68,8 @@ CASES = [
         None,
         _log("Taxi-v4", "Taxi-v3", is_rainy=True),
         "Taxi-v3 is played with is_rainy=False, but your environment had is_rainy=True, which changes the "
-        "game: this assignment accepts Taxi-v3; make the environment with gym.make('Taxi-v3') and no extra arguments",
+        "game: this assignment accepts Taxi-v3; make the environment with gym.make('Taxi-v3') and no extra "
+        "arguments",
     ),
 ]
 
