@@ -68,6 +68,11 @@ class Decision:
     evidence: tuple[Evidence, ...] = ()
     conflict: bool = False
 
+    @property
+    def strong(self) -> bool:
+        """Whether an unpacking decided (not only hints)."""
+        return bool(self.evidence) and self.evidence[0].strong
+
     def explain(self, limit: int = 3) -> str:
         """The lines that decided, for the report."""
         shown = [item.describe() for item in self.evidence[:limit]]
@@ -119,12 +124,17 @@ class ApiDetection:
     def decision_at(self, line: int) -> tuple[str, Decision]:
         """The scope name and decision that applies to code at `line`.
 
-        A function with decided evidence of its own wins; a function whose own lines conflict
-        reports that conflict; any other line follows the module.
+        A function whose own unpackings decide (or conflict) wins; then the module's unpackings; then the
+        function's own hints; then the module's hints.
         """
         scope = self.scope_at(line)
-        if scope is not None and (scope.decision.api is not None or scope.decision.conflict):
-            return scope.name, scope.decision
+        own = scope.decision if scope is not None else Decision(None)
+        if scope is not None and own.strong:
+            return scope.name, own
+        if self.module.strong and self.module.api is not None:
+            return "<module>", self.module
+        if scope is not None and own.api is not None:
+            return scope.name, own
         return "<module>", self.module
 
 

@@ -75,3 +75,18 @@ def test_each_function_of_a_mixed_module_gets_its_own_api() -> None:
 def test_source_that_does_not_parse_is_undecided() -> None:
     detection = detect_api("def broken(:\n")
     assert detection.module.api is None and detection.error.startswith("the source does not parse")
+
+
+def test_a_function_with_hints_only_follows_the_module_s_unpackings() -> None:
+    source = textwrap.dedent(
+        """
+        def play():
+            s, r, term, trunc, _ = env.step(0)
+
+        def start():
+            state = env.reset()
+            return state[0]
+        """
+    )
+    scope, decision = detect_api(source).decision_at(6)
+    assert (scope, decision.api) == ("<module>", Api.GYM026)
