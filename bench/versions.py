@@ -188,6 +188,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument("--quick", action="store_true", help="a smoke run: few games and regrades")
     parser.add_argument("--workers", type=int, default=multiprocessing.cpu_count())
+    parser.add_argument("--games", type=int, default=200_000, help="Monte Carlo games per Blackjack policy")
+    parser.add_argument("--episodes", type=int, default=20_000, help="CartPole-v1 episodes of the policy")
     parser.add_argument(
         "--regrades", type=int, default=100, help="regrades per v1 reference (Blackjack: half)"
     )
@@ -198,13 +200,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     cartpole = config.problems["cartpole"]
     started = time.perf_counter()
     print("### Sab=True oracles against gymnasium's Blackjack-v1\n")
-    print(oracle_table(5_000 if quick else 200_000))
+    print(oracle_table(5_000 if quick else arguments.games))
     print("\n### v0 and v1 oracles side by side (exact pass probabilities, 10 000 games, alpha 1e-6)\n")
     print(cross_oracle_table(10_000, 1e-6))
     print("\n### CartPole-v1 and the lab's bar\n")
     print(
         cartpole_v1_table(
-            500 if quick else 20_000, cartpole.min_mean_steps, cartpole.min_steps, cartpole.calls
+            500 if quick else arguments.episodes, cartpole.min_mean_steps, cartpole.min_steps, cartpole.calls
         )
     )  # type: ignore[attr-defined]
     print("\n### Regrades through the real checks\n")
