@@ -142,9 +142,7 @@ def remove_job_directories(directories: list[tuple[int, Path]]) -> bool:
     For cgroups whose owner is gone: the grading's scope (`grader.sandbox.isolation.scope`) and the
     sweep of stale jobs. Only directories named like job cgroups are touched.
     """
-    groups = [
-        _Group(path, version, ()) for version, path in directories if path.name.startswith(JOB_PREFIX)
-    ]
+    groups = [_Group(path, version, ()) for version, path in directories if path.name.startswith(JOB_PREFIX)]
     return JobCgroup(groups).remove()
 
 
