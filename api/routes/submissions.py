@@ -6,7 +6,7 @@ from typing import Annotated
 
 from fastapi import APIRouter, File, Query, UploadFile
 
-from api.deps import CallerDep, SessionDep, SettingsDep, StudentDep
+from api.deps import CallerDep, DispatcherDep, SessionDep, SettingsDep, StudentDep
 from api.schemas import ErrorBody, SubmissionAccepted, SubmissionDetail, SubmissionSummary
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
@@ -30,13 +30,14 @@ router = APIRouter(tags=["submissions"])
 def post_submission(
     session: SessionDep,
     settings: SettingsDep,
+    dispatcher: DispatcherDep,
     student: StudentDep,
     file: Annotated[UploadFile, File(description="The student's opengym.py (UTF-8 Python source).")],
 ) -> SubmissionAccepted:
     """Upload a file for grading; poll GET /submissions/{id} for the result."""
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
-    submission = create_submission(session, settings, student, upload)
+    submission = create_submission(session, settings, student, upload, dispatcher)
     return SubmissionAccepted(id=submission.id)
 
 
