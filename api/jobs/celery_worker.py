@@ -8,6 +8,7 @@ SIGKILL of the worker takes its gradings with it (the children die with their pa
 from __future__ import annotations
 
 import base64
+import json
 import logging
 import os
 import socket
@@ -22,7 +23,15 @@ from celery.signals import worker_shutting_down
 from sqlalchemy import text
 
 from api.database import make_engine, make_session_factory, migrate
-from api.jobs.distributed import GRADE_FILE, GRADE_SUBMISSION, QUEUE, CeleryDispatcher, broker_problem
+from api.jobs.distributed import (
+    GRADE_FILE,
+    GRADE_SUBMISSION,
+    QUEUE,
+    RESULT_SECONDS,
+    CeleryDispatcher,
+    broker_problem,
+    redis_client,
+)
 from api.jobs.local import DatabaseQueue
 from api.jobs.protocol import ClaimedJob
 from api.jobs.runner import run_job
@@ -140,6 +149,7 @@ class WorkerRuntime:
             max_attempts=settings.max_attempts,
         )
         self.dispatcher = CeleryDispatcher(settings)
+        self.redis = redis_client(settings)
         self.stop = threading.Event()
         self.prefix = f"{socket.gethostname()}:{os.getpid()}"
 
@@ -169,8 +179,9 @@ class WorkerRuntime:
             self.dispatcher.forget(submission_id)
         return status.value
 
-    def grade_file(self, request: dict[str, Any]) -> dict[str, Any]:
-        """Grade a batch file sent whole; ``{"report": ...}`` or ``{"error": ...}``.
+    def grade_file(self, request: dict[str, Any]) -> str:
+        """Grade a batch file sent whole and push ``{"key", "report"}`` or ``{"key", "error"}`` to the
+        batch's reply list in Redis; what happened, for the worker's log.
 
         Raises:
             celery.exceptions.Reject: The worker is shutting down; the task goes back to the queue.
@@ -191,13 +202,20 @@ class WorkerRuntime:
         run_job(job, outcome, f"{self.prefix}:{uuid.uuid4().hex[:8]}", settings, self.stop)
         if outcome.released:
             raise Reject("the worker is shutting down", requeue=True)
+        reply: dict[str, Any] = {"key": request["key"]}
         if outcome.report is not None:
-            return {"report": outcome.report}
-        return {"error": outcome.error or "the grading ended without a report"}
+            reply["report"] = outcome.report
+        else:
+            reply["error"] = outcome.error or "the grading ended without a report"
+        reply_to = str(request["reply_to"])
+        self.redis.rpush(reply_to, json.dumps(reply))
+        self.redis.expire(reply_to, RESULT_SECONDS)
+        return "report sent" if outcome.report is not None else "error sent"
 
     def close(self) -> None:
         """Close the database and broker connections."""
         self.dispatcher.close()
+        self.redis.close()
         self.engine.dispose()
 
 
@@ -208,8 +226,8 @@ def register_tasks(app: Celery, runtime: WorkerRuntime) -> None:
     def grade_submission(submission_id: int) -> str:
         return runtime.grade_row(int(submission_id))
 
-    @app.task(name=GRADE_FILE, ignore_result=False)  # type: ignore[untyped-decorator]
-    def grade_file(request: dict[str, Any]) -> dict[str, Any]:
+    @app.task(name=GRADE_FILE, ignore_result=True)  # type: ignore[untyped-decorator]
+    def grade_file(request: dict[str, Any]) -> str:
         return runtime.grade_file(request)
 
 

@@ -11,6 +11,8 @@ row's attempt count when it was enqueued, which is how the reconciler sees a tas
 from __future__ import annotations
 
 import logging
+import queue
+import threading
 from collections.abc import Sequence
 from datetime import timedelta
 
@@ -28,19 +30,23 @@ GRADE_FILE = "gymgrade.grade_file"
 """Task: grade a file sent whole and return its report (`gymgrade grade` on the cluster)."""
 _MARKER_PREFIX = "gymgrade:task:"
 _CONNECT_TIMEOUT_SECONDS = 5.0
-RESULT_EXPIRES = timedelta(days=7)
+RESULT_SECONDS = int(timedelta(days=7).total_seconds())
 """How long a batch file's report waits in Redis for the `gymgrade grade` that asked for it."""
 
 
 def make_celery(settings: BrokerSettings) -> Celery:
-    """The Celery application of the cluster (Redis as broker and, for batch reports, result backend).
+    """The Celery application of the cluster: Redis as broker, no result backend.
+
+    Results go to the database (service jobs) or to a Redis list the batch reads (``api.jobs.batch``):
+    Celery's Redis result backend gives up for good after a broker outage ("the Celery application must
+    be restarted"), which a long-running server or worker cannot afford.
 
     Raises:
         ValueError: No broker URL is configured.
     """
     if settings.broker_url is None:
         raise ValueError("GYMGRADE_BROKER_URL is not set; expected redis://HOST:PORT/N")
-    app = Celery("gymgrade", broker=settings.broker_url, backend=settings.broker_url, set_as_current=False)
+    app = Celery("gymgrade", broker=settings.broker_url, set_as_current=False)
     transport = {"visibility_timeout": settings.visibility_timeout_seconds}
     app.conf.update(
         task_default_queue=QUEUE,
@@ -48,13 +54,10 @@ def make_celery(settings: BrokerSettings) -> Celery:
         task_reject_on_worker_lost=True,
         task_ignore_result=True,
         task_serializer="json",
-        result_serializer="json",
         accept_content=["json"],
-        result_expires=RESULT_EXPIRES,
         worker_prefetch_multiplier=1,  # a worker holds no task it cannot start: the others take them
         worker_cancel_long_running_tasks_on_connection_loss=False,  # a grading survives a broker restart
         broker_transport_options=transport,
-        result_backend_transport_options=transport,
         broker_connection_retry_on_startup=True,
         broker_connection_timeout=_CONNECT_TIMEOUT_SECONDS,
         task_publish_retry_policy={"max_retries": 2, "interval_start": 0, "interval_step": 0.5},
@@ -93,6 +96,9 @@ def broker_problem(settings: BrokerSettings) -> str | None:
 class CeleryDispatcher:
     """A :class:`~api.jobs.protocol.Dispatcher` that sends one Celery task per queued submission.
 
+    New submissions are sent from a background thread, so an upload never waits for the broker; one the
+    broker could not take is logged and left to the reconciler.
+
     Args:
         settings: The broker settings.
     """
@@ -102,13 +108,24 @@ class CeleryDispatcher:
         self.app = make_celery(settings)
         self._redis = redis_client(settings)
         self._marker_seconds = int(2 * settings.visibility_timeout_seconds)
+        self._submitted: queue.SimpleQueue[int | None] = queue.SimpleQueue()
+        self._sender: threading.Thread | None = None
 
     def submitted(self, submission_id: int) -> None:
-        """Enqueue a new submission's grading; a broker outage is logged (the reconciler enqueues later)."""
-        try:
-            self.enqueue(submission_id, attempts=0)
-        except Exception as error:  # the row is stored: accepting the upload must not depend on Redis
-            logger.warning("could not enqueue submission %s (%s); the reconciler will", submission_id, error)
+        """Enqueue a new submission's grading soon, in the background (never raises)."""
+        if self._sender is None:
+            self._sender = threading.Thread(target=self._send_submitted, name="gymgrade-enqueue", daemon=True)
+            self._sender.start()
+        self._submitted.put(submission_id)
+
+    def _send_submitted(self) -> None:
+        while (submission_id := self._submitted.get()) is not None:
+            try:
+                self.enqueue(submission_id, attempts=0)
+            except Exception as error:  # the row is stored: the reconciler enqueues it once Redis is back
+                logger.warning(
+                    "could not enqueue submission %s (%s); the reconciler will", submission_id, error
+                )
 
     def enqueue(self, submission_id: int, *, attempts: int) -> None:
         """Send the task of ``submission_id`` and mark it as sent while the row had ``attempts``."""
@@ -130,7 +147,10 @@ class CeleryDispatcher:
         self._redis.delete(_MARKER_PREFIX + str(submission_id))
 
     def close(self) -> None:
-        """Close the broker connections."""
+        """Send what was submitted (briefly), then close the broker connections."""
+        if self._sender is not None:
+            self._submitted.put(None)
+            self._sender.join(_CONNECT_TIMEOUT_SECONDS)
         self._redis.close()
         self.app.close()
 

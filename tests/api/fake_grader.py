@@ -69,6 +69,7 @@ def grade_submission(
     try:
         compile(source, path.name, "exec")
     except SyntaxError as error:
+        message = f"{path.name} is not valid Python: line {error.lineno}: {error.msg}"
         return Report(
             submission=path.name,
             sha256=sha256,
@@ -78,7 +79,13 @@ def grade_submission(
             grader_version=grader.__version__,
             score=0.0,
             max_score=POINTS * len(chosen),
-            submission_error=f"{path.name} is not valid Python: line {error.lineno}: {error.msg}",
+            submission_error=message,
+            problems=[
+                ProblemResult(
+                    id=problem_id, title=title, status="error", score=0.0, max_score=POINTS, feedback=message
+                )
+                for problem_id, title in chosen
+            ],
         )
     delay = float(_directive(source, "sleep") or 0.0)
     problems = []
