@@ -47,13 +47,14 @@ def cores() -> int:
 
 
 def split_cores(concurrency: int | None, settings: Settings) -> tuple[int, int]:
-    """Gradings at once and xdist workers per grading for this machine (see bench/RESULTS.md).
+    """Gradings at once and xdist workers per grading on this machine (measured in bench/RESULTS.md).
 
-    One grading at a time spread over every core measured best on two cores (a grading's problems run in
-    parallel, and one grading finishes sooner, which is what a student waits for); more gradings at once
-    share the cores between them.
+    By default one grading per core, each without xdist (its checks run one after another in the pytest
+    process): under a burst of uploads that gave the most gradings per minute, since every xdist worker
+    costs a start-up that a grading's short checks do not repay. GYMGRADE_GRADING_WORKERS (or fewer
+    ``--workers``) trades throughput for the latency of one grading when the queue is short.
     """
-    gradings = concurrency or max(settings.workers, 1)
+    gradings = concurrency or cores()
     per_grading = settings.grading_workers or max(cores() // gradings, 1)
     return gradings, per_grading
 
