@@ -10,7 +10,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from grader.errors import BatchInterrupted, GraderError
+from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError
 from grader.problems import PROBLEM_IDS
 from grader.progress import ProgressBar, result_line
 from grader.report import ProblemResult, Report
@@ -289,7 +289,14 @@ def find_executor(policy: IsolationPolicy) -> BatchExecutor | None:
         grader.errors.GraderError: An executor is configured but cannot be used (its message says why).
     """
     for entry_point in entry_points(group=EXECUTOR_GROUP):
-        executor: BatchExecutor | None = entry_point.load()(policy)
+        try:
+            factory = entry_point.load()
+        except Exception as error:
+            raise ExecutorUnavailable(
+                f"the batch executor {entry_point.name!r} could not be loaded ({type(error).__name__}: "
+                f"{error}); reinstall the package providing it (pip install -e '.[distributed]')"
+            ) from error
+        executor: BatchExecutor | None = factory(policy)
         if executor is not None:
             return executor
     return None

@@ -18,10 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import redis
 from pydantic import ValidationError
 
-from api.jobs.distributed import GRADE_FILE, QUEUE, broker_problem, describe, make_celery, redis_client
 from api.settings import BrokerSettings
 from grader.batch import ReportCallback, ResultCallback
 from grader.errors import ExecutorUnavailable
@@ -39,6 +37,8 @@ _RECONNECT_SECONDS = 1.0
 def executor_from_environment(policy: IsolationPolicy) -> CeleryExecutor | None:
     """The ``gymgrade.executors`` entry point: the cluster when GYMGRADE_BROKER_URL is set, else None.
 
+    Celery and Redis are imported only when the setting is there, so a local batch never needs them.
+
     Raises:
         grader.errors.ExecutorUnavailable: The setting is invalid or the broker does not answer.
     """
@@ -48,6 +48,8 @@ def executor_from_environment(policy: IsolationPolicy) -> CeleryExecutor | None:
         raise ExecutorUnavailable(f"GYMGRADE_BROKER_URL is not usable: {error.errors()[0]['msg']}") from error
     if settings.broker_url is None:
         return None
+    from api.jobs.distributed import broker_problem
+
     problem = broker_problem(settings)
     if problem is not None:
         raise ExecutorUnavailable(problem + "; or unset GYMGRADE_BROKER_URL to grade on this machine")
@@ -67,6 +69,8 @@ class CeleryExecutor:
     policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL
 
     def __str__(self) -> str:
+        from api.jobs.distributed import describe
+
         return describe(self.settings)
 
     def grade(
@@ -86,6 +90,10 @@ class CeleryExecutor:
         Raises:
             KeyboardInterrupt: Interrupted; the outstanding tasks are revoked.
         """
+        import redis
+
+        from api.jobs.distributed import make_celery, redis_client
+
         app = make_celery(self.settings)
         client = redis_client(self.settings)
         reply_to = REPLY_PREFIX + uuid.uuid4().hex
@@ -149,6 +157,8 @@ class CeleryExecutor:
 
     @staticmethod
     def _send(app: Any, request: dict[str, Any]) -> str:
+        from api.jobs.distributed import GRADE_FILE, QUEUE
+
         task_id: str = app.send_task(GRADE_FILE, args=[request], queue=QUEUE).id
         return task_id
 

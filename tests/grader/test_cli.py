@@ -286,3 +286,16 @@ def test_ctrl_c_keeps_finished_reports_and_a_rerun_resumes(tmp_path: Path, fast_
     assert "endless.py: random_blackjack missing" in rerun.stderr
     assert "empty.py" not in rerun.stderr.split("grading 1.")[1]
     assert [row["submission"] for row in csv.DictReader((out / "grades.csv").open())] == ["empty", "endless"]
+
+
+def test_a_broken_executor_entry_point_is_refused_with_a_remedy(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    broken = FakeEntryPoint("cluster", ImportError("No module named 'celery'"))
+    monkeypatch.setattr(cli, "entry_points", lambda group: [broken] if group == cli.EXECUTOR_GROUP else [])
+    (tmp_path / "alice.py").write_bytes(b"")
+    assert cli.main(["grade", str(tmp_path / "alice.py"), "--out", str(tmp_path / "out")]) == cli.EXIT_ERROR
+    assert (
+        "gymgrade grade: the batch executor 'cluster' could not be loaded (ImportError: No module named "
+        "'celery'); reinstall the package providing it (pip install -e '.[distributed]')"
+    ) in capsys.readouterr().err
