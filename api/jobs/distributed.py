@@ -27,7 +27,7 @@ QUEUE = "gymgrade"
 GRADE_SUBMISSION = "gymgrade.grade_submission"
 """Task: grade the submission row with this id (the service's jobs)."""
 GRADE_FILE = "gymgrade.grade_file"
-"""Task: grade a file sent whole and return its report (`gymgrade grade` on the cluster)."""
+"""Task: grade a file sent whole and push its report to the batch's Redis list (`gymgrade grade`)."""
 _MARKER_PREFIX = "gymgrade:task:"
 _CONNECT_TIMEOUT_SECONDS = 5.0
 RESULT_SECONDS = int(timedelta(days=7).total_seconds())
