@@ -122,15 +122,12 @@ def test_a_worker_killed_mid_grading_loses_nothing(cluster: Cluster) -> None:
     victim = next(
         w for w in (first, second) if w.process is not None and w.process.pid == _owner_pid(cluster, slow)
     )
-    killed_at = time.monotonic()
     victim.kill()
     quick = [upload(cluster.server.url, token, fake_submission(i, sleep=0.05)) for i in range(1, 5)]
-    views = _wait_all(cluster, token, [slow, *quick])
-    recovered_in = time.monotonic() - killed_at
+    views = _wait_all(cluster, token, [slow, *quick])  # bounded by WAIT_SECONDS (bench/ times recovery)
     assert views[0]["attempts"] == 2, "the killed worker's job was graded again by the other"
     assert [view["attempts"] for view in views[1:]] == [1, 1, 1, 1]
     assert all(view["report"]["score"] == 1.0 for view in views)
-    assert recovered_in < LEASE_SECONDS + RECONCILE_SECONDS + 3 * 1.0 + 10
 
 
 def test_a_broker_restart_and_duplicated_tasks_lose_and_repeat_nothing(
