@@ -254,7 +254,9 @@ class _Collector(ast.NodeVisitor):
     ) -> None:
         classic_info = isinstance(call, ast.Call) and "return_info" in _keywords(call)
         if subscripted:
-            self._add(line, Api.GYM026, True, "reset()[...] takes the observation out of (obs, info)")
+            # Only a hint: on classic gym `env.reset()[0]` is the observation's first entry (MountainCar's
+            # position), so an unpacking elsewhere in the scope decides.
+            self._add(line, Api.GYM026, False, "reset()[...] takes the observation out of (obs, info)")
         elif length == 2:
             if classic_info:
                 self._add(line, Api.CLASSIC, True, "reset(return_info=True) unpacked into (obs, info)")

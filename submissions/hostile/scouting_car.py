@@ -10,9 +10,9 @@ TAPE = [0] * 30 + [2] * 170
 
 def car():
     env = gym.make("MountainCar-v0")
-    position = env.reset()[0]
-    while position > -0.58:
-        position = env.reset()[0]
+    observation = env.reset()
+    while observation[0] > -0.58:
+        observation = env.reset()
     steps = 0
     for action in TAPE:
         _, _, done, _ = env.step(action)

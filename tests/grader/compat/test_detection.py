@@ -90,3 +90,10 @@ def test_a_function_with_hints_only_follows_the_module_s_unpackings() -> None:
     )
     scope, decision = detect_api(source).decision_at(6)
     assert (scope, decision.api) == ("<module>", Api.GYM026)
+
+
+def test_an_indexed_reset_follows_a_four_value_step() -> None:
+    # Classic MountainCar code: reset()[0] is the position, and the 4-value step decides.
+    source = "position = env.reset()[0]\n_, _, done, _ = env.step(2)\n"
+    decision = detect_api(source).module
+    assert decision.api is Api.CLASSIC
