@@ -100,9 +100,8 @@ ACCEPTED_GAMES: Mapping[ProblemId, tuple[Game, ...]] = {
     "cartpole": (CARTPOLE_V0, CARTPOLE_V1),
     "car": (MOUNTAIN_CAR,),
     "taxi": (TAXI,),
-    "find_qvalues": (TAXI,),
 }
-"""Every game each problem accepts by default; the first is the classic lab's (named in feedback)."""
+"""Every game each problem that plays episodes accepts by default; the first is the classic lab's."""
 
 
 def accepted_game_names(problem: ProblemId) -> tuple[str, ...]:

@@ -3,7 +3,8 @@
 The code calling an environment is found on the stack (the first frame outside this package and
 gymnasium); its file is analysed once (`grader.compat.detection`) and the line decides. A function
 without evidence of its own follows its module, or, when the module mixes both APIs, the nearest caller
-that has evidence. Code with no evidence at all gets classic gym, the API the lab was written for.
+that has evidence. Code with no evidence at all (or none decided by a caller) gets classic gym, the API
+the lab was written for.
 Every decision is reported once per drain of the events (`api_detected`), with the lines that decided.
 """
 
@@ -43,8 +44,9 @@ def caller_api(env_id: str, depth: int = 2) -> Api:
         depth: frames between this function and the student's call (2: the env method's caller).
 
     Raises:
-        AmbiguousApiError: the calling function's lines expect both APIs, or no caller decides in a
-            module that uses both; the message names the lines.
+        AmbiguousApiError: the calling function's own lines (or module-level code) expect both APIs; the
+            message names the lines. A function without evidence in a file that uses both, called by no
+            function with evidence, gets `DEFAULT_API` and an event saying so.
     """
     global _served_generation
     frame = sys._getframe(depth)
@@ -67,29 +69,35 @@ def _resolve(frame: FrameType | None, site: tuple[CodeType, int], env_id: str) -
         detection = None if filename.startswith(_SKIPPED_DIRECTORIES) else _detection(filename)
         if detection is not None:
             scope, decision = detection.decision_at(frame.f_lineno)
-            if first is None:
+            calling = first is None
+            if calling:
                 first = (filename, scope, decision)
             if decision.api is not None:
                 if frame is origin:
                     _served[site] = decision.api
                 _announce(env_id, filename, scope, decision.api, decision)
                 return decision.api
-            if decision.conflict and scope != "<module>":
+            # Lines of one function, or module-level code calling the env, that expect both cannot be served.
+            module_code = calling and frame.f_code.co_name == "<module>"
+            if decision.conflict and (scope != "<module>" or module_code):
                 raise _ambiguous(filename, scope, decision)
         frame = frame.f_back
-    if first is not None and first[2].conflict:
-        raise _ambiguous(*first)
     _served[site] = DEFAULT_API
     where = Path(first[0]).name if first is not None else "the calling code"
     if (where, "") in _announced:
         return DEFAULT_API
     _announced.add((where, ""))
-    events.record(
-        events.API_DETECTED,
-        env_id,
-        f"{where}: no line shows which gym API it expects (no reset() or step() result unpacked), so it "
-        f"got {DEFAULT_API.label}, the lab's API",
-    )
+    if first is not None and first[2].conflict:
+        reason = (
+            f"the calling function shows no API of its own and its file uses both "
+            f"({first[2].explain(limit=2)}), so it got {DEFAULT_API.label}, the lab's API"
+        )
+    else:
+        reason = (
+            "no line shows which gym API it expects (no reset() or step() result unpacked), so it got "
+            f"{DEFAULT_API.label}, the lab's API"
+        )
+    events.record(events.API_DETECTED, env_id, f"{where}: {reason}")
     return DEFAULT_API
 
 

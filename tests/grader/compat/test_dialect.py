@@ -97,3 +97,33 @@ def test_gym_toytext_registers_the_package_s_games(run_through_layer: RunScript)
     lines = result.stdout.splitlines()
     assert all(line.endswith(" True") for line in lines[:6]), lines
     assert lines[6] == "True gymnasium.envs.toy_text.blackjack"
+
+
+def test_a_function_without_evidence_in_a_mixed_file_gets_classic_gym(run_through_layer: RunScript) -> None:
+    result = run_through_layer(
+        """
+        import gym
+
+        def old():
+            env = gym.make("CartPole-v0")
+            obs = env.reset()
+            obs, reward, done, info = env.step(0)
+
+        def new():
+            env = gym.make("CartPole-v1")
+            obs, info = env.reset()
+
+        def neither():
+            env = gym.make("NChain-v0")
+            return int(env.reset())
+
+        print(neither())
+        """
+    )
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == "0\n"
+    assert (
+        "api_detected [NChain-v0]: snippet.py: the calling function shows no API of its own and its file "
+        "uses both (line 7: step() unpacked into 4 values (obs, reward, done, info); line 11: reset() "
+        "unpacked into 2 values (obs, info))"
+    ) in result.stderr

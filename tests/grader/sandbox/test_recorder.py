@@ -331,7 +331,8 @@ def test_step_before_reset_records_the_implicit_reset(child: ChildClient) -> Non
 
     assert log.steps == 1
     assert result is not None
-    assert [event["kind"] for event in result["compat_events"]] == ["renamed_id", "step_before_reset"]
+    kinds = [event["kind"] for event in result["compat_events"]]
+    assert kinds == ["renamed_id", "api_detected", "step_before_reset"]
 
 
 def test_human_rendering_is_harmless_and_not_logged(child: ChildClient) -> None:
