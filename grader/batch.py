@@ -99,10 +99,11 @@ def grade_many(
 
 
 def write_grades(path: Path, names: Sequence[str], reports: Sequence[Report], plan: GradingPlan) -> None:
-    """Write the gradebook: a row per submission, a column per problem's score, the total and a note."""
+    """Write the gradebook: a row per submission (with its grading seed), a column per problem's score,
+    the total and a note."""
     with path.open("w", newline="", encoding="utf-8") as stream:
         writer = csv.writer(stream)
-        writer.writerow(["submission", "sha256", *plan.problems, "total", "max_score", "note"])
+        writer.writerow(["submission", "sha256", "seed", *plan.problems, "total", "max_score", "note"])
         for name, report in zip(names, reports, strict=True):
             scores = {result.id: result.score for result in report.problems}
             note = report.submission_error or "; ".join(report.grader_errors)
@@ -110,6 +111,7 @@ def write_grades(path: Path, names: Sequence[str], reports: Sequence[Report], pl
                 [
                     name,
                     report.sha256,
+                    report.seed,
                     *(f"{scores.get(problem, 0.0):g}" for problem in plan.problems),
                     f"{report.score:g}",
                     f"{report.max_score:g}",

@@ -11,7 +11,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib.metadata import version
 from pathlib import Path
 
@@ -20,7 +20,7 @@ from grader.config import load_config
 from grader.execution import problem_seed
 from grader.problems import PROBLEM_IDS, ProblemId
 from grader.progress import ResultsFollower
-from grader.report import GradingTimings, ProblemResult, ProblemRun, Report
+from grader.report import GradingTimings, ProblemResult, ProblemRun, Report, Visibility
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import IsolationUnavailable
 from grader.validation import FileVerdict, check_source
@@ -39,6 +39,7 @@ class GradingPlan:
     points: dict[ProblemId, float]
     titles: dict[ProblemId, str]
     config: Path | None
+    visibility: dict[ProblemId, Visibility] = field(default_factory=dict)
 
     @classmethod
     def load(cls, config: Path | None, only: Sequence[str] | None) -> GradingPlan:
@@ -64,6 +65,7 @@ class GradingPlan:
             points={problem: assignment.problem(problem).points for problem in problems},
             titles={problem: assignment.problem(problem).title for problem in problems},
             config=config,
+            visibility={problem: assignment.problem(problem).visibility for problem in problems},
         )
 
 
@@ -231,6 +233,7 @@ def _rejected_report(path: Path, data: bytes, plan: GradingPlan, seed: int, verd
             max_score=plan.points[problem],
             feedback=verdict.message,
             seed=problem_seed(seed, problem),
+            visibility=plan.visibility.get(problem, "visible"),
         )
         for problem in plan.problems
     ]
@@ -257,6 +260,7 @@ def _internal_error_run(
         points=plan.points[problem],
         seed=problem_seed(seed, problem),
         detail=detail,
+        visibility=plan.visibility.get(problem, "visible"),
     )
 
 
