@@ -6,7 +6,7 @@ from typing import Annotated
 
 from fastapi import APIRouter, File, Query, UploadFile
 
-from api.deps import CallerDep, SessionDep, SettingsDep, StudentDep
+from api.deps import CallerDep, DisclosureDep, SessionDep, SettingsDep, StudentDep
 from api.schemas import ErrorBody, SubmissionAccepted, SubmissionDetail, SubmissionSummary
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
@@ -45,9 +45,11 @@ def post_submission(
     response_model=SubmissionDetail,
     responses={401: {"model": ErrorBody}, 404: {"model": ErrorBody}},
 )
-def get_one_submission(submission_id: int, session: SessionDep, caller: CallerDep) -> SubmissionDetail:
+def get_one_submission(
+    submission_id: int, session: SessionDep, caller: CallerDep, disclosure: DisclosureDep
+) -> SubmissionDetail:
     """A submission's status, the problems finished so far, and its report once done."""
-    return detail(get_submission(session, caller, submission_id))
+    return detail(get_submission(session, caller, submission_id), disclosure)
 
 
 @router.get(
@@ -58,7 +60,8 @@ def get_one_submission(submission_id: int, session: SessionDep, caller: CallerDe
 def get_submissions(
     session: SessionDep,
     caller: CallerDep,
+    disclosure: DisclosureDep,
     student: str | None = Query(default=None, description="Instructor only: one student's submissions."),
 ) -> list[SubmissionSummary]:
     """The caller's submissions, newest first (the instructor sees everyone's)."""
-    return [summary(item) for item in list_submissions(session, caller, student)]
+    return [summary(item, disclosure) for item in list_submissions(session, caller, student)]
