@@ -7,6 +7,44 @@ class ServiceError(Exception):
     """Root of every error the service reports to a client; the message is shown to them as is."""
 
 
+class MalformedBody(ServiceError):
+    """Raised when a request body cannot be parsed at all (broken JSON or multipart framing)."""
+
+
+class InvalidRequest(ServiceError):
+    """Raised when a request parses but its parameters or body break the schema (a field missing or mistyped).
+
+    Args:
+        message: What was expected and what was found, for a person.
+        problems: One ``(location, message, type)`` triple per offending field, for a program.
+    """
+
+    def __init__(self, message: str, problems: list[tuple[list[str | int], str, str]]) -> None:
+        super().__init__(message)
+        self.problems = problems
+
+
+class PathNotFound(ServiceError):
+    """Raised when a URL names no resource of the service."""
+
+
+class MethodNotAllowed(ServiceError):
+    """Raised when a resource exists but does not support the request's method.
+
+    Args:
+        message: What was expected and what was found.
+        allowed: The methods the resource supports (sent in the ``Allow`` header).
+    """
+
+    def __init__(self, message: str, allowed: list[str]) -> None:
+        super().__init__(message)
+        self.allowed = allowed
+
+
+class InternalError(ServiceError):
+    """Raised (by the error handler, for the client) when the service itself failed on a request."""
+
+
 class NotAuthenticated(ServiceError):
     """Raised when a request carries no token or a token that belongs to nobody."""
 
@@ -40,7 +78,7 @@ class InvalidUpload(ServiceError):
 
 
 class UploadTooLarge(ServiceError):
-    """Raised when an upload exceeds GYMGRADE_MAX_UPLOAD_BYTES."""
+    """Raised when an upload, or any request body, exceeds GYMGRADE_MAX_UPLOAD_BYTES (plus framing)."""
 
 
 class LengthRequired(ServiceError):

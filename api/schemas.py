@@ -2,19 +2,40 @@
 
 from __future__ import annotations
 
-from datetime import datetime
-from typing import Any, Literal
+from datetime import UTC, datetime
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
+
+from api.students import MAX_NAME_CHARS, name_pattern
 
 Status = Literal["queued", "running", "done", "failed"]
+
+
+def _as_utc(moment: datetime) -> datetime:
+    # The database stores naive UTC times; an RFC 3339 date-time must carry its offset.
+    return moment if moment.tzinfo is not None else moment.replace(tzinfo=UTC)
+
+
+UtcDateTime = Annotated[datetime, AfterValidator(_as_utc)]
+
+
+def _document_name_rule(schema: dict[str, Any]) -> None:
+    # Documentation only: api.students.normalise_name checks names with messages a person can act on.
+    schema["properties"]["name"]["pattern"] = name_pattern()
 
 
 class StudentCreate(BaseModel):
     """A new student."""
 
+    model_config = ConfigDict(json_schema_extra=_document_name_rule)
+
     name: str = Field(
-        description="Unique display name, 1 to 100 printable characters.", examples=["Ada Lovelace"]
+        description=(
+            f"Unique display name: 1 to {MAX_NAME_CHARS} characters once whitespace around it is trimmed, "
+            "none of them a control, format (bidi, zero-width), private-use or line-separator character."
+        ),
+        examples=["Ada Lovelace"],
     )
 
 
@@ -42,8 +63,8 @@ class SubmissionSummary(BaseModel):
     status: Status
     score: float | None = None
     max_score: float | None = None
-    created_at: datetime
-    finished_at: datetime | None = None
+    created_at: UtcDateTime
+    finished_at: UtcDateTime | None = None
 
 
 class SubmissionDetail(SubmissionSummary):
@@ -52,7 +73,7 @@ class SubmissionDetail(SubmissionSummary):
     seed: int | None = Field(
         description="The grading seed; null for students unless the instructor released the seeds."
     )
-    started_at: datetime | None = None
+    started_at: UtcDateTime | None = None
     attempts: int
     progress: list[dict[str, Any]] = Field(
         default_factory=list, description="Problems finished so far (each as in the report's `problems`)."
@@ -75,7 +96,22 @@ class Health(BaseModel):
     running: int
 
 
-class ErrorBody(BaseModel):
-    """Every error response: what went wrong and what to do."""
+class FieldProblem(BaseModel):
+    """One part of a request that breaks the schema."""
 
-    detail: str
+    location: list[str | int] = Field(
+        description='Where it is: ["body", "name"], ["path", "submission_id"], ["query", "student"], ...',
+        examples=[["body", "name"]],
+    )
+    message: str = Field(description="What was expected there and what was found.")
+    type: str = Field(description="The kind of problem, stable for programs: missing, int_parsing, ...")
+
+
+class ErrorBody(BaseModel):
+    """Every error response of the API, whatever its status: what went wrong and what to do."""
+
+    detail: str = Field(description="What was expected, what was found, and what to do; shown to people.")
+    problems: list[FieldProblem] | None = Field(
+        default=None,
+        description="Only on 422 for a request that breaks the schema: each offending field, for programs.",
+    )

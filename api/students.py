@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import sys
 import unicodedata
+from functools import cache
 
 from sqlalchemy import select
 from sqlalchemy.exc import IntegrityError
@@ -13,25 +15,64 @@ from api.models import Student
 from api.security import new_token, token_digest
 
 MAX_NAME_CHARS = 100
+# Control, format (bidi overrides, zero-width), surrogate, private-use and line/paragraph separator
+# characters. Unassigned code points are allowed: a newer Unicode than the server's may assign them (new
+# emoji), and no JSON Schema pattern could follow the server's Unicode version.
+FORBIDDEN_NAME_CATEGORIES = frozenset({"Cc", "Cf", "Cs", "Co", "Zl", "Zp"})
 
 
 def normalise_name(name: str) -> str:
     """Validate a student name and return it trimmed.
 
     Raises:
-        InvalidStudentName: Empty, longer than 100 characters, or holding control or unassigned characters.
+        InvalidStudentName: Empty, longer than 100 characters, or holding control or format characters.
     """
     trimmed = name.strip()
     if not trimmed:
         raise InvalidStudentName("expected a student name, found an empty one")
     if len(trimmed) > MAX_NAME_CHARS:
         raise InvalidStudentName(f"expected at most {MAX_NAME_CHARS} characters, found {len(trimmed)}")
-    bad = [c for c in trimmed if unicodedata.category(c) in {"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"}]
+    bad = [c for c in trimmed if unicodedata.category(c) in FORBIDDEN_NAME_CATEGORIES]
     if bad:
         raise InvalidStudentName(
             f"a student name must be printable text; found the character U+{ord(bad[0]):04X}"
         )
     return trimmed
+
+
+def _spelled(code_point: int) -> str:
+    # \uXXXX reads the same in ECMA-262 and Python patterns; beyond the BMP only the character itself does.
+    return f"\\u{code_point:04x}" if code_point <= 0xFFFF else chr(code_point)
+
+
+def _character_class(code_points: list[int], *, negated: bool) -> str:
+    """A regex character class of ``code_points`` (ascending), merged into ranges."""
+    ranges: list[list[int]] = []
+    for code_point in code_points:
+        if ranges and ranges[-1][1] == code_point - 1:
+            ranges[-1][1] = code_point
+        else:
+            ranges.append([code_point, code_point])
+    parts = [_spelled(low) if low == high else f"{_spelled(low)}-{_spelled(high)}" for low, high in ranges]
+    return "[" + ("^" if negated else "") + "".join(parts) + "]"
+
+
+@cache
+def name_pattern() -> str:
+    """The names :func:`normalise_name` accepts, as a JSON Schema ``pattern`` (built from the same rules).
+
+    Any whitespace around a name is trimmed; what remains is 1 to ``MAX_NAME_CHARS`` characters, none of
+    them in ``FORBIDDEN_NAME_CATEGORIES``.
+    """
+    category = unicodedata.category
+    # Surrogates are left out: no UTF-8 text holds them, and regex engines refuse them in a class.
+    every = [point for point in range(sys.maxunicode + 1) if not 0xD800 <= point <= 0xDFFF]
+    forbidden = [point for point in every if category(chr(point)) in FORBIDDEN_NAME_CATEGORIES]
+    space = [point for point in every if chr(point).isspace()]
+    around = _character_class(space, negated=False)
+    edge = _character_class(sorted(set(forbidden) | set(space)), negated=True)
+    inner = _character_class(forbidden, negated=True)
+    return f"^{around}*{edge}(?:{inner}{{0,{MAX_NAME_CHARS - 2}}}{edge})?{around}*$"
 
 
 def create_student(session: Session, name: str) -> tuple[Student, str]:

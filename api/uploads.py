@@ -6,6 +6,7 @@ import hashlib
 import re
 import unicodedata
 from dataclasses import dataclass
+from typing import Any
 
 from api.errors import InvalidUpload, UploadTooLarge
 
@@ -13,6 +14,11 @@ MAX_DISPLAY_NAME_CHARS = 100
 _UNSAFE_NAME_CHARACTERS = re.compile(r"[^A-Za-z0-9._ -]+")
 _MODULE_STEM = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 GRADING_FALLBACK_NAME = "submission.py"
+# The rules of check_upload as a JSON Schema for the file's text (UTF-8): no NUL, not only whitespace
+# (bytes.strip() strips exactly these six ASCII characters), and for its multipart Content-Disposition.
+SOURCE_TEXT_PATTERN = r"^[^\u0000]*[^\u0000\t\n\u000b\u000c\r ][^\u0000]*$"
+CONTENT_DISPOSITION_PATTERN = r'filename="(?:[^"]*[/\\])?[^"/\\]*[^"/\\. ][^"/\\]*\.[Pp][Yy]"'
+ACCEPTED_CONTENT_TYPES = ("text/x-python", "text/plain", "application/octet-stream")
 
 
 @dataclass(frozen=True)
@@ -22,6 +28,45 @@ class CheckedUpload:
     display_name: str
     content: bytes
     sha256: str
+
+
+def upload_rules(max_bytes: int) -> tuple[dict[str, Any], dict[str, Any]]:
+    """What :func:`check_upload` accepts, for the OpenAPI schema of a multipart ``file`` part.
+
+    Args:
+        max_bytes: GYMGRADE_MAX_UPLOAD_BYTES.
+
+    Returns:
+        The JSON Schema of the part's content and its OpenAPI Encoding Object (accepted part types and
+        the file-name rule, as a Content-Disposition header).
+    """
+    content = {
+        "type": "string",
+        "contentMediaType": "application/octet-stream",
+        "minLength": 1,
+        "maxLength": max_bytes,
+        "pattern": SOURCE_TEXT_PATTERN,
+        "description": (
+            f"The student's opengym.py: Python source in UTF-8, at most {max_bytes} bytes (maxLength counts "
+            "characters; each non-ASCII character takes 2 to 4 of the bytes), without NUL bytes, "
+            "not empty or blank. Syntax errors are accepted: the grader reports them."
+        ),
+    }
+    encoding = {
+        "contentType": ", ".join(ACCEPTED_CONTENT_TYPES),
+        "headers": {
+            "Content-Disposition": {
+                "description": (
+                    "The part's file name must end in .py (like opengym.py); only its last path component "
+                    "is kept, as a sanitised display name."
+                ),
+                "required": True,
+                "schema": {"type": "string", "pattern": CONTENT_DISPOSITION_PATTERN},
+                "example": 'form-data; name="file"; filename="opengym.py"',
+            }
+        },
+    }
+    return content, encoding
 
 
 def display_name(client_name: str | None) -> str:

@@ -86,7 +86,8 @@ def table(rows: list[tuple[str, str, dict[str, object]]], call_seconds: float) -
         "peak RSS (the sandboxed student code is not counted); ratios against the honest lab solution's "
         "same problem.",
         "",
-        "| sample | problem | verdict | calls made | wall s | grader CPU s | x honest CPU | grader peak MiB |",
+        "| sample | problem | verdict | calls made | wall s | grader CPU s | x honest CPU "
+        "| grader peak MiB |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for sample, problem, figures in rows:
@@ -108,7 +109,9 @@ def table(rows: list[tuple[str, str, dict[str, object]]], call_seconds: float) -
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--write", action="store_true", help=f"replace the {HEADING!r} section of RESULTS.md")
     arguments = parser.parse_args()
     sys.path.insert(0, str(ROOT))

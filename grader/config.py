@@ -9,6 +9,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from grader.errors import ConfigError
+from grader.games import accepted_game_names
 from grader.problems import PROBLEM_IDS, ProblemId
 from grader.report import Visibility
 from grader.sandbox.limits import Limits
@@ -39,7 +40,42 @@ class ProblemConfig(_Strict):
     )
 
 
-class RandomBlackjackConfig(ProblemConfig):
+class PlayedProblemConfig(ProblemConfig):
+    """Settings of a problem whose function plays episodes in an environment."""
+
+    accepted_envs: list[str] | None = Field(
+        default=None,
+        description="The games the episodes may be played in, by id (grader/games.py lists each "
+        "problem's: Blackjack-v0/Blackjack-v1, CartPole-v0/CartPole-v1, MountainCar-v0, Taxi-v3); "
+        "absent = all of them.",
+    )
+
+    @model_validator(mode="after")
+    def _known_games(self) -> PlayedProblemConfig:
+        problem: ProblemId = getattr(self, "kind")  # noqa: B009 (every subclass declares its kind)
+        accepted = accepted_game_names(problem)
+        chosen = self.accepted_envs
+        if chosen is not None and (not chosen or not set(chosen) <= set(accepted)):
+            raise ValueError(
+                f"accepted_envs must be a non-empty list of {', '.join(accepted)}; found {chosen}"
+            )
+        return self
+
+
+class CountedStepsConfig(PlayedProblemConfig):
+    """Settings of a problem whose function returns the length of the episode it played."""
+
+    uncounted_steps_deduction: float = Field(
+        default=0.0,
+        ge=0.0,
+        le=1.0,
+        description="Share of the problem's points deducted when every returned count misses exactly the "
+        "steps taken before the counted loop (the lab-era 'one random step first' pattern); the verdict "
+        "follows the replayed episodes either way.",
+    )
+
+
+class RandomBlackjackConfig(PlayedProblemConfig):
     """Problem 1: `random_blackjack(n)`."""
 
     kind: Literal["random_blackjack"] = "random_blackjack"
@@ -54,7 +90,7 @@ class RandomBlackjackConfig(ProblemConfig):
     )
 
 
-class BlackjackConfig(ProblemConfig):
+class BlackjackConfig(PlayedProblemConfig):
     """Problem 2: `blackjack(n)`."""
 
     kind: Literal["blackjack"] = "blackjack"
@@ -77,7 +113,7 @@ class BlackjackConfig(ProblemConfig):
         return thresholds
 
 
-class CartpoleConfig(ProblemConfig):
+class CartpoleConfig(CountedStepsConfig):
     """Problem 3: `cartpole()`."""
 
     kind: Literal["cartpole"] = "cartpole"
@@ -86,7 +122,7 @@ class CartpoleConfig(ProblemConfig):
     min_steps: int = Field(ge=0, description="Every episode must last at least this many steps.")
 
 
-class CarConfig(ProblemConfig):
+class CarConfig(CountedStepsConfig):
     """Problem 4: `car()`."""
 
     kind: Literal["car"] = "car"
@@ -94,7 +130,7 @@ class CarConfig(ProblemConfig):
     max_mean_steps: float = Field(gt=0.0, description="The mean episode length must be strictly below this.")
 
 
-class TaxiConfig(ProblemConfig):
+class TaxiConfig(PlayedProblemConfig):
     """Problem 5: `taxi()` or `taxi(q_table)`."""
 
     kind: Literal["taxi"] = "taxi"

@@ -12,7 +12,8 @@ from pydantic import JsonValue
 from grader.checks import CHECKS
 from grader.checks.base import CallRecord, Verdict
 from grader.checks.episodes import replay_call, settled_by
-from grader.config import AssignmentConfig
+from grader.config import AssignmentConfig, PlayedProblemConfig
+from grader.games import allowed_games
 from grader.problems import ProblemId
 from grader.report import ProblemResult, ProblemRun, Timings, cap_output, plain_json
 from grader.sandbox import CallOutcome, IsolationPolicy, IsolationReport, Sandbox
@@ -71,13 +72,16 @@ def run_problem(
     settings = config.problem(problem)
     seed = problem_seed(grading_seed, problem)
     limits = config.sandbox.to_limits(settings.call_seconds)
+    games = (
+        allowed_games(problem, settings.accepted_envs) if isinstance(settings, PlayedProblemConfig) else None
+    )
     records: list[CallRecord] = []
     stopped: str | None = None
     with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:
         calls = check.plan(settings, sandbox.functions)
         for call in calls:
-            records.append(replay_call(sandbox.call(call), check.games))
-            stopped = settled_by(records[-1], check.games)
+            records.append(replay_call(sandbox.call(call), games))
+            stopped = settled_by(records[-1], games)
             if stopped is not None:
                 break
         isolation = isolation_summary(sandbox.isolation)

@@ -23,6 +23,7 @@ from grader.progress import ResultsFollower
 from grader.report import GradingTimings, ProblemResult, ProblemRun, Report, Visibility
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import IsolationUnavailable
+from grader.sandbox.isolation.scope import sandbox_scope
 from grader.validation import FileVerdict, check_source
 
 ACCEPTANCE_DIR = Path(__file__).with_name("acceptance")
@@ -289,7 +290,8 @@ def run_acceptance(
     """
     runs: dict[str, list[ProblemRun]] = {str(path): [] for path in paths}
     resolved = {str(path.resolve()): path for path in paths}
-    with tempfile.TemporaryDirectory(prefix="gymgrade-") as scratch:
+    # The scope outlives the pytest run: its harness trees, scratch dirs and cgroups go when it closes.
+    with sandbox_scope() as scope, tempfile.TemporaryDirectory(prefix="gymgrade-") as scratch:
         results_file = Path(scratch) / "results.jsonl"
         log_file = Path(scratch) / "pytest.log"
         command = acceptance_command(
@@ -303,7 +305,7 @@ def run_acceptance(
                 stdout=log,
                 stderr=subprocess.STDOUT,
                 cwd=scratch,
-                env=acceptance_environment(),
+                env=acceptance_environment() | scope,
                 start_new_session=True,
             )
             try:

@@ -6,8 +6,9 @@ from fastapi import APIRouter
 from fastapi.responses import Response
 
 from api.deps import InstructorDep, SessionDep, SettingsDep
+from api.errors import InstructorOnly, NotAuthenticated
 from api.gradebook import gradebook_csv
-from api.schemas import ErrorBody
+from api.handlers import error_responses
 
 router = APIRouter(tags=["gradebook"])
 
@@ -17,8 +18,7 @@ router = APIRouter(tags=["gradebook"])
     response_class=Response,
     responses={
         200: {"content": {"text/csv": {}}, "description": "One row per student, one column per problem."},
-        401: {"model": ErrorBody},
-        403: {"model": ErrorBody},
+        **error_responses(NotAuthenticated, InstructorOnly),
     },
 )
 def get_gradebook(session: SessionDep, settings: SettingsDep, _instructor: InstructorDep) -> Response:

@@ -5,7 +5,17 @@ from __future__ import annotations
 from fastapi import APIRouter
 
 from api.deps import InstructorDep, SessionDep
-from api.schemas import ErrorBody, StudentCreate, StudentCreated
+from api.errors import (
+    InstructorOnly,
+    InvalidRequest,
+    InvalidStudentName,
+    MalformedBody,
+    NotAuthenticated,
+    StudentExists,
+    UploadTooLarge,
+)
+from api.handlers import error_responses
+from api.schemas import StudentCreate, StudentCreated
 from api.students import create_student
 
 router = APIRouter(tags=["students"])
@@ -15,12 +25,15 @@ router = APIRouter(tags=["students"])
     "/students",
     status_code=201,
     response_model=StudentCreated,
-    responses={
-        401: {"model": ErrorBody},
-        403: {"model": ErrorBody},
-        409: {"model": ErrorBody},
-        422: {"model": ErrorBody},
-    },
+    responses=error_responses(
+        MalformedBody,
+        NotAuthenticated,
+        InstructorOnly,
+        StudentExists,
+        UploadTooLarge,
+        InvalidRequest,
+        InvalidStudentName,
+    ),
 )
 def post_student(body: StudentCreate, session: SessionDep, _instructor: InstructorDep) -> StudentCreated:
     """Create a student; the token in the response is shown only this once."""

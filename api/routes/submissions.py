@@ -2,48 +2,93 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Any
 
-from fastapi import APIRouter, File, Query, UploadFile
+from fastapi import APIRouter, File, Query, Request, Response, UploadFile
 
 from api.deps import CallerDep, DisclosureDep, SessionDep, SettingsDep, StudentDep
-from api.schemas import ErrorBody, SubmissionAccepted, SubmissionDetail, SubmissionSummary
+from api.errors import (
+    InvalidRequest,
+    InvalidUpload,
+    LengthRequired,
+    MalformedBody,
+    NotAuthenticated,
+    RateLimited,
+    StudentNotFound,
+    StudentOnly,
+    SubmissionNotFound,
+    UploadTooLarge,
+)
+from api.handlers import error_responses
+from api.schemas import SubmissionAccepted, SubmissionDetail, SubmissionSummary
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
-from api.uploads import check_upload
+from api.uploads import check_upload, upload_rules
 
 router = APIRouter(tags=["submissions"])
+
+UPLOAD_OPERATION = "post_submission_submissions_post"
+GET_ONE_OPERATION = "get_one_submission_submissions__submission_id__get"
+"""The operation ids FastAPI first generated; generated clients name their methods after them."""
+
+ACCEPTED_RESPONSE: dict[str, Any] = {
+    "description": "Stored and queued for grading; follow `Location` (or the link) to its status and report.",
+    "headers": {
+        "Location": {
+            "description": "The submission's URL, /submissions/{id}.",
+            "required": True,
+            "schema": {"type": "string", "format": "uri-reference"},
+        }
+    },
+    "links": {
+        "GetSubmission": {
+            "operationId": GET_ONE_OPERATION,
+            "parameters": {"submission_id": "$response.body#/id"},
+            "description": "The new submission's grading status, progress and report.",
+        }
+    },
+}
 
 
 @router.post(
     "/submissions",
     status_code=202,
     response_model=SubmissionAccepted,
+    operation_id=UPLOAD_OPERATION,
     responses={
-        401: {"model": ErrorBody},
-        403: {"model": ErrorBody},
-        411: {"model": ErrorBody},
-        413: {"model": ErrorBody},
-        422: {"model": ErrorBody},
-        429: {"model": ErrorBody},
+        202: ACCEPTED_RESPONSE,
+        **error_responses(
+            MalformedBody,
+            NotAuthenticated,
+            StudentOnly,
+            LengthRequired,
+            UploadTooLarge,
+            InvalidRequest,
+            InvalidUpload,
+            RateLimited,
+        ),
     },
 )
 def post_submission(
+    request: Request,
+    response: Response,
     session: SessionDep,
     settings: SettingsDep,
     student: StudentDep,
-    file: Annotated[UploadFile, File(description="The student's opengym.py (UTF-8 Python source).")],
+    file: Annotated[UploadFile, File()],
 ) -> SubmissionAccepted:
     """Upload a file for grading; poll GET /submissions/{id} for the result."""
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
     submission = create_submission(session, settings, student, upload)
+    response.headers["Location"] = request.app.url_path_for("get_one_submission", submission_id=submission.id)
     return SubmissionAccepted(id=submission.id)
 
 
 @router.get(
     "/submissions/{submission_id}",
     response_model=SubmissionDetail,
-    responses={401: {"model": ErrorBody}, 404: {"model": ErrorBody}},
+    operation_id=GET_ONE_OPERATION,
+    responses=error_responses(NotAuthenticated, SubmissionNotFound, InvalidRequest),
 )
 def get_one_submission(
     submission_id: int, session: SessionDep, caller: CallerDep, disclosure: DisclosureDep
@@ -55,7 +100,7 @@ def get_one_submission(
 @router.get(
     "/submissions",
     response_model=list[SubmissionSummary],
-    responses={401: {"model": ErrorBody}, 404: {"model": ErrorBody}},
+    responses=error_responses(NotAuthenticated, StudentNotFound, InvalidRequest),
 )
 def get_submissions(
     session: SessionDep,
@@ -65,3 +110,17 @@ def get_submissions(
 ) -> list[SubmissionSummary]:
     """The caller's submissions, newest first (the instructor sees everyone's)."""
     return [summary(item, disclosure) for item in list_submissions(session, caller, student)]
+
+
+def document_upload_rules(openapi: dict[str, Any], max_upload_bytes: int) -> None:
+    """Write the upload's rules (:func:`api.uploads.upload_rules`) into the OpenAPI schema, in place.
+
+    Args:
+        openapi: The application's OpenAPI schema.
+        max_upload_bytes: GYMGRADE_MAX_UPLOAD_BYTES, the limit the schema states.
+    """
+    content, encoding = upload_rules(max_upload_bytes)
+    media = openapi["paths"]["/submissions"]["post"]["requestBody"]["content"]["multipart/form-data"]
+    body_name = media["schema"]["$ref"].rsplit("/", 1)[-1]
+    openapi["components"]["schemas"][body_name]["properties"]["file"].update(content)
+    media["encoding"] = {"file": encoding}

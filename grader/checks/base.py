@@ -12,7 +12,6 @@ from grader.problems import PROBLEM_IDS, ProblemId
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, PlainValue
 
 if TYPE_CHECKING:
-    from grader.checks.episodes import GameRules
     from grader.config import ProblemConfig
     from grader.sandbox.replay import Replay
 
@@ -59,11 +58,6 @@ class ProblemCheck(Protocol):
 
     id: ProblemId
     title: str
-
-    @property
-    def games(self) -> GameRules | None:
-        """The game the problem's episodes must be played in (None: it plays none); checked before replay."""
-        ...
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The calls to run, given the functions the submission defines."""

@@ -34,18 +34,18 @@ def _play_blackjack(env: LabEnv, policy: Callable[[Any, int], int]) -> float:
     return reward
 
 
-def random_blackjack(lab: Lab, n: int) -> float:
+def random_blackjack(lab: Lab, n: int, *, env_id: str = "Blackjack-v0") -> float:
     """Reference: n games with random actions; the fraction won."""
-    env = lab.make("Blackjack-v0")
+    env = lab.make(env_id)
     rewards = [
         _play_blackjack(env, lambda _observation, _step: int(env.action_space.sample())) for _ in range(n)
     ]
     return sum(reward > 0 for reward in rewards) / n
 
 
-def blackjack(lab: Lab, n: int, games: int = BLACKJACK_GAMES) -> float:
+def blackjack(lab: Lab, n: int, games: int = BLACKJACK_GAMES, *, env_id: str = "Blackjack-v0") -> float:
     """Reference: draw while the sum is <= n over 10000 games; the fraction won."""
-    env = lab.make("Blackjack-v0")
+    env = lab.make(env_id)
     rewards = [
         _play_blackjack(env, lambda observation, _step: int(observation[0] <= n)) for _ in range(games)
     ]
@@ -66,14 +66,62 @@ def velocity_policy(observation: Any) -> int:
     return 1 if observation[3] > 0 else 0
 
 
-def cartpole(lab: Lab) -> int:
+def cartpole(lab: Lab, *, env_id: str = "CartPole-v0") -> int:
     """Reference: one CartPole-v0 episode with the velocity policy; its length."""
-    return _episode_length(lab.make("CartPole-v0"), velocity_policy)
+    return _episode_length(lab.make(env_id), velocity_policy)
+
+
+def car_policy(observation: Any) -> int:
+    """The reference MountainCar policy: push along the velocity."""
+    return 2 if observation[1] >= 0 else 0
 
 
 def car(lab: Lab) -> int:
     """Reference: one MountainCar-v0 episode pushing along the velocity; its length."""
-    return _episode_length(lab.make("MountainCar-v0"), lambda observation: 2 if observation[1] >= 0 else 0)
+    return _episode_length(lab.make("MountainCar-v0"), car_policy)
+
+
+def _random_step_first(lab: Lab, env_id: str, policy: Policy, *, counted_from: int = 0) -> int:
+    """The lab-era pattern: reset, one random step, then count the steps of the loop (from `counted_from`)."""
+    env = lab.make(env_id)
+    env.reset()
+    observation, _, terminated, truncated, _ = env.step(int(env.action_space.sample()))
+    steps, done = counted_from, terminated or truncated
+    while not done:
+        observation, _, terminated, truncated, _ = env.step(policy(observation))
+        steps, done = steps + 1, terminated or truncated
+    return steps
+
+
+def _counted_from_one(lab: Lab) -> int:
+    return cartpole(lab) + 1
+
+
+def _taxi_ignoring_truncation(lab: Lab, q_table: np.ndarray, episodes: int = 10) -> list[float]:
+    """gym 0.26 code that loops `while not terminated`: random episodes run until the passenger arrives.
+
+    At most 10 episodes per scenario whatever `episodes` asks: the first ones show the pattern, and the
+    lab's 10000 unlimited random episodes would take about 100 million steps.
+    """
+    episodes = min(episodes, 10)
+    env = lab.make("Taxi-v3")
+    greedy = np.argmax(q_table, axis=1)
+    means = []
+    policies: tuple[Policy, Policy] = (
+        lambda _state: int(env.action_space.sample()),
+        lambda state: int(greedy[state]),
+    )
+    for policy in policies:
+        totals = []
+        for _ in range(episodes):
+            state, _ = env.reset()
+            total, terminated = 0.0, False
+            while not terminated:
+                state, reward, terminated, _, _ = env.step(policy(state))
+                total += float(reward)
+            totals.append(total)
+        means.append(sum(totals) / episodes)
+    return means
 
 
 def _taxi_return(env: LabEnv, policy: Policy, *, seed: int | None = None, final_only: bool = False) -> float:
@@ -155,14 +203,6 @@ def _step_after_done(lab: Lab) -> int:
         observation, _, terminated, truncated, _ = env.step(velocity_policy(observation))
         done = done or terminated or truncated
     return steps
-
-
-def _sab_game(lab: Lab, n: int, games: int = BLACKJACK_GAMES) -> float:
-    env = lab.make("Blackjack-v1")
-    rewards = [
-        _play_blackjack(env, lambda observation, _step: int(observation[0] <= n)) for _ in range(games)
-    ]
-    return sum(reward > 0 for reward in rewards) / games
 
 
 def _strategy_not_random(lab: Lab, n: int) -> float:
@@ -264,7 +304,20 @@ REFERENCE: dict[ProblemId, dict[str, StudentFunction]] = {
 MISTAKES: tuple[Behaviour, ...] = (
     Behaviour("blackjack_less_than", "blackjack", {"blackjack": _less_than}, "failed", "`<` versus `<=`"),
     Behaviour("blackjack_stale_hand", "blackjack", {"blackjack": _stale_hand}, "failed", "first decision"),
-    Behaviour("blackjack_sab_rules", "blackjack", {"blackjack": _sab_game}, "failed", "sab=True"),
+    Behaviour(
+        "blackjack_v1",
+        "blackjack",
+        {"blackjack": partial(blackjack, env_id="Blackjack-v1")},
+        "passed",
+        "Blackjack-v1 (Sutton and Barto's rules, sab=True",
+    ),
+    Behaviour(
+        "random_blackjack_v1",
+        "random_blackjack",
+        {"random_blackjack": partial(random_blackjack, env_id="Blackjack-v1")},
+        "passed",
+        "games of Blackjack-v1",
+    ),
     Behaviour(
         "random_blackjack_not_random",
         "random_blackjack",
@@ -302,6 +355,23 @@ MISTAKES: tuple[Behaviour, ...] = (
         "failed",
         "after the game was over",
     ),
+    Behaviour(
+        "cartpole_v1",
+        "cartpole",
+        {"cartpole": partial(cartpole, env_id="CartPole-v1")},
+        "passed",
+        "CartPole-v1",
+    ),
+    Behaviour(
+        "cartpole_random_step_first",
+        "cartpole",
+        {"cartpole": partial(_random_step_first, env_id="CartPole-v0", policy=velocity_policy)},
+        "passed",
+        "is one step short of its replayed episode",
+    ),
+    Behaviour(
+        "cartpole_counted_from_one", "cartpole", {"cartpole": _counted_from_one}, "failed", "off by one"
+    ),
     Behaviour("car_never_reaches_goal", "car", {"car": _never_reaches}, "failed", "ran out of time"),
     Behaviour("cartpole_reset_after_make", "cartpole", {"cartpole": _reset_after_make}, "passed"),
     Behaviour(
@@ -312,6 +382,20 @@ MISTAKES: tuple[Behaviour, ...] = (
     ),
     Behaviour("car_scouting", "car", {"car": _scouting}, "failed", "games unplayed"),
     Behaviour("car_reset_options", "car", {"car": _chosen_start}, "failed", "call reset() without options"),
+    Behaviour(
+        "car_random_step_first",
+        "car",
+        {"car": partial(_random_step_first, env_id="MountainCar-v0", policy=car_policy)},
+        "passed",
+        "is one step short of its replayed episode",
+    ),
     Behaviour("taxi_final_reward", "taxi", {"taxi": partial(taxi, final_only=True)}, "failed", "LAST reward"),
     Behaviour("taxi_v2", "taxi", {"taxi": partial(taxi, env_id="Taxi-v2")}, "error", "Taxi-v3"),
+    Behaviour(
+        "taxi_ignores_truncated",
+        "taxi",
+        {"taxi": _taxi_ignoring_truncation},
+        "failed",
+        "a loop that waits for `terminated` alone ignores the 200-step limit",
+    ),
 )

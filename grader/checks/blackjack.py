@@ -10,9 +10,7 @@ from typing import TYPE_CHECKING, NamedTuple
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, HIT, count_games, player_sum
 from grader.checks.episodes import (
-    BLACKJACK,
     Episode,
-    GameRules,
     episodes_per_call,
     games_budget,
     integrity_problem,
@@ -22,6 +20,7 @@ from grader.checks.episodes import (
 from grader.checks.values import as_number, chance_text, describe, rate_mismatch_cause, read_rate
 from grader.config import BlackjackConfig, ProblemConfig
 from grader.errors import PlanError
+from grader.games import Game, allowed_games
 from grader.sandbox.outcome import Call, FunctionInfo
 from grader.stats import binomial_acceptance
 from reference.oracles import threshold_policy_outcome
@@ -33,14 +32,14 @@ THRESHOLDS = range(22)
 
 
 @cache
-def exact_curve() -> dict[int, float]:
-    """Exact win probability of "draw while sum <= n" for n = 0..21."""
-    return {n: threshold_policy_outcome(n).win for n in THRESHOLDS}
+def exact_curve(*, sab: bool = False) -> dict[int, float]:
+    """Exact win probability of "draw while sum <= n" for n = 0..21 (`sab`: Sutton and Barto's rules)."""
+    return {n: threshold_policy_outcome(n, sab=sab).win for n in THRESHOLDS}
 
 
-def exact_best_n() -> int:
+def exact_best_n(*, sab: bool = False) -> int:
     """The n with the highest exact win probability (the smallest one on ties)."""
-    curve = exact_curve()
+    curve = exact_curve(sab=sab)
     return max(curve, key=lambda n: (curve[n], -n))
 
 
@@ -120,7 +119,6 @@ class BlackjackCheck:
 
     id: ProblemId = "blackjack"
     title: str = "Problem 2: threshold Blackjack"
-    games: GameRules | None = BLACKJACK
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """One call blackjack(n) per configured n."""
@@ -136,12 +134,17 @@ class BlackjackCheck:
         if early is not None:
             return early
         episodes = played_episodes(records)
-        problem = integrity_problem(records, episodes, BLACKJACK)
+        rules = allowed_games(self.id, settings.accepted_envs)
+        problem = integrity_problem(records, episodes, rules)
         if problem:
             return Verdict("failed", 0.0, f"blackjack: {problem}.", {})
-        curve = exact_curve()
-        best = exact_best_n()
+        game = rules.played_game(episode.log for episode in episodes)
+        if isinstance(game, str):
+            return Verdict("failed", 0.0, f"blackjack: {game}.", {})
+        curve = exact_curve(sab=game.sab)
+        best = exact_best_n(sab=game.sab)
         measurements: dict[str, PlainValue] = {
+            "game": game.name,
             "exact_curve": {str(n): p for n, p in curve.items()},
             "exact_best_n": best,
             "exact_best_win_probability": curve[best],
@@ -153,7 +156,7 @@ class BlackjackCheck:
         grouped = episodes_per_call(records, episodes)
         # Every call is judged, even after a failure, so the report shows the student's whole curve.
         for n, record, call_episodes in zip(settings.thresholds, records, grouped, strict=True):
-            failure, line = self._judge_call(settings, n, record, call_episodes, student_curve)
+            failure, line = self._judge_call(settings, game, n, record, call_episodes, student_curve)
             if failure:
                 first_failure = first_failure or failure
             else:
@@ -165,7 +168,8 @@ class BlackjackCheck:
             "passed",
             1.0,
             f"Every replayed decision followed 'draw while the sum is <= n' and every win rate is within the "
-            f"tolerance of the exact one ({'; '.join(passed_lines)}). The exact best n is {best} "
+            f"tolerance of the exact one in {game.description} ({'; '.join(passed_lines)}). The exact best n "
+            f"is {best} "
             f"(wins {curve[best]:.4f}); among the n tried, your rates peak at n = {peak}.",
             measurements,
         )
@@ -173,6 +177,7 @@ class BlackjackCheck:
     @staticmethod
     def _judge_call(
         settings: BlackjackConfig,
+        game: Game,
         n: int,
         record: CallRecord,
         episodes: list[Episode],
@@ -201,7 +206,7 @@ class BlackjackCheck:
             )
         curve[str(n)] = counts.win_fraction
         deviation = policy_deviation(_decisions(episodes), n)
-        exact = exact_curve()[n]
+        exact = exact_curve(sab=game.sab)[n]
         acceptance = binomial_acceptance(counts.games, exact, settings.win_rate_alpha)
         expected = (
             f"a player drawing on sums <= {n} wins {exact:.4f} of games ({acceptance.low}..{acceptance.high} "

@@ -6,10 +6,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
-from grader.checks.episodes import MOUNTAIN_CAR, GameRules, games_budget
+from grader.checks.episodes import games_budget
 from grader.checks.lengths import judge_lengths
 from grader.config import CarConfig, ProblemConfig
 from grader.errors import PlanError
+from grader.games import allowed_games
 from grader.sandbox.outcome import Call, FunctionInfo
 
 EPISODE_STEPS = 1_000
@@ -28,7 +29,6 @@ class CarCheck:
 
     id: ProblemId = "car"
     title: str = "Problem 4: MountainCar"
-    games: GameRules | None = MOUNTAIN_CAR
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of car() calls."""
@@ -39,10 +39,11 @@ class CarCheck:
     def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned lengths against the replays, then the goal and the mean against the bar."""
         settings = _settings(config)
-        runs = judge_lengths("car", MOUNTAIN_CAR, records)
+        runs = judge_lengths("car", allowed_games(self.id, settings.accepted_envs), records)
         if isinstance(runs, Verdict):
             return runs
         measurements = runs.measurements()
+        note = runs.counting_note("car", settings.uncounted_steps_deduction)
         stuck = sum(1 for episode in runs.episodes if not episode.reached_terminal)
         measurements["runs_reaching_goal"] = len(runs.episodes) - stuck
         bar = (
@@ -59,7 +60,8 @@ class CarCheck:
                 0.0,
                 f"car(): {bar}; {measured}, and {stuck} ran out of time (200 steps) short of it. Build "
                 "momentum: "
-                f"push (action 2 right, 0 left) in the direction the car is already moving (observation[1]).",
+                "push (action 2 right, 0 left) in the direction the car is already moving "
+                f"(observation[1]).{note}",
                 measurements,
             )
         if runs.mean >= settings.max_mean_steps:
@@ -67,7 +69,8 @@ class CarCheck:
                 "failed",
                 0.0,
                 f"car(): {bar}; {measured}. Push in the direction of the velocity on every step to swing up "
-                "faster.",
+                f"faster.{note}",
                 measurements,
             )
-        return Verdict("passed", 1.0, f"car(): {measured}; {bar}.", measurements)
+        fraction = 1.0 - (settings.uncounted_steps_deduction if runs.uncounted_steps else 0.0)
+        return Verdict("passed", fraction, f"car(): {measured}; {bar}.{note}", measurements)

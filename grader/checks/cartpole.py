@@ -6,10 +6,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
-from grader.checks.episodes import CARTPOLE, GameRules, games_budget
+from grader.checks.episodes import games_budget
 from grader.checks.lengths import judge_lengths
 from grader.config import CartpoleConfig, ProblemConfig
 from grader.errors import PlanError
+from grader.games import allowed_games
 from grader.sandbox.outcome import Call, FunctionInfo
 
 EPISODE_STEPS = 1_000
@@ -28,7 +29,6 @@ class CartpoleCheck:
 
     id: ProblemId = "cartpole"
     title: str = "Problem 3: CartPole"
-    games: GameRules | None = CARTPOLE
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of cartpole() calls."""
@@ -39,7 +39,7 @@ class CartpoleCheck:
     def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned lengths against the replays, then mean and minimum against the bar."""
         settings = _settings(config)
-        runs = judge_lengths("cartpole", CARTPOLE, records)
+        runs = judge_lengths("cartpole", allowed_games(self.id, settings.accepted_envs), records)
         if isinstance(runs, Verdict):
             return runs
         measurements = runs.measurements()
@@ -50,15 +50,17 @@ class CartpoleCheck:
         )
         measured = (
             f"your {len(runs.lengths)} replayed runs lasted {runs.mean:.1f} steps on average, "
-            f"the shortest {shortest}"
+            f"the shortest {shortest} ({runs.game.description})"
         )
+        note = runs.counting_note("cartpole", settings.uncounted_steps_deduction)
         if runs.mean < settings.min_mean_steps or shortest < settings.min_steps:
             return Verdict(
                 "failed",
                 0.0,
                 f"cartpole(): {bar}; {measured}. Push the cart the way the tip of the pole is moving: action "
                 "1 "
-                f"(right) when the pole's angular velocity observation[3] is positive, else 0.",
+                f"(right) when the pole's angular velocity observation[3] is positive, else 0.{note}",
                 measurements,
             )
-        return Verdict("passed", 1.0, f"cartpole(): {measured}; {bar}.", measurements)
+        fraction = 1.0 - (settings.uncounted_steps_deduction if runs.uncounted_steps else 0.0)
+        return Verdict("passed", fraction, f"cartpole(): {measured}; {bar}.{note}", measurements)

@@ -2,30 +2,23 @@
 
 from __future__ import annotations
 
-import inspect
 from collections import Counter
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
-from functools import cache
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
-
-import gymnasium
-from gymnasium.envs.registration import load_env_creator
 
 from grader.checks.base import CallRecord
 from grader.sandbox.outcome import CallBudget
 from grader.sandbox.replay import not_replayed, replay_episodes, verify_reset_seeds
 
 if TYPE_CHECKING:
+    from grader.games import GameRules
     from grader.sandbox.episodes import EpisodeLog
     from grader.sandbox.outcome import CallOutcome
     from grader.sandbox.replay import Replay
 
 RESET_SLACK = 8
 """Resets beyond the planned games a call may record, so that extra resets get a diagnosis, not a cut-off."""
-
-# Constructor arguments that never change a game's rules.
-_HARMLESS_KWARGS = frozenset({"render_mode"})
 
 
 @dataclass(slots=True)
@@ -118,63 +111,6 @@ def all_resets(records: Sequence[CallRecord]) -> list[Episode]:
         for call_index, record in enumerate(records)
         for position, (log, replay) in enumerate(zip(record.outcome.episodes, record.replays, strict=True))
     ]
-
-
-@dataclass(frozen=True)
-class GameRules:
-    """Which environment a problem must be played in.
-
-    Attributes:
-        lab_id: The id the lab uses (named in feedback).
-        gymnasium_ids: Gymnasium ids that play exactly that game.
-        required_kwargs: Effective constructor arguments (registered defaults merged with the student's)
-            the game needs, e.g. Blackjack's ``sab=False``.
-    """
-
-    lab_id: str
-    gymnasium_ids: tuple[str, ...]
-    required_kwargs: Mapping[str, Any] = field(default_factory=dict)
-
-    def problem_with(self, log: EpisodeLog) -> str | None:
-        """Why an episode's environment is not the lab's game, or None when it is."""
-        if log.env_id not in self.gymnasium_ids:
-            return (
-                f"the episodes must be played in {self.lab_id}, but you made {log.requested_id!r} "
-                f"(gymnasium {log.env_id}), a different game: use gym.make({self.lab_id!r})"
-            )
-        effective = {**_default_kwargs(log.env_id), **dict(log.env_kwargs)}
-        for name, value in self.required_kwargs.items():
-            if effective.get(name) != value:
-                return (
-                    f"{self.lab_id} is played with {name}={value!r}, but your environment had "
-                    f"{name}={effective.get(name)!r}, which changes the game: make it with "
-                    f"gym.make({self.lab_id!r}) and no extra arguments"
-                )
-        extra = sorted(set(log.env_kwargs) - set(self.required_kwargs) - _HARMLESS_KWARGS)
-        if extra:
-            arguments = ", ".join(f"{name}={log.env_kwargs[name]!r}" for name in extra)
-            return (
-                f"you made {log.requested_id!r} with {arguments}, which changes the game (e.g. its time "
-                "limit): "
-                f"make it with gym.make({self.lab_id!r}) and no extra arguments"
-            )
-        return None
-
-
-@cache
-def _default_kwargs(env_id: str) -> dict[str, Any]:
-    """The arguments an env gets when made without any: registered kwargs over constructor defaults."""
-    spec = gymnasium.spec(env_id)
-    creator = load_env_creator(spec.entry_point) if isinstance(spec.entry_point, str) else spec.entry_point
-    parameters = inspect.signature(creator).parameters.values() if creator is not None else []
-    defaults = {p.name: p.default for p in parameters if p.default is not inspect.Parameter.empty}
-    return {**defaults, **spec.kwargs}
-
-
-BLACKJACK = GameRules("Blackjack-v0", ("Blackjack-v1",), {"natural": False, "sab": False})
-CARTPOLE = GameRules("CartPole-v0", ("CartPole-v0",))
-MOUNTAIN_CAR = GameRules("MountainCar-v0", ("MountainCar-v0",))
-TAXI = GameRules("Taxi-v3", ("Taxi-v4", "Taxi-v3"), {"is_rainy": False, "fickle_passenger": False})
 
 
 def games_budget(games: int, steps_per_game: int) -> CallBudget:

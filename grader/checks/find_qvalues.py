@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
-from grader.checks.episodes import NO_EPISODES, GameRules
+from grader.checks.episodes import NO_EPISODES
 from grader.checks.values import describe
 from grader.config import FindQvaluesConfig, ProblemConfig
 from grader.errors import PlanError
@@ -30,7 +30,6 @@ class FindQvaluesCheck:
 
     id: ProblemId = "find_qvalues"
     title: str = "find_qvalues (provided by the lab)"
-    games: GameRules | None = None
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """One unrecorded call (100 000 training episodes are not worth logging)."""

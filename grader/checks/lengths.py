@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING
 from grader.checks.base import CallRecord, Verdict, outcome_verdict
 from grader.checks.episodes import (
     Episode,
-    GameRules,
     all_resets,
     episodes_per_call,
     integrity_problem,
@@ -17,9 +16,13 @@ from grader.checks.episodes import (
     repeated_seed_problem,
 )
 from grader.checks.values import as_number, describe, same_number, step_count_mismatch_cause
+from grader.games import Game, GameRules
 
 if TYPE_CHECKING:
     from grader.sandbox.outcome import PlainValue
+
+MAX_UNCOUNTED_STEPS = 3
+"""Most steps before the counted loop that still read as the lab-era counting slip (one, in the lab)."""
 
 
 @dataclass(frozen=True)
@@ -29,10 +32,15 @@ class LengthRuns:
     Attributes:
         episodes: One episode per call, in call order.
         lengths: Their replayed lengths.
+        game: The game they were played in.
+        uncounted_steps: 0 when every call returned its episode's length; k > 0 when every call returned
+            k steps fewer (steps taken before the counted loop, such as "one random step first").
     """
 
     episodes: list[Episode]
     lengths: list[int]
+    game: Game
+    uncounted_steps: int = 0
 
     @property
     def mean(self) -> float:
@@ -47,15 +55,39 @@ class LengthRuns:
             "min_steps": min(self.lengths),
             "max_steps": max(self.lengths),
             "lengths": list(self.lengths),
+            "game": self.game.name,
+            "uncounted_steps": self.uncounted_steps,
         }
+
+    def counting_note(self, function: str, deduction: float) -> str:
+        """The feedback sentence on a counting slip ("" when every count was right)."""
+        if not self.uncounted_steps:
+            return ""
+        if self.uncounted_steps == 1:
+            short, uncounted = (
+                "one step",
+                "the step taken before the counted loop (e.g. a random step after reset) was",
+            )
+        else:
+            short = f"{self.uncounted_steps} steps"
+            uncounted = f"the {short} taken before the counted loop were"
+        cost = f" ({deduction:.0%} of the points deducted)" if deduction else ""
+        return (
+            f" Note: every count {function}() returned is {short} short of its replayed episode: {uncounted} "
+            f"not counted. The verdict follows the replayed episodes{cost}; count every env.step() call."
+        )
 
 
 def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]) -> Verdict | LengthRuns:
     """Check that every call played one real, complete episode and returned its length.
 
+    A call returning its length minus k, for the same 1 <= k <= `MAX_UNCOUNTED_STEPS` in every call,
+    is the lab-era "steps before the counted loop" slip: the runs are returned with `uncounted_steps = k`
+    and judged by their replayed lengths. Any other difference fails.
+
     Args:
         function: The student function's name (for feedback).
-        rules: The environment the episodes must be played in.
+        rules: The environments the episodes may be played in.
         records: One record per call.
 
     Returns:
@@ -70,7 +102,11 @@ def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]
     )
     if problem:
         return Verdict("failed", 0.0, f"{function}(): {problem}.", {})
+    game = rules.played_game(episode.log for episode in episodes)
+    if isinstance(game, str):
+        return Verdict("failed", 0.0, f"{function}(): {game}.", {})
     chosen: list[Episode] = []
+    shortfalls: list[float | None] = []
     for call_number, (record, call_episodes) in enumerate(
         zip(records, episodes_per_call(records, episodes), strict=True), 1
     ):
@@ -84,6 +120,13 @@ def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]
             )
         returned = as_number(record.outcome.value)
         episode = call_episodes[0]
+        chosen.append(episode)
+        shortfalls.append(None if returned is None else episode.length - returned)
+    uncounted = _uncounted_steps(shortfalls, [episode.length for episode in chosen])
+    if uncounted is not None:
+        return LengthRuns(chosen, [episode.length for episode in chosen], game, uncounted)
+    for call_number, (record, episode) in enumerate(zip(records, chosen, strict=True), 1):
+        returned = as_number(record.outcome.value)
         if returned is None or not same_number(returned, float(episode.length)):
             cause = (
                 "expected a number"
@@ -98,5 +141,16 @@ def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]
                 f"played lasted {episode.length} steps (replayed); {cause}.",
                 {"returned": returned, "replayed_steps": episode.length},
             )
-        chosen.append(episode)
-    return LengthRuns(chosen, [episode.length for episode in chosen])
+    return LengthRuns(chosen, [episode.length for episode in chosen], game)
+
+
+def _uncounted_steps(shortfalls: list[float | None], lengths: list[int]) -> int | None:
+    """k when every call returned its length minus the same k (0 <= k <= MAX_UNCOUNTED_STEPS), else None."""
+    if not shortfalls or any(shortfall is None for shortfall in shortfalls):
+        return None
+    first = shortfalls[0]
+    if first is None or not float(first).is_integer() or not 0 <= first <= MAX_UNCOUNTED_STEPS:
+        return None
+    if any(shortfall != first for shortfall in shortfalls) or any(length <= first for length in lengths):
+        return None
+    return int(first)

@@ -9,8 +9,6 @@ from typing import TYPE_CHECKING, Any
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, count_games, hits_by_sum
 from grader.checks.episodes import (
-    BLACKJACK,
-    GameRules,
     all_resets,
     games_budget,
     integrity_problem,
@@ -20,6 +18,7 @@ from grader.checks.episodes import (
 from grader.checks.values import as_number, chance_text, describe, rate_mismatch_cause, read_rate
 from grader.config import ProblemConfig, RandomBlackjackConfig
 from grader.errors import PlanError
+from grader.games import allowed_games
 from grader.sandbox.outcome import Call, FunctionInfo
 from grader.stats import binomial_acceptance, grouped_binomial_fit, mean_tolerance
 from reference.oracles import random_policy_outcome
@@ -40,7 +39,6 @@ class RandomBlackjackCheck:
 
     id: ProblemId = "random_blackjack"
     title: str = "Problem 1: random Blackjack"
-    games: GameRules | None = BLACKJACK
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """One call, random_blackjack(games)."""
@@ -61,11 +59,15 @@ class RandomBlackjackCheck:
                 f"{call} returned {describe(records[0].outcome.value)}; expected the win rate as a number."
             )
         episodes = played_episodes(records)
-        problem = integrity_problem(records, episodes, BLACKJACK) or repeated_seed_problem(
+        rules = allowed_games(self.id, settings.accepted_envs)
+        problem = integrity_problem(records, episodes, rules) or repeated_seed_problem(
             all_resets(records), across_calls=False
         )
         if problem:
             return _fail(f"{call}: {problem}.")
+        game = rules.played_game(episode.log for episode in episodes)
+        if isinstance(game, str):
+            return _fail(f"{call}: {game}.")
         counts = count_games(episodes)
         measurements: dict[str, PlainValue] = {
             "returned": returned,
@@ -73,6 +75,7 @@ class RandomBlackjackCheck:
             "wins": counts.wins,
             "draws": counts.draws,
             "replayed_win_fraction": counts.win_fraction,
+            "game": game.name,
         }
         if counts.games != settings.games:
             return _fail(
@@ -91,7 +94,7 @@ class RandomBlackjackCheck:
         randomness = _random_action_problem(episodes, settings, measurements)
         if randomness:
             return _fail(f"{call}: {randomness}", measurements)
-        exact = random_policy_outcome().win
+        exact = random_policy_outcome(sab=game.sab).win
         acceptance = binomial_acceptance(counts.games, exact, settings.win_rate_alpha)
         measurements |= {
             "exact_win_probability": exact,
@@ -100,7 +103,8 @@ class RandomBlackjackCheck:
             "false_fail_probability": acceptance.false_fail,
         }
         expected = (
-            f"a random player wins {exact:.4f} of games, so {counts.games} games win between "
+            f"a random player wins {exact:.4f} of games of {game.description}, so {counts.games} games win "
+            "between "
             f"{acceptance.low} and {acceptance.high} times"
         )
         if not acceptance.accepts(counts.wins):

@@ -11,18 +11,19 @@ import numpy as np
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
 from grader.checks.episodes import (
-    TAXI,
     Episode,
-    GameRules,
     all_resets,
     games_budget,
     integrity_problem,
     played_episodes,
     repeated_seed_problem,
+    seed_problem,
 )
+from grader.checks.truncation import ignored_truncation
 from grader.checks.values import as_number, describe, same_number
 from grader.config import ProblemConfig, TaxiConfig
 from grader.errors import PlanError
+from grader.games import allowed_games
 from grader.sandbox.outcome import Call, CallBudget, FunctionInfo
 from grader.stats import goodness_of_fit, mean_tolerance
 from reference.oracles import greedy_policy_return, optimal_q_table, optimal_return, random_policy_return
@@ -117,7 +118,6 @@ class TaxiCheck:
 
     id: ProblemId = "taxi"
     title: str = "Problem 5: Taxi"
-    games: GameRules | None = TAXI
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """taxi(optimal Q-table) when taxi takes a parameter, else taxi()."""
@@ -147,11 +147,13 @@ class TaxiCheck:
             )
         random_mean, greedy_mean = float(means[0]), float(means[1])  # type: ignore[arg-type]
         episodes = played_episodes(records)
-        problem = integrity_problem(records, episodes, TAXI) or repeated_seed_problem(
-            all_resets(records), across_calls=False
-        )
+        problem = integrity_problem(
+            records, episodes, allowed_games(self.id, settings.accepted_envs)
+        ) or repeated_seed_problem(all_resets(records), across_calls=False)
         if problem:
-            return _fail(f"taxi: {problem}.")
+            # An altered log is named as such; otherwise a loop that ignored `truncated` is named as that.
+            diagnosis = None if seed_problem(records) else ignored_truncation(episodes)
+            return _fail(f"taxi: {diagnosis or problem}.")
         measurements: dict[str, PlainValue] = {
             "returned_random_mean": random_mean,
             "returned_q_mean": greedy_mean,

@@ -1,4 +1,4 @@
-"""The lab-compatibility layer: classic `gym` code, as the lab writes it, running on gymnasium 1.4.
+"""The lab-compatibility layer: `gym` code of both lab versions (classic, gym 0.26) running on gymnasium 1.4.
 
 Importing this package installs nothing: `import gym` works only in code run through the layer
 (`activate()`, `run_script()`, `python -m grader.compat SCRIPT.py`, or a sandbox that puts
@@ -8,8 +8,10 @@ Importing this package installs nothing: `import gym` works only in code run thr
 from . import events
 from .activation import ShimPaths, activate, format_summary, run_script, shim_paths
 from .adapter import ClassicEnv
+from .detection import Api, ApiDetection, detect_api
 from .envs import GuessingGameEnv, NChainEnv, register_envs
 from .errors import (
+    AmbiguousApiError,
     CompatError,
     InvalidActionError,
     RetiredEnvironmentError,
@@ -21,6 +23,9 @@ from .ids import EnvTarget, lab_ids, resolve_env_id
 from .make import make
 
 __all__ = [
+    "AmbiguousApiError",
+    "Api",
+    "ApiDetection",
     "ClassicEnv",
     "CompatError",
     "CompatEvent",
@@ -33,6 +38,7 @@ __all__ = [
     "UnknownEnvironmentError",
     "UnsupportedRenderModeError",
     "activate",
+    "detect_api",
     "events",
     "format_summary",
     "lab_ids",

@@ -10,17 +10,25 @@ from gymnasium import spaces
 from gymnasium.wrappers import TimeLimit
 
 from . import events
+from .detection import Api
+from .dialect import caller_api
 from .errors import UnsupportedRenderModeError
 from .quiet import STEP_AFTER_TERMINATED, quiet_gymnasium
 
 
 class ClassicEnv:
-    """Classic gym (0.17 to 0.21) behaviour on top of a gymnasium 1.4 environment.
+    """`gym` behaviour on top of a gymnasium 1.4 environment: classic gym or gym 0.26, per call site.
+
+    Each `reset()`/`step()` serves the API its calling code was written for (`grader.compat.dialect`;
+    `api=` fixes one). Classic gym (0.17 to 0.25):
 
     - `reset()` returns the observation only (`return_info=True` gives `(obs, info)`);
     - `step(a)` returns `(obs, reward, done, info)` with `done = terminated or truncated`, and
       `info["TimeLimit.truncated"]` when the time limit ended the episode, as classic `TimeLimit` did;
     - `seed(s)` stores `s` for the next reset; `render()` draws nothing and returns None.
+
+    gym 0.26: `reset()` returns `(obs, info)` and `step(a)` `(obs, reward, terminated, truncated, info)`,
+    gymnasium's own API; everything else is shared.
 
     Where classic gym tolerated what gymnasium refuses, this class behaves as classic gym did and
     records a `CompatEvent` (see `grader.compat.events`): a step before the first reset resets first
@@ -33,10 +41,17 @@ class ClassicEnv:
     classic `gym.Wrapper.__getattr__` did; private names are not forwarded.
     """
 
-    def __init__(self, env: gymnasium.Env[Any, Any], requested_id: str) -> None:
-        """Wrap `env`, which `gymnasium.make` created for the classic id `requested_id`."""
+    def __init__(self, env: gymnasium.Env[Any, Any], requested_id: str, api: Api | None = None) -> None:
+        """Wrap `env`, which `gymnasium.make` created for the id `requested_id`.
+
+        Args:
+            env: the gymnasium environment.
+            requested_id: the id the student asked for.
+            api: serve this API to every caller; None decides per call site from the calling code.
+        """
         self.env = env
         self.requested_id = requested_id
+        self.api = api
         self._discrete_actions = isinstance(env.action_space, spaces.Discrete)
         self._needs_reset = True
         self._done = False
@@ -46,23 +61,36 @@ class ClassicEnv:
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None, return_info: bool = False
     ) -> Any:
-        """Start an episode; return the first observation (and info if `return_info`).
+        """Start an episode; return the first observation (classic), or `(obs, info)` (gym 0.26).
 
         Args:
             seed: seed for this reset; if None, the seed given to `seed()` since the last reset, if any.
             options: passed to the gymnasium reset.
             return_info: return `(obs, info)` as gym 0.22 to 0.25 did.
+
+        Raises:
+            AmbiguousApiError: the calling code expects both APIs (see `grader.compat.dialect`).
         """
+        api = self.api or caller_api(self.requested_id)
+        observation, info = self._reset(seed, options)
+        return (observation, info) if return_info or api is Api.GYM026 else observation
+
+    def _reset(self, seed: int | None, options: dict[str, Any] | None) -> tuple[Any, dict[str, Any]]:
         if seed is None:
             seed = self._next_seed
         self._next_seed = None
         observation, info = self.env.reset(seed=seed, options=options)
         self._needs_reset = False
         self._done = False
-        return (observation, info) if return_info else observation
+        return observation, info
 
-    def step(self, action: Any) -> tuple[Any, Any, bool, dict[str, Any]]:
-        """Take one step; return `(obs, reward, done, info)` (see the class docstring)."""
+    def step(self, action: Any) -> tuple[Any, ...]:
+        """Take one step; return `(obs, reward, done, info)` or gym 0.26's 5 values (see the class docstring).
+
+        Raises:
+            AmbiguousApiError: the calling code expects both APIs (see `grader.compat.dialect`).
+        """
+        api = self.api or caller_api(self.requested_id)
         if self._needs_reset:
             events.record(
                 events.STEP_BEFORE_RESET,
@@ -70,7 +98,7 @@ class ClassicEnv:
                 "step() was called before reset(); the layer reset the environment first, as classic "
                 "Blackjack had dealt a hand in its constructor",
             )
-            self.reset()
+            self._reset(None, None)
         if self._discrete_actions and type(action) is not int:
             action = self._plain_action(action)
         if self._done:
@@ -84,6 +112,9 @@ class ClassicEnv:
                 observation, reward, terminated, truncated, info = self.env.step(action)
         else:
             observation, reward, terminated, truncated, info = self.env.step(action)
+        if api is Api.GYM026:
+            self._done = self._done or bool(terminated or truncated)
+            return observation, reward, terminated, truncated, info
         if truncated:
             info = {**info, "TimeLimit.truncated": not terminated}
         done = bool(terminated or truncated)

@@ -27,3 +27,7 @@ class InvalidActionError(CompatError, ValueError):
 
 class UnsupportedRenderModeError(CompatError, ValueError):
     """Raised when `render(mode=...)` asks for a mode the environment cannot draw."""
+
+
+class AmbiguousApiError(CompatError, TypeError):
+    """Raised when code's lines expect both gym APIs (classic and 0.26) and no caller decides which."""

@@ -11,6 +11,7 @@ RENDER_WITHOUT_MODE = "render_without_mode"
 LEGACY_SEED_CALL = "legacy_seed_call"
 RENAMED_ID = "renamed_id"
 SEED_REPLACED = "seed_replaced"
+API_DETECTED = "api_detected"
 
 KINDS = (
     STEP_BEFORE_RESET,
@@ -20,6 +21,7 @@ KINDS = (
     LEGACY_SEED_CALL,
     RENAMED_ID,
     SEED_REPLACED,
+    API_DETECTED,
 )
 
 
@@ -41,6 +43,7 @@ class CompatEvent:
 # One entry per (kind, env_id), the first detail and how many times it happened: code that steps
 # millions of times with numpy actions must not grow this without bound.
 _pending: dict[tuple[str, str], tuple[str, int]] = {}
+_drains = 0
 
 
 def record(kind: str, env_id: str, detail: str) -> None:
@@ -71,4 +74,11 @@ def drain() -> list[CompatEvent]:
         for (kind, env_id), (detail, count) in _pending.items()
     ]
     _pending.clear()
+    global _drains
+    _drains += 1
     return drained
+
+
+def generation() -> int:
+    """How many times the events were drained: what is reported once per drain re-records when it changes."""
+    return _drains

@@ -5,12 +5,21 @@ from grader.sandbox.errors import IsolationUnavailable, SandboxClosedError, Sand
 from grader.sandbox.isolation import probe_isolation
 from grader.sandbox.isolation.protocol import IsolationReport, LayerReport
 from grader.sandbox.limits import IsolationPolicy, Limits
-from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo, PlainValue
+from grader.sandbox.outcome import (
+    Call,
+    CallBudget,
+    CallOutcome,
+    FunctionInfo,
+    OutcomeStatus,
+    ParameterInfo,
+    PlainValue,
+)
 from grader.sandbox.replay import Replay, replay_episode
 from grader.sandbox.runner import Sandbox, run_calls
 
 __all__ = [
     "Call",
+    "CallBudget",
     "CallOutcome",
     "EpisodeLog",
     "FunctionInfo",

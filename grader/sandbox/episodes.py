@@ -14,7 +14,9 @@ from typing import Any
 import numpy as np
 
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
-from grader.sandbox.child.protocol import MAX_INT_BITS, decode_value, paused_gc
+from grader.sandbox.child.protocol import MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
+from grader.sandbox.outcome import CallBudget
+from grader.sandbox.text import clean_plain, clean_text
 
 MAX_ID_LENGTH = 200
 MAX_SEED = 2**64
@@ -22,6 +24,7 @@ _LARGEST_INT = 2**MAX_INT_BITS
 _NUMBER_TYPES = frozenset({int, float})
 _INT_TYPE = frozenset({int})
 _BOOL_TYPE = frozenset({bool})
+_COLUMNS = ("actions", "rewards", "terminated", "truncated")
 _FIELDS = frozenset(
     {
         "env_index",
@@ -108,18 +111,51 @@ def _same_action(mine: Any, theirs: Any) -> bool:
     return bool(type(mine) is type(theirs) and mine == theirs)
 
 
-def episodes_from_plain(data: Any) -> list[EpisodeLog]:
+def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[EpisodeLog]:
     """Decode and validate the `episodes` field of a result frame (JSON data, as parsed).
 
     Each per-step column is either a tagged numpy array or, for short episodes, a plain list.
 
+    Args:
+        data: The parsed field.
+        budget: The call's budget: more episodes, or more steps summed over them, are refused from the
+            list lengths and array shapes, before any array is decoded.
+
     Raises:
-        InvalidEpisodeLogError: the data does not have the layout the child sends.
+        InvalidEpisodeLogError: the data does not have the layout the child sends, or exceeds `budget`.
     """
     if type(data) is not list:
         raise InvalidEpisodeLogError(f"episodes must be a list, found {type(data).__name__}")
+    if budget is not None:
+        _check_budget(data, budget)
     with paused_gc():
         return [_episode(item, number) for number, item in enumerate(data)]
+
+
+def _check_budget(data: list[Any], budget: CallBudget) -> None:
+    if len(data) > budget.max_episodes:
+        raise InvalidEpisodeLogError(
+            f"the log holds {len(data):,} episodes, more than the call's limit of {budget.max_episodes:,}"
+        )
+    steps = 0
+    for item in data:
+        if type(item) is dict:
+            steps += max((_column_length(item.get(name)) for name in _COLUMNS), default=0)
+        if steps > budget.max_steps:
+            raise InvalidEpisodeLogError(
+                f"the log holds more than {budget.max_steps:,} steps, the call's limit"
+            )
+
+
+def _column_length(column: Any) -> int:
+    """Entries of a per-step column as announced (list length or array shape), without decoding it."""
+    if type(column) is list:
+        return len(column)
+    spec = column.get(NDARRAY_TAG) if type(column) is dict else None
+    shape = spec.get("shape") if type(spec) is dict else None
+    if type(shape) is list and shape and all(type(size) is int and size >= 0 for size in shape):
+        return int(shape[0])
+    return 0  # not a column the decoder accepts: refused there
 
 
 def _episode(item: Any, number: int) -> EpisodeLog:
@@ -225,13 +261,13 @@ def _bounded_int(value: Any, low: int, high: int, where: str) -> int:
 def _identifier(value: Any, where: str) -> str:
     if type(value) is not str or not 0 < len(value) <= MAX_ID_LENGTH:
         raise InvalidEpisodeLogError(f"{where} must be a non-empty str of at most {MAX_ID_LENGTH} characters")
-    return value
+    return clean_text(value, MAX_ID_LENGTH)
 
 
 def _mapping(value: Any, where: str) -> dict[str, Any]:
     if type(value) is not dict:
         raise InvalidEpisodeLogError(f"{where} must be a dict, found {_describe(value)}")
-    return _decoded(value, where)  # type: ignore[no-any-return]
+    return clean_plain(_decoded(value, where))  # type: ignore[no-any-return]
 
 
 def _describe(value: Any) -> str:

@@ -1,4 +1,4 @@
-"""What a sandboxed call asks for and what it produced: `Call`, `OutcomeStatus`, `CallOutcome`."""
+"""What a sandboxed call asks for and what it produced: `Call`, its `CallBudget`, `CallOutcome`."""
 
 from __future__ import annotations
 
@@ -28,15 +28,32 @@ class OutcomeStatus(StrEnum):
     BAD_SIGNATURE = "bad_signature"
     OUTPUT_TOO_LARGE = "output_too_large"
     INVALID_VALUE = "invalid_value"
+    EPISODE_LIMIT = "episode_limit"
+    """The call reset its envs or stepped them more often than its `CallBudget` allows."""
     SANDBOX_ERROR = "sandbox_error"
 
 
 @dataclass(frozen=True)
 class CallBudget:
-    """What one call may record: resets (played or not) and steps summed over its episodes."""
+    """What one call may record: resets (played or not) and steps summed over its episodes.
+
+    The child stops recording once either is exceeded and the call ends with
+    `OutcomeStatus.EPISODE_LIMIT`; the parent also derives from it the largest result frame it parses
+    (`grader.sandbox.child.budget.frame_limits`).
+
+    Attributes:
+        max_episodes: Resets the call may make (every `reset`, whether or not a step follows).
+        max_steps: Steps the call may take, summed over all its episodes.
+    """
 
     max_episodes: int
     max_steps: int
+
+    def __post_init__(self) -> None:
+        for name in ("max_episodes", "max_steps"):
+            value = getattr(self, name)
+            if type(value) is not int or value < 0:
+                raise ValueError(f"CallBudget.{name} must be a non-negative int; found {value!r}")
 
 
 @dataclass(frozen=True)
@@ -48,7 +65,8 @@ class Call:
         args: Positional arguments, plain data only.
         kwargs: Keyword arguments, plain data only.
         record_episodes: Whether the child logs every episode played (False for long training runs).
-        budget: The most the call may record (None: the sandbox's global limits).
+        budget: The most the call may record; None keeps the sandbox-wide limits: the step limit
+            (`grader.sandbox.child.recorder.DEFAULT_MAX_RECORDED_STEPS`) and `Limits.frame_bytes`.
     """
 
     function: str

@@ -15,6 +15,7 @@ from enum import Enum
 
 from grader.sandbox.child.protocol import HEADER
 from grader.sandbox.isolation.launch import Launch
+from grader.sandbox.text import clean_text
 
 _READ_CHUNK = 1 << 16
 _EXIT_GRACE_SECONDS = 2.0
@@ -43,8 +44,8 @@ class CappedOutput:
         self.dropped += max(len(data) - max(room, 0), 0)
 
     def take(self) -> str:
-        """The kept text (with a note on what was dropped), then starts afresh."""
-        text = self.head.decode("utf-8", errors="replace")
+        """The kept text (NULs replaced, a note on what was dropped), then starts afresh."""
+        text = clean_text(self.head.decode("utf-8", errors="replace"), self.cap)
         if self.dropped:
             text += f"\n[... {self.dropped} more bytes of output were dropped (limit {self.cap} bytes)]\n"
         self.head = bytearray()

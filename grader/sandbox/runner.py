@@ -10,7 +10,9 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
+from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError, ProtocolError
+from grader.sandbox.child.importer import MAX_LISTED_NAMES, MAX_LISTED_PARAMETERS
 from grader.sandbox.child.protocol import decode_value, encode_frame, encode_value, parse_payload
 from grader.sandbox.child.seeding import derive_call_seed
 from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
@@ -22,7 +24,10 @@ from grader.sandbox.limits import IsolationPolicy, Limits
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
 from grader.sandbox.process import ChildProcess, FrameEnd, FrameWait
 from grader.sandbox.termination import Ending, classify_exit, forged_message
+from grader.sandbox.text import EVENT_CHARS, MESSAGE_CHARS, NAME_CHARS, clean_plain, clean_text
 
+READY_FRAME_LIMITS = FrameLimits(max_bytes=16 << 20, max_nodes=200_000)
+"""The `ready` frame lists at most `MAX_LISTED_NAMES` names of `MAX_LISTED_PARAMETERS` parameters each."""
 IMPORT_SEED_INDEX = 2**31
 """`derive_call_seed(seed, IMPORT_SEED_INDEX)` seeds randomness while the submission is imported."""
 
@@ -34,6 +39,7 @@ _CHILD_STATUSES = {
     "invalid_value": OutcomeStatus.INVALID_VALUE,
     "output_too_large": OutcomeStatus.OUTPUT_TOO_LARGE,
     "memory_limit": OutcomeStatus.MEMORY_LIMIT,
+    "episode_limit": OutcomeStatus.EPISODE_LIMIT,
 }
 _RESULT_FIELDS = {
     "type",
@@ -154,6 +160,8 @@ class Sandbox:
             failure = self._import_failure or Ending(OutcomeStatus.SANDBOX_ERROR, "the child did not start")
             return self._outcome(call, seed, failure, stdout=failure.stdout, stderr=failure.stderr)
         nonce = secrets.token_hex(16)
+        budget = None if call.budget is None else WireBudget(call.budget.max_episodes, call.budget.max_steps)
+        frame_limit = frame_limits(budget, record=call.record_episodes, max_frame=self.limits.frame_bytes)
         request = {
             "type": "call",
             "id": index,
@@ -163,13 +171,14 @@ class Sandbox:
             "kwargs": keywords,
             "seed": seed,
             "record": call.record_episodes,
+            "budget": None if budget is None else budget.to_plain(),
         }
         child.reset_oom_baseline()
         started = time.perf_counter()
         sent = child.send(encode_frame(request, self.limits.frame_bytes), self.limits.call_seconds)
         if sent is FrameEnd.FRAME:
             remaining = self.limits.call_seconds - (time.perf_counter() - started)
-            wait = child.wait_frame(remaining, self.limits.frame_bytes)
+            wait = child.wait_frame(remaining, frame_limit.max_bytes)
         else:
             wait = FrameWait(sent)
         if wait.end is FrameEnd.FRAME and child.oom_killed():
@@ -181,7 +190,7 @@ class Sandbox:
             )
             return self._fatal(call, seed, started, ending)
         if wait.end is FrameEnd.FRAME:
-            return self._result(call, seed, started, wait.payload, index, nonce)
+            return self._result(call, seed, started, wait.payload, index, nonce, frame_limit)
         if wait.end is FrameEnd.TIMEOUT:
             child.kill_tree()
             ending = Ending(
@@ -191,7 +200,8 @@ class Sandbox:
         elif wait.end is FrameEnd.TOO_LARGE:  # the harness reports oversized results in a small frame
             child.kill_tree()
             ending = _forged(
-                f"a frame announced {wait.size} bytes, more than the limit of {self.limits.frame_bytes} bytes"
+                f"a frame announced {wait.size:,} bytes, more than this call's limit of "
+                f"{frame_limit.max_bytes:,} bytes"
             )
         elif wait.end is FrameEnd.EXTRA_DATA:
             child.kill_tree()
@@ -201,28 +211,37 @@ class Sandbox:
         return self._fatal(call, seed, started, ending)
 
     def _result(
-        self, call: Call, seed: int, started: float, payload: bytes, index: int, nonce: str
+        self,
+        call: Call,
+        seed: int,
+        started: float,
+        payload: bytes,
+        index: int,
+        nonce: str,
+        frame_limit: FrameLimits,
     ) -> CallOutcome:
         elapsed = time.perf_counter() - started
         child = self._child
+        # Sized and counted before any Python object is built: a forged frame costs what an honest may.
+        problem = frame_limit.excess(payload)
         try:
-            frame = parse_payload(payload)
-            problem = _frame_problem(frame, index, nonce)
+            frame = {} if problem else parse_payload(payload)
+            problem = problem or _frame_problem(frame, index, nonce)
         except ProtocolError as error:
             problem = str(error)
         if problem:
             return self._fatal(call, seed, started, _forged(problem))
         status = _CHILD_STATUSES[frame["status"]]
         wall_time = min(float(frame["wall_time"]), elapsed)
-        message = frame["message"] if status is not OutcomeStatus.OK else ""
+        message = clean_text(frame["message"], MESSAGE_CHARS) if status is not OutcomeStatus.OK else ""
         if frame["traceback"]:
-            message = f"{message}\n\n{frame['traceback']}"
+            message = f"{message}\n\n{clean_text(frame['traceback'], MESSAGE_CHARS)}"
         value: Any = None
         episodes: list[EpisodeLog] = []
         if status is OutcomeStatus.OK:
             try:
-                value = decode_value(frame["value"], f"the value returned by {call.function}()")
-                episodes = episodes_from_plain(frame["episodes"])
+                value = clean_plain(decode_value(frame["value"], f"the value returned by {call.function}()"))
+                episodes = episodes_from_plain(frame["episodes"], call.budget)
             except (InvalidValueError, InvalidEpisodeLogError) as error:
                 return self._fatal(call, seed, started, _forged(str(error)))
         return CallOutcome(
@@ -230,7 +249,10 @@ class Sandbox:
             status=status,
             value=value,
             episodes=episodes,
-            compat_events=frame["compat_events"],
+            compat_events=[
+                {name: clean_text(text, EVENT_CHARS) for name, text in event.items()}
+                for event in frame["compat_events"]
+            ],
             stdout=child.stdout.take() if child else "",
             stderr=child.stderr.take() if child else "",
             message=message,
@@ -295,7 +317,7 @@ class Sandbox:
         return self._child
 
     def _await_ready(self, child: ChildProcess) -> Ending | None:
-        wait = child.wait_frame(self.limits.import_seconds, self.limits.frame_bytes)
+        wait = child.wait_frame(self.limits.import_seconds, READY_FRAME_LIMITS.max_bytes)
         if wait.end is FrameEnd.TIMEOUT:
             child.kill_tree()
             return Ending(
@@ -309,14 +331,19 @@ class Sandbox:
             child.kill_tree()
             return Ending(OutcomeStatus.INVALID_VALUE, forged_message("the first frame was malformed"))
         try:
-            frame = parse_payload(wait.payload)
+            problem = READY_FRAME_LIMITS.excess(wait.payload)
+            frame = {} if problem else parse_payload(wait.payload)
         except ProtocolError as error:
+            problem = str(error)
+        if problem:
             child.kill_tree()
-            return Ending(OutcomeStatus.INVALID_VALUE, forged_message(str(error)))
+            return Ending(OutcomeStatus.INVALID_VALUE, forged_message(problem))
         if frame.get("type") == "import_error" and type(frame.get("message")) is str:
             traceback = frame.get("traceback")
-            detail = f"\n\n{traceback}" if type(traceback) is str and traceback else ""
-            return Ending(OutcomeStatus.IMPORT_ERROR, frame["message"] + detail)
+            detail = (
+                f"\n\n{clean_text(traceback, MESSAGE_CHARS)}" if type(traceback) is str and traceback else ""
+            )
+            return Ending(OutcomeStatus.IMPORT_ERROR, clean_text(frame["message"], MESSAGE_CHARS) + detail)
         functions = _function_table(frame)
         if functions is None:
             child.kill_tree()
@@ -364,7 +391,10 @@ def _function_table(frame: dict[str, Any]) -> dict[str, FunctionInfo] | None:
     ):
         return None
     table: dict[str, FunctionInfo] = {}
-    for name, info in frame["functions"].items():
+    if len(frame["functions"]) > MAX_LISTED_NAMES:
+        return None
+    for raw_name, info in frame["functions"].items():
+        name = clean_text(raw_name, NAME_CHARS)
         if (
             type(info) is not dict
             or info.keys() != {"parameters", "is_callable"}
@@ -372,14 +402,16 @@ def _function_table(frame: dict[str, Any]) -> dict[str, FunctionInfo] | None:
         ):
             return None
         parameters = info["parameters"]
-        if type(parameters) is not list:
+        if type(parameters) is not list or len(parameters) > MAX_LISTED_PARAMETERS:
             return None
         try:
             table[name] = FunctionInfo(
                 name,
                 info["is_callable"],
                 tuple(
-                    ParameterInfo(p["name"], p["kind"], p["has_default"])
+                    ParameterInfo(
+                        clean_text(p["name"], NAME_CHARS), clean_text(p["kind"], NAME_CHARS), p["has_default"]
+                    )
                     for p in parameters
                     if type(p["name"]) is str and type(p["kind"]) is str and type(p["has_default"]) is bool
                 ),

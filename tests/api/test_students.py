@@ -3,13 +3,18 @@
 from __future__ import annotations
 
 import hashlib
+import re
 
 import pytest
 from api_testing import bearer, instructor_headers
 from fastapi.testclient import TestClient
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from sqlalchemy import select
 
+from api.errors import InvalidStudentName
 from api.models import Student
+from api.students import name_pattern, normalise_name
 
 
 def test_a_new_student_gets_a_working_token_stored_as_a_digest(client: TestClient) -> None:
@@ -49,3 +54,41 @@ def test_an_oversized_json_body_is_refused_before_it_is_read(client: TestClient)
     )
     assert response.status_code == 413
     assert response.json()["detail"].startswith("the request body is larger than the limit of")
+
+
+NAME_SAMPLES = [
+    "ada",
+    "  Ada Lovelace ",
+    "\x1cada\x1f",
+    " " + "x" * 100 + "\t",
+    "x" * 101,
+    "a\u2028b",
+    "\u2028ab",
+    "a\U000e0001",
+    "a\U0001f600",
+    "a\U0003fffe",
+    "",
+]
+
+
+@pytest.mark.parametrize("name", NAME_SAMPLES, ids=range(len(NAME_SAMPLES)))
+def test_the_schema_pattern_accepts_exactly_the_names_the_service_accepts(name: str) -> None:
+    assert _schema_accepts(name) == _service_accepts(name)
+
+
+@settings(max_examples=300, derandomize=True, database=None, deadline=None)
+@given(st.text(max_size=110))
+def test_the_schema_pattern_agrees_with_the_service_on_any_text(name: str) -> None:
+    assert _schema_accepts(name) == _service_accepts(name)
+
+
+def _schema_accepts(name: str) -> bool:
+    return re.fullmatch(name_pattern(), name) is not None
+
+
+def _service_accepts(name: str) -> bool:
+    try:
+        normalise_name(name)
+    except InvalidStudentName:
+        return False
+    return True

@@ -46,6 +46,15 @@ def test_every_field_is_described(model: type[BaseModel]) -> None:
     assert undescribed == []
 
 
+def test_accepted_envs_restrict_the_games(tmp_path: Path) -> None:
+    assert load_config().problems["blackjack"].accepted_envs is None  # type: ignore[attr-defined]
+    restricted = BUNDLED.replace(
+        "games_per_call = 10000", 'games_per_call = 10000\naccepted_envs = ["Blackjack-v1"]'
+    )
+    config = load_config(_write(tmp_path, restricted))
+    assert config.problems["blackjack"].accepted_envs == ["Blackjack-v1"]  # type: ignore[attr-defined]
+
+
 def test_sandbox_settings_become_limits() -> None:
     limits = load_config().sandbox.to_limits(12.5)
     assert isinstance(limits, Limits)
@@ -103,6 +112,17 @@ def test_sandbox_settings_become_limits() -> None:
             "problems.cartpole.visibility: Input should be 'visible', 'after_due_date' or 'hidden' "
             "(found 'after_published')",
         ),
+        (
+            "uncounted_steps_deduction = 0.0\n\n[problems.car]",
+            'uncounted_steps_deduction = 0.0\naccepted_envs = ["CartPole-v2"]\n\n[problems.car]',
+            "problems.cartpole: Value error, accepted_envs must be a non-empty list of CartPole-v0, "
+            "CartPole-v1; found ['CartPole-v2']",
+        ),
+        (
+            "uncounted_steps_deduction = 0.0\n\n[problems.taxi]",
+            "uncounted_steps_deduction = 1.5\n\n[problems.taxi]",
+            "problems.car.uncounted_steps_deduction: Input should be less than or equal to 1 (found 1.5)",
+        ),
     ],
     ids=[
         "negative-points",
@@ -114,6 +134,8 @@ def test_sandbox_settings_become_limits() -> None:
         "missing-problem",
         "unknown-visibility",
         "gradescope-only-visibility",
+        "unknown-game",
+        "deduction-above-one",
     ],
 )
 def test_invalid_fields_are_named_with_what_was_found(

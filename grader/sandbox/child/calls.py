@@ -11,13 +11,16 @@ from types import ModuleType
 from typing import Any
 
 from grader.compat import events as compat_events
+from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
 from grader.sandbox.child.protocol import decode_value, encode_value
 from grader.sandbox.child.recorder import Recorder
 
 MAX_COMPAT_EVENTS = 100
-_CALL_FIELDS = {"type", "id", "nonce", "function", "args", "kwargs", "seed", "record"}
+MAX_EVENT_DETAIL = 1000
+"""Characters kept of a compat event's detail (100 events stay far below the frame's allowance)."""
+_CALL_FIELDS = {"type", "id", "nonce", "function", "args", "kwargs", "seed", "record", "budget"}
 
 
 @dataclass(frozen=True)
@@ -31,6 +34,7 @@ class CallRequest:
     kwargs: dict[str, Any]
     seed: int
     record: bool
+    budget: WireBudget | None = None
 
 
 def parse_call(frame: dict[str, Any]) -> CallRequest:
@@ -58,10 +62,13 @@ def parse_call(frame: dict[str, Any]) -> CallRequest:
     try:
         args = decode_value(frame["args"], "the call's arguments")
         kwargs = decode_value(frame["kwargs"], "the call's keyword arguments")
+        budget = WireBudget.from_plain(frame["budget"])
     except InvalidValueError as error:
         raise ProtocolError(error.message) from None
+    except ValueError as error:
+        raise ProtocolError(str(error)) from None
     return CallRequest(
-        frame["id"], frame["nonce"], frame["function"], args, kwargs, frame["seed"], frame["record"]
+        frame["id"], frame["nonce"], frame["function"], args, kwargs, frame["seed"], frame["record"], budget
     )
 
 
@@ -71,13 +78,20 @@ def run_call(
     """Call the student's function as `request` says and return the encoded result frame payload.
 
     `SystemExit` propagates (the process ends and the runner reports the exit); every other
-    failure, `KeyboardInterrupt` included, becomes a status with a message.
+    failure, `KeyboardInterrupt` included, becomes a status with a message. The frame stays within the
+    limits the parent derives from the call's budget (`frame_limits`).
     """
+    limits = frame_limits(request.budget, record=request.record, max_frame=max_frame)
+    max_frame = limits.max_bytes
     compat_events.drain()
-    recorder.begin_call(request.seed, record=request.record)
+    recorder.begin_call(request.seed, record=request.record, budget=request.budget)
     result = _outcome(module, request, submission, max_frame)
     episodes = recorder.finish_call()
-    if result["status"] == "ok" and recorder.overflowed:
+    if recorder.exceeded is not None and result["status"] not in ("missing_function", "bad_signature"):
+        result = _status(
+            "episode_limit", _budget_message(request.function, recorder), wall_time=result["wall_time"]
+        )
+    elif result["status"] == "ok" and recorder.overflowed:
         result = _status(
             "output_too_large",
             f"{request.function}() took more than {recorder.max_recorded_steps} environment steps while "
@@ -107,11 +121,28 @@ def run_call(
         {
             "kind": str(event.kind)[:100],
             "env_id": str(event.env_id)[:200],
-            "detail": shortened(str(event.detail)),
+            "detail": str(event.detail)[:MAX_EVENT_DETAIL],
         }
         for event in compat_events.drain()[:MAX_COMPAT_EVENTS]
     ]
-    return _payload(result, request, max_frame)
+    return _payload(result, request, limits)
+
+
+def _budget_message(function: str, recorder: Recorder) -> str:
+    budget = recorder.budget
+    if budget is None:  # only a call with a budget can exceed it
+        return ""
+    if recorder.exceeded == "episodes":
+        return (
+            f"{function}() reset its environment {recorder.resets:,} times in one call; the grader records "
+            f"at most {budget.max_episodes:,} resets per call of {function}() — reset once per game and "
+            "don't reset to look for an easy start"
+        )
+    return (
+        f"{function}() took {recorder.steps:,} environment steps in one call; the grader records at most "
+        f"{budget.max_steps:,} steps per call of {function}() — play only the games {function}() is asked "
+        "to play and end each one when `terminated` or `truncated` is true"
+    )
 
 
 def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_frame: int) -> dict[str, Any]:
@@ -200,18 +231,23 @@ def _status(status: str, message: str, *, traceback: str = "", wall_time: float 
     }
 
 
-def _payload(result: dict[str, Any], request: CallRequest, max_frame: int) -> bytes:
+def _payload(result: dict[str, Any], request: CallRequest, limits: FrameLimits) -> bytes:
     frame = {"type": "result", "id": request.call_id, "nonce": request.nonce, **result}
     payload = json.dumps(frame, allow_nan=False, separators=(",", ":")).encode()
-    if len(payload) <= max_frame:
+    excess = limits.excess(payload)
+    if not excess:
         return payload
-    value_size = len(json.dumps(result["value"], separators=(",", ":")))
-    culprit = "its return value" if value_size > max_frame // 2 else "the episode log"
+    value = json.dumps(result["value"], separators=(",", ":")).encode()
+    culprit = (
+        "its return value"
+        if limits.excess(value) or len(value) > limits.max_bytes // 2
+        else "the episode log"
+    )
     small = {
         **_status(
             "output_too_large",
-            f"{request.function}() produced {len(payload)} bytes of results, more than the limit of "
-            f"{max_frame} bytes; {culprit} is too large",
+            f"{request.function}() produced too much data ({excess.removeprefix('a ')}); {culprit} is too "
+            "large: return less data or play fewer episodes",
             wall_time=result["wall_time"],
         ),
         "compat_events": result["compat_events"][:20],

@@ -13,6 +13,7 @@ from typing import Any
 
 MODULE_NAME = "submission"
 MAX_LISTED_NAMES = 500
+MAX_LISTED_PARAMETERS = 64
 MAX_NAME_LENGTH = 200
 MAX_TEXT = 20_000
 
@@ -95,11 +96,11 @@ def parameter_list(value: Any) -> list[dict[str, Any]]:
         return []
     return [
         {
-            "name": parameter.name,
+            "name": parameter.name[:MAX_NAME_LENGTH],
             "kind": parameter.kind.name,
             "has_default": parameter.default is not inspect.Parameter.empty,
         }
-        for parameter in signature.parameters.values()
+        for parameter in list(signature.parameters.values())[:MAX_LISTED_PARAMETERS]
     ]
 
 

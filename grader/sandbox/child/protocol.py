@@ -268,11 +268,16 @@ def _decode_array(spec: dict[str, Any], what: str, where: str) -> np.ndarray:
         raise _invalid(what, where, f"array shape {shape!r} is not a list of non-negative ints")
     if type(data) is not str:
         raise _invalid(what, where, "array data must be a base64 string")
+    dtype = np.dtype(dtype_name)
+    size = math.prod(shape) * dtype.itemsize
+    if len(data) != 4 * ((size + 2) // 3):  # checked before decoding: the shape bounds the work
+        raise _invalid(
+            what, where, f"array data of {len(data)} characters cannot hold shape {shape} of {dtype}"
+        )
     try:
         raw = base64.b64decode(data.encode("ascii"), validate=True)
     except (binascii.Error, UnicodeEncodeError):
         raise _invalid(what, where, "array data is not valid base64") from None
-    dtype = np.dtype(dtype_name)
     if len(raw) != math.prod(shape) * dtype.itemsize:
         raise _invalid(
             what, where, f"array data has {len(raw)} bytes, shape {shape} of {dtype} needs more or less"

@@ -28,6 +28,7 @@ import numpy as np
 from grader.compat import events as compat_events
 from grader.compat import make as compat_make
 from grader.compat import register_envs, resolve_env_id
+from grader.sandbox.child.budget import WireBudget
 from grader.sandbox.child.protocol import MAX_NODES
 from grader.sandbox.child.seeding import CallSeeds, kept_generator_seed
 
@@ -105,13 +106,24 @@ class MadeEnv:
 
 
 class Recorder:
-    """Per-process recording state; `begin_call` starts a call, `finish_call` returns its episodes."""
+    """Per-process recording state; `begin_call` starts a call, `finish_call` returns its episodes.
+
+    While a call records, every reset and every step of its envs is counted against the call's
+    budget (`resets`, `steps`), whether or not it is logged; once either count exceeds the budget,
+    `exceeded` names it and nothing more is logged.
+    """
 
     def __init__(self, seed: int, max_recorded_steps: int = DEFAULT_MAX_RECORDED_STEPS) -> None:
         self.seeds = CallSeeds(seed)
         self.max_recorded_steps = max_recorded_steps
         self.recording = False
         self.overflowed = False
+        self.record_call = False
+        self.budget: WireBudget | None = None
+        self.resets = 0
+        self.steps = 0
+        self.exceeded: str | None = None
+        """"episodes" or "steps" once the call went beyond its budget."""
         self.episodes: list[EpisodeRecord] = []
         self._recorded_steps = 0
         self._live_envs: list[weakref.ref[RecordingEnv]] = []
@@ -134,11 +146,16 @@ class Recorder:
         self.importing = False
         self.finish_call()
 
-    def begin_call(self, call_seed: int, *, record: bool) -> None:
-        """Reseed everything from `call_seed` and start an empty episode log."""
+    def begin_call(self, call_seed: int, *, record: bool, budget: WireBudget | None = None) -> None:
+        """Reseed everything from `call_seed` and start an empty episode log (limited by `budget`)."""
         self.importing = False
         self.seeds = CallSeeds(call_seed)
         self.recording = record
+        self.record_call = record
+        self.budget = budget
+        self.resets = 0
+        self.steps = 0
+        self.exceeded = None
         self.overflowed = False
         self.episodes = []
         self._recorded_steps = 0
@@ -164,6 +181,7 @@ class Recorder:
         the episodes, not with their steps, as `grader.sandbox.child.protocol.MAX_NODES` requires).
         """
         self.recording = False
+        self.record_call = False
         episodes, self.episodes = self.episodes, []
         list_nodes = sum(
             EPISODE_NODES + len(episode.env_kwargs) + 4 * _list_entries(len(episode.actions))
@@ -196,10 +214,19 @@ class Recorder:
         env.action_space.seed(self.seeds.space_seed(2 * number))
         env.observation_space.seed(self.seeds.space_seed(2 * number + 1))
 
+    def count_reset(self) -> None:
+        """Count one reset of an env against the call's budget (every reset, logged or not)."""
+        if not self.record_call:
+            return
+        self.resets += 1
+        if self.budget is not None and self.resets > self.budget.max_episodes:
+            self._exceed("episodes")
+
     def start_episode(
         self, env: RecordingEnv, reset_seed: int, student_seed: int | None, options: dict[str, Any] | None
     ) -> EpisodeRecord | None:
-        """Open a new episode for `env`, or return None when not recording."""
+        """Count the reset and open a new episode for `env`; None when not recording."""
+        self.count_reset()
         if not self.recording or not self._spend_step():
             return None
         index = self._call_indices.setdefault(id(env), len(self._call_indices))
@@ -211,10 +238,15 @@ class Recorder:
         return episode
 
     def record_step(
-        self, episode: EpisodeRecord, action: Any, reward: Any, terminated: Any, truncated: Any
+        self, episode: EpisodeRecord | None, action: Any, reward: Any, terminated: Any, truncated: Any
     ) -> None:
-        """Append one step to `episode` unless the step budget is spent."""
-        if not self._spend_step():
+        """Count one step against the call's budget and append it to `episode` while recording."""
+        if not self.record_call:
+            return
+        self.steps += 1
+        if self.budget is not None and self.steps > self.budget.max_steps:
+            self._exceed("steps")
+        if episode is None or not self.recording or not self._spend_step():
             return
         episode.actions.append(_copy_action(action))
         try:
@@ -223,6 +255,12 @@ class Recorder:
             episode.rewards.append(float("nan"))
         episode.terminated.append(bool(terminated))
         episode.truncated.append(bool(truncated))
+
+    def _exceed(self, what: str) -> None:
+        if self.exceeded is None:
+            self.exceeded = what
+        self.recording = False
+        self.episodes = []  # never sent: the call ends with episode_limit
 
     def _spend_step(self) -> bool:
         if self._recorded_steps >= self.max_recorded_steps:
@@ -268,7 +306,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
     def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
         """Step the env and log the action and what the student sees."""
         result = self.env.step(action)
-        if self._episode is not None and self.recorder.recording:
+        if self.recorder.record_call:
             _, reward, terminated, truncated, _ = result
             self.recorder.record_step(self._episode, action, reward, terminated, truncated)
         return result

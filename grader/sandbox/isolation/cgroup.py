@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from grader.sandbox.isolation.protocol import LayerReport
+from grader.sandbox.isolation.scope import forget_cgroup, record_cgroup
 
 CGROUP_ROOT = Path("/sys/fs/cgroup")
 CONTROLLERS = ("memory", "pids", "cpu")
@@ -130,24 +131,37 @@ class JobCgroup:
                     time.sleep(0.01)
             else:
                 removed = False
+        if removed and self.groups:
+            forget_cgroup(self.groups[0].path.name)
         return emptied and removed
 
 
-def _remove_stale(parent: Path) -> None:
-    """Removes empty job cgroups left by grader processes that died without cleaning up (e.g. SIGKILL)."""
+def remove_job_directories(directories: list[tuple[int, Path]]) -> bool:
+    """Kills the processes in, and removes, the job cgroup directories given as (version, path).
+
+    For cgroups whose owner is gone: the grading's scope (`grader.sandbox.isolation.scope`) and the
+    sweep of stale jobs. Only directories named like job cgroups are touched.
+    """
+    groups = [_Group(path, version, ()) for version, path in directories if path.name.startswith(JOB_PREFIX)]
+    return JobCgroup(groups).remove()
+
+
+def _remove_stale(parent: Path, version: int) -> None:
+    """Removes job cgroups left by grader processes that died without cleaning up (e.g. SIGKILL), killing
+    any process still inside (its grader is gone)."""
     for path in parent.glob(f"{JOB_PREFIX}*-*"):
         try:
             os.kill(int(path.name.split("-")[1]), 0)
         except ProcessLookupError:
-            with contextlib.suppress(OSError):
-                path.rmdir()  # fails, as it should, while any process is still inside
+            remove_job_directories([(version, path)])
         except (ValueError, IndexError, PermissionError):
             continue
 
 
 def _make_group(parent: Path, name: str, version: int, controllers: tuple[str, ...]) -> _Group:
-    _remove_stale(parent)
+    _remove_stale(parent, version)
     path = parent / name
+    record_cgroup(name, version, path)  # before it exists: a kill right after mkdir leaves nothing
     path.mkdir()
     return _Group(path, version, controllers)
 

@@ -12,6 +12,8 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from grader.sandbox.isolation.scope import temp_root
+
 PROJECT_PACKAGES = ("grader", "reference", "api")
 """Top-level packages of the project; hidden wherever an installed copy would make them importable."""
 
@@ -19,7 +21,8 @@ _GRADER_ROOT = Path(__file__).resolve().parents[2]
 _HARNESS_SOURCES = ("sandbox/child", "compat")
 _ISOLATION_DIR = Path(__file__).resolve().parent
 TREE_PREFIX = "gymgrade-harness-"
-"""Harness trees are temporary directories named gymgrade-harness-<grader pid>-<random>."""
+"""Harness trees are temporary directories named gymgrade-harness-<grader pid>-<random>, inside the
+grading's scope when there is one (`grader.sandbox.isolation.scope`), which removes them with it."""
 
 
 @dataclass(frozen=True)
@@ -85,7 +88,7 @@ def harness_tree() -> Path:
     ``grader/compat``. Nothing else of the project (not `reference`, not the assignment config).
     """
     remove_stale_trees()
-    root = Path(tempfile.mkdtemp(prefix=f"{TREE_PREFIX}{os.getpid()}-"))
+    root = Path(tempfile.mkdtemp(prefix=f"{TREE_PREFIX}{os.getpid()}-", dir=temp_root()))
     atexit.register(shutil.rmtree, root, ignore_errors=True)
     lib = root / "lib"
     (lib / "grader" / "sandbox").mkdir(parents=True)

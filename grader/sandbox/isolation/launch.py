@@ -15,6 +15,7 @@ from grader.sandbox.isolation.cgroup import JobCgroup, create_job_cgroup
 from grader.sandbox.isolation.filesystem import harness_tree, python_paths
 from grader.sandbox.isolation.protocol import IsolationReport
 from grader.sandbox.isolation.rlimits import rlimit_table
+from grader.sandbox.isolation.scope import temp_root
 from grader.sandbox.isolation.seccomp import compile_filter
 from grader.sandbox.limits import Limits
 
@@ -120,7 +121,7 @@ def build_launch(
             )
             bootstrap_seccomp = None
         else:
-            launch.scratch = Path(tempfile.mkdtemp(prefix="gymgrade-scratch-"))
+            launch.scratch = Path(tempfile.mkdtemp(prefix="gymgrade-scratch-", dir=temp_root()))
             os.chmod(launch.scratch, 0o1777)
             submission_dir = launch.scratch / ".submission"
             submission_dir.mkdir()

@@ -116,9 +116,13 @@ def test_python_m_runs_the_script_as_main_with_its_args_and_summarises_events(
     )
     assert result.returncode == 0, result.stderr
     assert result.stdout == "__main__ ['--episodes', '3'] True\n"
-    assert result.stderr.splitlines()[0] == "gymgrade compat: 2 compatibility event(s)"
+    assert result.stderr.splitlines()[0] == "gymgrade compat: 3 compatibility event(s)"
     assert result.stderr.splitlines()[1].startswith("  renamed_id [Taxi-v3]: Taxi-v3 was made as")
     assert result.stderr.splitlines()[2].startswith("  legacy_seed_call [Taxi-v3]: env.seed()")
+    assert result.stderr.splitlines()[3] == (
+        "  api_detected [Taxi-v3]: snippet.py was served the classic gym API (4-value step): line 5: "
+        "env.seed() (classic seeding)"
+    )
 
 
 def test_python_m_keeps_the_script_s_exit_status_and_still_summarises(run_through_layer: RunScript) -> None:

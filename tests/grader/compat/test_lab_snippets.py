@@ -5,6 +5,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 from .conftest import RunScript
 
 SNIPPETS = Path(__file__).resolve().parents[3] / "submissions" / "lab_snippets"
@@ -15,9 +17,27 @@ def _snippet(name: str) -> str:
 
 
 def _event_lines(stderr: str) -> list[str]:
-    """The summary's event lines (after its "gymgrade compat:" header), reduced to "kind [env_id]"."""
+    """The summary's event lines (after its "gymgrade compat:" header) reduced to "kind [env_id]", except
+    the API detections (every snippet gets classic gym: `test_every_snippet_is_served_classic_gym`)."""
     summary = stderr[stderr.rindex("gymgrade compat:") :].splitlines()[1:]
-    return [line.split(":")[0].strip() for line in summary]
+    lines = [line.split(":")[0].strip() for line in summary]
+    return [line for line in lines if not line.startswith("api_detected")]
+
+
+def _detections(stderr: str) -> list[str]:
+    summary = stderr[stderr.rindex("gymgrade compat:") :].splitlines()[1:]
+    return [line.strip() for line in summary if line.strip().startswith("api_detected")]
+
+
+@pytest.mark.parametrize(
+    "name",
+    sorted(path.name for path in SNIPPETS.glob("*.py") if path.name != "find_qvalues.py"),
+)
+def test_every_snippet_is_served_classic_gym(run_through_layer: RunScript, name: str) -> None:
+    result = run_through_layer(_snippet(name))
+    detections = _detections(result.stderr)
+    assert detections, result.stderr
+    assert all("classic gym API" in line for line in detections), detections
 
 
 def test_registry_listing_and_nchain_reset(run_through_layer: RunScript) -> None:
@@ -27,7 +47,7 @@ def test_registry_listing_and_nchain_reset(run_through_layer: RunScript) -> None
     assert listing.startswith("dict_values([EnvSpec(id='")
     assert "id='NChain-v0'" in listing
     assert reset == "0"
-    assert result.stderr == "gymgrade compat: no compatibility events\n"
+    assert _event_lines(result.stderr) == []
 
 
 def test_action_spaces_and_a_random_step(run_through_layer: RunScript) -> None:
@@ -47,7 +67,7 @@ def test_a_random_guess_returns_observation_reward_done_info(run_through_layer: 
     assert (observation in (1, 3), reward in (0, 1), done == bool(reward)) == (True, True, True)
     assert list(info) == ["guesses", "number"] and info["guesses"] == 1
     assert -1000 <= info["number"] < 1000
-    assert result.stderr == "gymgrade compat: no compatibility events\n"
+    assert _event_lines(result.stderr) == []
 
 
 def test_acrobot_render_loop_runs_headless_and_ends(run_through_layer: RunScript) -> None:

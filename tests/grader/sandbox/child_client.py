@@ -57,7 +57,13 @@ class ChildClient:
         return protocol.read_frame(self._results)
 
     def call(
-        self, function: str, *args: Any, seed: int = 1, record: bool = True, **kwargs: Any
+        self,
+        function: str,
+        *args: Any,
+        seed: int = 1,
+        record: bool = True,
+        budget: dict[str, int] | None = None,
+        **kwargs: Any,
     ) -> dict[str, Any] | None:
         """Send one call; return the result frame (None if the child ended without one)."""
         self._next_id += 1
@@ -70,6 +76,7 @@ class ChildClient:
             "kwargs": protocol.encode_value(kwargs),
             "seed": seed,
             "record": record,
+            "budget": budget,
         }
         try:
             protocol.write_frame(self._requests, frame)

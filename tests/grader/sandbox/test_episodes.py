@@ -12,6 +12,7 @@ from grader.sandbox.child.errors import InvalidEpisodeLogError
 from grader.sandbox.child.protocol import encode_frame, encode_value, parse_payload
 from grader.sandbox.child.recorder import SHORT_EPISODE_STEPS, EpisodeRecord
 from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
+from grader.sandbox.outcome import CallBudget
 
 STEPS = [(1, -1.0), (4, -10.0), (5, 20.0)]
 LONG = SHORT_EPISODE_STEPS + 1
@@ -178,3 +179,37 @@ def test_logs_with_array_actions_compare_by_dtype_and_values() -> None:
     assert same == log(np.array([0.5], dtype=np.float32))
     assert same != log(np.array([0.5], dtype=np.float64))
     assert same != log(np.array([0.25], dtype=np.float32))
+
+
+@pytest.mark.parametrize(
+    ("episodes", "repeats", "budget", "message"),
+    [
+        (
+            5,
+            1,
+            CallBudget(max_episodes=4, max_steps=100),
+            "the log holds 5 episodes, more than the call's limit of 4",
+        ),
+        (2, 1, CallBudget(max_episodes=4, max_steps=5), "the log holds more than 5 steps, the call's limit"),
+        (
+            1,
+            LONG,
+            CallBudget(max_episodes=4, max_steps=50),
+            "the log holds more than 50 steps, the call's limit",
+        ),
+    ],
+    ids=["episodes", "steps-in-lists", "steps-in-array-shapes"],
+)
+def test_logs_beyond_the_calls_budget_are_refused_before_decoding(
+    episodes: int, repeats: int, budget: CallBudget, message: str
+) -> None:
+    data = encode_value([recorded(repeats).to_plain() for _ in range(episodes)])
+
+    with pytest.raises(InvalidEpisodeLogError, match=message):
+        episodes_from_plain(data, budget)
+
+
+def test_logs_within_the_calls_budget_decode() -> None:
+    data = encode_value([recorded(LONG).to_plain(), recorded().to_plain()])
+
+    assert len(episodes_from_plain(data, CallBudget(max_episodes=2, max_steps=3 * LONG + 3))) == 2

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import secrets
 import shutil
@@ -15,8 +16,9 @@ from typing import Any
 
 import pytest
 
-from grader.sandbox import Call, IsolationPolicy, Limits, OutcomeStatus, Sandbox, probe_isolation
+from grader.sandbox import Call, CallBudget, IsolationPolicy, Limits, OutcomeStatus, Sandbox, probe_isolation
 from grader.sandbox.replay import replay_episode
+from grader.sandbox.text import EVENT_CHARS, MESSAGE_CHARS
 
 ROOT = Path(__file__).resolve().parents[3]
 HOSTILE = ROOT / "submissions" / "hostile"
@@ -130,7 +132,10 @@ def test_hostile_sample_gets_its_outcome_and_leaves_the_host_unaffected(
 
     limits = replace(LIMITS, call_seconds=sample.get("call_seconds", LIMITS.call_seconds))
     with Sandbox(submission, seed=7, limits=limits, policy=IsolationPolicy.REQUIRE_FULL) as sandbox:
-        outcome = sandbox.call(Call(function or "ok", _arguments(sample, loopback.port, marker)))
+        budget = CallBudget(**sample["budget"]) if "budget" in sample else None
+        outcome = sandbox.call(
+            Call(function or "ok", _arguments(sample, loopback.port, marker), budget=budget)
+        )
         following = sandbox.call(Call("ok"))
 
     assert outcome.status == OutcomeStatus(sample["status"]), outcome.message + outcome.stderr[-2000:]
@@ -143,6 +148,14 @@ def test_hostile_sample_gets_its_outcome_and_leaves_the_host_unaffected(
     if "value" in sample:
         assert outcome.value == sample["value"]
         assert type(outcome.value) is type(sample["value"])
+    if "value_text" in sample:
+        assert sample["value_text"] in json.dumps(outcome.value, ensure_ascii=False)
+    for text in (outcome.message, outcome.stdout, outcome.stderr, json.dumps(outcome.compat_events)):
+        assert "\x00" not in text
+        text.encode("utf-8")  # no lone surrogate
+    json.dumps(outcome.value, ensure_ascii=False).encode("utf-8")
+    assert len(outcome.message) < 2 * MESSAGE_CHARS + 200
+    assert all(len(text) < EVENT_CHARS + 100 for event in outcome.compat_events for text in event.values())
     if sample.get("value_below_max_pids"):
         assert 0 < outcome.value < LIMITS.max_pids
     if sample.get("replay_mismatch"):
@@ -150,7 +163,7 @@ def test_hostile_sample_gets_its_outcome_and_leaves_the_host_unaffected(
         assert any(replay_episode(log).mismatch for log in outcome.episodes)
     if function is None:
         assert following.status == outcome.status, "a failed import is reported for every call"
-    else:
+    elif sample.get("following_call", True):
         assert (following.status, following.value) == (OutcomeStatus.OK, 42), following.message
 
     assert sandbox.leftovers == 0

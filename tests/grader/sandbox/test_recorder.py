@@ -152,6 +152,24 @@ STUDENT = textwrap.dedent("""
         return 0
 
 
+    def scouting(resets, seed=None):
+        env = gymnasium.make("CartPole-v1")
+        for _ in range(resets):
+            env.reset(seed=seed)
+        env.reset()
+        for _ in range(5):
+            env.step(0)
+        return 0
+
+
+    def stepping(steps):
+        env = gymnasium.make("Taxi-v3")
+        env.reset()
+        for _ in range(steps):
+            env.step(0)
+        return 0
+
+
     def long_run():
         env = gym.make("CartPole-v0")
         for _ in range(10):
@@ -391,3 +409,51 @@ def test_short_episodes_use_lists_only_within_the_element_budget(count: int, lis
     assert {type(episode["actions"]) for episode in plain} == {list if lists else np.ndarray}
     encoded = encode_value(plain, "the episode log")  # as lists, the second case would pass MAX_NODES
     assert len(episodes_from_plain(encoded)) == count
+
+
+BUDGET = {"max_episodes": 4, "max_steps": 20}
+
+
+@pytest.mark.parametrize(
+    ("function", "args", "message"),
+    [
+        (
+            "scouting",
+            (3000,),
+            "scouting() reset its environment 3,001 times in one call; the grader records at most 4 resets "
+            "per call of scouting() — reset once per game and don't reset to look for an easy start",
+        ),
+        (
+            "scouting",
+            (4, True),  # seed=True is not logged (not a grader-mapped seed), but still counted
+            "scouting() reset its environment 5 times in one call; the grader records at most 4 resets "
+            "per call of scouting() — reset once per game and don't reset to look for an easy start",
+        ),
+        (
+            "stepping",
+            (25,),
+            "stepping() took 25 environment steps in one call; the grader records at most 20 steps per "
+            "call of stepping() — play only the games stepping() is asked to play and end each one when "
+            "`terminated` or `truncated` is true",
+        ),
+    ],
+    ids=["zero-step-resets", "unlogged-resets", "steps"],
+)
+def test_a_call_beyond_its_budget_ends_with_episode_limit(
+    child: ChildClient, function: str, args: tuple[Any, ...], message: str
+) -> None:
+    result = child.call(function, *args, budget=BUDGET)
+
+    assert result is not None and result["status"] == "episode_limit"
+    assert result["message"] == message
+    assert result["episodes"] == []
+
+
+def test_every_reset_within_the_budget_is_recorded(child: ChildClient) -> None:
+    logs = episodes_of(child.call("scouting", 3, budget=BUDGET))
+
+    assert [log.steps for log in logs] == [0, 0, 0, 5]
+
+
+def test_an_unlimited_call_keeps_the_global_limit(child: ChildClient) -> None:
+    assert len(episodes_of(child.call("scouting", 3000))) == 3001

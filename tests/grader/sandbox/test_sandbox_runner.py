@@ -14,6 +14,7 @@ import pytest
 
 from grader.sandbox import (
     Call,
+    CallBudget,
     IsolationPolicy,
     Limits,
     OutcomeStatus,
@@ -75,6 +76,14 @@ SAMPLE = textwrap.dedent("""
     def huge():
         return "y" * (2 << 20)
 
+    def resets(n):
+        import gymnasium
+
+        env = gymnasium.make("CartPole-v1")
+        for _ in range(n):
+            env.reset()
+        return n
+
     not_a_function = 3
 """)
 
@@ -122,9 +131,15 @@ CLASSIFIED = [
         "forged frame header",
         Call("forge_header"),
         OutcomeStatus.INVALID_VALUE,
-        "the result channel carried data the harness did not send (a frame announced 2147483648 bytes",
+        "the result channel carried data the harness did not send (a frame announced 2,147,483,648 bytes",
     ),
     ("too large", Call("huge"), OutcomeStatus.OUTPUT_TOO_LARGE, "more than the limit of 1048576 bytes"),
+    (
+        "episode limit",
+        Call("resets", (10,), budget=CallBudget(max_episodes=4, max_steps=100)),
+        OutcomeStatus.EPISODE_LIMIT,
+        "resets() reset its environment 10 times in one call; the grader records at most 4 resets per call",
+    ),
 ]
 
 

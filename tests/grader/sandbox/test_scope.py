@@ -1,0 +1,136 @@
+"""A grading leaves no harness tree, scratch dir, cgroup or process behind, even when its run is killed."""
+
+from __future__ import annotations
+
+import os
+import secrets
+import tempfile
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from grader.grading import GradingPlan, grade_files
+from grader.sandbox import IsolationPolicy, probe_isolation
+from grader.sandbox.isolation.scope import CGROUP_RECORDS, SCOPE_PREFIX, sandbox_scope
+
+SUBMISSION = textwrap.dedent("""
+    import time
+
+    import gymnasium
+
+
+    def random_blackjack(n):
+        time.sleep(3)  # cartpole() is under way by now
+        env = gymnasium.make("Blackjack-v1", natural=False, sab=False)
+        wins = 0
+        for _ in range(n):
+            env.reset()
+            done = False
+            while not done:
+                _, reward, terminated, truncated, _ = env.step(env.action_space.sample())
+                done = terminated or truncated
+            wins += reward > 0
+        return wins / n
+
+
+    def cartpole():
+        while True:
+            pass
+""")
+
+pytestmark = [
+    pytest.mark.sandbox,
+    pytest.mark.skipif(
+        not probe_isolation().full, reason="needs full isolation:\n" + probe_isolation().summary()
+    ),
+]
+
+
+@pytest.fixture
+def private_tmp(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """A temp dir of this test's own, for the grading and the pytest run it starts."""
+    directory = tmp_path / "tmp"
+    directory.mkdir()
+    monkeypatch.setenv("TMPDIR", str(directory))
+    monkeypatch.setattr(tempfile, "tempdir", None)
+    return directory
+
+
+def _recorded_cgroups(tmp: Path) -> set[Path]:
+    """The job cgroups the grading's scope knows of right now."""
+    paths = set()
+    for record in tmp.glob(f"{SCOPE_PREFIX}*/{CGROUP_RECORDS}/*"):
+        paths.update(Path(line.split(" ", 1)[1]) for line in record.read_text().splitlines() if line)
+    return paths
+
+
+def _processes_mentioning(token: str) -> list[str]:
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit() and int(entry.name) != os.getpid():
+            try:
+                command = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+                state = (entry / "stat").read_text().rsplit(")", 1)[1].split()[0]
+            except (OSError, IndexError):
+                continue
+            if token in command and state != "Z":
+                found.append(f"{entry.name}: {command[:200]}")
+    return found
+
+
+@pytest.mark.parametrize("abandoned", [False, True], ids=["completed", "killed-mid-run"])
+def test_a_grading_leaves_nothing_behind(private_tmp: Path, tmp_path: Path, abandoned: bool) -> None:
+    token = secrets.token_hex(6)
+    submission = tmp_path / f"student_{token}.py"
+    submission.write_text(SUBMISSION)
+    plan = GradingPlan.load(None, ["random_blackjack", "cartpole"] if abandoned else ["random_blackjack"])
+    seen: set[Path] = set()
+
+    def on_result(path: Path, result: object) -> None:
+        seen.update(_recorded_cgroups(private_tmp))
+        if abandoned:
+            raise KeyboardInterrupt
+
+    if abandoned:
+        with pytest.raises(KeyboardInterrupt):
+            grade_files(
+                [submission],
+                plan,
+                seed=5,
+                workers=2,
+                policy=IsolationPolicy.ALLOW_FALLBACK,
+                on_result=on_result,
+            )
+        assert seen, "cartpole()'s sandbox was running when the run was killed"
+    else:
+        [report] = grade_files(
+            [submission], plan, seed=5, workers=2, policy=IsolationPolicy.ALLOW_FALLBACK, on_result=on_result
+        )
+        assert [problem.status for problem in report.problems] == ["passed"], report.problems[0].feedback
+
+    assert sorted(path.name for path in private_tmp.glob("gymgrade-*")) == []  # pytest's own dirs may stay
+    assert [path for path in seen if path.exists()] == []
+    deadline = time.monotonic() + 5  # SIGKILLed processes take a moment to go
+    while _processes_mentioning(token) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert _processes_mentioning(token) == []
+
+
+def test_closing_a_scope_removes_its_cgroups_and_files(private_tmp: Path) -> None:
+    from grader.sandbox.isolation.cgroup import create_job_cgroup
+
+    with sandbox_scope() as variables:
+        os.environ.update(variables)
+        try:
+            job = create_job_cgroup(memory_bytes=1 << 30, max_pids=16)
+            (Path(variables["GYMGRADE_SANDBOX_SCOPE"]) / "gymgrade-harness-1-x").mkdir()
+        finally:
+            for name in variables:
+                del os.environ[name]
+        paths = [group.path for group in job.groups]
+        assert all(path.exists() for path in paths)
+
+    assert [path for path in paths if path.exists()] == []
+    assert list(private_tmp.iterdir()) == []
