@@ -104,7 +104,17 @@ def test_batch_writes_a_report_per_submission_and_grades_csv(batch: tuple[Path, 
     assert written == reports[1]
     rows = list(csv.DictReader((out / "grades.csv").open()))
     assert [row["submission"] for row in rows] == ["os_exit_at_import", "classic_complete", "empty"]
-    assert list(rows[0]) == ["submission", "sha256", "random_blackjack", "car", "total", "max_score", "note"]
+    assert list(rows[0]) == [
+        "submission",
+        "sha256",
+        "seed",
+        "random_blackjack",
+        "car",
+        "total",
+        "max_score",
+        "note",
+    ]
+    assert {row["seed"] for row in rows} == {"3"}
     assert [(row["total"], row["max_score"]) for row in rows] == [("0", "2"), ("2", "2"), ("0", "2")]
 
 
