@@ -37,8 +37,10 @@ def add_worker_command(subparsers: argparse._SubParsersAction[argparse.ArgumentP
     """Register ``gymgrade worker [--workers N]``."""
     parser = subparsers.add_parser(
         "worker",
-        help="grade queued submissions in this process (next to `gymgrade serve` with GYMGRADE_WORKERS=0)",
-        description="Grade queued submissions from the service's database until Ctrl-C or SIGTERM.",
+        help="grade queued submissions in this process (a Celery worker when GYMGRADE_BROKER_URL is set)",
+        description="Grade queued submissions until Ctrl-C or SIGTERM: from the service's database next to "
+        "`gymgrade serve` with GYMGRADE_WORKERS=0, or, with GYMGRADE_BROKER_URL=redis://HOST:PORT/N, as a "
+        "Celery worker of the cluster (it needs the broker, the database and full isolation).",
     )
     parser.add_argument(
         "--workers",
@@ -91,6 +93,14 @@ def work(args: argparse.Namespace) -> int:
         print(f"gymgrade worker: --workers must be at least 1, found {args.workers}", file=sys.stderr)
         return 2
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    if settings.broker_url is not None:
+        from api.jobs.celery_worker import run_worker, startup_problem
+
+        problem = startup_problem(settings)
+        if problem is not None:
+            print(f"gymgrade worker: {problem}", file=sys.stderr)
+            return 2
+        return run_worker(settings, args.workers)
     context = ServiceContext.open(settings, pool_size=args.workers or max(settings.workers, 1))
     pool = context.pool
     if pool is None:

@@ -1,4 +1,4 @@
-"""What the routes share at run time: settings, the database, the job queue and the worker pool."""
+"""What the routes share at run time: settings, the database, the job queue, its dispatcher and workers."""
 
 from __future__ import annotations
 
@@ -8,9 +8,10 @@ from sqlalchemy import Engine
 from sqlalchemy.orm import Session, sessionmaker
 
 from api.database import make_engine, make_session_factory, migrate
-from api.jobs.local import DatabaseQueue
+from api.jobs.local import DatabaseQueue, PollingDispatcher
 from api.jobs.pool import WorkerPool
-from api.jobs.protocol import JobQueue
+from api.jobs.protocol import Dispatcher, JobQueue
+from api.jobs.reconciler import Reconciler
 from api.settings import Settings
 
 
@@ -22,24 +23,37 @@ class ServiceContext:
     engine: Engine
     sessions: sessionmaker[Session]
     jobs: JobQueue
+    dispatcher: Dispatcher
     pool: WorkerPool | None = None
+    reconciler: Reconciler | None = None
 
     @classmethod
     def open(cls, settings: Settings, *, pool_size: int) -> ServiceContext:
-        """Connect, migrate the schema, and start ``pool_size`` grading workers (none when 0)."""
+        """Connect, migrate the schema, and start grading: ``pool_size`` in-process workers (none when 0),
+        or, with GYMGRADE_BROKER_URL, no grading here but Celery tasks and their reconciler."""
         engine = make_engine(settings)
         migrate(engine)
         sessions = make_session_factory(engine)
         jobs = DatabaseQueue(
             sessions, lease_seconds=settings.lease_seconds, max_attempts=settings.max_attempts
         )
+        if settings.broker_url is not None:
+            from api.jobs.distributed import CeleryDispatcher  # Celery is imported only where it is used
+
+            celery = CeleryDispatcher(settings)
+            reconciler = Reconciler(sessions, celery, settings.reconcile_seconds)
+            reconciler.start()
+            return cls(settings, engine, sessions, jobs, dispatcher=celery, reconciler=reconciler)
         pool = WorkerPool(jobs, settings, pool_size) if pool_size > 0 else None
         if pool is not None:
             pool.start()
-        return cls(settings=settings, engine=engine, sessions=sessions, jobs=jobs, pool=pool)
+        return cls(settings, engine, sessions, jobs, dispatcher=PollingDispatcher(), pool=pool)
 
     def close(self) -> None:
         """Stop the workers (their running jobs return to the queue) and close the database."""
         if self.pool is not None:
             self.pool.stop()
+        if self.reconciler is not None:
+            self.reconciler.stop()
+        self.dispatcher.close()
         self.engine.dispose()

@@ -19,6 +19,7 @@ from api.auth import Principal, authenticate
 from api.context import ServiceContext
 from api.disclosure import Disclosure, disclosure_for
 from api.errors import NotAuthenticated
+from api.jobs.protocol import Dispatcher
 from api.models import Student
 from api.settings import Settings
 
@@ -45,6 +46,14 @@ async def get_settings(context: ContextDep) -> Settings:
 
 
 SettingsDep = Annotated[Settings, Depends(get_settings)]
+
+
+async def get_dispatcher(context: ContextDep) -> Dispatcher:
+    """Who tells the workers about a new job (Celery tasks, or nothing for the polling workers)."""
+    return context.dispatcher
+
+
+DispatcherDep = Annotated[Dispatcher, Depends(get_dispatcher)]
 
 
 async def get_session(context: ContextDep) -> AsyncIterator[Session]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -18,8 +18,20 @@ ProgressCallback = Callable[[JsonObject], None]
 class Grader(Protocol):
     """Grades one file and returns the report as JSON data, reporting each problem as it finishes."""
 
-    def __call__(self, path: Path, *, seed: int, on_progress: ProgressCallback) -> JsonObject:
-        """Grade the file at ``path`` with ``seed``; call ``on_progress`` with each finished problem."""
+    def __call__(
+        self,
+        path: Path,
+        *,
+        seed: int,
+        on_progress: ProgressCallback,
+        only: Sequence[str] | None = None,
+        config: Path | None = None,
+    ) -> JsonObject:
+        """Grade the file at ``path`` with ``seed``; call ``on_progress`` with each finished problem.
+
+        ``only`` and ``config`` (a distributed batch's --only and --config) default to every enabled
+        problem of the bundled configuration.
+        """
         ...
 
 
@@ -37,18 +49,32 @@ class ImportedGrader:
     workers: int | None = None
     allow_weak_isolation: bool = False
 
-    def __call__(self, path: Path, *, seed: int, on_progress: ProgressCallback) -> JsonObject:
+    def __call__(
+        self,
+        path: Path,
+        *,
+        seed: int,
+        on_progress: ProgressCallback,
+        only: Sequence[str] | None = None,
+        config: Path | None = None,
+    ) -> JsonObject:
         """Grade the file at ``path``; see :class:`Grader`."""
         grade_submission = load_function(self.target)
         from grader.sandbox import IsolationPolicy  # the grader is heavy: import it only where grading runs
 
         policy = IsolationPolicy.ALLOW_FALLBACK if self.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
+        selection: dict[str, Any] = {}
+        if only is not None:
+            selection["only"] = only
+        if config is not None:  # passed only when set, so graders without the parameter still work
+            selection["config"] = config
         report = grade_submission(
             path,
             seed=seed,
             workers=self.workers,
             policy=policy,
             on_progress=lambda result: on_progress(result.model_dump(mode="json")),
+            **selection,
         )
         if report.grader_errors:
             failures = "; ".join(report.grader_errors)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from datetime import UTC, datetime
 from enum import StrEnum
 from pathlib import Path
+from urllib.parse import urlsplit
 
 from pydantic import Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
@@ -29,7 +30,40 @@ class GradebookPolicy(StrEnum):
     BEST = "best"
 
 
-class Settings(BaseSettings):
+class BrokerSettings(BaseSettings):
+    """The distributed engine's settings: all `gymgrade grade` on a cluster needs (no token, no database)."""
+
+    model_config = SettingsConfigDict(env_prefix="GYMGRADE_", extra="ignore", frozen=True)
+
+    broker_url: str | None = Field(
+        default=None,
+        description="redis://HOST:PORT/N of the Celery broker: `serve` enqueues gradings there, `worker` "
+        "runs a Celery worker, `grade` sends batches to the cluster. Unset: the embedded database queue.",
+    )
+    visibility_timeout_seconds: float = Field(
+        default=3600.0,
+        gt=0,
+        description="A task taken by a worker that vanished is delivered again after this long; must "
+        "exceed GRADING_TIMEOUT_SECONDS (the longest grading).",
+    )
+    reconcile_seconds: float = Field(
+        default=30.0,
+        gt=0,
+        description="How often the server re-enqueues queued jobs whose task is gone (broker restart or "
+        "flush) and running jobs whose worker stopped renewing its lease.",
+    )
+
+    @field_validator("broker_url")
+    @classmethod
+    def _redis_url(cls, url: str | None) -> str | None:
+        if url is None or url == "":
+            return None
+        if urlsplit(url).scheme not in ("redis", "rediss"):
+            raise ValueError("expected a Redis URL such as redis://127.0.0.1:6379/0")
+        return url
+
+
+class Settings(BrokerSettings):
     """Everything the service and its workers can be configured with (environment prefix ``GYMGRADE_``)."""
 
     model_config = SettingsConfigDict(env_prefix="GYMGRADE_", extra="ignore", frozen=True)
@@ -55,7 +89,8 @@ class Settings(BaseSettings):
     workers: int = Field(
         default=1,
         ge=0,
-        description="Gradings the server's worker pool runs at once (0: leave them to `gymgrade worker`).",
+        description="Gradings the server's worker pool runs at once (0: leave them to `gymgrade worker`); "
+        "ignored by the server when BROKER_URL is set (Celery workers grade).",
     )
     grading_workers: int | None = Field(
         default=None, gt=0, description="Processes one grading spreads its checks over (default: all cores)."
@@ -114,6 +149,12 @@ class Settings(BaseSettings):
 
     @model_validator(mode="after")
     def _refuse_unsafe_values(self) -> Settings:
+        if self.broker_url is not None and self.visibility_timeout_seconds <= self.grading_timeout_seconds:
+            raise ValueError(
+                f"GYMGRADE_VISIBILITY_TIMEOUT_SECONDS must exceed GYMGRADE_GRADING_TIMEOUT_SECONDS "
+                f"({self.grading_timeout_seconds:g}), found {self.visibility_timeout_seconds:g}: a task "
+                "would be delivered to a second worker while the first is still grading it"
+            )
         if self.development:
             return self
         if self.seed_policy is SeedPolicy.FIXED and self.seed == PRACTICE_SEED:

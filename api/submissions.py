@@ -11,6 +11,7 @@ from sqlalchemy.orm import Session, joinedload
 from api.auth import Principal
 from api.disclosure import Disclosure, problem_view, report_view, withholds_any
 from api.errors import RateLimited, SubmissionNotFound
+from api.jobs.protocol import Dispatcher
 from api.models import JobStatus, Student, Submission, utcnow
 from api.schemas import SubmissionDetail, SubmissionSummary
 from api.settings import SeedPolicy, Settings
@@ -24,15 +25,17 @@ MAX_ID = 2**31 - 1  # the largest id every database's integer column holds
 
 
 def create_submission(
-    session: Session, settings: Settings, student: Student, upload: CheckedUpload
+    session: Session, settings: Settings, student: Student, upload: CheckedUpload, dispatcher: Dispatcher
 ) -> Submission:
-    """Store an upload as a queued grading job.
+    """Store an upload as a queued grading job, then tell the workers (the row is stored first: an upload
+    accepted while the broker is down is enqueued later by the reconciler).
 
     Args:
         session: A database session (committed here).
         settings: Service settings (rate limit, seed policy).
         student: The uploading student.
         upload: The checked file.
+        dispatcher: Tells the workers about the new job.
 
     Returns:
         The stored submission, status queued.
@@ -68,6 +71,7 @@ def create_submission(
     )
     session.add(submission)
     session.commit()
+    dispatcher.submitted(submission.id)
     return submission
 
 

@@ -1,11 +1,28 @@
-"""Batch grading: many submissions over all cores, a report JSON per file and grades.csv."""
+"""Batch grading: many submissions, a report JSON per file and grades.csv, kept as each file finishes.
+
+The batch core is executor-agnostic: an executor grades files and hands over each report the moment it
+exists; the core writes it (atomically) and rewrites ``grades.csv``. Re-running a batch into the same
+output directory reuses every report that still matches its file's bytes, seed and configuration, so an
+interrupted batch resumes where it stopped. The local executor runs pytest-xdist on this machine;
+others (the distributed one in ``api``) are found through the ``gymgrade.executors`` entry points.
+"""
 
 from __future__ import annotations
 
 import csv
+import hashlib
+import io
+import os
+import tempfile
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Protocol
 
+from pydantic import ValidationError
+
+import grader
+from grader.errors import BatchInterrupted
 from grader.grading import GradingPlan, grade_files
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
@@ -15,6 +32,63 @@ CHUNK_SUBMISSIONS = 24
 takes few results with it (its unfinished problems are reported as grader errors, the batch goes on)."""
 
 GRADES_FILE = "grades.csv"
+
+ReportCallback = Callable[[Path, Report], None]
+ResultCallback = Callable[[Path, ProblemResult], None]
+
+
+class BatchExecutor(Protocol):
+    """Grades files and hands over each report as soon as that file is done (in any order)."""
+
+    def grade(
+        self,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        *,
+        seed: int,
+        on_report: ReportCallback,
+        on_result: ResultCallback | None,
+    ) -> None:
+        """Grade ``paths`` with ``seed`` under ``plan``; call ``on_report`` once per file as it finishes.
+
+        Raises:
+            KeyboardInterrupt: The batch was interrupted; reports already handed over are kept.
+        """
+        ...
+
+
+@dataclass(frozen=True)
+class LocalExecutor:
+    """Grades on this machine: chunks of files per pytest-xdist run, spread over the cores.
+
+    Attributes:
+        workers: Parallel pytest-xdist workers; the machine's cores when None.
+        policy: Isolation policy (see ``grader.grading.grade_submission``).
+    """
+
+    workers: int | None = None
+    policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL
+
+    def grade(
+        self,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        *,
+        seed: int,
+        on_report: ReportCallback,
+        on_result: ResultCallback | None,
+    ) -> None:
+        """Grade ``paths`` locally; see :class:`BatchExecutor`."""
+        for start in range(0, len(paths), CHUNK_SUBMISSIONS):
+            grade_files(
+                paths[start : start + CHUNK_SUBMISSIONS],
+                plan,
+                seed=seed,
+                workers=self.workers,
+                policy=self.policy,
+                on_result=on_result,
+                on_report=on_report,
+            )
 
 
 def collect_submissions(targets: Sequence[Path]) -> list[Path]:
@@ -52,6 +126,95 @@ def report_names(paths: Sequence[Path]) -> dict[Path, str]:
     return names
 
 
+def stale_reason(report_text: str | None, data: bytes | None, *, seed: int, plan: GradingPlan) -> str | None:
+    """Why an existing report cannot stand for a file's grade now, or None when it can be reused.
+
+    Args:
+        report_text: The report file's text (None: there is none).
+        data: The submission's bytes now (None: unreadable, so it is graded to say so).
+        seed: The grading seed of this run.
+        plan: This run's problems and configuration.
+
+    Returns:
+        A short phrase ("the file changed", "graded with seed 3", ...) or None.
+    """
+    if report_text is None:
+        return "not graded yet"
+    try:
+        report = Report.model_validate_json(report_text)
+    except ValidationError:
+        return "its report in the output directory is not a gymgrade report"
+    if data is None or report.sha256 != hashlib.sha256(data).hexdigest():
+        return "the file changed"
+    if report.seed != seed:
+        return f"graded with seed {report.seed}"
+    if not plan.config_sha256 or report.config_sha256 != plan.config_sha256:
+        return "graded with another assignment configuration"
+    if tuple(problem.id for problem in report.problems) != plan.problems:
+        return "graded for other problems"
+    if report.grader_version != grader.__version__:
+        return f"graded by gymgrade {report.grader_version}"
+    if report.grader_errors:
+        return "its last grading failed (grader error)"
+    return None
+
+
+@dataclass
+class BatchOutcome:
+    """What a batch did: every report in the order of the files, and which files it reused or graded."""
+
+    reports: list[Report]
+    reused: list[Path]
+    graded: list[Path]
+    reasons: dict[Path, str] = field(default_factory=dict)
+    """Why each graded file needed grading ("not graded yet", "the file changed", ...)."""
+
+
+class OutputDirectory:
+    """The batch's output directory: one ``<name>.json`` per file and ``grades.csv``, each written whole.
+
+    Args:
+        out_dir: The directory (created).
+        paths: Every file of the batch, in gradebook order.
+        plan: The problems graded (the gradebook's columns).
+    """
+
+    def __init__(self, out_dir: Path, paths: Sequence[Path], plan: GradingPlan) -> None:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        self.out_dir = out_dir
+        self.paths = list(paths)
+        self.plan = plan
+        self.names = report_names(paths)
+        self.reports: dict[Path, Report] = {}
+
+    def report_path(self, path: Path) -> Path:
+        """Where the report of ``path`` is kept."""
+        return self.out_dir / f"{self.names[path]}.json"
+
+    def existing_text(self, path: Path) -> str | None:
+        """The text of the report file of ``path``, None when there is none or it cannot be read."""
+        try:
+            return self.report_path(path).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            return None
+
+    def reuse(self, path: Path, report: Report) -> None:
+        """Count an earlier run's report of ``path`` as this run's (``grades.csv`` is written later)."""
+        self.reports[path] = report
+
+    def keep(self, path: Path, report: Report) -> None:
+        """Write a finished file's report and rewrite ``grades.csv`` with every file finished so far."""
+        self.reports[path] = report
+        _write_atomically(self.report_path(path), report.to_json() + "\n")
+        self.write_gradebook()
+
+    def write_gradebook(self) -> None:
+        """Rewrite ``grades.csv``: a row per finished file, in the batch's order."""
+        finished = [path for path in self.paths if path in self.reports]
+        names = [self.names[path] for path in finished]
+        write_grades(self.out_dir / GRADES_FILE, names, [self.reports[path] for path in finished], self.plan)
+
+
 def grade_many(
     paths: Sequence[Path],
     out_dir: Path,
@@ -61,60 +224,113 @@ def grade_many(
     only: Sequence[str] | None = None,
     policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL,
     config: Path | None = None,
-    on_result: Callable[[Path, ProblemResult], None] | None = None,
-) -> list[Report]:
-    """Grade many submissions; write ``<name>.json`` per submission and ``grades.csv`` to ``out_dir``.
+    on_result: ResultCallback | None = None,
+    executor: BatchExecutor | None = None,
+    on_plan: Callable[[BatchOutcome], None] | None = None,
+) -> BatchOutcome:
+    """Grade many submissions; keep ``<name>.json`` per submission and ``grades.csv`` in ``out_dir``.
 
-    Work is spread over the workers across submissions (longest checks first). A submission that cannot
-    be read, crashes or times out gets its verdicts; nothing it does stops the batch. ``grades.csv`` is
-    rewritten after every chunk, so an interrupted batch keeps what it finished.
+    Each report is written, and ``grades.csv`` rewritten, the moment its file is done, so an interrupted
+    batch keeps everything it finished. A file whose report in ``out_dir`` matches its bytes (sha256),
+    the seed, the configuration, the problems and the grader version is not graded again. A submission
+    that cannot be read, crashes or times out gets its verdicts; nothing it does stops the batch.
 
     Args:
         paths: Submission files.
         out_dir: Directory for the reports and ``grades.csv`` (created).
         seed: Grading seed.
-        workers: Parallel workers; the machine's cores when None.
+        workers: Parallel workers of the local executor; the machine's cores when None.
         only: Problem ids to grade; all enabled problems when None.
-        policy: Isolation policy (see ``grader.grading.grade_submission``).
+        policy: Isolation policy of the local executor (see ``grader.grading.grade_submission``).
         config: Assignment configuration TOML; the bundled one when None.
         on_result: Called with (file, result) as each check finishes.
+        executor: Who grades; the local executor (``workers``, ``policy``) when None.
+        on_plan: Called once before grading with the outcome so far (reused files, files to grade).
 
     Returns:
-        The reports, in the order of ``paths``.
+        Every report in the order of ``paths``, and which files were reused or graded.
+
+    Raises:
+        grader.errors.BatchInterrupted: Interrupted; the reports finished so far are in ``out_dir``.
     """
     plan = GradingPlan.load(config, only)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    names = report_names(paths)
-    reports: list[Report] = []
-    for start in range(0, len(paths), CHUNK_SUBMISSIONS):
-        chunk = paths[start : start + CHUNK_SUBMISSIONS]
-        chunk_reports = grade_files(
-            chunk, plan, seed=seed, workers=workers, policy=policy, on_result=on_result
-        )
-        for path, report in zip(chunk, chunk_reports, strict=True):
-            (out_dir / f"{names[path]}.json").write_text(report.to_json() + "\n", encoding="utf-8")
-        reports += chunk_reports
-        write_grades(out_dir / GRADES_FILE, [names[path] for path in paths[: len(reports)]], reports, plan)
-    return reports
+    output = OutputDirectory(out_dir, paths, plan)
+    outcome = BatchOutcome(reports=[], reused=[], graded=[])
+    for path in paths:
+        report_text = output.existing_text(path)
+        reason = stale_reason(report_text, _read(path), seed=seed, plan=plan)
+        if reason is None and report_text is not None:
+            output.reuse(path, Report.model_validate_json(report_text))
+            outcome.reused.append(path)
+        else:
+            outcome.graded.append(path)
+            outcome.reasons[path] = reason or "not graded yet"
+    if on_plan is not None:
+        on_plan(outcome)
+    if outcome.reused:
+        output.write_gradebook()
+    if outcome.graded:
+        try:
+            (executor or LocalExecutor(workers, policy)).grade(
+                outcome.graded, plan, seed=seed, on_report=output.keep, on_result=on_result
+            )
+        except KeyboardInterrupt as interruption:
+            raise BatchInterrupted(len(output.reports), len(paths)) from interruption
+    outcome.reports = [output.reports[path] for path in paths]
+    return outcome
+
+
+def recorded_seed(out_dir: Path) -> int | None:
+    """The grading seed of the batch whose ``grades.csv`` is in ``out_dir``, or None (no such file, no
+    seed column, or several seeds)."""
+    try:
+        with (out_dir / GRADES_FILE).open(newline="", encoding="utf-8") as stream:
+            seeds = {row.get("seed") or "" for row in csv.DictReader(stream)}
+    except (OSError, UnicodeDecodeError, csv.Error):
+        return None
+    if len(seeds) != 1:
+        return None
+    value = seeds.pop()
+    return int(value) if value.isdigit() else None
 
 
 def write_grades(path: Path, names: Sequence[str], reports: Sequence[Report], plan: GradingPlan) -> None:
-    """Write the gradebook: a row per submission (with its grading seed), a column per problem's score,
-    the total and a note."""
-    with path.open("w", newline="", encoding="utf-8") as stream:
-        writer = csv.writer(stream)
-        writer.writerow(["submission", "sha256", "seed", *plan.problems, "total", "max_score", "note"])
-        for name, report in zip(names, reports, strict=True):
-            scores = {result.id: result.score for result in report.problems}
-            note = report.submission_error or "; ".join(report.grader_errors)
-            writer.writerow(
-                [
-                    name,
-                    report.sha256,
-                    report.seed,
-                    *(f"{scores.get(problem, 0.0):g}" for problem in plan.problems),
-                    f"{report.score:g}",
-                    f"{report.max_score:g}",
-                    note,
-                ]
-            )
+    """Write the gradebook (in one rename): a row per submission (with its grading seed), a column per
+    problem's score, the total and a note."""
+    stream = io.StringIO()
+    writer = csv.writer(stream)
+    writer.writerow(["submission", "sha256", "seed", *plan.problems, "total", "max_score", "note"])
+    for name, report in zip(names, reports, strict=True):
+        scores = {result.id: result.score for result in report.problems}
+        note = report.submission_error or "; ".join(report.grader_errors)
+        writer.writerow(
+            [
+                name,
+                report.sha256,
+                report.seed,
+                *(f"{scores.get(problem, 0.0):g}" for problem in plan.problems),
+                f"{report.score:g}",
+                f"{report.max_score:g}",
+                note,
+            ]
+        )
+    _write_atomically(path, stream.getvalue())
+
+
+def _write_atomically(path: Path, text: str) -> None:
+    """Replace ``path`` with ``text`` in one rename, so an interruption never leaves half a file."""
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
+            stream.write(text)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def _read(path: Path) -> bytes | None:
+    try:
+        return path.read_bytes()
+    except OSError:
+        return None

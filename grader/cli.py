@@ -8,9 +8,9 @@ import sys
 from collections.abc import Callable, Sequence
 from importlib.metadata import entry_points
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from grader.errors import GraderError
+from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError
 from grader.problems import PROBLEM_IDS
 from grader.progress import ProgressBar, result_line
 from grader.report import ProblemResult, Report
@@ -18,7 +18,13 @@ from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import SandboxError
 from grader.seeds import PRACTICE_SEED, held_out_seed
 
+if TYPE_CHECKING:
+    from grader.batch import BatchExecutor
+
 COMMAND_GROUP = "gymgrade.commands"
+EXECUTOR_GROUP = "gymgrade.executors"
+"""Entry points ``factory(policy) -> BatchExecutor | None`` that `gymgrade grade` asks, in order, for an
+executor; one that is not configured (e.g. no GYMGRADE_BROKER_URL) returns None, and the batch is local."""
 EXIT_FULL_MARKS, EXIT_NOT_FULL, EXIT_ERROR = 0, 1, 2
 EXIT_INTERRUPTED = 130
 
@@ -228,41 +234,112 @@ def isolation_lines(isolation: dict[str, Any]) -> list[str]:
     return lines
 
 
+def choose_seed(given: int | None, out_dir: Path) -> int:
+    """The batch's grading seed, announced on stderr: ``--seed``, else the one an earlier (interrupted)
+    batch recorded in ``out_dir``, so that re-running the same command resumes it, else a fresh held-out
+    seed."""
+    from grader.batch import recorded_seed
+
+    recorded = recorded_seed(out_dir) if given is None else None
+    if given is not None:
+        seed, origin = given, "given"
+    elif recorded is not None:
+        seed, origin = recorded, f"recorded in {out_dir / 'grades.csv'}; pass --seed for another"
+    else:
+        seed, origin = held_out_seed(), "held out, drawn at random"
+    print(
+        f"Grading seed {seed} ({origin}; regrade identically with --seed {seed})", file=sys.stderr, flush=True
+    )
+    return seed
+
+
 def run_grade(args: argparse.Namespace) -> int:
-    """`gymgrade grade`: grade every file, write reports + grades.csv, show a progress bar."""
-    from grader.batch import collect_submissions, grade_many
-    from grader.grading import GradingPlan
+    """`gymgrade grade`: grade every file not yet graded in --out, keep each report as it is done."""
+    from grader.batch import BatchOutcome, collect_submissions, grade_many
 
     paths = collect_submissions(args.targets)
     if not paths:
         print("gymgrade grade: no .py files found in the given targets", file=sys.stderr)
         return EXIT_ERROR
-    problems = GradingPlan.load(args.config, args.only).problems
-    bar = ProgressBar(total=len(paths) * len(problems))
+    policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
+    executor = find_executor(policy)
+    bar = ProgressBar(total=0)
+    graded: list[Path] = []
+
+    def planned(outcome: BatchOutcome) -> None:
+        graded.extend(outcome.graded)
+        bar.total = max(len(outcome.graded) * len(problems_of(args)), 1)
+        if outcome.reused:
+            print(
+                f"Resuming in {args.out}: {len(outcome.reused)} of {len(paths)} submissions are already "
+                f"graded there (same file, seed and configuration); grading {len(outcome.graded)}.",
+                file=sys.stderr,
+            )
+        if executor is not None:
+            print(f"Grading on {executor}.", file=sys.stderr)
 
     def advance(path: Path, result: ProblemResult) -> None:
         bar.advance(f"{path.name}: {result.id} {result.status}")
 
-    policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
-    seed = held_out_seed() if args.seed is None else args.seed
-    print(f"Grading seed {seed} (regrade identically with --seed {seed})", file=sys.stderr, flush=True)
-    reports = grade_many(
-        paths,
-        args.out,
-        seed=seed,
-        workers=args.workers,
-        only=args.only,
-        policy=policy,
-        config=args.config,
-        on_result=advance,
-    )
-    errors = sum(1 for report in reports if report.grader_errors)
+    seed = choose_seed(args.seed, args.out)
+    try:
+        outcome = grade_many(
+            paths,
+            args.out,
+            seed=seed,
+            workers=args.workers,
+            only=args.only,
+            policy=policy,
+            config=args.config,
+            on_result=advance,
+            executor=executor,
+            on_plan=planned,
+        )
+    except BatchInterrupted as interruption:
+        print(
+            f"\ngymgrade grade: interrupted. {interruption.finished} of {interruption.total} submissions are "
+            f"graded in {args.out} (their reports and grades.csv are kept). Run the same command again "
+            f"(same --out, --seed, --only and --config) to grade the other "
+            f"{interruption.total - interruption.finished}; the finished ones are skipped.",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
+    errors = sum(1 for report in outcome.reports if report.grader_errors)
     print(
-        f"Graded {len(reports)} submissions into {args.out} (grades.csv) with seed {seed}"
-        + (f"; {errors} with grader errors" if errors else ""),
+        f"Graded {len(outcome.graded)} submissions"
+        + (f" (reused {len(outcome.reused)} earlier reports)" if outcome.reused else "")
+        + f" into {args.out} (grades.csv) with seed {seed}"
+        + (f"; {errors} with grader errors (run again to retry them)" if errors else ""),
         file=sys.stderr,
     )
     return EXIT_ERROR if errors else 0
+
+
+def problems_of(args: argparse.Namespace) -> tuple[str, ...]:
+    """The problems a `gymgrade grade` run covers."""
+    from grader.grading import GradingPlan
+
+    return GradingPlan.load(args.config, args.only).problems
+
+
+def find_executor(policy: IsolationPolicy) -> BatchExecutor | None:
+    """The first configured executor of the ``gymgrade.executors`` entry points, or None (local).
+
+    Raises:
+        grader.errors.GraderError: An executor is configured but cannot be used (its message says why).
+    """
+    for entry_point in entry_points(group=EXECUTOR_GROUP):
+        try:
+            factory = entry_point.load()
+        except Exception as error:
+            raise ExecutorUnavailable(
+                f"the batch executor {entry_point.name!r} could not be loaded ({type(error).__name__}: "
+                f"{error}); reinstall the package providing it (pip install -e '.[distributed]')"
+            ) from error
+        executor: BatchExecutor | None = factory(policy)
+        if executor is not None:
+            return executor
+    return None
 
 
 if __name__ == "__main__":

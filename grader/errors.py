@@ -11,3 +11,21 @@ class ConfigError(GraderError, ValueError):
 
 class PlanError(GraderError, ValueError):
     """Raised when a check is asked to plan calls with a configuration of another problem."""
+
+
+class ExecutorUnavailable(GraderError):
+    """Raised when a configured batch executor (e.g. the distributed one) cannot be reached or used."""
+
+
+class BatchInterrupted(KeyboardInterrupt):
+    """Raised when a batch is interrupted (Ctrl-C, SIGTERM); says how much of it is kept in its directory.
+
+    Args:
+        finished: Files whose report is in the output directory (reused or graded by this run).
+        total: Files in the batch.
+    """
+
+    def __init__(self, finished: int, total: int) -> None:
+        super().__init__(f"{finished} of {total} submissions graded")
+        self.finished = finished
+        self.total = total

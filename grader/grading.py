@@ -40,6 +40,9 @@ class GradingPlan:
     points: dict[ProblemId, float]
     titles: dict[ProblemId, str]
     config: Path | None
+    config_sha256: str = ""
+    """SHA-256 of the effective assignment configuration (its validated JSON form); "" for a plan made by
+    hand. A report records it, so a resumed batch knows which configuration graded a file."""
     visibility: dict[ProblemId, Visibility] = field(default_factory=dict)
 
     @classmethod
@@ -66,6 +69,7 @@ class GradingPlan:
             points={problem: assignment.problem(problem).points for problem in problems},
             titles={problem: assignment.problem(problem).title for problem in problems},
             config=config,
+            config_sha256=hashlib.sha256(assignment.model_dump_json().encode()).hexdigest(),
             visibility={problem: assignment.problem(problem).visibility for problem in problems},
         )
 
@@ -122,6 +126,7 @@ def grade_files(
     workers: int | None,
     policy: IsolationPolicy,
     on_result: Callable[[Path, ProblemResult], None] | None = None,
+    on_report: Callable[[Path, Report], None] | None = None,
 ) -> list[Report]:
     """Grade several files in one pytest-xdist run (work spread over all workers), a report per file.
 
@@ -132,33 +137,49 @@ def grade_files(
         workers: Parallel workers; the machine's cores when None.
         policy: Isolation policy (see ``grade_submission``).
         on_result: Called with (file, result) as each check finishes.
+        on_report: Called with (file, report) as soon as the file's last check finishes (at once for a
+            file rejected without running), so a batch can keep each report the moment it exists.
 
     Returns:
         One report per path, in the order given.
     """
     started = time.perf_counter()
     contents = {path: _read(path) for path in paths}
-    rejected: dict[Path, Report] = {}
+    reports: dict[Path, Report] = {}
     for path, data in contents.items():
         verdict = _file_verdict(path, data)
         if verdict is not None:
-            rejected[path] = _rejected_report(path, data or b"", plan, seed, verdict)
-            _announce(on_result, path, rejected[path].problems)
-    runnable = [path for path in paths if path not in rejected]
+            reports[path] = _rejected_report(path, data or b"", plan, seed, verdict)
+            _announce(on_result, path, reports[path].problems)
+            if on_report is not None:
+                on_report(path, reports[path])
+    runnable = [path for path in paths if path not in reports]
     worker_count = min(workers or default_workers(), max(len(runnable) * len(plan.problems), 1))
     runs: dict[str, list[ProblemRun]] = {}
+
+    def finish(path: Path, runs_of_path: Sequence[ProblemRun]) -> Report:
+        elapsed = time.perf_counter() - started
+        report = build_report(path, contents[path] or b"", seed, runs_of_path, plan, elapsed, worker_count)
+        reports[path] = report
+        if on_report is not None:
+            on_report(path, report)
+        return report
+
+    def collect(path: Path, runs_of_path: Sequence[ProblemRun]) -> None:
+        if len(runs_of_path) == len(plan.problems) and path not in reports:
+            finish(path, runs_of_path)
+
     if runnable and plan.problems:
         runs = run_acceptance(
-            runnable, plan, seed=seed, workers=worker_count, policy=policy, on_result=on_result
+            runnable,
+            plan,
+            seed=seed,
+            workers=worker_count,
+            policy=policy,
+            on_result=on_result,
+            on_runs=collect,
         )
-    elapsed = time.perf_counter() - started
-    return [
-        rejected.get(path)
-        or build_report(
-            path, contents[path] or b"", seed, runs.get(str(path), []), plan, elapsed, worker_count
-        )
-        for path in paths
-    ]
+    return [reports.get(path) or finish(path, runs.get(str(path), [])) for path in paths]
 
 
 def build_report(
@@ -190,6 +211,7 @@ def build_report(
         submission=path.name,
         sha256=hashlib.sha256(data).hexdigest(),
         seed=seed,
+        config_sha256=plan.config_sha256,
         gymnasium_version=version("gymnasium"),
         grader_version=grader.__version__,
         isolation=isolation,
@@ -242,6 +264,7 @@ def _rejected_report(path: Path, data: bytes, plan: GradingPlan, seed: int, verd
         submission=path.name,
         sha256=hashlib.sha256(data).hexdigest(),
         seed=seed,
+        config_sha256=plan.config_sha256,
         gymnasium_version=version("gymnasium"),
         grader_version=grader.__version__,
         score=0.0,
@@ -280,10 +303,12 @@ def run_acceptance(
     workers: int,
     policy: IsolationPolicy,
     on_result: Callable[[Path, ProblemResult], None] | None,
+    on_runs: Callable[[Path, Sequence[ProblemRun]], None] | None = None,
 ) -> dict[str, list[ProblemRun]]:
     """Run the acceptance tests of valid files in one pytest run; the runs per file path, as given.
 
     Problems the run ended without a result for (pytest or a worker died) get an internal-error run.
+    ``on_runs`` is called with a file and all its runs so far each time one of them arrives.
 
     Raises:
         grader.sandbox.errors.IsolationUnavailable: ``REQUIRE_FULL`` and this machine cannot isolate.
@@ -310,13 +335,13 @@ def run_acceptance(
             )
             try:
                 complete = _follow(
-                    process, follower, resolved, runs, on_result, len(paths) * len(plan.problems)
+                    process, follower, resolved, runs, on_result, on_runs, len(paths) * len(plan.problems)
                 )
             finally:
                 _stop(process)
         if not complete and process.returncode not in (0, 1):
             log_text = log_file.read_text(errors="replace")
-            _fill_missing(runs, paths, plan, seed, log_text, process.returncode, on_result)
+            _fill_missing(runs, paths, plan, seed, log_text, process.returncode, on_result, on_runs)
     return runs
 
 
@@ -326,6 +351,7 @@ def _follow(
     resolved: dict[str, Path],
     runs: dict[str, list[ProblemRun]],
     on_result: Callable[[Path, ProblemResult], None] | None,
+    on_runs: Callable[[Path, Sequence[ProblemRun]], None] | None,
     expected: int,
 ) -> bool:
     """Hand every result over as soon as the controller writes it, until the run ends.
@@ -344,6 +370,8 @@ def _follow(
                 raise IsolationUnavailable(run.internal_error.removeprefix(_ISOLATION_ERROR))
             if on_result is not None:
                 on_result(path, run.result)
+            if on_runs is not None:
+                on_runs(path, runs[str(path)])
         if received >= expected or finished:
             return received >= expected
         time.sleep(_POLL_SECONDS)
@@ -398,6 +426,7 @@ def _fill_missing(
     log_text: str,
     returncode: int,
     on_result: Callable[[Path, ProblemResult], None] | None,
+    on_runs: Callable[[Path, Sequence[ProblemRun]], None] | None,
 ) -> None:
     tail = " | ".join(line for line in log_text.strip().splitlines()[-5:] if line.strip())
     detail = f"the grading run stopped (pytest exit code {returncode}): {tail}"
@@ -409,6 +438,8 @@ def _fill_missing(
                 runs[str(path)].append(run)
                 if on_result is not None:
                     on_result(path, run.result)
+                if on_runs is not None:
+                    on_runs(path, runs[str(path)])
 
 
 def acceptance_environment() -> dict[str, str]:

@@ -147,6 +147,9 @@ class Report(BaseModel):
     submission: str = Field(description="The submission's file name (never a path).")
     sha256: str = Field(description="SHA-256 of the submission's bytes.")
     seed: int = Field(description="The grading seed; the same bytes and seed give the same verdicts.")
+    config_sha256: str = Field(
+        default="", description="SHA-256 of the assignment configuration that graded the file (its JSON)."
+    )
     gymnasium_version: str = Field(description="Gymnasium version the episodes were replayed with.")
     grader_version: str = Field(description="gymgrade version.")
     isolation: dict[str, JsonValue] = Field(

@@ -10,6 +10,7 @@ DEBIAN_PACKAGES=(
   libseccomp2
   chromium          # the web page's browser test (Playwright drives Debian's Chromium)
   postgresql        # the service's PostgreSQL storage test
+  redis-server      # the Celery broker of the distributed workers (tests start their own)
 )
 
 if command -v apt-get >/dev/null 2>&1; then
@@ -27,4 +28,4 @@ else
   echo "setup: no apt-get here; install bubblewrap and libseccomp yourself for full sandbox isolation" >&2
 fi
 
-python3 -m pip install --quiet --disable-pip-version-check -e ".[dev,postgres]"
+python3 -m pip install --quiet --disable-pip-version-check -e ".[dev,postgres,distributed]"

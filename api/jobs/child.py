@@ -69,6 +69,8 @@ def main() -> int:
             Path(request["path"]),
             seed=int(request["seed"]),
             on_progress=lambda problem: _send(channel, {"kind": "progress", "problem": problem}),
+            only=request.get("only"),
+            config=Path(request["config"]) if request.get("config") else None,
         )
     except ServiceError as error:
         _send(channel, {"kind": "error", "message": str(error)})

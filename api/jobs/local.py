@@ -30,26 +30,24 @@ class DatabaseQueue:
         self._lease = timedelta(seconds=lease_seconds)
         self._max_attempts = max_attempts
 
-    def claim(self, worker_id: str) -> ClaimedJob | None:
-        """Take the oldest claimable job; see :meth:`JobQueue.claim`."""
+    def claim(self, worker_id: str, submission_id: int | None = None) -> ClaimedJob | None:
+        """Take the oldest claimable job, or job ``submission_id``; see :meth:`JobQueue.claim`."""
         with self._sessions() as session:
             for _ in range(_CLAIM_TRIES):
                 now = utcnow()
-                candidate = session.execute(
-                    select(Submission.id, Submission.attempts)
-                    .where(_claimable(now))
-                    .order_by(Submission.id)
-                    .limit(1)
-                ).first()
+                query = select(Submission.id, Submission.attempts).where(_claimable(now))
+                if submission_id is not None:
+                    query = query.where(Submission.id == submission_id)
+                candidate = session.execute(query.order_by(Submission.id).limit(1)).first()
                 if candidate is None:
                     return None
-                submission_id, attempts = candidate
+                candidate_id, attempts = candidate
                 if attempts >= self._max_attempts:
-                    self._give_up(session, submission_id, attempts, now)
+                    self._give_up(session, candidate_id, attempts, now)
                     continue
                 claimed = session.execute(
                     update(Submission)
-                    .where(Submission.id == submission_id, Submission.attempts == attempts, _claimable(now))
+                    .where(Submission.id == candidate_id, Submission.attempts == attempts, _claimable(now))
                     .values(
                         status=JobStatus.RUNNING.value,
                         lease_owner=worker_id,
@@ -61,9 +59,17 @@ class DatabaseQueue:
                 )
                 session.commit()
                 if claimed.rowcount == 1:  # type: ignore[attr-defined]
-                    row = session.get_one(Submission, submission_id)
-                    return ClaimedJob(submission_id, row.filename, row.content, row.seed, attempts + 1)
+                    row = session.get_one(Submission, candidate_id)
+                    return ClaimedJob(candidate_id, row.filename, row.content, row.seed, attempts + 1)
         return None
+
+    def state(self, submission_id: int) -> tuple[JobStatus, int] | None:
+        """The job's status and attempts so far, None when there is no such row."""
+        with self._sessions() as session:
+            row = session.execute(
+                select(Submission.status, Submission.attempts).where(Submission.id == submission_id)
+            ).first()
+        return (JobStatus(row.status), row.attempts) if row is not None else None
 
     def renew(self, submission_id: int, worker_id: str) -> bool:
         """Extend the lease; see :meth:`JobQueue.renew`."""
@@ -165,3 +171,13 @@ def _claimable(now: datetime) -> ColumnElement[bool]:
 
 def _finished() -> dict[str, Any]:
     return {"finished_at": utcnow(), "lease_owner": None, "lease_expires_at": None}
+
+
+class PollingDispatcher:
+    """The embedded queue's :class:`~api.jobs.protocol.Dispatcher`: its workers poll the rows themselves."""
+
+    def submitted(self, submission_id: int) -> None:
+        """Nothing to do: a polling worker finds the queued row."""
+
+    def close(self) -> None:
+        """Nothing to release."""

@@ -15,6 +15,10 @@ class ClaimedJob:
     content: bytes
     seed: int
     attempt: int
+    only: tuple[str, ...] | None = None
+    """Problems to grade (a batch's --only); all enabled ones when None."""
+    config_toml: str | None = None
+    """The assignment configuration's TOML text (a batch's --config); the bundled one when None."""
 
 
 class JobQueue(Protocol):
@@ -24,8 +28,12 @@ class JobQueue(Protocol):
     worker no longer holds the job's lease, so a worker presumed dead can never overwrite a newer result.
     """
 
-    def claim(self, worker_id: str) -> ClaimedJob | None:
-        """Take the oldest queued job, or a running one whose lease expired; None when there is none."""
+    def claim(self, worker_id: str, submission_id: int | None = None) -> ClaimedJob | None:
+        """Take the oldest queued job, or a running one whose lease expired; None when there is none.
+
+        With ``submission_id`` (a Celery task names its row), take that job only if it is claimable: a
+        job that is done, failed, or held under a live lease is not taken again.
+        """
         ...
 
     def renew(self, submission_id: int, worker_id: str) -> bool:
@@ -50,4 +58,16 @@ class JobQueue(Protocol):
 
     def release(self, submission_id: int, worker_id: str) -> bool:
         """Put the job back in the queue without counting the attempt (the worker is shutting down)."""
+        ...
+
+
+class Dispatcher(Protocol):
+    """Tells the workers that a queued job exists (the embedded queue's workers poll, so it does nothing)."""
+
+    def submitted(self, submission_id: int) -> None:
+        """Make sure a worker will pick up the queued submission ``submission_id`` (never raises)."""
+        ...
+
+    def close(self) -> None:
+        """Release connections and stop background work."""
         ...

@@ -55,6 +55,10 @@ def run_job(
     submission = workdir / "submission" / grading_file_name(job.filename)
     submission.parent.mkdir()
     submission.write_bytes(job.content)
+    config = None
+    if job.config_toml is not None:
+        config = workdir / "assignment.toml"
+        config.write_text(job.config_toml, encoding="utf-8")
     stderr_path = workdir / "grader-stderr.log"
     with stderr_path.open("wb") as stderr:
         child = subprocess.Popen(
@@ -68,7 +72,7 @@ def run_job(
             encoding="utf-8",
         )
     try:
-        _send_request(child, submission, job, settings)
+        _send_request(child, submission, config, job, settings)
         _follow(child, job, jobs, worker_id, settings, stop, stderr_path)
     finally:
         _kill_group(child)
@@ -76,12 +80,14 @@ def run_job(
 
 
 def _send_request(
-    child: subprocess.Popen[str], submission: Path, job: ClaimedJob, settings: Settings
+    child: subprocess.Popen[str], submission: Path, config: Path | None, job: ClaimedJob, settings: Settings
 ) -> None:
     request = {
         "grader": settings.grader,
         "path": str(submission),
         "seed": job.seed,
+        "only": list(job.only) if job.only is not None else None,
+        "config": str(config) if config is not None else None,
         "workers": settings.grading_workers,
         "allow_weak_isolation": settings.allow_weak_isolation,
         "nice": settings.nice,

@@ -6,7 +6,7 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, File, Query, Request, Response, UploadFile
 
-from api.deps import CallerDep, DisclosureDep, SessionDep, SettingsDep, StudentDep
+from api.deps import CallerDep, DisclosureDep, DispatcherDep, SessionDep, SettingsDep, StudentDep
 from api.errors import (
     InvalidRequest,
     InvalidUpload,
@@ -73,13 +73,14 @@ def post_submission(
     response: Response,
     session: SessionDep,
     settings: SettingsDep,
+    dispatcher: DispatcherDep,
     student: StudentDep,
     file: Annotated[UploadFile, File()],
 ) -> SubmissionAccepted:
     """Upload a file for grading; poll GET /submissions/{id} for the result."""
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
-    submission = create_submission(session, settings, student, upload)
+    submission = create_submission(session, settings, student, upload, dispatcher)
     response.headers["Location"] = request.app.url_path_for("get_one_submission", submission_id=submission.id)
     return SubmissionAccepted(id=submission.id)
 

@@ -9,7 +9,7 @@ from fastapi.responses import RedirectResponse, Response
 from sqlalchemy.orm import Session
 
 from api.auth import Principal, authenticate
-from api.deps import SESSION_COOKIE, PageCallerDep, SessionDep, SettingsDep
+from api.deps import SESSION_COOKIE, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
 from api.disclosure import disclosure_for
 from api.errors import NotAuthenticated
 from api.gradebook import gradebook_csv
@@ -77,14 +77,17 @@ def sign_out() -> Response:
 
 @router.post("/ui/submissions")
 def upload(
-    session: SessionDep, settings: SettingsDep, caller: PageCallerDep, file: Annotated[UploadFile, File()]
+    session: SessionDep,
+    settings: SettingsDep,
+    dispatcher: DispatcherDep,
+    caller: PageCallerDep,
+    file: Annotated[UploadFile, File()],
 ) -> Response:
     """Upload from the form, then show the submission's page."""
     student = _signed_in(caller).require_student()
     content = file.file.read(settings.max_upload_bytes + 1)
-    submission = create_submission(
-        session, settings, student, check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
-    )
+    upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
+    submission = create_submission(session, settings, student, upload, dispatcher)
     return RedirectResponse(f"/ui/submissions/{submission.id}", status_code=303)
 
 

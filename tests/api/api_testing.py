@@ -1,4 +1,4 @@
-"""Shared helpers of the service's tests: the instructor token, students, ports, a PostgreSQL cluster."""
+"""Shared helpers of the service's tests: the instructor token, students, ports, PostgreSQL and Redis."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import shutil
 import socket
 import subprocess
 import tempfile
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -95,3 +96,55 @@ def postgres_bin_dir() -> Path | None:
         return Path(initdb).resolve().parent
     candidates = sorted(Path("/usr/lib/postgresql").glob("*/bin/initdb"))
     return candidates[-1].parent if candidates else None
+
+
+class RedisServer:
+    """A throw-away redis-server (no persistence: a restart loses every key) on a loopback port."""
+
+    def __init__(self, executable: Path) -> None:
+        self.executable = executable
+        self.directory = Path(tempfile.mkdtemp(prefix="gymgrade-redis-"))
+        self.port = free_port()
+        self.process: subprocess.Popen[bytes] | None = None
+        self._databases = 0
+
+    def start(self) -> None:
+        """Start the server and wait until it answers PING (at most 20 s)."""
+        command = [str(self.executable), "--port", str(self.port), "--bind", "127.0.0.1"]
+        command += ["--dir", str(self.directory), "--save", "", "--appendonly", "no", "--databases", "64"]
+        with (self.directory / "redis.log").open("ab") as log:
+            self.process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT)
+        deadline = time.monotonic() + 20
+        while not self.answers():
+            if self.process.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError(
+                    f"redis-server did not start: {(self.directory / 'redis.log').read_text()}"
+                )
+            time.sleep(0.05)
+
+    def answers(self) -> bool:
+        """True when the server accepts a connection and answers PING."""
+        try:
+            with socket.create_connection(("127.0.0.1", self.port), timeout=1) as connection:
+                connection.sendall(b"PING\r\n")
+                return connection.recv(16).startswith(b"+PONG")
+        except OSError:
+            return False
+
+    def stop(self) -> None:
+        """Stop the server (its keys are gone: nothing is persisted)."""
+        if self.process is not None and self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+
+    def close(self) -> None:
+        """Stop the server and delete its directory."""
+        self.stop()
+        shutil.rmtree(self.directory, ignore_errors=True)
+
+    def new_url(self) -> str:
+        """The URL of a database index no earlier caller got."""
+        self._databases += 1
+        if self._databases >= 64:
+            raise RuntimeError("more than 63 Redis databases asked for in one run")
+        return f"redis://127.0.0.1:{self.port}/{self._databases}"

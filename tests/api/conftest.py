@@ -15,6 +15,7 @@ from api_testing import (
     INSTRUCTOR_TOKEN,
     TESTS_DIR,
     PostgresServer,
+    RedisServer,
     SettingsFactory,
     postgres_bin_dir,
 )
@@ -87,3 +88,21 @@ def postgres_server() -> Iterator[PostgresServer]:
         pytest.skip(f"could not start a PostgreSQL cluster: {error}")
     yield server
     server.stop()
+
+
+@pytest.fixture(scope="session")
+def redis_server() -> Iterator[RedisServer]:
+    """A redis-server for the whole run (Debian's redis-server package); its tests skip without it."""
+    executable = shutil.which("redis-server")
+    if executable is None:
+        pytest.skip(
+            "redis-server is not installed (apt-get install -y redis-server); Celery tests are skipped"
+        )
+    server = RedisServer(Path(executable))
+    try:
+        server.start()
+    except (RuntimeError, OSError) as error:
+        server.close()
+        pytest.skip(f"could not start redis-server: {error}")
+    yield server
+    server.close()

@@ -21,6 +21,8 @@ from typing import Any
 
 from pydantic import JsonValue
 
+import grader
+from grader.grading import GradingPlan
 from grader.report import ProblemResult, Report
 
 PROBLEMS = (
@@ -49,11 +51,17 @@ def grade_submission(
     only: Sequence[str] | None = None,
     policy: Any = None,
     on_progress: Callable[[ProblemResult], None] | None = None,
+    config: Path | None = None,
 ) -> Report:
-    """Grade ``path`` the fake way (see the module docstring)."""
+    """Grade ``path`` the fake way (see the module docstring); ``only`` picks among its problems.
+
+    Reports carry the real configuration digest of ``config``, so a resumed batch can reuse them.
+    """
     data = path.read_bytes()
     source = data.decode("utf-8")
     sha256 = hashlib.sha256(data).hexdigest()
+    chosen = [(problem_id, title) for problem_id, title in PROBLEMS if only is None or problem_id in only]
+    config_sha256 = GradingPlan.load(config, only).config_sha256 if only is not None else ""
     if _directive(source, "crash") is not None:
         os._exit(3)
     if _directive(source, "fail") is not None:
@@ -61,19 +69,27 @@ def grade_submission(
     try:
         compile(source, path.name, "exec")
     except SyntaxError as error:
+        message = f"{path.name} is not valid Python: line {error.lineno}: {error.msg}"
         return Report(
             submission=path.name,
             sha256=sha256,
             seed=seed,
+            config_sha256=config_sha256,
             gymnasium_version="fake",
-            grader_version="fake",
+            grader_version=grader.__version__,
             score=0.0,
-            max_score=POINTS * len(PROBLEMS),
-            submission_error=f"{path.name} is not valid Python: line {error.lineno}: {error.msg}",
+            max_score=POINTS * len(chosen),
+            submission_error=message,
+            problems=[
+                ProblemResult(
+                    id=problem_id, title=title, status="error", score=0.0, max_score=POINTS, feedback=message
+                )
+                for problem_id, title in chosen
+            ],
         )
     delay = float(_directive(source, "sleep") or 0.0)
     problems = []
-    for problem_id, title in PROBLEMS:
+    for problem_id, title in chosen:
         time.sleep(delay)
         defined = re.search(rf"^def {problem_id}\(", source, flags=re.MULTILINE) is not None
         result = ProblemResult(
@@ -98,8 +114,9 @@ def grade_submission(
         submission=path.name,
         sha256=sha256,
         seed=seed,
+        config_sha256=config_sha256,
         gymnasium_version="fake",
-        grader_version="fake",
+        grader_version=grader.__version__,
         score=sum(p.score for p in problems),
         max_score=POINTS * len(problems),
         problems=problems,

@@ -162,3 +162,18 @@ def test_release_requeues_without_spending_an_attempt(sessions: sessionmaker[Ses
     assert queue.release(submission_id, "w")
     job = queue.claim("w2")
     assert job is not None and job.attempt == 1
+
+
+@BOTH_DATABASES
+def test_a_task_claims_only_the_row_it_names_and_only_while_claimable(
+    sessions: sessionmaker[Session],
+) -> None:
+    first, second = _submit(sessions, 2)
+    queue = _queue(sessions, lease_seconds=0.2)
+    job = queue.claim("w1", second)
+    assert job is not None and job.submission_id == second, "the named row, not the oldest"
+    assert queue.claim("w2", second) is None, "a duplicated task leaves a row under a live lease alone"
+    assert queue.complete(second, "w1", {"score": 1.0, "max_score": 1.0, "problems": []})
+    assert queue.claim("w3", second) is None, "a finished row is never graded again"
+    assert queue.state(second) == (JobStatus.DONE, 1)
+    assert queue.state(first) == (JobStatus.QUEUED, 0)

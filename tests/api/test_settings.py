@@ -137,3 +137,35 @@ def test_a_due_date_that_is_not_a_date_is_refused(monkeypatch: pytest.MonkeyPatc
     monkeypatch.setenv("GYMGRADE_DUE_DATE", "next friday")
     with pytest.raises(ValidationError, match="due_date"):
         Settings()
+
+
+@pytest.mark.parametrize(
+    ("environment", "message"),
+    [
+        (
+            {"GYMGRADE_BROKER_URL": "amqp://127.0.0.1:5672//"},
+            "expected a Redis URL such as redis://127.0.0.1:6379/0",
+        ),
+        (
+            {"GYMGRADE_BROKER_URL": "redis://127.0.0.1:6379/0", "GYMGRADE_VISIBILITY_TIMEOUT_SECONDS": "600"},
+            "GYMGRADE_VISIBILITY_TIMEOUT_SECONDS must exceed GYMGRADE_GRADING_TIMEOUT_SECONDS (1800), "
+            "found 600",
+        ),
+    ],
+    ids=["not-redis", "visibility-shorter-than-a-grading"],
+)
+def test_unsafe_broker_settings_are_refused(
+    monkeypatch: pytest.MonkeyPatch, environment: dict[str, str], message: str
+) -> None:
+    monkeypatch.setenv("GYMGRADE_DEVELOPMENT", "1")
+    for name, value in environment.items():
+        monkeypatch.setenv(name, value)
+    with pytest.raises(ValidationError) as raised:
+        Settings()
+    assert message in str(raised.value)
+
+
+def test_without_a_broker_url_nothing_distributed_is_configured(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GYMGRADE_DEVELOPMENT", "1")
+    monkeypatch.setenv("GYMGRADE_BROKER_URL", "")
+    assert Settings().broker_url is None

@@ -1,13 +1,19 @@
-"""Tests of grader/batch.py that need no grading run: finding files, naming reports, grades.csv."""
+"""Tests of grader/batch.py that need no grading run: files, report names, grades.csv, resuming."""
 
 from __future__ import annotations
 
 import csv
+import hashlib
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
+from grading_support import write_config
 
-from grader.batch import collect_submissions, report_names, write_grades
+import grader
+from grader.batch import GRADES_FILE, collect_submissions, grade_many, report_names, write_grades
+from grader.errors import BatchInterrupted
 from grader.grading import GradingPlan
 from grader.report import ProblemResult, Report
 
@@ -75,3 +81,146 @@ def test_grades_csv_has_a_row_per_submission_and_a_column_per_problem(tmp_path: 
         ["alice", "0" * 64, "0", "1", "0", "1", "2", ""],
         ["bob", "0" * 64, "0", "0", "0", "0", "2", "bob.py is empty"],
     ]
+
+
+# Resumable batches: a fake executor grades instantly and records what it was asked to grade.
+
+ONLY = ("cartpole", "car")
+
+
+@dataclass
+class FakeExecutor:
+    """Grades each file into a report of its bytes; can be told to stop (as Ctrl-C would) after N files."""
+
+    interrupt_after: int | None = None
+    asked: list[list[str]] = field(default_factory=list)
+
+    def grade(
+        self,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        *,
+        seed: int,
+        on_report: Callable[[Path, Report], None],
+        on_result: Callable[[Path, ProblemResult], None] | None,
+    ) -> None:
+        self.asked.append([path.name for path in paths])
+        for done, path in enumerate(paths):
+            if self.interrupt_after is not None and done >= self.interrupt_after:
+                raise KeyboardInterrupt
+            on_report(path, graded_report(path, plan, seed))
+
+
+def graded_report(path: Path, plan: GradingPlan, seed: int) -> Report:
+    data = path.read_bytes()
+    report = _report(path.name, {problem: float(len(data) % 2) for problem in plan.problems})
+    return report.model_copy(
+        update={
+            "sha256": hashlib.sha256(data).hexdigest(),
+            "seed": seed,
+            "config_sha256": plan.config_sha256,
+            "grader_version": grader.__version__,
+        }
+    )
+
+
+@pytest.fixture
+def inputs(tmp_path: Path) -> list[Path]:
+    folder = tmp_path / "inputs"
+    folder.mkdir()
+    for name, text in [("alice.py", "a = 1\n"), ("bob.py", "b = 22\n"), ("carol.py", "c = 333\n")]:
+        (folder / name).write_text(text)
+    return collect_submissions([folder])
+
+
+def _rows(out: Path) -> list[str]:
+    return [row["submission"] for row in csv.DictReader((out / GRADES_FILE).open())]
+
+
+def test_a_second_run_reuses_every_matching_report(tmp_path: Path, inputs: list[Path]) -> None:
+    executor = FakeExecutor()
+    first = grade_many(inputs, tmp_path / "out", seed=4, only=ONLY, executor=executor)
+    second = grade_many(inputs, tmp_path / "out", seed=4, only=ONLY, executor=executor)
+    assert executor.asked == [["alice.py", "bob.py", "carol.py"]], "the second run graded nothing"
+    assert (first.graded, second.reused, second.graded) == (inputs, inputs, [])
+    assert second.reports == first.reports
+    assert _rows(tmp_path / "out") == ["alice", "bob", "carol"]
+
+
+@pytest.mark.parametrize(
+    ("damage", "reason"),
+    [
+        (
+            lambda out, files: (out / "bob.json").write_text('{"format": 1, "submis'),
+            "is not a gymgrade report",
+        ),
+        (lambda out, files: (out / "bob.json").write_text('{"grades": [1, 2]}'), "is not a gymgrade report"),
+        (lambda out, files: (out / "bob.json").unlink(), "not graded yet"),
+        (lambda out, files: files[1].write_text("b = 23\n"), "the file changed"),
+        (
+            lambda out, files: (out / "bob.json").write_text((out / "alice.json").read_text()),
+            "the file changed",
+        ),
+    ],
+    ids=["truncated-report", "foreign-json", "deleted-report", "changed-file", "another-files-report"],
+)
+def test_only_files_whose_report_no_longer_matches_are_graded_again(
+    tmp_path: Path, inputs: list[Path], damage: Callable[[Path, list[Path]], object], reason: str
+) -> None:
+    out = tmp_path / "out"
+    grade_many(inputs, out, seed=4, only=ONLY, executor=FakeExecutor())
+    damage(out, inputs)
+    executor = FakeExecutor()
+    outcome = grade_many(inputs, out, seed=4, only=ONLY, executor=executor)
+    assert executor.asked == [["bob.py"]]
+    assert reason in outcome.reasons[inputs[1]]
+    assert Report.model_validate_json((out / "bob.json").read_text()) == outcome.reports[1]
+    assert _rows(out) == ["alice", "bob", "carol"]
+
+
+@pytest.mark.parametrize(
+    ("change", "reason"),
+    [
+        ({"seed": 5}, "graded with seed 4"),
+        ({"only": ("car",)}, "graded for other problems"),
+        ({"config": "points"}, "graded with another assignment configuration"),
+    ],
+    ids=["seed", "problems", "config"],
+)
+def test_a_changed_seed_selection_or_configuration_grades_everything_again(
+    tmp_path: Path, inputs: list[Path], change: dict[str, object], reason: str
+) -> None:
+    out = tmp_path / "out"
+    grade_many(inputs, out, seed=4, only=ONLY, executor=FakeExecutor())
+    options: dict[str, object] = {"seed": 4, "only": ONLY, **change}
+    if change.get("config") == "points":
+        options["config"] = write_config(tmp_path / "assignment.toml", {"car": {"points": 2.0}})
+    executor = FakeExecutor()
+    outcome = grade_many(inputs, out, executor=executor, **options)  # type: ignore[arg-type]
+    assert executor.asked == [["alice.py", "bob.py", "carol.py"]]
+    assert {outcome.reasons[path] for path in inputs} == {reason}
+
+
+def test_an_interrupted_batch_keeps_what_it_finished_and_resumes(tmp_path: Path, inputs: list[Path]) -> None:
+    out = tmp_path / "out"
+    with pytest.raises(BatchInterrupted) as interrupted:
+        grade_many(inputs, out, seed=4, only=ONLY, executor=FakeExecutor(interrupt_after=1))
+    assert (interrupted.value.finished, interrupted.value.total) == (1, 3)
+    assert sorted(path.name for path in out.iterdir()) == ["alice.json", GRADES_FILE]
+    assert _rows(out) == ["alice"]
+    executor = FakeExecutor()
+    outcome = grade_many(inputs, out, seed=4, only=ONLY, executor=executor)
+    assert executor.asked == [["bob.py", "carol.py"]]
+    assert outcome.reused == inputs[:1]
+    assert _rows(out) == ["alice", "bob", "carol"]
+
+
+def test_a_report_listing_grader_errors_is_graded_again(tmp_path: Path, inputs: list[Path]) -> None:
+    out = tmp_path / "out"
+    grade_many(inputs, out, seed=4, only=ONLY, executor=FakeExecutor())
+    broken = Report.model_validate_json((out / "carol.json").read_text())
+    (out / "carol.json").write_text(broken.model_copy(update={"grader_errors": ["car: died"]}).to_json())
+    executor = FakeExecutor()
+    outcome = grade_many(inputs, out, seed=4, only=ONLY, executor=executor)
+    assert executor.asked == [["carol.py"]]
+    assert outcome.reasons[inputs[2]] == "its last grading failed (grader error)"

@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import csv
 import re
+import signal
+import subprocess
+import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -149,7 +153,9 @@ def test_grade_writes_reports_and_grades_csv_with_plain_progress(
         ("bob", "0", "0", "0"),
     ]
     assert sorted(path.name for path in out.iterdir()) == ["alice.json", "bob.json", "grades.csv"]
-    announced = re.search(r"Grading seed (\d+) \(regrade identically with --seed \1\)", err)
+    announced = re.search(
+        r"Grading seed (\d+) \(held out, drawn at random; regrade identically with --seed \1\)", err
+    )
     assert announced is not None, err
     seed = int(announced[1])
     assert seed != 0, "without --seed the grading seed is held out, never the public practice seed"
@@ -157,6 +163,11 @@ def test_grade_writes_reports_and_grades_csv_with_plain_progress(
     assert {
         Report.model_validate_json((out / name).read_text()).seed for name in ["alice.json", "bob.json"]
     } == {seed}
+    assert cli.main(["grade", str(inputs), "--out", str(out), "--only", "car,taxi"]) == 0
+    assert (
+        f"Grading seed {seed} (recorded in {out / 'grades.csv'}; pass --seed for another; regrade "
+        f"identically with --seed {seed})" in capsys.readouterr().err
+    ), "a re-run without --seed resumes with the batch's seed"
 
 
 def test_grade_with_a_given_seed_records_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -166,7 +177,7 @@ def test_grade_with_a_given_seed_records_it(tmp_path: Path, capsys: pytest.Captu
         cli.main(["grade", str(tmp_path / "alice.py"), "--out", str(out), "--only", "car", "--seed", "7"])
         == 0
     )
-    assert "Grading seed 7 (regrade identically with --seed 7)" in capsys.readouterr().err
+    assert "Grading seed 7 (given; regrade identically with --seed 7)" in capsys.readouterr().err
     assert [row["seed"] for row in csv.DictReader((out / "grades.csv").open())] == ["7"]
     assert Report.model_validate_json((out / "alice.json").read_text()).seed == 7
 
@@ -256,3 +267,69 @@ def _layer(name: str, active: bool, required: bool = True, remedy: str = "") -> 
 )
 def test_check_says_how_the_code_was_isolated(isolation: dict[str, Any], expected: list[str]) -> None:
     assert cli.isolation_lines(isolation) == expected
+
+
+ENDLESS = b"def random_blackjack(n):\n    while True:\n        pass\n"
+RESUME_SEED = 736251  # marks this test's pytest command lines
+
+
+def _processes_mentioning(text: str) -> list[int]:
+    found = []
+    for entry in Path("/proc").iterdir():
+        try:
+            if text.encode() in (entry / "cmdline").read_bytes().split(b"\0"):
+                found.append(int(entry.name))
+        except OSError:
+            continue
+    return found
+
+
+@pytest.mark.slow
+def test_ctrl_c_keeps_finished_reports_and_a_rerun_resumes(tmp_path: Path, fast_config: Path) -> None:
+    inputs, out = tmp_path / "inputs", tmp_path / "out"
+    inputs.mkdir()
+    (inputs / "empty.py").write_bytes(b"")
+    (inputs / "endless.py").write_bytes(ENDLESS)
+    argv = [sys.executable, "-m", "grader.cli", "grade", str(inputs), "--out", str(out)]
+    argv += ["--only", "random_blackjack", "--config", str(fast_config), "--seed", str(RESUME_SEED)]
+    argv += ["--allow-weak-isolation"]
+    batch = subprocess.Popen(argv, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    # Interrupt while the endless file is being graded: the empty file's report is kept, pytest is running.
+    while not ((out / "empty.json").exists() and len(_processes_mentioning(str(RESUME_SEED))) >= 2):
+        assert time.monotonic() < deadline, "the batch did not start grading within 60 s"
+        time.sleep(0.1)
+    time.sleep(1.0)
+    batch.send_signal(signal.SIGINT)
+    _, err = batch.communicate(timeout=30)
+    assert batch.returncode == cli.EXIT_INTERRUPTED, err
+    assert (
+        f"gymgrade grade: interrupted. 1 of 2 submissions are graded in {out} (their reports and grades.csv "
+        "are kept). Run the same command again (same --out, --seed, --only and --config) to grade the "
+        "other 1; the finished ones are skipped." in err
+    )
+    assert sorted(path.name for path in out.iterdir()) == ["empty.json", "grades.csv"]
+    assert [row["submission"] for row in csv.DictReader((out / "grades.csv").open())] == ["empty"]
+    time.sleep(0.5)
+    assert _processes_mentioning(str(RESUME_SEED)) == [], "the interrupted grading left processes behind"
+
+    (inputs / "endless.py").write_bytes(b"x = 1\n")
+    rerun = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    assert rerun.returncode == 0, rerun.stderr
+    assert f"Resuming in {out}: 1 of 2 submissions are already graded there" in rerun.stderr
+    assert "endless.py: random_blackjack missing" in rerun.stderr
+    assert "empty.py" not in rerun.stderr.split("grading 1.")[1]
+    assert [row["submission"] for row in csv.DictReader((out / "grades.csv").open())] == ["empty", "endless"]
+
+
+def test_a_broken_executor_entry_point_is_refused_with_a_remedy(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    broken = FakeEntryPoint("cluster", ImportError("No module named 'celery'"))
+    monkeypatch.setattr(cli, "entry_points", lambda group: [broken] if group == cli.EXECUTOR_GROUP else [])
+    (tmp_path / "alice.py").write_bytes(b"")
+    assert cli.main(["grade", str(tmp_path / "alice.py"), "--out", str(tmp_path / "out")]) == cli.EXIT_ERROR
+    assert (
+        "gymgrade grade: the batch executor 'cluster' could not be loaded (ImportError: No module named "
+        "'celery'); reinstall the package providing it (pip install -e '.[distributed]')"
+    ) in capsys.readouterr().err

@@ -77,7 +77,7 @@ def batch(tmp_path_factory: pytest.TempPathFactory, fast_config: Path) -> tuple[
         only=["car", "random_blackjack"],
         policy=IsolationPolicy.ALLOW_FALLBACK,
         config=fast_config,
-    )
+    ).reports
     return out, reports
 
 

@@ -1,0 +1,63 @@
+"""The Celery worker's start-up checks and its split of the cores, without a broker."""
+
+from __future__ import annotations
+
+import pytest
+from api_testing import SettingsFactory
+
+from api.jobs import celery_worker
+from api.jobs.celery_worker import split_cores, startup_problem
+from grader.sandbox import IsolationReport, LayerReport
+
+
+@pytest.mark.parametrize(
+    ("cores", "concurrency", "grading_workers", "expected"),
+    [
+        (2, None, None, (2, 1)),
+        (2, 1, None, (1, 2)),
+        (8, 4, None, (4, 2)),
+        (8, 3, 1, (3, 1)),
+        (1, 4, None, (4, 1)),
+    ],
+    ids=[
+        "a-grading-per-core",
+        "one-grading-all-cores",
+        "four-of-eight",
+        "explicit-grading-workers",
+        "never-zero",
+    ],
+)
+def test_cores_are_split_between_gradings_and_their_xdist_workers(
+    monkeypatch: pytest.MonkeyPatch,
+    make_settings: SettingsFactory,
+    cores: int,
+    concurrency: int | None,
+    grading_workers: int | None,
+    expected: tuple[int, int],
+) -> None:
+    monkeypatch.setattr(celery_worker, "cores", lambda: cores)
+    settings = make_settings(grading_workers=grading_workers)
+    assert split_cores(concurrency, settings) == expected
+
+
+def test_a_worker_refuses_a_machine_that_cannot_isolate(
+    monkeypatch: pytest.MonkeyPatch, make_settings: SettingsFactory
+) -> None:
+    missing = LayerReport(
+        name="bubblewrap",
+        active=False,
+        detail="bubblewrap (bwrap) is not installed",
+        remedy="apt-get install bubblewrap",
+        required=True,
+    )
+    monkeypatch.setattr(celery_worker, "broker_problem", lambda settings: None)
+    monkeypatch.setattr("grader.sandbox.probe_isolation", lambda: IsolationReport(layers=(missing,)))
+    problem = startup_problem(make_settings(broker_url="redis://127.0.0.1:1/0"))
+    assert problem == (
+        "this machine cannot isolate submissions as grading requires: bubblewrap: bubblewrap (bwrap) is not "
+        "installed (apt-get install bubblewrap). Install the missing layers (see scripts/setup.sh), or set "
+        "GYMGRADE_ALLOW_WEAK_ISOLATION=1 for a trial only"
+    )
+    assert (
+        startup_problem(make_settings(broker_url="redis://127.0.0.1:1/0", allow_weak_isolation=True)) is None
+    )

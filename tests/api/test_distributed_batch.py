@@ -1,0 +1,133 @@
+"""`gymgrade grade` on the cluster: a real redis-server and `gymgrade worker`, the fake grader.
+
+The batch core is the local one (tests/grader/test_batch.py); these tests pin that the cluster's executor
+hands every report back, that a re-run resumes, and that an interrupted batch keeps what it finished.
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from api_testing import FAKE_GRADER, RedisServer
+from live_server import LiveProcess, service_environment
+
+from api.jobs.batch import CeleryExecutor, executor_from_environment
+from api.settings import BrokerSettings
+from grader import cli
+from grader.batch import collect_submissions, grade_many
+from grader.errors import BatchInterrupted, ExecutorUnavailable
+from grader.report import ProblemResult
+from grader.sandbox import IsolationPolicy
+
+pytestmark = pytest.mark.e2e
+
+ONLY = "random_blackjack,blackjack,cartpole"  # the fake grader's problems
+READY_SECONDS = 60.0
+
+
+@pytest.fixture
+def broker_url(tmp_path: Path, redis_server: RedisServer) -> Iterator[str]:
+    """A Redis database served by one `gymgrade worker` (SQLite for its unused job rows)."""
+    url = redis_server.new_url()
+    env = service_environment(tmp_path / "data", FAKE_GRADER, broker_url=url, allow_weak_isolation=1, nice=0)
+    worker = LiveProcess("worker", env, tmp_path / "worker.log").start(wait_for_http=False)
+    deadline = time.monotonic() + READY_SECONDS
+    while not re.search(r"gymgrade-\d+@\S+ ready", worker.log()):
+        assert time.monotonic() < deadline, worker.log()
+        time.sleep(0.1)
+    yield url
+    worker.stop()
+
+
+@pytest.fixture
+def inputs(tmp_path: Path) -> Path:
+    folder = tmp_path / "inputs"
+    folder.mkdir()
+    (folder / "alice.py").write_text("def random_blackjack(n):\n    return n\n")
+    (folder / "bob.py").write_text("def cartpole():\n    return 1\n")
+    (folder / "carol.py").write_text("def car(:\n")
+    return folder
+
+
+def _use_cluster(monkeypatch: pytest.MonkeyPatch, broker_url: str) -> None:
+    class ClusterEntryPoint:
+        name = "cluster"
+
+        def load(self) -> object:
+            return executor_from_environment
+
+    monkeypatch.setenv("GYMGRADE_BROKER_URL", broker_url)
+    monkeypatch.setattr(
+        cli, "entry_points", lambda group: [ClusterEntryPoint()] if group == cli.EXECUTOR_GROUP else []
+    )
+
+
+def test_a_batch_on_the_cluster_keeps_every_report_and_resumes(
+    tmp_path: Path,
+    broker_url: str,
+    inputs: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    _use_cluster(monkeypatch, broker_url)
+    out = tmp_path / "out"
+    argv = ["grade", str(inputs), "--out", str(out), "--only", ONLY, "--allow-weak-isolation"]
+    assert cli.main(argv) == 0
+    err = capsys.readouterr().err
+    assert f"Grading on the Celery cluster at {broker_url}." in err
+    rows = list(csv.DictReader((out / "grades.csv").open()))
+    assert [(row["submission"], row["total"]) for row in rows] == [
+        ("alice", "1"),
+        ("bob", "1"),
+        ("carol", "0"),
+    ]
+    assert rows[2]["note"].startswith("carol.py is not valid Python")
+
+    (inputs / "bob.py").write_text("def cartpole():\n    return 2\n\ndef blackjack(n):\n    return n\n")
+    assert cli.main(argv) == 0
+    err = capsys.readouterr().err
+    assert f"Resuming in {out}: 2 of 3 submissions are already graded there" in err
+    assert "bob.py: blackjack passed" in err and "alice.py" not in err
+    rows = list(csv.DictReader((out / "grades.csv").open()))
+    assert [(row["submission"], row["total"]) for row in rows] == [
+        ("alice", "1"),
+        ("bob", "2"),
+        ("carol", "0"),
+    ]
+
+
+def test_an_interrupted_cluster_batch_keeps_what_it_finished(
+    tmp_path: Path, broker_url: str, inputs: Path
+) -> None:
+    paths = collect_submissions([inputs])
+    executor = CeleryExecutor(BrokerSettings(broker_url=broker_url), IsolationPolicy.ALLOW_FALLBACK)
+    seen: list[str] = []
+
+    def stop_at_the_second_file(path: Path, result: ProblemResult) -> None:
+        seen.append(path.name)
+        if len(set(seen)) == 2:
+            raise KeyboardInterrupt
+
+    out = tmp_path / "out"
+    with pytest.raises(BatchInterrupted) as interrupted:
+        grade_many(paths, out, only=ONLY.split(","), executor=executor, on_result=stop_at_the_second_file)
+    assert (interrupted.value.finished, interrupted.value.total) == (1, 3)
+    outcome = grade_many(paths, out, only=ONLY.split(","), executor=executor)
+    assert len(outcome.reused) == 1 and len(outcome.graded) == 2
+    assert [report.score for report in outcome.reports] == [1.0, 1.0, 0.0]
+
+
+def test_an_unreachable_broker_is_refused_with_a_remedy(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GYMGRADE_BROKER_URL", "redis://127.0.0.1:1/0")
+    with pytest.raises(
+        ExecutorUnavailable,
+        match=r"cannot reach the Redis broker at redis://127.0.0.1:1/0 .*unset GYMGRADE_BROKER_URL",
+    ):
+        executor_from_environment(IsolationPolicy.REQUIRE_FULL)
+    monkeypatch.delenv("GYMGRADE_BROKER_URL")
+    assert executor_from_environment(IsolationPolicy.REQUIRE_FULL) is None
