@@ -17,6 +17,7 @@ from sqlalchemy.orm import Session
 
 from api.auth import Principal, authenticate
 from api.context import ServiceContext
+from api.disclosure import Disclosure, disclosure_for
 from api.errors import NotAuthenticated
 from api.jobs.protocol import Dispatcher
 from api.models import Student
@@ -74,6 +75,14 @@ def get_caller(
 
 
 CallerDep = Annotated[Principal, Depends(get_caller)]
+
+
+async def get_disclosure(caller: CallerDep, settings: SettingsDep) -> Disclosure:
+    """What the caller may see of reports: everything (instructor) or the student's view."""
+    return disclosure_for(caller, settings)
+
+
+DisclosureDep = Annotated[Disclosure, Depends(get_disclosure)]
 
 
 async def get_instructor(caller: CallerDep) -> Principal:

@@ -70,14 +70,19 @@ class SubmissionSummary(BaseModel):
 class SubmissionDetail(SubmissionSummary):
     """A submission with its live progress and, once done, its report."""
 
-    seed: int
+    seed: int | None = Field(
+        description="The grading seed; null for students unless the instructor released the seeds."
+    )
     started_at: UtcDateTime | None = None
     attempts: int
     progress: list[dict[str, Any]] = Field(
         default_factory=list, description="Problems finished so far (each as in the report's `problems`)."
     )
     report: dict[str, Any] | None = Field(
-        default=None, description="The grader's report, when status is done."
+        default=None,
+        description="The grader's report, when status is done. Students see null seeds unless released, "
+        "and problems withheld by their visibility (hidden, after_due_date before the due date) with "
+        "status 'withheld', a note for feedback and a null score, as is then the total.",
     )
     error: str | None = Field(default=None, description="Why grading failed, when status is failed.")
 

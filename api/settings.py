@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from datetime import UTC, datetime
 from enum import StrEnum
 from pathlib import Path
 from urllib.parse import urlsplit
 
 from pydantic import Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
+
+from grader.seeds import PRACTICE_SEED
 
 MIN_TOKEN_LENGTH = 24
 MIN_TOKEN_DISTINCT_CHARACTERS = 10
@@ -93,10 +96,21 @@ class Settings(BrokerSettings):
         default=None, gt=0, description="Processes one grading spreads its checks over (default: all cores)."
     )
     seed_policy: SeedPolicy = Field(
-        default=SeedPolicy.FIXED,
-        description="fixed: every submission graded with SEED (same bytes, same grade); random: fresh seeds.",
+        default=SeedPolicy.RANDOM,
+        description="random: a fresh held-out seed per submission, stored in its row (an instructor regrades "
+        "with it); fixed: every submission graded with SEED (never the public practice seed 0).",
     )
     seed: int = Field(default=0, ge=0, description="The grading seed under the fixed seed policy.")
+    release_seeds: bool = Field(
+        default=False,
+        description="Show students the grading seed and per-problem seeds of their reports (instructors "
+        "always see them); false keeps the starts unforeseeable.",
+    )
+    due_date: datetime | None = Field(
+        default=None,
+        description="The assignment's due date (ISO 8601; UTC when no offset is given): students see "
+        "problems marked after_due_date from then on; unset, never.",
+    )
     gradebook_policy: GradebookPolicy = Field(
         default=GradebookPolicy.LATEST, description="latest or best graded submission per student."
     )
@@ -126,6 +140,13 @@ class Settings(BrokerSettings):
         description="A grading still running after this long is stopped and marked failed.",
     )
 
+    @field_validator("due_date")
+    @classmethod
+    def _in_utc(cls, due_date: datetime | None) -> datetime | None:
+        if due_date is None:
+            return None
+        return due_date.replace(tzinfo=UTC) if due_date.tzinfo is None else due_date.astimezone(UTC)
+
     @model_validator(mode="after")
     def _refuse_unsafe_values(self) -> Settings:
         if self.broker_url is not None and self.visibility_timeout_seconds <= self.grading_timeout_seconds:
@@ -136,6 +157,13 @@ class Settings(BrokerSettings):
             )
         if self.development:
             return self
+        if self.seed_policy is SeedPolicy.FIXED and self.seed == PRACTICE_SEED:
+            raise ValueError(
+                f"GYMGRADE_SEED_POLICY=fixed with GYMGRADE_SEED={PRACTICE_SEED}: that is the public practice "
+                "seed of `gymgrade check`, so a file could memorise every start; expected the random "
+                "policy (the default) or a secret GYMGRADE_SEED (e.g. `python -c 'import secrets; "
+                "print(secrets.randbelow(2**31))'`)"
+            )
         if self.instructor_token is None:
             raise ValueError(
                 "GYMGRADE_INSTRUCTOR_TOKEN is not set; expected a long random token "

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import math
-import secrets
 from datetime import timedelta
 
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session, joinedload
 
 from api.auth import Principal
+from api.disclosure import Disclosure, problem_view, report_view, withholds_any
 from api.errors import RateLimited, SubmissionNotFound
 from api.jobs.protocol import Dispatcher
 from api.models import JobStatus, Student, Submission, utcnow
@@ -17,6 +17,7 @@ from api.schemas import SubmissionDetail, SubmissionSummary
 from api.settings import SeedPolicy, Settings
 from api.students import find_student
 from api.uploads import CheckedUpload
+from grader.seeds import held_out_seed
 
 RATE_WINDOW = timedelta(seconds=60)
 MAX_SEED = 2**31 - 1
@@ -55,7 +56,7 @@ def create_submission(
             f"at most {settings.rate_limit_per_minute} uploads per minute; try again in {max(wait, 1)} s",
             retry_after_seconds=max(wait, 1),
         )
-    seed = settings.seed if settings.seed_policy is SeedPolicy.FIXED else secrets.randbelow(MAX_SEED)
+    seed = settings.seed if settings.seed_policy is SeedPolicy.FIXED else held_out_seed(MAX_SEED + 1)
     submission = Submission(
         student_id=student.id,
         filename=upload.display_name,
@@ -109,29 +110,31 @@ def count_by_status(session: Session) -> dict[str, int]:
     return {status: count for status, count in rows}
 
 
-def summary(submission: Submission) -> SubmissionSummary:
-    """The listing view of a submission."""
+def summary(submission: Submission, disclosure: Disclosure) -> SubmissionSummary:
+    """The listing view of a submission (no total score where ``disclosure`` withholds a problem)."""
+    withheld = withholds_any(submission.report, disclosure)
     return SubmissionSummary(
         id=submission.id,
         student=submission.student.name,
         filename=submission.filename,
         sha256=submission.sha256,
         status=submission.status,  # type: ignore[arg-type]
-        score=submission.score,
+        score=None if withheld else submission.score,
         max_score=submission.max_score,
         created_at=submission.created_at,
         finished_at=submission.finished_at,
     )
 
 
-def detail(submission: Submission) -> SubmissionDetail:
-    """The full view of a submission: progress while running, the report once done."""
+def detail(submission: Submission, disclosure: Disclosure) -> SubmissionDetail:
+    """A submission with its progress while running and its report once done, as ``disclosure`` allows."""
+    report = submission.report if submission.status == JobStatus.DONE.value else None
     return SubmissionDetail(
-        **summary(submission).model_dump(),
-        seed=submission.seed,
+        **summary(submission, disclosure).model_dump(),
+        seed=submission.seed if disclosure.seeds else None,
         started_at=submission.started_at,
         attempts=submission.attempts,
-        progress=submission.progress,
-        report=submission.report if submission.status == JobStatus.DONE.value else None,
+        progress=[problem_view(problem, disclosure) for problem in submission.progress],
+        report=report_view(report, disclosure) if report is not None else None,
         error=submission.error,
     )

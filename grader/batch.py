@@ -280,12 +280,26 @@ def grade_many(
     return outcome
 
 
+def recorded_seed(out_dir: Path) -> int | None:
+    """The grading seed of the batch whose ``grades.csv`` is in ``out_dir``, or None (no such file, no
+    seed column, or several seeds)."""
+    try:
+        with (out_dir / GRADES_FILE).open(newline="", encoding="utf-8") as stream:
+            seeds = {row.get("seed") or "" for row in csv.DictReader(stream)}
+    except (OSError, UnicodeDecodeError, csv.Error):
+        return None
+    if len(seeds) != 1:
+        return None
+    value = seeds.pop()
+    return int(value) if value.isdigit() else None
+
+
 def write_grades(path: Path, names: Sequence[str], reports: Sequence[Report], plan: GradingPlan) -> None:
-    """Write the gradebook (in one rename): a row per submission, a column per problem's score, the total
-    and a note."""
+    """Write the gradebook (in one rename): a row per submission (with its grading seed), a column per
+    problem's score, the total and a note."""
     stream = io.StringIO()
     writer = csv.writer(stream)
-    writer.writerow(["submission", "sha256", *plan.problems, "total", "max_score", "note"])
+    writer.writerow(["submission", "sha256", "seed", *plan.problems, "total", "max_score", "note"])
     for name, report in zip(names, reports, strict=True):
         scores = {result.id: result.score for result in report.problems}
         note = report.submission_error or "; ".join(report.grader_errors)
@@ -293,6 +307,7 @@ def write_grades(path: Path, names: Sequence[str], reports: Sequence[Report], pl
             [
                 name,
                 report.sha256,
+                report.seed,
                 *(f"{scores.get(problem, 0.0):g}" for problem in plan.problems),
                 f"{report.score:g}",
                 f"{report.max_score:g}",

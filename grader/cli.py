@@ -16,6 +16,7 @@ from grader.progress import ProgressBar, result_line
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import SandboxError
+from grader.seeds import PRACTICE_SEED, held_out_seed
 
 if TYPE_CHECKING:
     from grader.batch import BatchExecutor
@@ -47,8 +48,15 @@ def _positive(text: str) -> int:
     return value
 
 
-def _add_common(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--seed", type=int, default=0, help="grading seed (same file + seed = same verdicts)")
+def _seed(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a non-negative seed, found {value}")
+    return value
+
+
+def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
+    parser.add_argument("--seed", type=_seed, default=None, help=seed_help)
     parser.add_argument(
         "--workers", type=_positive, default=None, help="parallel workers (default: all cores)"
     )
@@ -75,7 +83,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     check = subparsers.add_parser("check", help="grade one file and explain every verdict (for students)")
     check.add_argument("file", type=Path, metavar="FILE")
-    _add_common(check)
+    _add_common(
+        check,
+        f"seed of the starts (default: the practice seed {PRACTICE_SEED}; instructors grade on another)",
+    )
     check.add_argument("--json", action="store_true", help="print exactly the report JSON on stdout")
     check.add_argument(
         "--output", type=Path, default=None, metavar="PATH", help="also write the report JSON here"
@@ -89,7 +100,11 @@ def build_parser() -> argparse.ArgumentParser:
     grade.add_argument(
         "--out", type=Path, required=True, metavar="DIR", help="directory for reports + grades.csv"
     )
-    _add_common(grade)
+    _add_common(
+        grade,
+        "grading seed (default: a fresh random one, printed and kept in every report and grades.csv; "
+        "pass it again to regrade identically)",
+    )
     grade.add_argument(
         "--allow-weak-isolation",
         action="store_true",
@@ -151,15 +166,16 @@ def run_check(args: argparse.Namespace) -> int:
         print(f"gymgrade check: {args.file} is not a file: pass the path of your .py file", file=sys.stderr)
         return EXIT_ERROR
     progress = sys.stderr if args.json else sys.stdout
+    seed = PRACTICE_SEED if args.seed is None else args.seed
 
     def show(result: ProblemResult) -> None:
         print(result_line(result), file=progress, flush=True)
 
     if not args.json:
-        print(f"Checking {args.file.name} (seed {args.seed})...", flush=True)
+        print(f"Checking {args.file.name} (practice seed {seed})...", flush=True)
     report = grade_submission(
         args.file,
-        seed=args.seed,
+        seed=seed,
         workers=args.workers,
         only=args.only,
         policy=IsolationPolicy.ALLOW_FALLBACK,
@@ -188,6 +204,10 @@ def summary(report: Report) -> str:
     lines.append(
         f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
     )
+    lines.append(
+        f"Practice seed {report.seed}: your instructor grades on different, unseen starts (a held-out "
+        "seed), so code that only does well from these starts will fail there."
+    )
     lines += isolation_lines(report.isolation)
     lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
     return "\n".join(lines)
@@ -212,6 +232,25 @@ def isolation_lines(isolation: dict[str, Any]) -> list[str]:
         if layer.get("required") and not layer.get("active")
     ]
     return lines
+
+
+def choose_seed(given: int | None, out_dir: Path) -> int:
+    """The batch's grading seed, announced on stderr: ``--seed``, else the one an earlier (interrupted)
+    batch recorded in ``out_dir``, so that re-running the same command resumes it, else a fresh held-out
+    seed."""
+    from grader.batch import recorded_seed
+
+    recorded = recorded_seed(out_dir) if given is None else None
+    if given is not None:
+        seed, origin = given, "given"
+    elif recorded is not None:
+        seed, origin = recorded, f"recorded in {out_dir / 'grades.csv'}; pass --seed for another"
+    else:
+        seed, origin = held_out_seed(), "held out, drawn at random"
+    print(
+        f"Grading seed {seed} ({origin}; regrade identically with --seed {seed})", file=sys.stderr, flush=True
+    )
+    return seed
 
 
 def run_grade(args: argparse.Namespace) -> int:
@@ -242,11 +281,12 @@ def run_grade(args: argparse.Namespace) -> int:
     def advance(path: Path, result: ProblemResult) -> None:
         bar.advance(f"{path.name}: {result.id} {result.status}")
 
+    seed = choose_seed(args.seed, args.out)
     try:
         outcome = grade_many(
             paths,
             args.out,
-            seed=args.seed,
+            seed=seed,
             workers=args.workers,
             only=args.only,
             policy=policy,
@@ -268,7 +308,7 @@ def run_grade(args: argparse.Namespace) -> int:
     print(
         f"Graded {len(outcome.graded)} submissions"
         + (f" (reused {len(outcome.reused)} earlier reports)" if outcome.reused else "")
-        + f" into {args.out} (grades.csv)"
+        + f" into {args.out} (grades.csv) with seed {seed}"
         + (f"; {errors} with grader errors (run again to retry them)" if errors else ""),
         file=sys.stderr,
     )

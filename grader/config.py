@@ -11,6 +11,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from grader.errors import ConfigError
 from grader.games import accepted_game_names
 from grader.problems import PROBLEM_IDS, ProblemId
+from grader.report import Visibility
 from grader.sandbox.limits import Limits
 
 DEFAULT_CONFIG_PATH = Path(__file__).with_name("assignment.toml")
@@ -31,6 +32,11 @@ class ProblemConfig(_Strict):
     call_seconds: float = Field(gt=0.0, description="Wall-clock limit of ONE call of the student's function.")
     expected_seconds: float = Field(
         ge=0.0, description="Typical total time of the problem's calls; slowest problems are started first."
+    )
+    visibility: Visibility = Field(
+        default="visible",
+        description="When students see this problem's result and feedback in the service: 'visible' (at "
+        "once), 'after_due_date' (once GYMGRADE_DUE_DATE has passed) or 'hidden' (instructors only).",
     )
 
 

@@ -104,6 +104,7 @@ def run_problem(
         output=cap_output(student_output(outcomes)),
         compat_events=_distinct_events(outcomes),
         seed=seed,
+        visibility=settings.visibility,
         timings=Timings(
             wall_seconds=wall_seconds,
             student_seconds=student_seconds,

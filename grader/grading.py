@@ -11,7 +11,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib.metadata import version
 from pathlib import Path
 
@@ -20,7 +20,7 @@ from grader.config import load_config
 from grader.execution import problem_seed
 from grader.problems import PROBLEM_IDS, ProblemId
 from grader.progress import ResultsFollower
-from grader.report import GradingTimings, ProblemResult, ProblemRun, Report
+from grader.report import GradingTimings, ProblemResult, ProblemRun, Report, Visibility
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import IsolationUnavailable
 from grader.sandbox.isolation.scope import sandbox_scope
@@ -43,6 +43,7 @@ class GradingPlan:
     config_sha256: str = ""
     """SHA-256 of the effective assignment configuration (its validated JSON form); "" for a plan made by
     hand. A report records it, so a resumed batch knows which configuration graded a file."""
+    visibility: dict[ProblemId, Visibility] = field(default_factory=dict)
 
     @classmethod
     def load(cls, config: Path | None, only: Sequence[str] | None) -> GradingPlan:
@@ -69,6 +70,7 @@ class GradingPlan:
             titles={problem: assignment.problem(problem).title for problem in problems},
             config=config,
             config_sha256=hashlib.sha256(assignment.model_dump_json().encode()).hexdigest(),
+            visibility={problem: assignment.problem(problem).visibility for problem in problems},
         )
 
 
@@ -254,6 +256,7 @@ def _rejected_report(path: Path, data: bytes, plan: GradingPlan, seed: int, verd
             max_score=plan.points[problem],
             feedback=verdict.message,
             seed=problem_seed(seed, problem),
+            visibility=plan.visibility.get(problem, "visible"),
         )
         for problem in plan.problems
     ]
@@ -281,6 +284,7 @@ def _internal_error_run(
         points=plan.points[problem],
         seed=problem_seed(seed, problem),
         detail=detail,
+        visibility=plan.visibility.get(problem, "visible"),
     )
 
 

@@ -246,6 +246,7 @@ class ResultsWriter:
             points=settings.points,
             seed=problem_seed(self.options.seed, problem),
             detail=detail,
+            visibility=settings.visibility,
         )
         self._write(report.nodeid, run.to_json())
 

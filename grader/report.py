@@ -11,6 +11,9 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, JsonValue
 
 Status = Literal["passed", "failed", "error", "timeout", "missing"]
+Visibility = Literal["visible", "after_due_date", "hidden"]
+"""Who sees a problem's result and feedback (Gradescope's words): students at once, after the due date, or
+only the instructor. The report always holds everything; the service's student views honour it."""
 
 REPORT_FORMAT = 1
 OUTPUT_CAP_CHARS = 8_000
@@ -68,6 +71,10 @@ class ProblemResult(BaseModel):
         description="What the lab-compatibility layer had to tolerate (e.g. steps after the episode ended).",
     )
     seed: int = Field(default=0, description="The sandbox seed this problem ran with.")
+    visibility: Visibility = Field(
+        default="visible",
+        description="visible, after_due_date or hidden: when students may see this result (from the config).",
+    )
     timings: Timings | None = Field(
         default=None, description="Where the check's time went (not deterministic)."
     )
@@ -85,7 +92,15 @@ class ProblemRun(BaseModel):
 
     @classmethod
     def grader_failure(
-        cls, submission: str, problem: str, *, title: str, points: float, seed: int, detail: str
+        cls,
+        submission: str,
+        problem: str,
+        *,
+        title: str,
+        points: float,
+        seed: int,
+        detail: str,
+        visibility: Visibility = "visible",
     ) -> ProblemRun:
         """The run of a problem the grader failed on: an ``error`` the student is told is not theirs."""
         result = ProblemResult(
@@ -97,6 +112,7 @@ class ProblemRun(BaseModel):
             feedback=f"The grader failed while checking this problem (not your code's fault): {detail}. "
             "Please report this to your instructor.",
             seed=seed,
+            visibility=visibility,
         )
         return cls(submission=submission, result=result, internal_error=detail)
 

@@ -6,7 +6,7 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, File, Query, Request, Response, UploadFile
 
-from api.deps import CallerDep, DispatcherDep, SessionDep, SettingsDep, StudentDep
+from api.deps import CallerDep, DisclosureDep, DispatcherDep, SessionDep, SettingsDep, StudentDep
 from api.errors import (
     InvalidRequest,
     InvalidUpload,
@@ -91,9 +91,11 @@ def post_submission(
     operation_id=GET_ONE_OPERATION,
     responses=error_responses(NotAuthenticated, SubmissionNotFound, InvalidRequest),
 )
-def get_one_submission(submission_id: int, session: SessionDep, caller: CallerDep) -> SubmissionDetail:
+def get_one_submission(
+    submission_id: int, session: SessionDep, caller: CallerDep, disclosure: DisclosureDep
+) -> SubmissionDetail:
     """A submission's status, the problems finished so far, and its report once done."""
-    return detail(get_submission(session, caller, submission_id))
+    return detail(get_submission(session, caller, submission_id), disclosure)
 
 
 @router.get(
@@ -104,10 +106,11 @@ def get_one_submission(submission_id: int, session: SessionDep, caller: CallerDe
 def get_submissions(
     session: SessionDep,
     caller: CallerDep,
+    disclosure: DisclosureDep,
     student: str | None = Query(default=None, description="Instructor only: one student's submissions."),
 ) -> list[SubmissionSummary]:
     """The caller's submissions, newest first (the instructor sees everyone's)."""
-    return [summary(item) for item in list_submissions(session, caller, student)]
+    return [summary(item, disclosure) for item in list_submissions(session, caller, student)]
 
 
 def document_upload_rules(openapi: dict[str, Any], max_upload_bytes: int) -> None:

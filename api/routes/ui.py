@@ -6,13 +6,17 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, File, Form, Request, UploadFile
 from fastapi.responses import RedirectResponse, Response
+from sqlalchemy.orm import Session
 
 from api.auth import Principal, authenticate
 from api.deps import SESSION_COOKIE, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
+from api.disclosure import disclosure_for
 from api.errors import NotAuthenticated
 from api.gradebook import gradebook_csv
 from api.models import JobStatus
-from api.submissions import create_submission, detail, get_submission, list_submissions
+from api.schemas import SubmissionDetail
+from api.settings import Settings
+from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
 from api.web import PAGE_HEADERS, templates
 
@@ -38,7 +42,8 @@ def home(request: Request, session: SessionDep, caller: PageCallerDep, settings:
     """The start page: the sign-in form, or the caller's submissions and the upload form."""
     if caller is None:
         return _page(request, "signin.html", {})
-    submissions = list_submissions(session, caller)
+    disclosure = disclosure_for(caller, settings)
+    submissions = [summary(item, disclosure) for item in list_submissions(session, caller)]
     return _page(
         request,
         "home.html",
@@ -88,20 +93,24 @@ def upload(
 
 @router.get("/ui/submissions/{submission_id}")
 def submission_page(
-    request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep
+    request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep, settings: SettingsDep
 ) -> Response:
     """A submission's page; its live part is refreshed from the fragment below until grading ends."""
-    view = detail(get_submission(session, _signed_in(caller), submission_id))
+    view = _view(session, _signed_in(caller), settings, submission_id)
     return _page(request, "submission.html", {"submission": view, "final": view.status in FINAL_STATUSES})
 
 
 @router.get("/ui/submissions/{submission_id}/live")
 def submission_fragment(
-    request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep
+    request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep, settings: SettingsDep
 ) -> Response:
     """The live part of a submission's page: status, finished problems, report."""
-    view = detail(get_submission(session, _signed_in(caller), submission_id))
+    view = _view(session, _signed_in(caller), settings, submission_id)
     return _page(request, "_live.html", {"submission": view, "final": view.status in FINAL_STATUSES})
+
+
+def _view(session: Session, caller: Principal, settings: Settings, submission_id: int) -> SubmissionDetail:
+    return detail(get_submission(session, caller, submission_id), disclosure_for(caller, settings))
 
 
 @router.get("/ui/gradebook.csv")

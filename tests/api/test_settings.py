@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from datetime import UTC, datetime, timedelta
+
 import pytest
 from pydantic import ValidationError
 
@@ -85,6 +87,56 @@ def test_isolation_is_strict_by_default(monkeypatch: pytest.MonkeyPatch) -> None
 
 def test_a_generated_token_is_strong() -> None:
     assert token_weakness(STRONG) is None
+
+
+def test_each_submission_gets_a_held_out_seed_by_default(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.delenv("GYMGRADE_SEED_POLICY", raising=False)
+    settings = Settings()
+    assert (settings.seed_policy, settings.release_seeds, settings.due_date) == (
+        SeedPolicy.RANDOM,
+        False,
+        None,
+    )
+
+
+def test_the_public_practice_seed_is_refused_as_a_fixed_grading_seed(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.delenv("GYMGRADE_DEVELOPMENT", raising=False)
+    monkeypatch.setenv("GYMGRADE_SEED_POLICY", "fixed")
+    with pytest.raises(ValidationError) as raised:
+        Settings()
+    assert (
+        "GYMGRADE_SEED_POLICY=fixed with GYMGRADE_SEED=0: that is the public practice seed of `gymgrade "
+        "check`, so a file could memorise every start" in str(raised.value)
+    )
+    monkeypatch.setenv("GYMGRADE_SEED", "8675309")
+    assert Settings().seed == 8675309
+    monkeypatch.delenv("GYMGRADE_SEED")
+    monkeypatch.setenv("GYMGRADE_DEVELOPMENT", "1")
+    assert Settings().seed == 0, "development may grade on the practice seed"
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        ("2026-12-01T12:00:00", datetime(2026, 12, 1, 12, 0, tzinfo=UTC)),
+        ("2026-12-01T13:00:00+01:00", datetime(2026, 12, 1, 12, 0, tzinfo=UTC)),
+    ],
+    ids=["naive-is-utc", "offset-converted"],
+)
+def test_the_due_date_is_held_in_utc(monkeypatch: pytest.MonkeyPatch, value: str, expected: datetime) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.setenv("GYMGRADE_DUE_DATE", value)
+    due_date = Settings().due_date
+    assert due_date == expected and due_date is not None and due_date.utcoffset() == timedelta(0)
+
+
+def test_a_due_date_that_is_not_a_date_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.setenv("GYMGRADE_DUE_DATE", "next friday")
+    with pytest.raises(ValidationError, match="due_date"):
+        Settings()
 
 
 @pytest.mark.parametrize(

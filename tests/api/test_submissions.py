@@ -226,3 +226,23 @@ def test_odd_identifiers_are_client_errors_on_every_database(
     client: TestClient, path: str, status: int
 ) -> None:
     assert client.get(path, headers=instructor_headers()).status_code == status
+
+
+@pytest.mark.parametrize(
+    ("settings", "fixed"),
+    [({}, None), ({"seed_policy": "fixed", "seed": 77}, 77)],
+    ids=["random-by-default", "fixed"],
+)
+def test_each_submission_stores_its_grading_seed(
+    make_settings: SettingsFactory, settings: dict[str, object], fixed: int | None
+) -> None:
+    with TestClient(create_app(make_settings(**settings), run_workers=False)) as client:
+        token = add_student(client, "ada")
+        ids = [_upload(client, token)["id"] for _ in range(3)]
+        seeds = [client.get(f"/submissions/{i}", headers=instructor_headers()).json()["seed"] for i in ids]
+        own = client.get(f"/submissions/{ids[0]}", headers=bearer(token)).json()
+    assert own["seed"] is None, "a student never sees the grading seed unless it is released"
+    if fixed is not None:
+        assert seeds == [fixed] * 3
+    else:
+        assert len(set(seeds)) == 3 and all(1 <= seed < 2**31 for seed in seeds)

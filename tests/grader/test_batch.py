@@ -77,9 +77,9 @@ def test_grades_csv_has_a_row_per_submission_and_a_column_per_problem(tmp_path: 
     write_grades(tmp_path / "grades.csv", ["alice", "bob"], reports, plan)
     rows = list(csv.reader((tmp_path / "grades.csv").open()))
     assert rows == [
-        ["submission", "sha256", "cartpole", "car", "total", "max_score", "note"],
-        ["alice", "0" * 64, "1", "0", "1", "2", ""],
-        ["bob", "0" * 64, "0", "0", "0", "2", "bob.py is empty"],
+        ["submission", "sha256", "seed", "cartpole", "car", "total", "max_score", "note"],
+        ["alice", "0" * 64, "0", "1", "0", "1", "2", ""],
+        ["bob", "0" * 64, "0", "0", "0", "0", "2", "bob.py is empty"],
     ]
 
 

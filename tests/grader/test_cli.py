@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import re
 import signal
 import subprocess
 import sys
@@ -54,9 +55,14 @@ def test_check_explains_what_is_missing_and_exits_1(
     argv = ["check", str(SUBMISSIONS / "template.py"), "--only", "car", "--config", str(fast_config)]
     assert cli.main(argv) == cli.EXIT_NOT_FULL
     out = capsys.readouterr().out
+    assert out.startswith("Checking template.py (practice seed 0)...\n")
     assert "[MISSING] Problem 4: MountainCar (0/1)" in out
     assert "car() raised NotImplementedError: not attempted yet." in out
     assert "Score: 0 / 1" in out
+    assert (
+        "Practice seed 0: your instructor grades on different, unseen starts (a held-out seed), so code "
+        "that only does well from these starts will fail there." in out
+    )
 
 
 @pytest.fixture
@@ -118,9 +124,10 @@ def test_usage_errors_exit_2_with_a_message(
             "expected a positive number of workers, found 0",
         ),
         (["grade", str(CLASSIC_COMPLETE)], "the following arguments are required: --out"),
+        (["check", str(CLASSIC_COMPLETE), "--seed", "-1"], "expected a non-negative seed, found -1"),
         ([], "the following arguments are required: COMMAND"),
     ],
-    ids=["unknown-problem", "zero-workers", "grade-without-out", "no-command"],
+    ids=["unknown-problem", "zero-workers", "grade-without-out", "negative-seed", "no-command"],
 )
 def test_argument_errors_exit_2(argv: list[str], message: str, capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as exit_info:
@@ -146,6 +153,33 @@ def test_grade_writes_reports_and_grades_csv_with_plain_progress(
         ("bob", "0", "0", "0"),
     ]
     assert sorted(path.name for path in out.iterdir()) == ["alice.json", "bob.json", "grades.csv"]
+    announced = re.search(
+        r"Grading seed (\d+) \(held out, drawn at random; regrade identically with --seed \1\)", err
+    )
+    assert announced is not None, err
+    seed = int(announced[1])
+    assert seed != 0, "without --seed the grading seed is held out, never the public practice seed"
+    assert {row["seed"] for row in rows} == {str(seed)}
+    assert {
+        Report.model_validate_json((out / name).read_text()).seed for name in ["alice.json", "bob.json"]
+    } == {seed}
+    assert cli.main(["grade", str(inputs), "--out", str(out), "--only", "car,taxi"]) == 0
+    assert (
+        f"Grading seed {seed} (recorded in {out / 'grades.csv'}; pass --seed for another; regrade "
+        f"identically with --seed {seed})" in capsys.readouterr().err
+    ), "a re-run without --seed resumes with the batch's seed"
+
+
+def test_grade_with_a_given_seed_records_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "alice.py").write_bytes(b"")
+    out = tmp_path / "out"
+    assert (
+        cli.main(["grade", str(tmp_path / "alice.py"), "--out", str(out), "--only", "car", "--seed", "7"])
+        == 0
+    )
+    assert "Grading seed 7 (given; regrade identically with --seed 7)" in capsys.readouterr().err
+    assert [row["seed"] for row in csv.DictReader((out / "grades.csv").open())] == ["7"]
+    assert Report.model_validate_json((out / "alice.json").read_text()).seed == 7
 
 
 @dataclass

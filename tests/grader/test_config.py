@@ -101,6 +101,18 @@ def test_sandbox_settings_become_limits() -> None:
             "problems.find_qvalues: Field required (add it to the file)",
         ),
         (
+            "min_steps = 120",
+            'min_steps = 120\nvisibility = "secret"',
+            "problems.cartpole.visibility: Input should be 'visible', 'after_due_date' or 'hidden' "
+            "(found 'secret')",
+        ),
+        (
+            "min_steps = 120",
+            'min_steps = 120\nvisibility = "after_published"',
+            "problems.cartpole.visibility: Input should be 'visible', 'after_due_date' or 'hidden' "
+            "(found 'after_published')",
+        ),
+        (
             "uncounted_steps_deduction = 0.0\n\n[problems.car]",
             'uncounted_steps_deduction = 0.0\naccepted_envs = ["CartPole-v2"]\n\n[problems.car]',
             "problems.cartpole: Value error, accepted_envs must be a non-empty list of CartPole-v0, "
@@ -120,6 +132,8 @@ def test_sandbox_settings_become_limits() -> None:
         "alpha-above-one",
         "memory-too-small",
         "missing-problem",
+        "unknown-visibility",
+        "gradescope-only-visibility",
         "unknown-game",
         "deduction-above-one",
     ],
@@ -132,6 +146,22 @@ def test_invalid_fields_are_named_with_what_was_found(
         load_config(_write(tmp_path, BUNDLED.replace(old, new, 1)))
     assert message in str(raised.value)
     assert "invalid assignment configuration" in str(raised.value)
+
+
+def test_visibility_defaults_to_visible_and_can_be_set_per_problem(tmp_path: Path) -> None:
+    assert {problem.visibility for problem in load_config().problems.values()} == {"visible"}
+    text = BUNDLED.replace("min_steps = 120", 'min_steps = 120\nvisibility = "hidden"', 1).replace(
+        "max_mean_steps = 180.0", 'max_mean_steps = 180.0\nvisibility = "after_due_date"', 1
+    )
+    config = load_config(_write(tmp_path, text))
+    assert {problem: settings.visibility for problem, settings in config.problems.items()} == {
+        "random_blackjack": "visible",
+        "blackjack": "visible",
+        "cartpole": "hidden",
+        "car": "after_due_date",
+        "taxi": "visible",
+        "find_qvalues": "visible",
+    }
 
 
 def test_no_points_at_all_is_refused(tmp_path: Path) -> None:

@@ -104,7 +104,17 @@ def test_batch_writes_a_report_per_submission_and_grades_csv(batch: tuple[Path, 
     assert written == reports[1]
     rows = list(csv.DictReader((out / "grades.csv").open()))
     assert [row["submission"] for row in rows] == ["os_exit_at_import", "classic_complete", "empty"]
-    assert list(rows[0]) == ["submission", "sha256", "random_blackjack", "car", "total", "max_score", "note"]
+    assert list(rows[0]) == [
+        "submission",
+        "sha256",
+        "seed",
+        "random_blackjack",
+        "car",
+        "total",
+        "max_score",
+        "note",
+    ]
+    assert {row["seed"] for row in rows} == {"3"}
     assert [(row["total"], row["max_score"]) for row in rows] == [("0", "2"), ("2", "2"), ("0", "2")]
 
 
@@ -148,3 +158,34 @@ def test_an_abandoned_run_leaves_no_process_behind(fast_config: Path) -> None:
     while _processes(group=controller) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert _processes(group=controller) == [], "the pytest run and its xdist workers must be gone"
+
+
+def test_each_result_carries_its_problems_visibility(tmp_path: Path) -> None:
+    overrides = {
+        **FAST_OVERRIDES,
+        "cartpole": {**FAST_OVERRIDES["cartpole"], "visibility": "after_due_date"},
+        "car": {**FAST_OVERRIDES["car"], "visibility": "hidden"},
+    }
+    config = write_config(tmp_path / "assignment.toml", overrides)
+    empty = tmp_path / "empty.py"
+    empty.write_bytes(b"")
+    plan = GradingPlan.load(config, ["cartpole", "car", "taxi"])
+    assert plan.visibility == {"cartpole": "after_due_date", "car": "hidden", "taxi": "visible"}
+
+    graded = grade_submission(
+        CLASSIC_COMPLETE,
+        seed=3,
+        workers=1,
+        only=["car"],
+        policy=IsolationPolicy.ALLOW_FALLBACK,
+        config=config,
+    )
+    assert [(result.id, result.status, result.visibility) for result in graded.problems] == [
+        ("car", "passed", "hidden")
+    ]
+    rejected = grade_submission(empty, only=["cartpole", "car", "taxi"], config=config)
+    assert [(result.id, result.visibility) for result in rejected.problems] == [
+        ("cartpole", "after_due_date"),
+        ("car", "hidden"),
+        ("taxi", "visible"),
+    ]

@@ -105,3 +105,18 @@ def test_a_grader_failure_is_reported_as_such(plan: GradingPlan, tmp_path: Path)
     assert run.result.feedback.startswith(
         "The grader failed while checking this problem (not your code's fault)"
     )
+
+
+def test_a_grader_failure_keeps_the_problems_visibility(tmp_path: Path) -> None:
+    config = write_config(tmp_path / "assignment.toml", {"car": {"visibility": "hidden"}})
+    vanished = tmp_path / "vanished.py"
+    runs = run_acceptance(
+        [vanished],
+        GradingPlan.load(config, ["car"]),
+        seed=0,
+        workers=1,
+        policy=IsolationPolicy.ALLOW_FALLBACK,
+        on_result=None,
+    )
+    [run] = runs[str(vanished)]
+    assert (run.result.status, run.result.visibility) == ("error", "hidden")

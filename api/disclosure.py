@@ -1,0 +1,113 @@
+"""What a caller may see of a graded submission: everything (the instructor) or the student's view.
+
+Students never see a grading seed (the submission's, the report's or a problem's) unless the instructor
+releases them (GYMGRADE_RELEASE_SEEDS), because every start of every call follows from it through public
+functions. A problem marked ``hidden`` in the assignment config, or ``after_due_date`` before
+GYMGRADE_DUE_DATE, is withheld: its status, score, feedback, measurements, output, events and timings are
+replaced by a note, and so is the total score, which would give the withheld scores away. The stored
+report always keeps everything; these pure functions only shape the views.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from typing import Any
+
+from api.auth import Principal
+from api.settings import Settings
+
+JsonObject = dict[str, Any]
+
+WITHHELD = "withheld"
+"""The status a student sees for a withheld problem."""
+
+EVERY_VISIBILITY = frozenset({"visible", "after_due_date", "hidden"})
+
+
+@dataclass(frozen=True)
+class Disclosure:
+    """What one caller may see.
+
+    Attributes:
+        seeds: The grading seed and the per-problem seeds are shown.
+        shown: The problem visibilities whose results are shown.
+        due_date: The assignment's due date (for the note on ``after_due_date`` problems), if set.
+    """
+
+    seeds: bool
+    shown: frozenset[str]
+    due_date: datetime | None = None
+
+    def shows(self, problem: JsonObject) -> bool:
+        """True when the problem's result may be shown (reports without visibility are visible)."""
+        return str(problem.get("visibility", "visible")) in self.shown
+
+
+FULL = Disclosure(seeds=True, shown=EVERY_VISIBILITY)
+"""The instructor's view: everything."""
+
+
+def disclosure_for(caller: Principal, settings: Settings, now: datetime | None = None) -> Disclosure:
+    """What ``caller`` may see now.
+
+    Args:
+        caller: The instructor or a student.
+        settings: GYMGRADE_RELEASE_SEEDS and GYMGRADE_DUE_DATE.
+        now: The current time (aware); the clock when None.
+    """
+    if caller.is_instructor:
+        return FULL
+    moment = now or datetime.now(UTC)
+    due = settings.due_date
+    shown = {"visible"} | ({"after_due_date"} if due is not None and moment >= due else set())
+    return Disclosure(seeds=settings.release_seeds, shown=frozenset(shown), due_date=due)
+
+
+def problem_view(problem: JsonObject, disclosure: Disclosure) -> JsonObject:
+    """One problem's result as ``disclosure`` allows (a copy; the stored result is not changed)."""
+    view = dict(problem)
+    if not disclosure.seeds:
+        view["seed"] = None
+    if disclosure.shows(problem):
+        return view
+    view.update(
+        status=WITHHELD,
+        score=None,
+        feedback=_withheld_note(str(problem.get("visibility")), disclosure.due_date),
+        measurements={},
+        output="",
+        compat_events=[],
+        timings=None,
+    )
+    return view
+
+
+def report_view(report: JsonObject, disclosure: Disclosure) -> JsonObject:
+    """A report as ``disclosure`` allows: seeds and withheld problems (and then the total) replaced."""
+    view = dict(report)
+    view["problems"] = [problem_view(problem, disclosure) for problem in report.get("problems", [])]
+    if not disclosure.seeds:
+        view["seed"] = None
+    if withholds_any(report, disclosure):
+        view["score"] = None
+    return view
+
+
+def withholds_any(report: JsonObject | None, disclosure: Disclosure) -> bool:
+    """True when ``disclosure`` withholds some problem of ``report`` (so also its total score)."""
+    problems = report.get("problems", []) if report else []
+    return any(not disclosure.shows(problem) for problem in problems)
+
+
+def _withheld_note(visibility: str, due_date: datetime | None) -> str:
+    if visibility == "after_due_date":
+        when = f"{due_date:%Y-%m-%d %H:%M} UTC" if due_date is not None else "a date your instructor sets"
+        return (
+            f"This problem's result is shown after the due date ({when}); your instructor already sees it. "
+            "The total score is shown then too."
+        )
+    return (
+        "This problem's result is hidden from students (your instructor sees it); the total score is "
+        "hidden with it."
+    )
