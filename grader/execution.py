@@ -121,7 +121,8 @@ def _stopped_early(verdict: Verdict, reason: str, made: int, planned: int) -> Ve
         f" Grading stopped after call {made} of {planned}: {reason}, so no later call could change the "
         "verdict."
     )
-    return Verdict(verdict.status, verdict.fraction, verdict.feedback + note, measurements)
+    feedback = verdict.feedback if verdict.feedback.endswith((".", "!", "?")) else f"{verdict.feedback}."
+    return Verdict(verdict.status, verdict.fraction, feedback + note, measurements)
 
 
 def student_output(outcomes: Sequence[CallOutcome]) -> str:

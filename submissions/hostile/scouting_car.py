@@ -11,7 +11,7 @@ TAPE = [0] * 30 + [2] * 170
 def car():
     env = gym.make("MountainCar-v0")
     observation = env.reset()
-    while observation[0] > -0.58:
+    while observation[0] > -0.5:
         observation = env.reset()
     steps = 0
     for action in TAPE:
