@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from grader.errors import GraderError
+from grader.notebook import NotebookSummary
 from grader.problems import PROBLEM_IDS
 from grader.progress import ProgressBar, result_line
 from grader.report import ProblemResult, Report
@@ -142,7 +143,10 @@ def run_check(args: argparse.Namespace) -> int:
     from grader.grading import grade_submission
 
     if not args.file.is_file():
-        print(f"gymgrade check: {args.file} is not a file: pass the path of your .py file", file=sys.stderr)
+        print(
+            f"gymgrade check: {args.file} is not a file: pass the path of your .py or .ipynb file",
+            file=sys.stderr,
+        )
         return EXIT_ERROR
     progress = sys.stderr if args.json else sys.stdout
 
@@ -174,6 +178,8 @@ def run_check(args: argparse.Namespace) -> int:
 def summary(report: Report) -> str:
     """The readable end of `gymgrade check`: every verdict's feedback, the total, the isolation."""
     lines = [""]
+    if report.notebook is not None:
+        lines += notebook_lines(report.notebook)
     if report.submission_error is not None:
         lines.append(report.submission_error)
     else:
@@ -185,6 +191,18 @@ def summary(report: Report) -> str:
     lines += isolation_lines(report.isolation)
     lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
     return "\n".join(lines)
+
+
+def notebook_lines(notebook: NotebookSummary) -> list[str]:
+    """What of a notebook ran at import, and every statement that did not, cell by cell."""
+    lines = [
+        f"Notebook: {notebook.kept_statements} imports, definitions and constants from "
+        f"{notebook.code_cells} code cells ran at import; {len(notebook.skipped)} statements did not:"
+    ]
+    for entry in notebook.skipped:
+        label = f"In [{entry.execution_count}]" if entry.execution_count is not None else "no run"
+        lines.append(f"  cell {entry.cell} ({label}), line {entry.line}: {entry.code}  <- {entry.reason}")
+    return [*lines, ""]
 
 
 def isolation_lines(isolation: dict[str, Any]) -> list[str]:
@@ -215,7 +233,7 @@ def run_grade(args: argparse.Namespace) -> int:
 
     paths = collect_submissions(args.targets)
     if not paths:
-        print("gymgrade grade: no .py files found in the given targets", file=sys.stderr)
+        print("gymgrade grade: no .py or .ipynb files found in the given targets", file=sys.stderr)
         return EXIT_ERROR
     problems = GradingPlan.load(args.config, args.only).problems
     bar = ProgressBar(total=len(paths) * len(problems))

@@ -18,6 +18,7 @@ from pathlib import Path
 import grader
 from grader.config import load_config
 from grader.execution import problem_seed
+from grader.notebook import NotebookModule, build_module, is_notebook
 from grader.problems import PROBLEM_IDS, ProblemId
 from grader.progress import ResultsFollower
 from grader.report import GradingTimings, ProblemResult, ProblemRun, Report
@@ -136,26 +137,87 @@ def grade_files(
     started = time.perf_counter()
     contents = {path: _read(path) for path in paths}
     rejected: dict[Path, Report] = {}
-    for path, data in contents.items():
-        verdict = _file_verdict(path, data)
-        if verdict is not None:
-            rejected[path] = _rejected_report(path, data or b"", plan, seed, verdict)
-            _announce(on_result, path, rejected[path].problems)
-    runnable = [path for path in paths if path not in rejected]
-    worker_count = min(workers or default_workers(), max(len(runnable) * len(plan.problems), 1))
-    runs: dict[str, list[ProblemRun]] = {}
-    if runnable and plan.problems:
-        runs = run_acceptance(
-            runnable, plan, seed=seed, workers=worker_count, policy=policy, on_result=on_result
-        )
+    with tempfile.TemporaryDirectory(prefix="gymgrade-modules-") as modules_dir:
+        graded: dict[Path, Path] = {}
+        notebooks: dict[Path, NotebookModule] = {}
+        for path, data in contents.items():
+            prepared = _prepare(path, data, Path(modules_dir))
+            if isinstance(prepared, FileVerdict):
+                rejected[path] = _rejected_report(path, data or b"", plan, seed, prepared)
+                _announce(on_result, path, rejected[path].problems)
+            else:
+                graded[path], notebook = prepared
+                if notebook is not None:
+                    notebooks[path] = notebook
+        original = {module: path for path, module in graded.items()}
+
+        def callback(module: Path, result: ProblemResult) -> None:
+            if on_result is not None:
+                on_result(original.get(module, module), result)
+
+        worker_count = min(workers or default_workers(), max(len(graded) * len(plan.problems), 1))
+        runs: dict[str, list[ProblemRun]] = {}
+        if graded and plan.problems:
+            runs = run_acceptance(
+                list(graded.values()),
+                plan,
+                seed=seed,
+                workers=worker_count,
+                policy=policy,
+                on_result=callback,
+            )
     elapsed = time.perf_counter() - started
     return [
         rejected.get(path)
-        or build_report(
-            path, contents[path] or b"", seed, runs.get(str(path), []), plan, elapsed, worker_count
+        or with_notebook(
+            build_report(
+                path,
+                contents[path] or b"",
+                seed,
+                runs.get(str(graded[path]), []),
+                plan,
+                elapsed,
+                worker_count,
+            ),
+            notebooks.get(path),
         )
         for path in paths
     ]
+
+
+def _prepare(
+    path: Path, data: bytes | None, modules_dir: Path
+) -> tuple[Path, NotebookModule | None] | FileVerdict:
+    """The file the sandbox imports for a submission: the file itself, or the module built from a notebook."""
+    if data is None or not is_notebook(path.name):
+        return _file_verdict(path, data) or (path, None)
+    built = build_module(data, path.name)
+    if isinstance(built, FileVerdict):
+        return built
+    module = modules_dir / f"{len(list(modules_dir.iterdir()))}" / f"{path.name}.py"
+    module.parent.mkdir()
+    module.write_text(built.source, encoding="utf-8")
+    return module, built
+
+
+def with_notebook(report: Report, notebook: NotebookModule | None) -> Report:
+    """The report of a notebook: its summary attached, each problem told about the globals it lacks, and
+    tracebacks pointing at the notebook's cells rather than at the module built from them."""
+    if notebook is None:
+        return report
+    module_name = f"{report.submission}.py"
+    problems = [
+        result.model_copy(
+            update={
+                "feedback": notebook.cited(
+                    " ".join([*notebook.summary.notes_for(result.id), result.feedback]), module_name
+                ),
+                "output": notebook.cited(result.output, module_name),
+            }
+        )
+        for result in report.problems
+    ]
+    return report.model_copy(update={"notebook": notebook.summary, "problems": problems})
 
 
 def build_report(

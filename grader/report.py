@@ -9,6 +9,8 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, JsonValue
 
+from grader.notebook import NotebookSummary
+
 Status = Literal["passed", "failed", "error", "timeout", "missing"]
 
 REPORT_FORMAT = 1
@@ -120,6 +122,10 @@ class Report(BaseModel):
         default=None, description="Why the file could not be graded at all (empty, not UTF-8, not Python...)."
     )
     problems: list[ProblemResult] = Field(default_factory=list, description="One result per graded problem.")
+    notebook: NotebookSummary | None = Field(
+        default=None,
+        description="For a .ipynb submission: what ran at import and what was skipped, cell by cell.",
+    )
     grader_errors: list[str] = Field(
         default_factory=list, description="Failures of the grader itself (not the student's); normally empty."
     )
