@@ -71,7 +71,14 @@ def build_parser() -> argparse.ArgumentParser:
     check = subparsers.add_parser("check", help="grade one file and explain every verdict (for students)")
     check.add_argument("file", type=Path, metavar="FILE")
     _add_common(check)
-    check.add_argument("--json", action="store_true", help="print exactly the report JSON on stdout")
+    check.add_argument(
+        "--format",
+        choices=("text", "json", "gradescope"),
+        default="text",
+        help="text (default): live progress and a summary; json: exactly the report JSON on stdout; "
+        "gradescope: exactly Gradescope's results.json on stdout",
+    )
+    check.add_argument("--json", action="store_true", help="same as --format json")
     check.add_argument(
         "--output", type=Path, default=None, metavar="PATH", help="also write the report JSON here"
     )
@@ -91,6 +98,23 @@ def build_parser() -> argparse.ArgumentParser:
         help="grade even where the sandbox cannot enforce every isolation layer",
     )
     grade.set_defaults(handler=run_grade)
+
+    bundle = subparsers.add_parser(
+        "gradescope-bundle", help="build the Gradescope autograder zip (setup.sh, run_autograder, config)"
+    )
+    bundle.add_argument("--out", type=Path, default=Path("autograder.zip"), metavar="ZIP")
+    bundle.add_argument("--seed", type=int, default=0, help="grading seed of every submission")
+    bundle.add_argument("--config", type=Path, default=None, metavar="PATH", help="assignment configuration")
+    bundle.set_defaults(handler=run_gradescope_bundle)
+
+    gradescope_run = subparsers.add_parser(
+        "gradescope-run", help="grade ROOT/submission into ROOT/results/results.json (run_autograder)"
+    )
+    gradescope_run.add_argument("--root", type=Path, default=None, metavar="DIR")
+    gradescope_run.add_argument("--seed", type=int, default=0)
+    gradescope_run.add_argument("--config", type=Path, default=None, metavar="PATH")
+    gradescope_run.add_argument("--workers", type=_positive, default=None)
+    gradescope_run.set_defaults(handler=run_gradescope_run)
 
     for entry_point in entry_points(group=COMMAND_GROUP):
         try:
@@ -148,12 +172,13 @@ def run_check(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_ERROR
-    progress = sys.stderr if args.json else sys.stdout
+    output_format = "json" if args.json else args.format
+    progress = sys.stdout if output_format == "text" else sys.stderr
 
     def show(result: ProblemResult) -> None:
         print(result_line(result), file=progress, flush=True)
 
-    if not args.json:
+    if output_format == "text":
         print(f"Checking {args.file.name} (seed {args.seed})...", flush=True)
     report = grade_submission(
         args.file,
@@ -166,8 +191,12 @@ def run_check(args: argparse.Namespace) -> int:
     )
     if args.output is not None:
         args.output.write_text(report.to_json() + "\n", encoding="utf-8")
-    if args.json:
+    if output_format == "json":
         sys.stdout.write(report.to_json() + "\n")
+    elif output_format == "gradescope":
+        from grader.gradescope import results
+
+        sys.stdout.write(results(report).model_dump_json(indent=2) + "\n")
     else:
         print(summary(report))
     if report.grader_errors:
@@ -224,6 +253,28 @@ def isolation_lines(isolation: dict[str, Any]) -> list[str]:
         if layer.get("required") and not layer.get("active")
     ]
     return lines
+
+
+def run_gradescope_bundle(args: argparse.Namespace) -> int:
+    """`gymgrade gradescope-bundle`: write the autograder zip to upload to Gradescope."""
+    from grader.config import load_config
+    from grader.gradescope import bundle
+
+    load_config(args.config)  # an invalid configuration fails here, not on Gradescope
+    path = bundle(args.out, config=args.config, seed=args.seed)
+    print(f"Wrote {path} ({path.stat().st_size:,} bytes): upload it as the assignment's autograder.")
+    return 0
+
+
+def run_gradescope_run(args: argparse.Namespace) -> int:
+    """`gymgrade gradescope-run`: what the bundle's run_autograder calls; always writes results.json."""
+    from grader.gradescope import default_root, run_autograder
+
+    graded = run_autograder(
+        args.root or default_root(), seed=args.seed, config=args.config, workers=args.workers
+    )
+    print(f"Score: {graded.score:g}")
+    return 0
 
 
 def run_grade(args: argparse.Namespace) -> int:
