@@ -82,6 +82,13 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument(
         "--output", type=Path, default=None, metavar="PATH", help="also write the report JSON here"
     )
+    check.add_argument(
+        "--html",
+        type=Path,
+        default=None,
+        metavar="PATH",
+        help="also write a self-contained HTML report with plots and replays of your episodes",
+    )
     check.set_defaults(handler=run_check)
 
     grade = subparsers.add_parser(
@@ -191,6 +198,11 @@ def run_check(args: argparse.Namespace) -> int:
     )
     if args.output is not None:
         args.output.write_text(report.to_json() + "\n", encoding="utf-8")
+    if args.html is not None:
+        from grader.config import load_config
+        from grader.html_report import render_html
+
+        args.html.write_text(render_html(report, load_config(args.config)), encoding="utf-8")
     if output_format == "json":
         sys.stdout.write(report.to_json() + "\n")
     elif output_format == "gradescope":

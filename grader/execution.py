@@ -16,6 +16,7 @@ from grader.problems import ProblemId
 from grader.report import ProblemResult, ProblemRun, Timings, cap_output, plain_json
 from grader.sandbox import CallOutcome, IsolationPolicy, IsolationReport, Sandbox
 from grader.sandbox.replay import replay_episodes
+from grader.showcase import showcase_episode
 
 MAX_COMPAT_EVENTS = 20
 """Distinct compatibility events kept per problem: enough to explain, bounded for 100-call problems."""
@@ -92,6 +93,7 @@ def run_problem(
         output=cap_output(student_output(outcomes)),
         compat_events=_distinct_events(outcomes),
         seed=seed,
+        replay=showcase_episode(problem, records),
         timings=Timings(
             wall_seconds=wall_seconds,
             student_seconds=student_seconds,

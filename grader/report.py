@@ -49,6 +49,19 @@ class GradingTimings(BaseModel):
     )
 
 
+class EpisodeReplay(BaseModel):
+    """Enough to re-render one episode the student played: the game, its reset seed and the actions."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    label: str = Field(description="Which episode this is, in words ('your shortest of 100 episodes').")
+    env_id: str = Field(description="The gymnasium id the episode was played and replayed in.")
+    reset_seed: int = Field(description="The seed the episode was reset with.")
+    actions: list[int] = Field(description="The actions, in order, until the episode ended.")
+    length: int = Field(description="Steps until the episode ended (as replayed).")
+    total_reward: float = Field(description="Sum of the replayed rewards.")
+
+
 class ProblemResult(BaseModel):
     """The verdict on one problem of one submission."""
 
@@ -69,6 +82,9 @@ class ProblemResult(BaseModel):
         description="What the lab-compatibility layer had to tolerate (e.g. steps after the episode ended).",
     )
     seed: int = Field(default=0, description="The sandbox seed this problem ran with.")
+    replay: EpisodeReplay | None = Field(
+        default=None, description="The episode the HTML report animates (CartPole, MountainCar, Taxi)."
+    )
     timings: Timings | None = Field(
         default=None, description="Where the check's time went (not deterministic)."
     )
