@@ -190,7 +190,8 @@ def test_the_check_summary_lists_what_was_skipped_cell_by_cell() -> None:
         max_score=0, notebook=module.summary,
     )  # fmt: skip
     assert summary(report).splitlines()[1:4] == [
-        "Notebook: 2 imports, definitions and constants from 2 code cells ran at import; 2 statements did not:",
+        "Notebook: 2 imports, definitions and constants from 2 code cells ran at import; "
+        "2 statements did not:",
         "  cell 1 (no run), line 1: !pip install gym  <- shell command",
         "  cell 2 (no run), line 3: print(cartpole())  <- call of print(...) (a demo, not run at import)",
     ]
