@@ -46,6 +46,9 @@ CHEAP_CALLS: frozenset[str] = frozenset(
 """Calls an assignment may make and still run at import: constructors that cost nothing and are how real
 notebooks set up shared state (``env = gym.make("CartPole-v0")``, ``q = np.zeros((500, 6))``)."""
 
+PYTHON_CELL_MAGICS = frozenset({"%%time", "%%capture"})
+"""Cell magics whose cell is Python run in the notebook's namespace, so its definitions count; the body
+of any other cell magic (``%%bash``, ``%%writefile``, ``%%timeit``, ...) is not the module's code."""
 _MAGIC_LINE = re.compile(r"^\s*(?:[%!?]|[A-Za-z_][\w.]*\s*=\s*[%!])|^\s*[\w.]+\?{1,2}\s*$")
 _MAIN_GUARD = "__main__"
 
@@ -267,9 +270,16 @@ def _invalid(name: str, error: Exception) -> FileVerdict:
 
 def _add_cell(builder: _Builder, cell: _Cell, name: str) -> FileVerdict | None:
     first = cell.source.lstrip().splitlines()[0]
-    if first.startswith("%%"):
-        _skip_cell(builder, cell, f"cell magic {first.split()[0]}: the whole cell is left out")
+    magic = first.split()[0] if first.startswith("%%") else None
+    if magic is not None and magic not in PYTHON_CELL_MAGICS:
+        _skip_cell(builder, cell, f"cell magic {magic}: the whole cell is left out")
         return None
+    if magic is not None:  # the magic line goes; the cell's Python is judged statement by statement
+        _skip_cell(builder, cell, f"cell magic {magic} (the cell's statements are judged like any other's)")
+        lines = cell.source.splitlines()
+        index = next(number for number, line in enumerate(lines) if line.strip())
+        lines[index] = ""
+        cell = _Cell(cell.number, cell.execution_count, "\n".join(lines))
     source = cell.source
     try:
         tree = ast.parse(source)

@@ -40,7 +40,7 @@ COMPUTED = "assignment computed by a call (a demo or training run, not run at im
         ("%matplotlib inline", "IPython magic"),
         ("files = !ls", "shell command"),
         ("gym.make?", "help request"),
-        ("%%time\nx = 1", "cell magic %%time: the whole cell is left out"),
+        ("%%bash\nls", "cell magic %%bash: the whole cell is left out"),
         ("print(cartpole())", "call of print(...) (a demo, not run at import)"),
         ("cartpole()", "call of cartpole(...) (a demo, not run at import)"),
         ("env.action_space", "expression whose value Jupyter displays"),
@@ -53,7 +53,7 @@ COMPUTED = "assignment computed by a call (a demo or training run, not run at im
         ("with open('x') as f:\n    pass", "`with` block (a demo, not run at import)"),
         ("d = {}\nd['k'] = 1", "assignment into an object (not run at import)"),
     ],
-    ids=["shell", "line-magic", "shell-assignment", "help", "cell-magic", "print", "call", "display", "loop",
+    ids=["shell", "line-magic", "shell-assignment", "help", "bash-cell", "print", "call", "display", "loop",
          "training-run", "comprehension-of-calls", "main-guard", "render-demo", "with", "item-assignment"],
 )  # fmt: skip
 def test_demo_statements_are_skipped_and_listed(cell: str, reason: str) -> None:
@@ -117,6 +117,15 @@ def test_tracebacks_point_at_the_notebook_cell() -> None:
     line = module.source.splitlines().index("    return y") + 1
     cited = module.cited(f'File "/submission/lab.ipynb.py", line {line}, in car', "lab.ipynb.py")
     assert cited == 'File "lab.ipynb", cell 2, line 4, in car'
+
+
+def test_a_time_cell_keeps_its_definitions_and_skips_its_demos() -> None:
+    module = built("import gym", "%%time\n" + DEFINITION + "\nprint(cartpole())")
+    assert [(entry.line, entry.reason) for entry in module.summary.skipped] == [
+        (1, "cell magic %%time (the cell's statements are judged like any other's)"),
+        (4, "call of print(...) (a demo, not run at import)"),
+    ]
+    assert "def cartpole" in module.source
 
 
 def test_future_imports_move_to_the_top() -> None:
