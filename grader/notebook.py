@@ -568,12 +568,15 @@ def _bound_names(statement: ast.stmt) -> set[str]:
 def _unbound_globals(source: str, skipped_bindings: dict[str, SkippedCode]) -> list[UnboundGlobal]:
     """For each top-level function, the skipped-only globals its body reads, directly or via calls."""
     module = symtable.symtable(source, "notebook", "exec")
-    reads: dict[str, set[str]] = {}
+    reads: dict[str, set[str]] = {}  # top-level functions and classes (a class reads what its methods read)
+    functions: list[str] = []
     for child in module.get_children():
-        if child.get_type() == "function":
+        if child.get_type() in ("function", "class"):
             reads[child.get_name()] = set(_globals_read(child))
+            if child.get_type() == "function":
+                functions.append(child.get_name())
     entries: list[UnboundGlobal] = []
-    for function in sorted(reads):
+    for function in sorted(functions):
         reachable, frontier = {function}, [function]
         while frontier:
             for name in reads[frontier.pop()]:

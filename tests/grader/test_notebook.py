@@ -107,6 +107,15 @@ def test_a_global_set_only_by_a_skipped_statement_is_named_for_every_function_re
     ]
 
 
+def test_a_global_read_by_a_method_of_a_class_the_function_uses_is_named() -> None:
+    module = built(
+        "table = train()",
+        "class Agent:\n    def act(self, state):\n        return table[state]",
+        "def taxi():\n    return Agent().act(0)",
+    )
+    assert [(entry.function, entry.name) for entry in module.summary.unbound_globals] == [("taxi", "table")]
+
+
 def test_a_global_that_a_kept_statement_also_sets_is_not_reported() -> None:
     module = built("q = compute()", "q = None", "def taxi():\n    return q")
     assert module.summary.unbound_globals == []
