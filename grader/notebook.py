@@ -18,6 +18,7 @@ import builtins
 import json
 import re
 import symtable
+import warnings
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 
@@ -213,7 +214,9 @@ def _read_cells(data: bytes, name: str) -> list[_Cell] | FileVerdict:
         return FileVerdict("missing", f"{name} is empty: nothing to grade. Submit your saved notebook.")
     try:
         text = data.decode("utf-8")
-        notebook = nbformat.reads(text, as_version=nbformat.NO_CONVERT)  # type: ignore[no-untyped-call]
+        with warnings.catch_warnings():  # nbformat warns about what Jupyter repairs silently (cell ids)
+            warnings.simplefilter("ignore")
+            notebook = nbformat.reads(text, as_version=nbformat.NO_CONVERT)  # type: ignore[no-untyped-call]
     except (UnicodeDecodeError, json.JSONDecodeError, nbformat.reader.NotJSONError) as error:
         detail = str(error).splitlines()[0][:200] if str(error) else type(error).__name__
         return FileVerdict(
@@ -223,10 +226,10 @@ def _read_cells(data: bytes, name: str) -> list[_Cell] | FileVerdict:
         )
     except nbformat.ValidationError as error:
         return _invalid(name, error)
-    except (ValueError, TypeError, KeyError, AttributeError) as error:
+    except (ValueError, TypeError, KeyError, AttributeError):
         return FileVerdict(
             "error",
-            f"{name} is JSON but not a Jupyter notebook ({type(error).__name__}: {str(error)[:200]}). "
+            f'{name} is JSON but not a Jupyter notebook (expected an object with "nbformat" and "cells"). '
             "Submit the .ipynb file Jupyter saved, or your code as a .py file.",
         )
     version = notebook.get("nbformat")
@@ -237,7 +240,9 @@ def _read_cells(data: bytes, name: str) -> list[_Cell] | FileVerdict:
             "since 2015). Open it in a current Jupyter, save it, and submit again.",
         )
     try:
-        nbformat.validate(notebook)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            nbformat.validate(notebook)
     except nbformat.ValidationError as error:
         return _invalid(name, error)
     language = str(notebook.get("metadata", {}).get("language_info", {}).get("name", "python"))
