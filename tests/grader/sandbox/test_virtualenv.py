@@ -37,9 +37,13 @@ def test_a_package_only_the_virtualenv_holds_is_importable_in_the_sandbox(tmp_pa
     (Path(site) / "venv_only").mkdir(parents=True)
     (Path(site) / "venv_only" / "__init__.py").write_text("VALUE = 42\n")
     submission = tmp_path / "opengym.py"
-    submission.write_text("import venv_only\n\ndef random_blackjack(n):\n    return venv_only.VALUE / 100\n")
+    submission.write_text(
+        "import os, venv_only\n\ndef random_blackjack(n):\n"
+        "    with open('/tmp/scratch.txt', 'w') as scratch:\n        scratch.write('still writable')\n"
+        "    return venv_only.VALUE / 100 + os.stat('/tmp').st_mode % 0o10000\n"
+    )
     result = subprocess.run(
         [str(python), "-c", PROBE, str(submission)],
         env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=120,
     )  # fmt: skip
-    assert result.stdout.strip() == "ok 0.42", result.stdout + result.stderr
+    assert result.stdout.strip() == f"ok {0.42 + 0o1777}", result.stdout + result.stderr  # scratch: 1777
