@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from api.errors import InvalidUpload, UploadTooLarge
+from grader.notebook import NOTEBOOK_SUFFIX
 
 MAX_DISPLAY_NAME_CHARS = 100
 _UNSAFE_NAME_CHARACTERS = re.compile(r"[^A-Za-z0-9._ -]+")
@@ -17,8 +18,18 @@ GRADING_FALLBACK_NAME = "submission.py"
 # The rules of check_upload as a JSON Schema for the file's text (UTF-8): no NUL, not only whitespace
 # (bytes.strip() strips exactly these six ASCII characters), and for its multipart Content-Disposition.
 SOURCE_TEXT_PATTERN = r"^[^\u0000]*[^\u0000\t\n\u000b\u000c\r ][^\u0000]*$"
-CONTENT_DISPOSITION_PATTERN = r'filename="(?:[^"]*[/\\])?[^"/\\]*[^"/\\. ][^"/\\]*\.[Pp][Yy]"'
-ACCEPTED_CONTENT_TYPES = ("text/x-python", "text/plain", "application/octet-stream")
+CONTENT_DISPOSITION_PATTERN = (
+    r'filename="(?:[^"]*[/\\])?[^"/\\]*[^"/\\. ][^"/\\]*\.(?:[Pp][Yy]|[Ii][Pp][Yy][Nn][Bb])"'
+)
+ACCEPTED_CONTENT_TYPES = (
+    "text/x-python",
+    "text/plain",
+    "application/octet-stream",
+    "application/x-ipynb+json",
+    "application/json",
+)
+SUBMISSION_SUFFIXES = (".py", NOTEBOOK_SUFFIX)
+"""What may be uploaded: a Python source, or a Jupyter notebook whose code cells the grader extracts."""
 
 
 @dataclass(frozen=True)
@@ -47,7 +58,8 @@ def upload_rules(max_bytes: int) -> tuple[dict[str, Any], dict[str, Any]]:
         "maxLength": max_bytes,
         "pattern": SOURCE_TEXT_PATTERN,
         "description": (
-            f"The student's opengym.py: Python source in UTF-8, at most {max_bytes} bytes (maxLength counts "
+            f"The student's opengym.py (Python source) or opengym.ipynb (a Jupyter notebook), UTF-8, at "
+            f"most {max_bytes} bytes (maxLength counts "
             "characters; each non-ASCII character takes 2 to 4 of the bytes), without NUL bytes, "
             "not empty or blank. Syntax errors are accepted: the grader reports them."
         ),
@@ -57,8 +69,8 @@ def upload_rules(max_bytes: int) -> tuple[dict[str, Any], dict[str, Any]]:
         "headers": {
             "Content-Disposition": {
                 "description": (
-                    "The part's file name must end in .py (like opengym.py); only its last path component "
-                    "is kept, as a sanitised display name."
+                    "The part's file name must end in .py or .ipynb (like opengym.py); only its last path "
+                    "component is kept, as a sanitised display name."
                 ),
                 "required": True,
                 "schema": {"type": "string", "pattern": CONTENT_DISPOSITION_PATTERN},
@@ -84,18 +96,24 @@ def display_name(client_name: str | None) -> str:
     name = _UNSAFE_NAME_CHARACTERS.sub("_", name).lstrip(". ").strip()
     if len(name) <= MAX_DISPLAY_NAME_CHARS:
         return name
-    suffix = ".py" if name.lower().endswith(".py") else ""
+    suffix = _suffix(name)
     return name[: MAX_DISPLAY_NAME_CHARS - len(suffix)] + suffix
+
+
+def _suffix(name: str) -> str:
+    return next((suffix for suffix in SUBMISSION_SUFFIXES if name.lower().endswith(suffix)), "")
 
 
 def grading_file_name(name: str) -> str:
     """The file name a submission is graded under: its display name when it is a valid module name."""
-    stem = name.removesuffix(".py")
-    return name if name.endswith(".py") and _MODULE_STEM.fullmatch(stem) else GRADING_FALLBACK_NAME
+    suffix = next((suffix for suffix in SUBMISSION_SUFFIXES if name.endswith(suffix)), None)
+    if suffix is not None and _MODULE_STEM.fullmatch(name.removesuffix(suffix)):
+        return name
+    return GRADING_FALLBACK_NAME.removesuffix(".py") + (suffix or ".py")
 
 
 def check_upload(client_name: str | None, content: bytes, *, max_bytes: int) -> CheckedUpload:
-    """Accept a Python source file or say precisely why it cannot be graded.
+    """Accept a Python source file or notebook, or say precisely why it cannot be graded.
 
     Args:
         client_name: The file name the client sent.
@@ -107,16 +125,18 @@ def check_upload(client_name: str | None, content: bytes, *, max_bytes: int) -> 
 
     Raises:
         UploadTooLarge: More than ``max_bytes`` bytes.
-        InvalidUpload: Not a ``.py`` name, empty, binary (NUL bytes) or not UTF-8.
+        InvalidUpload: Not a ``.py`` or ``.ipynb`` name, empty, binary (NUL bytes) or not UTF-8.
     """
     if len(content) > max_bytes:
         raise UploadTooLarge(
             f"the file is larger than the limit of {max_bytes} bytes; upload only your opengym.py source"
         )
     name = display_name(client_name)
-    if not name.lower().endswith(".py") or name.lower() == ".py":
+    suffix = _suffix(name)
+    if not suffix or name.lower() == suffix:
         raise InvalidUpload(
-            f"expected a Python file named like opengym.py, found the name {name or '(none)'!r}"
+            "expected a Python file named like opengym.py or a notebook named like opengym.ipynb, "
+            f"found the name {name or '(none)'!r}"
         )
     if not content.strip():
         raise InvalidUpload(f"{name} is empty; upload the file with your functions in it")

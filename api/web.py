@@ -2,11 +2,18 @@
 
 from __future__ import annotations
 
+import functools
+import json
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 from fastapi.templating import Jinja2Templates
 
 from api.plots import problem_plots
+from grader.config import load_config
+from grader.figures import Figure, all_figures
+from grader.report import Report
 
 TEMPLATES_DIR = Path(__file__).with_name("templates")
 STATIC_DIR = Path(__file__).with_name("static")
@@ -14,6 +21,32 @@ STATIC_DIR = Path(__file__).with_name("static")
 templates = Jinja2Templates(directory=TEMPLATES_DIR)
 templates.env.autoescape = True
 templates.env.globals["problem_plots"] = problem_plots
+
+
+def report_figures(report: Mapping[str, Any] | None) -> dict[str, list[Figure]]:
+    """The plots and replays of a finished report, by problem id (drawn once per report, then cached).
+
+    Args:
+        report: The stored report, or None while the grading runs.
+
+    Returns:
+        The figures; empty for no report or one that is not a grader report.
+    """
+    if not report:
+        return {}
+    try:
+        return _figures(json.dumps(report, sort_keys=True))
+    except (ValueError, TypeError, KeyError):  # a report of another layout: the page shows it without figures
+        return {}
+
+
+@functools.lru_cache(maxsize=32)
+def _figures(report_json: str) -> dict[str, list[Figure]]:
+    report = Report.model_validate_json(report_json)
+    return all_figures(report.problems, load_config(None))
+
+
+templates.env.globals["report_figures"] = report_figures
 
 PAGE_HEADERS = {
     "Content-Security-Policy": (

@@ -24,6 +24,7 @@ from pydantic import ValidationError
 import grader
 from grader.errors import BatchInterrupted
 from grader.grading import GradingPlan, grade_files
+from grader.notebook import NOTEBOOK_SUFFIX
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
 
@@ -32,6 +33,7 @@ CHUNK_SUBMISSIONS = 24
 takes few results with it (its unfinished problems are reported as grader errors, the batch goes on)."""
 
 GRADES_FILE = "grades.csv"
+SUBMISSION_SUFFIXES = (".py", NOTEBOOK_SUFFIX)
 
 ReportCallback = Callable[[Path, Report], None]
 ResultCallback = Callable[[Path, ProblemResult], None]
@@ -92,7 +94,9 @@ class LocalExecutor:
 
 
 def collect_submissions(targets: Sequence[Path]) -> list[Path]:
-    """The ``.py`` files named, and those under the directories named (recursively, sorted).
+    """The ``.py`` and ``.ipynb`` files named, and those under the directories named (recursively, sorted).
+
+    Jupyter's ``.ipynb_checkpoints`` copies are left out with every other hidden directory.
 
     Raises:
         FileNotFoundError: A target does not exist.
@@ -102,13 +106,17 @@ def collect_submissions(targets: Sequence[Path]) -> list[Path]:
         if target.is_dir():
             files += sorted(
                 path
-                for path in target.rglob("*.py")
-                if path.is_file() and not any(part.startswith(".") for part in path.parts)
+                for path in target.rglob("*")
+                if path.suffix.lower() in SUBMISSION_SUFFIXES
+                and path.is_file()
+                and not any(part.startswith(".") for part in path.relative_to(target).parts)
             )
         elif target.exists():
             files.append(target)
         else:
-            raise FileNotFoundError(f"{target} does not exist: pass .py files or directories holding them")
+            raise FileNotFoundError(
+                f"{target} does not exist: pass .py or .ipynb files or directories holding them"
+            )
     return files
 
 

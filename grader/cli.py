@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError
+from grader.notebook import NotebookSummary
 from grader.problems import PROBLEM_IDS
 from grader.progress import ProgressBar, result_line
 from grader.report import ProblemResult, Report
@@ -87,9 +88,23 @@ def build_parser() -> argparse.ArgumentParser:
         check,
         f"seed of the starts (default: the practice seed {PRACTICE_SEED}; instructors grade on another)",
     )
-    check.add_argument("--json", action="store_true", help="print exactly the report JSON on stdout")
+    check.add_argument(
+        "--format",
+        choices=("text", "json", "gradescope"),
+        default="text",
+        help="text (default): live progress and a summary; json: exactly the report JSON on stdout; "
+        "gradescope: exactly Gradescope's results.json on stdout",
+    )
+    check.add_argument("--json", action="store_true", help="same as --format json")
     check.add_argument(
         "--output", type=Path, default=None, metavar="PATH", help="also write the report JSON here"
+    )
+    check.add_argument(
+        "--html",
+        type=Path,
+        default=None,
+        metavar="PATH",
+        help="also write a self-contained HTML report with plots and replays of your episodes",
     )
     check.set_defaults(handler=run_check)
 
@@ -111,6 +126,28 @@ def build_parser() -> argparse.ArgumentParser:
         help="grade even where the sandbox cannot enforce every isolation layer",
     )
     grade.set_defaults(handler=run_grade)
+
+    bundle = subparsers.add_parser(
+        "gradescope-bundle", help="build the Gradescope autograder zip (setup.sh, run_autograder, config)"
+    )
+    bundle.add_argument("--out", type=Path, default=Path("autograder.zip"), metavar="ZIP")
+    bundle.add_argument(
+        "--seed",
+        type=_seed,
+        default=None,
+        help="grading seed of every submission (default: a held-out seed drawn at random and printed)",
+    )
+    bundle.add_argument("--config", type=Path, default=None, metavar="PATH", help="assignment configuration")
+    bundle.set_defaults(handler=run_gradescope_bundle)
+
+    gradescope_run = subparsers.add_parser(
+        "gradescope-run", help="grade ROOT/submission into ROOT/results/results.json (run_autograder)"
+    )
+    gradescope_run.add_argument("--root", type=Path, default=None, metavar="DIR")
+    gradescope_run.add_argument("--seed", type=int, default=0)
+    gradescope_run.add_argument("--config", type=Path, default=None, metavar="PATH")
+    gradescope_run.add_argument("--workers", type=_positive, default=None)
+    gradescope_run.set_defaults(handler=run_gradescope_run)
 
     for entry_point in entry_points(group=COMMAND_GROUP):
         try:
@@ -163,15 +200,19 @@ def run_check(args: argparse.Namespace) -> int:
     from grader.grading import grade_submission
 
     if not args.file.is_file():
-        print(f"gymgrade check: {args.file} is not a file: pass the path of your .py file", file=sys.stderr)
+        print(
+            f"gymgrade check: {args.file} is not a file: pass the path of your .py or .ipynb file",
+            file=sys.stderr,
+        )
         return EXIT_ERROR
-    progress = sys.stderr if args.json else sys.stdout
+    output_format = "json" if args.json else args.format
+    progress = sys.stdout if output_format == "text" else sys.stderr
     seed = PRACTICE_SEED if args.seed is None else args.seed
 
     def show(result: ProblemResult) -> None:
         print(result_line(result), file=progress, flush=True)
 
-    if not args.json:
+    if output_format == "text":
         print(f"Checking {args.file.name} (practice seed {seed})...", flush=True)
     report = grade_submission(
         args.file,
@@ -184,8 +225,17 @@ def run_check(args: argparse.Namespace) -> int:
     )
     if args.output is not None:
         args.output.write_text(report.to_json() + "\n", encoding="utf-8")
-    if args.json:
+    if args.html is not None:
+        from grader.config import load_config
+        from grader.html_report import render_html
+
+        args.html.write_text(render_html(report, load_config(args.config)), encoding="utf-8")
+    if output_format == "json":
         sys.stdout.write(report.to_json() + "\n")
+    elif output_format == "gradescope":
+        from grader.gradescope import results
+
+        sys.stdout.write(results(report).model_dump_json(indent=2) + "\n")
     else:
         print(summary(report))
     if report.grader_errors:
@@ -196,6 +246,8 @@ def run_check(args: argparse.Namespace) -> int:
 def summary(report: Report) -> str:
     """The readable end of `gymgrade check`: every verdict's feedback, the total, the isolation."""
     lines = [""]
+    if report.notebook is not None:
+        lines += notebook_lines(report.notebook)
     if report.submission_error is not None:
         lines.append(report.submission_error)
     else:
@@ -211,6 +263,18 @@ def summary(report: Report) -> str:
     lines += isolation_lines(report.isolation)
     lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
     return "\n".join(lines)
+
+
+def notebook_lines(notebook: NotebookSummary) -> list[str]:
+    """What of a notebook ran at import, and every statement that did not, cell by cell."""
+    lines = [
+        f"Notebook: {notebook.kept_statements} imports, definitions and constants from "
+        f"{notebook.code_cells} code cells ran at import; {len(notebook.skipped)} statements did not:"
+    ]
+    for entry in notebook.skipped:
+        label = f"In [{entry.execution_count}]" if entry.execution_count is not None else "no run"
+        lines.append(f"  cell {entry.cell} ({label}), line {entry.line}: {entry.code}  <- {entry.reason}")
+    return [*lines, ""]
 
 
 def isolation_lines(isolation: dict[str, Any]) -> list[str]:
@@ -253,13 +317,37 @@ def choose_seed(given: int | None, out_dir: Path) -> int:
     return seed
 
 
+def run_gradescope_bundle(args: argparse.Namespace) -> int:
+    """`gymgrade gradescope-bundle`: write the autograder zip to upload to Gradescope."""
+    from grader.config import load_config
+    from grader.gradescope import bundle
+
+    load_config(args.config)  # an invalid configuration fails here, not on Gradescope
+    seed = held_out_seed() if args.seed is None else args.seed
+    print(f"Grading seed {seed} (kept in the bundle, never shown to students; rebuild with --seed {seed})")
+    path = bundle(args.out, config=args.config, seed=seed)
+    print(f"Wrote {path} ({path.stat().st_size:,} bytes): upload it as the assignment's autograder.")
+    return 0
+
+
+def run_gradescope_run(args: argparse.Namespace) -> int:
+    """`gymgrade gradescope-run`: what the bundle's run_autograder calls; always writes results.json."""
+    from grader.gradescope import default_root, run_autograder
+
+    graded = run_autograder(
+        args.root or default_root(), seed=args.seed, config=args.config, workers=args.workers
+    )
+    print(f"Score: {graded.score:g}")
+    return 0
+
+
 def run_grade(args: argparse.Namespace) -> int:
     """`gymgrade grade`: grade every file not yet graded in --out, keep each report as it is done."""
     from grader.batch import BatchOutcome, collect_submissions, grade_many
 
     paths = collect_submissions(args.targets)
     if not paths:
-        print("gymgrade grade: no .py files found in the given targets", file=sys.stderr)
+        print("gymgrade grade: no .py or .ipynb files found in the given targets", file=sys.stderr)
         return EXIT_ERROR
     policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
     executor = find_executor(policy)

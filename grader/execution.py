@@ -17,6 +17,7 @@ from grader.games import allowed_games
 from grader.problems import ProblemId
 from grader.report import ProblemResult, ProblemRun, Timings, cap_output, plain_json
 from grader.sandbox import CallOutcome, IsolationPolicy, IsolationReport, Sandbox
+from grader.showcase import showcase_episode
 
 MAX_COMPAT_EVENTS = 20
 """Distinct compatibility events kept per problem: enough to explain, bounded for 100-call problems."""
@@ -105,6 +106,7 @@ def run_problem(
         compat_events=_distinct_events(outcomes),
         seed=seed,
         visibility=settings.visibility,
+        replay=showcase_episode(problem, records),
         timings=Timings(
             wall_seconds=wall_seconds,
             student_seconds=student_seconds,

@@ -18,6 +18,7 @@ from pathlib import Path
 import grader
 from grader.config import load_config
 from grader.execution import problem_seed
+from grader.notebook import NotebookModule, build_module, is_notebook
 from grader.problems import PROBLEM_IDS, ProblemId
 from grader.progress import ResultsFollower
 from grader.report import GradingTimings, ProblemResult, ProblemRun, Report, Visibility
@@ -146,40 +147,90 @@ def grade_files(
     started = time.perf_counter()
     contents = {path: _read(path) for path in paths}
     reports: dict[Path, Report] = {}
-    for path, data in contents.items():
-        verdict = _file_verdict(path, data)
-        if verdict is not None:
-            reports[path] = _rejected_report(path, data or b"", plan, seed, verdict)
-            _announce(on_result, path, reports[path].problems)
+    with tempfile.TemporaryDirectory(prefix="gymgrade-modules-") as modules_dir:
+        graded: dict[Path, Path] = {}
+        notebooks: dict[Path, NotebookModule] = {}
+        for path, data in contents.items():
+            prepared = _prepare(path, data, Path(modules_dir))
+            if isinstance(prepared, FileVerdict):
+                reports[path] = _rejected_report(path, data or b"", plan, seed, prepared)
+                _announce(on_result, path, reports[path].problems)
+                if on_report is not None:
+                    on_report(path, reports[path])
+            else:
+                graded[path], notebook = prepared
+                if notebook is not None:
+                    notebooks[path] = notebook
+        original = {module: path for path, module in graded.items()}
+        worker_count = min(workers or default_workers(), max(len(graded) * len(plan.problems), 1))
+        runs: dict[str, list[ProblemRun]] = {}
+
+        def finish(path: Path, runs_of_path: Sequence[ProblemRun]) -> Report:
+            elapsed = time.perf_counter() - started
+            report = with_notebook(
+                build_report(path, contents[path] or b"", seed, runs_of_path, plan, elapsed, worker_count),
+                notebooks.get(path),
+            )
+            reports[path] = report
             if on_report is not None:
-                on_report(path, reports[path])
-    runnable = [path for path in paths if path not in reports]
-    worker_count = min(workers or default_workers(), max(len(runnable) * len(plan.problems), 1))
-    runs: dict[str, list[ProblemRun]] = {}
+                on_report(path, report)
+            return report
 
-    def finish(path: Path, runs_of_path: Sequence[ProblemRun]) -> Report:
-        elapsed = time.perf_counter() - started
-        report = build_report(path, contents[path] or b"", seed, runs_of_path, plan, elapsed, worker_count)
-        reports[path] = report
-        if on_report is not None:
-            on_report(path, report)
+        def callback(module: Path, result: ProblemResult) -> None:
+            if on_result is not None:
+                on_result(original.get(module, module), result)
+
+        def collect(module: Path, runs_of_path: Sequence[ProblemRun]) -> None:
+            path = original.get(module, module)
+            if len(runs_of_path) == len(plan.problems) and path not in reports:
+                finish(path, runs_of_path)
+
+        if graded and plan.problems:
+            runs = run_acceptance(
+                list(graded.values()),
+                plan,
+                seed=seed,
+                workers=worker_count,
+                policy=policy,
+                on_result=callback,
+                on_runs=collect,
+            )
+        return [reports.get(path) or finish(path, runs.get(str(graded[path]), [])) for path in paths]
+
+
+def _prepare(
+    path: Path, data: bytes | None, modules_dir: Path
+) -> tuple[Path, NotebookModule | None] | FileVerdict:
+    """The file the sandbox imports for a submission: the file itself, or the module built from a notebook."""
+    if data is None or not is_notebook(path.name):
+        return _file_verdict(path, data) or (path, None)
+    built = build_module(data, path.name)
+    if isinstance(built, FileVerdict):
+        return built
+    module = modules_dir / f"{len(list(modules_dir.iterdir()))}" / f"{path.name}.py"
+    module.parent.mkdir()
+    module.write_text(built.source, encoding="utf-8")
+    return module, built
+
+
+def with_notebook(report: Report, notebook: NotebookModule | None) -> Report:
+    """The report of a notebook: its summary attached, each problem told about the globals it lacks, and
+    tracebacks pointing at the notebook's cells rather than at the module built from them."""
+    if notebook is None:
         return report
-
-    def collect(path: Path, runs_of_path: Sequence[ProblemRun]) -> None:
-        if len(runs_of_path) == len(plan.problems) and path not in reports:
-            finish(path, runs_of_path)
-
-    if runnable and plan.problems:
-        runs = run_acceptance(
-            runnable,
-            plan,
-            seed=seed,
-            workers=worker_count,
-            policy=policy,
-            on_result=on_result,
-            on_runs=collect,
+    module_name = f"{report.submission}.py"
+    problems = [
+        result.model_copy(
+            update={
+                "feedback": notebook.cited(
+                    " ".join([*notebook.summary.notes_for(result.id), result.feedback]), module_name
+                ),
+                "output": notebook.cited(result.output, module_name),
+            }
         )
-    return [reports.get(path) or finish(path, runs.get(str(path), [])) for path in paths]
+        for result in report.problems
+    ]
+    return report.model_copy(update={"notebook": notebook.summary, "problems": problems})
 
 
 def build_report(

@@ -10,6 +10,8 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, JsonValue
 
+from grader.notebook import NotebookSummary
+
 Status = Literal["passed", "failed", "error", "timeout", "missing"]
 Visibility = Literal["visible", "after_due_date", "hidden"]
 """Who sees a problem's result and feedback (Gradescope's words): students at once, after the due date, or
@@ -51,6 +53,19 @@ class GradingTimings(BaseModel):
     )
 
 
+class EpisodeReplay(BaseModel):
+    """Enough to re-render one episode the student played: the game, its reset seed and the actions."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    label: str = Field(description="Which episode this is, in words ('your shortest of 100 episodes').")
+    env_id: str = Field(description="The gymnasium id the episode was played and replayed in.")
+    reset_seed: int = Field(description="The seed the episode was reset with.")
+    actions: list[int] = Field(description="The actions, in order, until the episode ended.")
+    length: int = Field(description="Steps until the episode ended (as replayed).")
+    total_reward: float = Field(description="Sum of the replayed rewards.")
+
+
 class ProblemResult(BaseModel):
     """The verdict on one problem of one submission."""
 
@@ -74,6 +89,9 @@ class ProblemResult(BaseModel):
     visibility: Visibility = Field(
         default="visible",
         description="visible, after_due_date or hidden: when students may see this result (from the config).",
+    )
+    replay: EpisodeReplay | None = Field(
+        default=None, description="The episode the HTML report animates (CartPole, MountainCar, Taxi)."
     )
     timings: Timings | None = Field(
         default=None, description="Where the check's time went (not deterministic)."
@@ -161,6 +179,10 @@ class Report(BaseModel):
         default=None, description="Why the file could not be graded at all (empty, not UTF-8, not Python...)."
     )
     problems: list[ProblemResult] = Field(default_factory=list, description="One result per graded problem.")
+    notebook: NotebookSummary | None = Field(
+        default=None,
+        description="For a .ipynb submission: what ran at import and what was skipped, cell by cell.",
+    )
     grader_errors: list[str] = Field(
         default_factory=list, description="Failures of the grader itself (not the student's); normally empty."
     )

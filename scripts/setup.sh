@@ -1,8 +1,18 @@
 #!/usr/bin/env bash
 # Set up a fresh Debian machine for gymgrade: system packages, then the project and its Python packages.
 # Idempotent; safe to run again. Needs root (or sudo) for the Debian packages.
+#
+# Where the project is installed:
+#   - into the interpreter `python3` (or $PYTHON) when pip may install there (pyenv, a virtualenv, ...);
+#   - into the project virtualenv $GYMGRADE_VENV (default .venv) when the interpreter is externally
+#     managed (PEP 668: Debian's and Ubuntu's own python3), or when GYMGRADE_USE_VENV=1.
+# `scripts/run COMMAND...` runs a command with that virtualenv first on PATH when it exists, so the
+# README's commands work either way.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+PYTHON="${PYTHON:-python3}"
+VENV="${GYMGRADE_VENV:-.venv}"
 
 DEBIAN_PACKAGES=(
   bubblewrap        # the sandbox's namespaces, read-only filesystem and seccomp loading
@@ -12,6 +22,20 @@ DEBIAN_PACKAGES=(
   postgresql        # the service's PostgreSQL storage test
   redis-server      # the Celery broker of the distributed workers (tests start their own)
 )
+
+externally_managed() {
+  "$PYTHON" - <<'PY'
+import os, sys, sysconfig
+marker = os.path.join(sysconfig.get_path("stdlib"), "EXTERNALLY-MANAGED")
+sys.exit(0 if os.path.exists(marker) and sys.prefix == sys.base_prefix else 1)
+PY
+}
+
+use_venv=0
+if [ "${GYMGRADE_USE_VENV:-0}" = 1 ] || externally_managed; then
+  use_venv=1
+  DEBIAN_PACKAGES+=(python3-venv)  # Debian's python3 has no venv/ensurepip without it
+fi
 
 if command -v apt-get >/dev/null 2>&1; then
   missing=()
@@ -28,4 +52,11 @@ else
   echo "setup: no apt-get here; install bubblewrap and libseccomp yourself for full sandbox isolation" >&2
 fi
 
-python3 -m pip install --quiet --disable-pip-version-check -e ".[dev,postgres,distributed]"
+if ((use_venv)); then
+  # System site packages stay visible (Debian's python3-seccomp); everything else goes into the venv.
+  [ -x "$VENV/bin/python" ] || "$PYTHON" -m venv --system-site-packages "$VENV"
+  PYTHON="$VENV/bin/python"
+  echo "setup: installed into the project virtualenv $VENV (the interpreter is externally managed," \
+    "or GYMGRADE_USE_VENV=1): run commands through scripts/run, or put $VENV/bin first on PATH" >&2
+fi
+"$PYTHON" -m pip install --quiet --disable-pip-version-check -e ".[dev,postgres,distributed]"

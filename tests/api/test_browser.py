@@ -44,6 +44,8 @@ def test_sign_in_upload_and_see_the_score(server: LiveProcess, tmp_path: Path) -
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
         try:
             page = browser.new_page()
+            console: list[str] = []
+            page.on("console", lambda message: console.append(message.text))
             page.goto(server.url + "/")
             page.fill("#token", token)
             page.click("#sign-in button[type=submit]")
@@ -58,5 +60,18 @@ def test_sign_in_upload_and_see_the_score(server: LiveProcess, tmp_path: Path) -
             assert page.inner_text("#score") == "Score: 3 / 5"
             assert page.locator("#problem-cartpole .badge").inner_text() == "passed"
             assert page.locator("#problem-blackjack .badge").inner_text() == "missing"
+            # The plot and the replay of the student's shortest episode, decoded under the strict CSP.
+            page.wait_for_selector("#problem-cartpole figure img")
+            images = page.eval_on_selector_all(
+                "#problem-cartpole figure img, #problem-car figure img",
+                "images => images.map(image => [image.alt, image.complete && image.naturalWidth > 0])",
+            )
+            assert images == [
+                ["CartPole episode lengths", True],
+                ["Replay: CartPole-v0", True],
+                ["MountainCar episode lengths", True],
+                ["Replay: MountainCar-v0", True],
+            ]
+            assert not [text for text in console if "Content Security Policy" in text], console
         finally:
             browser.close()

@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 from api_testing import SettingsFactory, add_student, bearer, instructor_headers
 from fastapi.testclient import TestClient
 
 from api.main import create_app
+from api.uploads import grading_file_name
+
+SUBMISSIONS = Path(__file__).resolve().parents[2] / "submissions"
 
 SOLUTION = b"def random_blackjack(n):\n    return 0.3\n"
 
@@ -101,7 +105,8 @@ def test_the_instructor_cannot_upload(client: TestClient) -> None:
             "opengym.txt",
             SOLUTION,
             422,
-            "expected a Python file named like opengym.py, found the name 'opengym.txt'",
+            "expected a Python file named like opengym.py or a notebook named like opengym.ipynb, "
+            "found the name 'opengym.txt'",
         ),
         ("opengym.py", b"", 422, "opengym.py is empty; upload the file with your functions in it"),
         ("opengym.py", b"  \n\n", 422, "opengym.py is empty; upload the file with your functions in it"),
@@ -246,3 +251,13 @@ def test_each_submission_stores_its_grading_seed(
         assert seeds == [fixed] * 3
     else:
         assert len(set(seeds)) == 3 and all(1 <= seed < 2**31 for seed in seeds)
+
+
+def test_notebooks_are_accepted_and_graded_under_their_own_name(client: TestClient) -> None:
+    token = add_student(client, "ada")
+    notebook = (SUBMISSIONS / "notebooks" / "classic_complete.ipynb").read_bytes()
+    accepted = _upload(client, token, name="opengym.ipynb", content=notebook)
+    view = client.get(f"/submissions/{accepted['id']}", headers=bearer(token)).json()
+    assert (view["status"], view["filename"]) == ("queued", "opengym.ipynb")
+    assert grading_file_name("opengym.ipynb") == "opengym.ipynb"
+    assert grading_file_name("my lab.ipynb") == "submission.ipynb"

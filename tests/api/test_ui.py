@@ -101,3 +101,32 @@ def test_upload_then_watch_the_checks_complete(make_settings: SettingsFactory) -
         assert "running" in seen_statuses, "the live fragment should show the grading while it runs"
         assert live.count("<svg") == 1, "the blackjack curve is drawn"
         assert "&lt;output of blackjack&gt;" in live
+
+
+def test_a_notebook_report_lists_what_was_skipped_and_shows_its_figures() -> None:
+    from types import SimpleNamespace
+
+    from api.web import templates
+    from grader.notebook import NotebookSummary, SkippedCode
+
+    notebook = NotebookSummary(
+        code_cells=3,
+        kept_statements=4,
+        skipped=[
+            SkippedCode(cell=2, execution_count=5, line=1, reason="shell command", code="!pip install gym")
+        ],
+    )
+    report = {
+        "score": 0.0, "max_score": 1.0, "submission_error": None, "notebook": notebook.model_dump(),
+        "submission": "lab.ipynb", "sha256": "0" * 64, "seed": 0, "gymnasium_version": "1.4.0",
+        "grader_version": "0.1.0",
+        "problems": [{"id": "taxi", "title": "Problem 5", "status": "failed", "score": 0.0, "max_score": 1.0,
+                      "feedback": "off", "measurements": {
+                          "returned_random_mean": -700.0, "exact_random_mean": -771.09,
+                          "random_tolerance": 4.98, "returned_q_mean": 7.93, "exact_q_mean": 7.93,
+                          "q_tolerance": 0.127}}],
+    }  # fmt: skip
+    submission = SimpleNamespace(status="done", report=report, progress=[], error=None)
+    live = templates.get_template("_live.html").render(submission=submission, final=True)
+    assert "<code>!pip install gym</code></td><td>shell command</td>" in live
+    assert live.count('<img src="data:image/png;base64,') == 1 and 'alt="Taxi average returns"' in live

@@ -28,6 +28,13 @@ def test_collect_submissions_walks_directories_in_order(tmp_path: Path) -> None:
     assert tmp_path / ".git/hook.py" not in hidden
 
 
+def test_collect_submissions_takes_notebooks_but_not_their_checkpoints(tmp_path: Path) -> None:
+    for relative in ["ada/lab.ipynb", "ada/.ipynb_checkpoints/lab-checkpoint.ipynb", "bob/opengym.py"]:
+        (tmp_path / relative).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / relative).write_text("{}")
+    assert collect_submissions([tmp_path]) == [tmp_path / "ada/lab.ipynb", tmp_path / "bob/opengym.py"]
+
+
 def test_collect_submissions_names_a_missing_target(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError, match=r"nope\.py does not exist"):
         collect_submissions([tmp_path / "nope.py"])

@@ -79,6 +79,9 @@ def bwrap_argv(
     hide_local = os.path.isdir(LOCAL_DIR) and not os.path.islink(LOCAL_DIR)
     if hide_local:  # site-specific programs and data; the interpreter's directories are bound again below
         argv += ["--tmpfs", LOCAL_DIR]
+    # The scratch tmpfs comes before the interpreter's directories: a virtualenv under /tmp (or anywhere
+    # below it) is bound on top of it and stays visible, instead of being hidden by it.
+    argv += _scratch(scratch_bytes)
     for root in paths.roots:
         argv += [*_dirs_for(root), "--ro-bind", str(root), str(root)]
     if hide_local:
@@ -101,7 +104,7 @@ def bwrap_argv(
         f"{SUBMISSION_DIR}/{submission_name}",
     ]
     argv += ["--proc", "/proc", "--dev", "/dev"]
-    argv += [*_scratch(scratch_bytes), "--chdir", SCRATCH_DIR]
+    argv += ["--chdir", SCRATCH_DIR]
     for name, value in env.items():
         argv += ["--setenv", name, value]
     if seccomp_fd is not None:

@@ -1,0 +1,61 @@
+"""The self-contained HTML report: verdicts, feedback, plots and replays in one file that needs nothing else.
+
+Every image is a ``data:`` URI; the page carries its own Content-Security-Policy (no scripts, no network,
+images only from ``data:``, and only its own stylesheet, pinned by hash), so it can be mailed, uploaded to
+a learning platform or opened from disk.
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+from pathlib import Path
+
+from jinja2 import Environment, FileSystemLoader, select_autoescape
+
+from grader.cli import isolation_lines
+from grader.config import AssignmentConfig
+from grader.figures import Figure, all_figures
+from grader.report import Report
+
+TEMPLATES = Path(__file__).with_name("templates")
+STYLE = (
+    "body{font-family:system-ui,sans-serif;max-width:52rem;margin:2rem auto;padding:0 1rem;color:#222}"
+    ".meta{color:#555;font-size:.9rem}.badge{font-size:.8rem;padding:.1rem .4rem;border-radius:.3rem;"
+    "background:#eee}.status-passed .badge{background:#d4edda}.status-failed .badge,.status-error .badge,"
+    ".status-timeout .badge{background:#f8d7da}.points{float:right;font-size:1rem}.error{color:#a00}"
+    "figure{margin:1rem 0}img{max-width:100%}figcaption{font-size:.85rem;color:#555}"
+    "pre{white-space:pre-wrap;background:#f6f6f6;padding:.5rem}table{border-collapse:collapse;font-size:.85rem}"
+    "td,th{border:1px solid #ddd;padding:.2rem .4rem;text-align:left;vertical-align:top}"
+    ".feedback{white-space:pre-wrap}"
+)
+CSP = (
+    "default-src 'none'; img-src data:; style-src 'sha256-"
+    + base64.b64encode(hashlib.sha256(STYLE.encode()).digest()).decode()
+    + "'; base-uri 'none'; form-action 'none'"
+)
+"""The page's policy: nothing loads or runs except its images (data: URIs) and its own style."""
+
+_environment = Environment(
+    loader=FileSystemLoader(TEMPLATES), autoescape=select_autoescape(["html"]), keep_trailing_newline=True
+)
+
+
+def render_html(
+    report: Report, config: AssignmentConfig, figures: dict[str, list[Figure]] | None = None
+) -> str:
+    """The report as one self-contained HTML page.
+
+    Args:
+        report: The grading report.
+        config: The assignment configuration it was graded with (bars and tolerances of the plots).
+        figures: Figures already drawn (by problem id); drawn here when None.
+
+    Returns:
+        The page.
+    """
+    drawn = figures if figures is not None else all_figures(report.problems, config)
+    isolation = " ".join(isolation_lines(report.isolation))
+    return _environment.get_template("report.html").render(
+        report=report, figures=drawn, csp=CSP, style=STYLE, isolation=isolation
+    )

@@ -1,0 +1,215 @@
+"""The graded module of a notebook: what runs at import, what is skipped and said, what cannot be graded."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import nbformat
+import pytest
+from grading_support import SUBMISSIONS
+from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
+
+from grader.grading import grade_submission, with_notebook
+from grader.notebook import NotebookModule, build_module
+from grader.report import ProblemResult, Report
+from grader.sandbox import IsolationPolicy
+from grader.validation import FileVerdict
+
+
+def notebook_bytes(*sources: str, markdown_first: bool = False) -> bytes:
+    cells = [new_markdown_cell("# Lab")] if markdown_first else []
+    cells += [new_code_cell(source) for source in sources]
+    return nbformat.writes(new_notebook(cells=cells)).encode()
+
+
+def built(*sources: str) -> NotebookModule:
+    module = build_module(notebook_bytes(*sources), "lab.ipynb")
+    assert isinstance(module, NotebookModule), module
+    return module
+
+
+DEFINITION = "def cartpole():\n    return 1"
+COMPUTED = "assignment computed by a call (a demo or training run, not run at import)"
+
+
+@pytest.mark.parametrize(
+    ("cell", "reason"),
+    [
+        ("!pip install gym", "shell command"),
+        ("%matplotlib inline", "IPython magic"),
+        ("files = !ls", "shell command"),
+        ("gym.make?", "help request"),
+        ("%%bash\nls", "cell magic %%bash: the whole cell is left out"),
+        ("print(cartpole())", "call of print(...) (a demo, not run at import)"),
+        ("cartpole()", "call of cartpole(...) (a demo, not run at import)"),
+        ("env.action_space", "expression whose value Jupyter displays"),
+        ("for i in range(3):\n    cartpole()", "loop (a demo or training run, not run at import)"),
+        ("q = find_qvalues('Taxi-v3')", COMPUTED),
+        ("rates = [cartpole() for n in range(21)]", COMPUTED),
+        ("if __name__ == '__main__':\n    cartpole()", "`if __name__ == '__main__':` block (a demo)"),
+        ("env = gym.make('CartPole-v0')\ntry:\n    env.render()\nfinally:\n    env.close()",
+         "`try` block running code (a demo, not run at import)"),
+        ("with open('x') as f:\n    pass", "`with` block (a demo, not run at import)"),
+        ("d = {}\nd['k'] = 1", "assignment into an object (not run at import)"),
+    ],
+    ids=["shell", "line-magic", "shell-assignment", "help", "bash-cell", "print", "call", "display", "loop",
+         "training-run", "comprehension-of-calls", "main-guard", "render-demo", "with", "item-assignment"],
+)  # fmt: skip
+def test_demo_statements_are_skipped_and_listed(cell: str, reason: str) -> None:
+    module = built("import gym\n" + DEFINITION, cell)
+    assert [skipped.reason for skipped in module.summary.skipped] == [reason]
+    assert module.summary.skipped[0].cell == 2
+    assert "def cartpole" in module.source
+
+
+@pytest.mark.parametrize(
+    "cell",
+    [
+        "import numpy as np\nfrom IPython.display import clear_output",
+        "ALPHA, GAMMA = .1, .6\nN = 10_000\nNAMES = ['a', 'b']\nHALF = N // 2",
+        "import gym\nenv = gym.make('Taxi-v3')",
+        "import numpy as np\nq = np.zeros((500, 6))\ndomain = np.arange(1, 22)",
+        "SQUARES = [n * n for n in range(5)]",
+        "try:\n    import gym\nexcept ImportError:\n    import gymnasium as gym",
+        "'''Module docstring.'''",
+        "class Agent:\n    rate = .1\n    def act(self, obs):\n        return 0",
+        "import functools\n@functools.lru_cache\ndef helper(n=3):\n    return n",
+    ],
+    ids=["imports", "constants", "gym-make", "numpy-constructors", "comprehension-of-constants",
+         "import-fallback", "docstring", "class", "decorated-definition"],
+)  # fmt: skip
+def test_imports_definitions_and_simple_constants_run(cell: str) -> None:
+    module = built(cell, DEFINITION)
+    assert module.summary.skipped == []
+    compile(module.source, "lab.ipynb.py", "exec")
+
+
+def test_a_global_set_only_by_a_skipped_statement_is_named_for_every_function_reaching_it() -> None:
+    module = built(
+        "import numpy as np",
+        "def find_qvalues(env):\n    return np.zeros((500, 6))",
+        "q_table = find_qvalues('Taxi-v3')",
+        "def greedy(state):\n    return int(np.argmax(q_table[state]))",
+        "def taxi():\n    return greedy(0)",
+        "def cartpole():\n    return 1",
+    )
+    unbound = [
+        (entry.function, entry.name, entry.cell, entry.line) for entry in module.summary.unbound_globals
+    ]
+    assert unbound == [("greedy", "q_table", 3, 1), ("taxi", "q_table", 3, 1)]
+    assert module.summary.notes_for("cartpole") == []
+    assert module.summary.notes_for("taxi") == [
+        "Notebook: taxi() reads the global `q_table`, which only a skipped top-level statement sets (cell 3, "
+        "line 1: `q_table = find_qvalues('Taxi-v3')`). The grader runs only imports, definitions and simple "
+        "constants of a notebook, so there is no `q_table` when taxi() is called: compute it inside the "
+        "function."
+    ]
+
+
+def test_a_global_read_by_a_method_of_a_class_the_function_uses_is_named() -> None:
+    module = built(
+        "table = train()",
+        "class Agent:\n    def act(self, state):\n        return table[state]",
+        "def taxi():\n    return Agent().act(0)",
+    )
+    assert [(entry.function, entry.name) for entry in module.summary.unbound_globals] == [("taxi", "table")]
+
+
+def test_a_global_that_a_kept_statement_also_sets_is_not_reported() -> None:
+    module = built("q = compute()", "q = None", "def taxi():\n    return q")
+    assert module.summary.unbound_globals == []
+
+
+def test_tracebacks_point_at_the_notebook_cell() -> None:
+    module = built("import gym  # first", "print('demo')\ndef car():\n    x = 1\n    return y")
+    line = module.source.splitlines().index("    return y") + 1
+    cited = module.cited(f'File "/submission/lab.ipynb.py", line {line}, in car', "lab.ipynb.py")
+    assert cited == 'File "lab.ipynb", cell 2, line 4, in car'
+
+
+def test_a_time_cell_keeps_its_definitions_and_skips_its_demos() -> None:
+    module = built("import gym", "%%time\n" + DEFINITION + "\nprint(cartpole())")
+    assert [(entry.line, entry.reason) for entry in module.summary.skipped] == [
+        (1, "cell magic %%time (the cell's statements are judged like any other's)"),
+        (4, "call of print(...) (a demo, not run at import)"),
+    ]
+    assert "def cartpole" in module.source
+
+
+def test_future_imports_move_to_the_top() -> None:
+    module = built("import gym", "from __future__ import annotations\n" + DEFINITION)
+    assert module.source.startswith("from __future__ import annotations\n")
+    compile(module.source, "lab.ipynb.py", "exec")
+
+
+@pytest.mark.parametrize(
+    ("data", "status", "message"),
+    [
+        (b'{"cells": [', "error", "lab.ipynb is not a readable notebook: it is not valid JSON"),
+        (b"", "missing", "lab.ipynb is empty: nothing to grade."),
+        (json.dumps({"nbformat": 3, "nbformat_minor": 0, "worksheets": [], "metadata": {}}).encode(), "error",
+         "lab.ipynb is a notebook in format version 3; the grader reads nbformat 4"),
+        (json.dumps({"nbformat": 4, "nbformat_minor": 5, "cells": "x", "metadata": {}}).encode(), "error",
+         "lab.ipynb is not a valid nbformat 4 notebook"),
+        (nbformat.writes(new_notebook(cells=[new_markdown_cell("# only text")])).encode(), "missing",
+         "lab.ipynb has no code cells: nothing to grade."),
+        (notebook_bytes("print('hello')", "%timeit 1"), "missing",
+         "lab.ipynb has code cells, but none of them defines anything"),
+        (notebook_bytes(DEFINITION, "def taxi(:\n    pass", markdown_first=True), "error",
+         "lab.ipynb: code cell 3 is not valid Python: invalid syntax (line 1 of the cell)."),
+        (nbformat.writes(new_notebook(cells=[new_code_cell("x <- 1")],
+                                      metadata={"language_info": {"name": "R"}})).encode(), "error",
+         "lab.ipynb is a R notebook; the lab is graded in Python."),
+    ],
+    ids=["invalid-json", "empty", "nbformat-3", "not-a-notebook", "no-code-cells", "only-demos",
+         "syntax-error", "other-language"],
+)  # fmt: skip
+def test_bad_notebooks_get_a_clear_verdict(data: bytes, status: str, message: str) -> None:
+    verdict = build_module(data, "lab.ipynb")
+    assert isinstance(verdict, FileVerdict)
+    assert verdict.status == status
+    assert verdict.message.startswith(message), verdict.message
+
+
+def test_a_bad_notebook_is_a_submission_error_without_running_anything(tmp_path: Path) -> None:
+    path = tmp_path / "lab.ipynb"
+    path.write_bytes(b"not json at all")
+    report = grade_submission(path, only=["cartpole"], policy=IsolationPolicy.ALLOW_FALLBACK)
+    assert report.submission_error is not None
+    assert report.submission_error.startswith("lab.ipynb is not a readable notebook")
+    assert [problem.status for problem in report.problems] == ["error"]
+
+
+def test_the_report_carries_the_summary_and_the_notes() -> None:
+    module = build_module((SUBMISSIONS / "notebooks" / "taxi_global_table.ipynb").read_bytes(), "t.ipynb")
+    assert isinstance(module, NotebookModule)
+    result = ProblemResult(
+        id="taxi", title="Taxi", status="error", score=0, max_score=1,
+        feedback='NameError\nFile "/submission/t.ipynb.py", line 74, in taxi',
+    )  # fmt: skip
+    report = Report(
+        submission="t.ipynb", sha256="0", seed=0, gymnasium_version="1", grader_version="1", score=0,
+        max_score=1, problems=[result],
+    )  # fmt: skip
+    annotated = with_notebook(report, module)
+    assert annotated.notebook == module.summary
+    feedback = annotated.problems[0].feedback
+    assert feedback.startswith("Notebook: taxi() reads the global `q_table`")
+    assert 'File "t.ipynb", cell 4, line' in feedback
+
+
+def test_the_check_summary_lists_what_was_skipped_cell_by_cell() -> None:
+    from grader.cli import summary
+
+    module = built("!pip install gym\nimport gym", DEFINITION + "\nprint(cartpole())")
+    report = Report(
+        submission="lab.ipynb", sha256="0", seed=0, gymnasium_version="1", grader_version="1", score=0,
+        max_score=0, notebook=module.summary,
+    )  # fmt: skip
+    assert summary(report).splitlines()[1:4] == [
+        "Notebook: 2 imports, definitions and constants from 2 code cells ran at import; "
+        "2 statements did not:",
+        "  cell 1 (no run), line 1: !pip install gym  <- shell command",
+        "  cell 2 (no run), line 3: print(cartpole())  <- call of print(...) (a demo, not run at import)",
+    ]
