@@ -79,6 +79,7 @@ def problem_view(problem: JsonObject, disclosure: Disclosure) -> JsonObject:
         output="",
         compat_events=[],
         timings=None,
+        replay=None,
     )
     return view
 
