@@ -35,9 +35,25 @@ def report_figures(report: Mapping[str, Any] | None) -> dict[str, list[Figure]]:
     if not report:
         return {}
     try:
-        return _figures(json.dumps(report, sort_keys=True))
+        return _figures(json.dumps(_figure_inputs(report), sort_keys=True))
     except (ValueError, TypeError, KeyError):  # a report of another layout: the page shows it without figures
         return {}
+
+
+def _figure_inputs(report: Mapping[str, Any]) -> dict[str, Any]:
+    """The report as the figures read it: a student's view has its seeds (and a withheld total) nulled,
+    which the figures never draw, so stand-ins keep it a valid `Report`; withheld problems are left out."""
+    problems = [
+        {**problem, "seed": problem.get("seed") or 0, "score": problem.get("score") or 0.0}
+        for problem in report.get("problems", [])
+        if problem.get("status") != "withheld"
+    ]
+    return {
+        **report,
+        "seed": report.get("seed") or 0,
+        "score": report.get("score") or 0.0,
+        "problems": problems,
+    }
 
 
 @functools.lru_cache(maxsize=32)
