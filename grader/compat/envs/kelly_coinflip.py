@@ -9,6 +9,9 @@ from gymnasium import Env, spaces
 
 from ..errors import InvalidActionError
 
+MAX_WEALTH = 10**12
+"""Largest maximum wealth a generalized game draws (its action space counts cents in an int64)."""
+
 
 class KellyCoinflipEnv(Env[Any, Any]):
     """Bet on a biased coin (Haghani & Dewey 2016): start with $25, at most $250, 300 rounds.
@@ -105,12 +108,16 @@ class KellyCoinflipGeneralizedEnv(Env[Any, Any]):
         shape = self.max_wealth_alpha
         return float(self.max_wealth_m + ((1.0 - probability) ** -shape - 1.0) / shape)
 
+    def _draw_max_wealth(self) -> int:
+        # The Pareto tail is unbounded; the action space counts cents in an int64, so the draw is capped.
+        return min(round(self._pareto_quantile(float(self.np_random.uniform()))), MAX_WEALTH)
+
     def _draw_game(self) -> None:
         edge = float(self.np_random.beta(*self.edge_prior))
         wealth_bound = round(self._pareto_quantile(0.85)) if self.clip_distributions else None
-        max_wealth = round(self._pareto_quantile(float(self.np_random.uniform())))
+        max_wealth = self._draw_max_wealth()
         while wealth_bound is not None and max_wealth > wealth_bound:
-            max_wealth = round(self._pareto_quantile(float(self.np_random.uniform())))
+            max_wealth = self._draw_max_wealth()
         # N(mean, sd)'s 99% quantile: mean + 2.3263 sd.
         rounds_bound = round(self.max_rounds_mean + 2.3263478740 * self.max_rounds_sd)
         max_rounds = round(float(self.np_random.normal(self.max_rounds_mean, self.max_rounds_sd)))
