@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Mapping, Sequence
 from typing import Any, Literal
 
@@ -11,6 +10,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, JsonValue
 
 from grader.notebook import NotebookSummary
+from grader.sandbox.text import clean_plain
 
 Status = Literal["passed", "failed", "error", "timeout", "missing"]
 Visibility = Literal["visible", "after_due_date", "hidden"]
@@ -144,7 +144,7 @@ class ProblemRun(BaseModel):
         try:
             return self.model_dump_json()
         except ValueError as error:
-            cleaned = ProblemRun.model_validate(_encodable(self.model_dump(mode="python")))
+            cleaned = ProblemRun.model_validate(clean_plain(self.model_dump(mode="python")))
             result = cleaned.result
             result.status = "error"
             result.score = 0.0
@@ -237,20 +237,6 @@ def plain_json(value: object) -> JsonValue:
     raise TypeError(
         f"a measurement must be plain data (numbers, strings, lists, dicts); found {type(value).__name__}"
     )
-
-
-_SURROGATES = re.compile("[\ud800-\udfff]")
-
-
-def _encodable(value: object) -> object:
-    """`value` with every string made UTF-8 encodable (lone surrogates become U+FFFD)."""
-    if isinstance(value, str):
-        return _SURROGATES.sub("\ufffd", value)
-    if isinstance(value, dict):
-        return {_encodable(key): _encodable(item) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [_encodable(item) for item in value]
-    return value
 
 
 def cap_output(text: str, limit: int = OUTPUT_CAP_CHARS) -> str:

@@ -249,17 +249,9 @@ def integrity_problem(
     altered = seed_problem(records)
     if altered:
         return altered
-    resets = all_resets(records)
-    environments = {
-        (e.log.env_id, e.log.requested_id, repr(sorted(e.log.env_kwargs.items()))): e for e in resets
-    }
-    for episode in environments.values():
-        problem = rules.problem_with(episode.log)
-        if problem:
-            return problem
-    chosen = options_problem([episode.log for episode in resets])
-    if chosen:
-        return chosen
+    refused = _replay_refusal([episode.log for episode in all_resets(records)], rules)
+    if refused:
+        return refused
     scouted = scouting_problem(records)
     if scouted:
         return scouted
