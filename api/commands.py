@@ -11,7 +11,7 @@ from types import FrameType
 from pydantic import ValidationError
 
 from api.errors import GraderUnavailable
-from api.grading import check_grader_target
+from api.grader_adapter import check_grader_target
 from api.settings import Settings, load_settings
 
 DEFAULT_HOST = "127.0.0.1"

@@ -8,9 +8,9 @@ from sqlalchemy import Engine
 from sqlalchemy.orm import Session, sessionmaker
 
 from api.database import make_engine, make_session_factory, migrate
+from api.jobs.job_queue import Dispatcher, JobQueue
 from api.jobs.local import DatabaseQueue, PollingDispatcher
 from api.jobs.pool import WorkerPool
-from api.jobs.protocol import Dispatcher, JobQueue
 from api.jobs.reconciler import Reconciler
 from api.settings import Settings
 

@@ -19,7 +19,7 @@ from api.auth import Principal, authenticate
 from api.context import ServiceContext
 from api.disclosure import Disclosure, disclosure_for
 from api.errors import NotAuthenticated
-from api.jobs.protocol import Dispatcher
+from api.jobs.job_queue import Dispatcher
 from api.models import Student
 from api.settings import Settings
 

@@ -11,7 +11,7 @@ from sqlalchemy.orm import Session, joinedload
 from api.auth import Principal
 from api.disclosure import Disclosure, problem_view, report_view, withholds_any
 from api.errors import RateLimited, SubmissionNotFound
-from api.jobs.protocol import Dispatcher
+from api.jobs.job_queue import Dispatcher
 from api.models import JobStatus, Student, Submission, utcnow
 from api.schemas import SubmissionDetail, SubmissionSummary
 from api.settings import SeedPolicy, Settings

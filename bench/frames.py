@@ -35,15 +35,15 @@ sys.path.insert(0, str(ROOT))
 
 from child_client import ChildClient  # noqa: E402
 
-from grader.sandbox.child import protocol  # noqa: E402
+from grader.sandbox.child import frames  # noqa: E402
 
 MEASURE = """
 import json, sys, time, tracemalloc
 sys.path.insert(0, {root!r})
 from grader.sandbox.child.budget import WireBudget, frame_limits
 from grader.sandbox.child.errors import ProtocolError
-from grader.sandbox.child.protocol import parse_payload
-from grader.sandbox.episodes import episodes_from_plain
+from grader.sandbox.child.frames import parse_payload
+from grader.sandbox.episode_log import episodes_from_plain
 from grader.sandbox.outcome import CallBudget
 
 mode, path, budget, trace = sys.argv[1], sys.argv[2], json.loads(sys.argv[3]), sys.argv[4] == "trace"
@@ -75,25 +75,25 @@ print(json.dumps({{"seconds": seconds, "peak_mib": peak, "verdict": verdict[:90]
 def honest_frame(function: str, args: tuple[object, ...]) -> bytes:
     """The payload of one call of the complete gymnasium solution, as the child harness sends it."""
     captured: list[bytes] = []
-    read_frame = protocol.read_frame
+    read_frame = frames.read_frame
 
-    def capturing_read_frame(stream, max_frame=protocol.DEFAULT_MAX_FRAME):  # type: ignore[no-untyped-def]
-        header = stream.read(protocol.HEADER.size)
+    def capturing_read_frame(stream, max_frame=frames.DEFAULT_MAX_FRAME):  # type: ignore[no-untyped-def]
+        header = stream.read(frames.HEADER.size)
         if not header:
             return None
-        (size,) = protocol.HEADER.unpack(header)
+        (size,) = frames.HEADER.unpack(header)
         payload = bytearray()
         while len(payload) < size:
             payload += stream.read(size - len(payload))
         captured.append(bytes(payload))
-        return protocol.parse_payload(bytes(payload))
+        return frames.parse_payload(bytes(payload))
 
-    protocol.read_frame = capturing_read_frame
+    frames.read_frame = capturing_read_frame
     try:
         with ChildClient((ROOT / "submissions" / "gymnasium_complete.py").resolve()) as client:
             frame = client.call(function, *args)
     finally:
-        protocol.read_frame = read_frame
+        frames.read_frame = read_frame
     if frame is None or frame["status"] != "ok":
         raise RuntimeError(f"{function}{args} did not return: {frame and frame['message']}")
     return captured[-1]

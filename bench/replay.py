@@ -29,8 +29,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from grader.sandbox.child import protocol
-from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
+from grader.sandbox.child import frames
+from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
 from grader.sandbox.replay import replay_episode, replay_episodes
 
 HARNESS = Path(__file__).resolve().parents[1] / "grader" / "sandbox" / "child" / "__main__.py"
@@ -133,7 +133,7 @@ def play(function: str, args: list[Any], calls: int, seed: int) -> tuple[float, 
         os.close(results_write)
         wall_time, logs = 0.0, []
         with os.fdopen(results_read, "rb") as results:
-            ready = protocol.read_frame(results)
+            ready = frames.read_frame(results)
             if ready is None or ready["type"] != "ready":
                 raise RuntimeError(f"the harness did not start: {ready}")
             for call in range(calls):
@@ -147,8 +147,8 @@ def play(function: str, args: list[Any], calls: int, seed: int) -> tuple[float, 
                     "seed": seed * calls + call,
                     "record": True,
                 }
-                protocol.write_frame(requests_write, frame)
-                result = protocol.read_frame(results)
+                frames.write_frame(requests_write, frame)
+                result = frames.read_frame(results)
                 if result is None or result["status"] != "ok":
                     raise RuntimeError(f"call {call} failed: {result}")
                 wall_time += result["wall_time"]

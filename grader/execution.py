@@ -11,7 +11,7 @@ from pydantic import JsonValue
 
 from grader.checks import CHECKS
 from grader.checks.base import CallRecord, Verdict
-from grader.checks.episodes import replay_call, settled_by
+from grader.checks.integrity import replay_call, settled_by
 from grader.config import AssignmentConfig, PlayedProblemConfig
 from grader.games import allowed_games
 from grader.problems import ProblemId

@@ -21,7 +21,7 @@ from gymnasium.envs.registration import load_env_creator
 from grader.problems import ProblemId
 
 if TYPE_CHECKING:
-    from grader.sandbox.episodes import EpisodeLog
+    from grader.sandbox.episode_log import EpisodeLog
 
 # Constructor arguments that never change a game's rules.
 _HARMLESS_KWARGS = frozenset({"render_mode"})

@@ -16,7 +16,7 @@ from numbers import Integral
 from grader.checks.base import CallRecord
 from grader.report import EpisodeReplay
 from grader.sandbox import OutcomeStatus
-from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.episode_log import EpisodeLog
 from grader.sandbox.replay import Replay
 
 MAX_REPLAY_STEPS = 500

@@ -32,8 +32,8 @@ from api.jobs.distributed import (
     broker_problem,
     redis_client,
 )
+from api.jobs.job_queue import ClaimedJob
 from api.jobs.local import DatabaseQueue
-from api.jobs.protocol import ClaimedJob
 from api.jobs.runner import run_job
 from api.models import JobStatus
 from api.settings import Settings
@@ -92,7 +92,7 @@ def startup_problem(settings: Settings) -> str | None:
 
 @dataclass
 class BatchFileJob:
-    """A :class:`~api.jobs.protocol.JobQueue` for one batch file: no row, the outcome is returned."""
+    """A :class:`~api.jobs.job_queue.JobQueue` for one batch file: no row, the outcome is returned."""
 
     report: dict[str, Any] | None = None
     error: str | None = None

@@ -19,7 +19,7 @@ from types import FrameType
 from typing import IO, Any
 
 from api.errors import ServiceError
-from api.grading import ImportedGrader
+from api.grader_adapter import ImportedGrader
 
 _PR_SET_PDEATHSIG = 1
 

@@ -94,7 +94,7 @@ def broker_problem(settings: BrokerSettings) -> str | None:
 
 
 class CeleryDispatcher:
-    """A :class:`~api.jobs.protocol.Dispatcher` that sends one Celery task per queued submission.
+    """A :class:`~api.jobs.job_queue.Dispatcher` that sends one Celery task per queued submission.
 
     New submissions are sent from a background thread, so an upload never waits for the broker; one the
     broker could not take is logged and left to the reconciler.

@@ -8,14 +8,14 @@ from typing import Any
 from sqlalchemy import ColumnElement, and_, or_, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
-from api.jobs.protocol import ClaimedJob
+from api.jobs.job_queue import ClaimedJob
 from api.models import JobStatus, Submission, utcnow
 
 _CLAIM_TRIES = 10
 
 
 class DatabaseQueue:
-    """A :class:`~api.jobs.protocol.JobQueue` whose claims are conditional UPDATEs on the submission rows.
+    """A :class:`~api.jobs.job_queue.JobQueue` whose claims are conditional UPDATEs on the submission rows.
 
     Args:
         session_factory: Makes sessions on the service's database.
@@ -174,7 +174,7 @@ def _finished() -> dict[str, Any]:
 
 
 class PollingDispatcher:
-    """The embedded queue's :class:`~api.jobs.protocol.Dispatcher`: its workers poll the rows themselves."""
+    """The embedded queue's :class:`~api.jobs.job_queue.Dispatcher`: its workers poll the rows themselves."""
 
     def submitted(self, submission_id: int) -> None:
         """Nothing to do: a polling worker finds the queued row."""

@@ -8,7 +8,7 @@ import socket
 import threading
 import uuid
 
-from api.jobs.protocol import JobQueue
+from api.jobs.job_queue import JobQueue
 from api.jobs.runner import run_job
 from api.settings import Settings
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-from api.jobs.protocol import ClaimedJob, JobQueue
+from api.jobs.job_queue import ClaimedJob, JobQueue
 from api.settings import Settings
 from api.uploads import grading_file_name
 

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, HIT, count_games, player_sum
-from grader.checks.episodes import (
+from grader.checks.integrity import (
     Episode,
     episodes_per_call,
     games_budget,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from grader.checks.episodes import Episode
+from grader.checks.integrity import Episode
 from grader.checks.values import GameCounts
 
 HIT = 1

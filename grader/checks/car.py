@@ -6,7 +6,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
-from grader.checks.episodes import games_budget
+from grader.checks.integrity import games_budget
 from grader.checks.lengths import judge_lengths
 from grader.config import CarConfig, ProblemConfig
 from grader.errors import PlanError

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
-from grader.checks.episodes import NO_EPISODES
+from grader.checks.integrity import NO_EPISODES
 from grader.checks.values import describe
 from grader.config import FindQvaluesConfig, ProblemConfig
 from grader.errors import PlanError

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from grader.checks.base import CallRecord, Verdict, outcome_verdict
-from grader.checks.episodes import (
+from grader.checks.integrity import (
     Episode,
     all_resets,
     episodes_per_call,

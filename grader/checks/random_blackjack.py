@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, count_games, hits_by_sum
-from grader.checks.episodes import (
+from grader.checks.integrity import (
     all_resets,
     games_budget,
     integrity_problem,

@@ -27,7 +27,7 @@ import numpy as np
 from grader.checks.base import CallRecord
 from grader.compat import resolve_env_id
 from grader.sandbox.child.seeding import SeedStream, Stream, space_seed
-from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.episode_log import EpisodeLog
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
 from grader.sandbox.replay import Replay, replay_episode
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
-from grader.checks.episodes import (
+from grader.checks.integrity import (
     Episode,
     all_resets,
     games_budget,

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from functools import cache
 
-from grader.checks.episodes import Episode
+from grader.checks.integrity import Episode
 from reference.oracles import random_policy_return
 
 UNLIMITED_STEPS = 40_000

@@ -1,9 +1,9 @@
 """Untrusted execution of student code: isolated children, plain-data results, trusted replay."""
 
-from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.episode_log import EpisodeLog
 from grader.sandbox.errors import IsolationUnavailable, SandboxClosedError, SandboxError
 from grader.sandbox.isolation import probe_isolation
-from grader.sandbox.isolation.protocol import IsolationReport, LayerReport
+from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 from grader.sandbox.limits import IsolationPolicy, Limits
 from grader.sandbox.outcome import (
     Call,

@@ -8,7 +8,7 @@ from enum import StrEnum
 from typing import TYPE_CHECKING, Any, TypeAlias
 
 if TYPE_CHECKING:
-    from grader.sandbox.episodes import EpisodeLog
+    from grader.sandbox.episode_log import EpisodeLog
 
 PlainValue: TypeAlias = Any
 """None, bool, int, float, str, lists and str-keyed dicts of these, or a numeric numpy array."""

@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 
-from grader.sandbox.child.protocol import HEADER
+from grader.sandbox.child.frames import HEADER
 from grader.sandbox.isolation.launch import Launch
 from grader.sandbox.text import clean_text
 

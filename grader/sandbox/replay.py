@@ -22,9 +22,9 @@ from gymnasium.envs.registration import EnvSpec
 
 from grader.compat import register_envs
 from grader.sandbox.batched import REPLAYERS, BatchedEpisode, BatchedReplayer
-from grader.sandbox.child.protocol import paused_gc
+from grader.sandbox.child.frames import paused_gc
 from grader.sandbox.child.seeding import reset_seeds
-from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.episode_log import EpisodeLog
 
 MAX_CACHED_ENVS = 16
 MAX_BATCH_CELLS = 2_000_000

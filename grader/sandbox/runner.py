@@ -12,14 +12,14 @@ from typing import Any
 
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError, ProtocolError
+from grader.sandbox.child.frames import decode_value, encode_frame, encode_value, parse_payload
 from grader.sandbox.child.importer import MAX_LISTED_NAMES, MAX_LISTED_PARAMETERS
-from grader.sandbox.child.protocol import decode_value, encode_frame, encode_value, parse_payload
 from grader.sandbox.child.seeding import derive_call_seed
-from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
+from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
 from grader.sandbox.errors import IsolationUnavailable, SandboxClosedError
 from grader.sandbox.isolation import probe_isolation
 from grader.sandbox.isolation.launch import build_launch
-from grader.sandbox.isolation.protocol import IsolationReport
+from grader.sandbox.isolation.layer import IsolationReport
 from grader.sandbox.limits import IsolationPolicy, Limits
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
 from grader.sandbox.process import ChildProcess, FrameEnd, FrameWait

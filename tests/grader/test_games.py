@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from grader.games import BLACKJACK_V1, CARTPOLE_V0, accepted_game_names, allowed_games
-from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.episode_log import EpisodeLog
 
 
 def _log(env_id: str, requested_id: str, **kwargs: object) -> EpisodeLog:

@@ -2,7 +2,7 @@
 
 from grader.sandbox.batched.blackjack import BlackjackReplayer
 from grader.sandbox.batched.cartpole import CartPoleReplayer
-from grader.sandbox.batched.protocol import BatchedEpisode, BatchedReplayer
+from grader.sandbox.batched.replayer import BatchedEpisode, BatchedReplayer
 from grader.sandbox.batched.taxi import TaxiReplayer
 
 REPLAYERS: tuple[BatchedReplayer, ...] = (CartPoleReplayer(), TaxiReplayer(), BlackjackReplayer())

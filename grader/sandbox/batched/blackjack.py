@@ -19,8 +19,8 @@ import gymnasium
 from gymnasium.envs.toy_text.blackjack import BlackjackEnv
 
 from grader.sandbox.batched.draws import SeededDraws
-from grader.sandbox.batched.protocol import BatchedEpisode
-from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.batched.replayer import BatchedEpisode
+from grader.sandbox.episode_log import EpisodeLog
 
 ENV_IDS = frozenset({"Blackjack-v1"})
 GAME_ARGUMENTS = frozenset({"natural", "sab"})

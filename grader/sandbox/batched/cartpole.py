@@ -17,7 +17,7 @@ from collections.abc import Sequence
 import numpy as np
 from gymnasium.envs.classic_control.cartpole import CartPoleEnv
 
-from grader.sandbox.batched.protocol import (
+from grader.sandbox.batched.replayer import (
     BatchedEpisode,
     action_matrix,
     finish,
@@ -26,7 +26,7 @@ from grader.sandbox.batched.protocol import (
     plain_arguments,
     unlimited_env,
 )
-from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.episode_log import EpisodeLog
 
 ENV_IDS = frozenset({"CartPole-v0", "CartPole-v1"})
 

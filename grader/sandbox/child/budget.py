@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from grader.sandbox.child.protocol import MAX_NODES
+from grader.sandbox.child.frames import MAX_NODES
 
 FRAME_ALLOWANCE_BYTES = 4 << 20
 """Bytes of a result frame besides its episodes: return value, message, traceback, compat events."""

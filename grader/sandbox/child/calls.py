@@ -13,8 +13,8 @@ from typing import Any
 from grader.compat import events as compat_events
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
+from grader.sandbox.child.frames import decode_value, encode_value
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
-from grader.sandbox.child.protocol import decode_value, encode_value
 from grader.sandbox.child.recorder import Recorder
 
 MAX_COMPAT_EVENTS = 100

@@ -1,7 +1,7 @@
 """The child harness: prepare the process, import the submission, then serve call requests.
 
 Started by the sandbox runner (see `grader.sandbox.child.__main__` for the command line). Results go
-to the results fd as frames (`protocol.py`); the student's prints go to fds 1 and 2 unchanged.
+to the results fd as frames (`frames.py`); the student's prints go to fds 1 and 2 unchanged.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from types import ModuleType
 from typing import Any
 
 import grader.compat
-from grader.sandbox.child import protocol
+from grader.sandbox.child import frames
 from grader.sandbox.child.calls import parse_call, run_call
 from grader.sandbox.child.errors import ProtocolError
 from grader.sandbox.child.importer import ImportFailure, function_table, import_submission
@@ -34,7 +34,7 @@ def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--submission", type=Path, required=True)
     parser.add_argument("--requests", type=int, required=True, help="fd carrying call frames from the runner")
     parser.add_argument("--results", type=int, required=True, help="fd carrying result frames to the runner")
-    parser.add_argument("--max-frame", type=int, default=protocol.DEFAULT_MAX_FRAME)
+    parser.add_argument("--max-frame", type=int, default=frames.DEFAULT_MAX_FRAME)
     parser.add_argument(
         "--seed", type=int, default=0, help="seeds randomness while the submission is imported"
     )
@@ -74,7 +74,7 @@ def prepare_process(submission: Path) -> None:
 def _serve(module: ModuleType, requests: Any, recorder: Recorder, arguments: argparse.Namespace) -> int:
     while True:
         try:
-            frame = protocol.read_frame(requests, arguments.max_frame)
+            frame = frames.read_frame(requests, arguments.max_frame)
             if frame is None:
                 return 0
             request = parse_call(frame)
@@ -83,11 +83,11 @@ def _serve(module: ModuleType, requests: Any, recorder: Recorder, arguments: arg
             return EXIT_PROTOCOL_ERROR
         payload = run_call(module, request, recorder, arguments.submission, arguments.max_frame)
         _flush_student_output()
-        _write_all(arguments.results, protocol.HEADER.pack(len(payload)) + payload)
+        _write_all(arguments.results, frames.HEADER.pack(len(payload)) + payload)
 
 
 def _send(arguments: argparse.Namespace, message: dict[str, Any]) -> None:
-    _write_all(arguments.results, protocol.encode_frame(message, arguments.max_frame))
+    _write_all(arguments.results, frames.encode_frame(message, arguments.max_frame))
 
 
 def _write_all(fd: int, data: bytes) -> None:

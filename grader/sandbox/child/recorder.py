@@ -29,7 +29,7 @@ from grader.compat import events as compat_events
 from grader.compat import make as compat_make
 from grader.compat import register_envs, resolve_env_id
 from grader.sandbox.child.budget import WireBudget
-from grader.sandbox.child.protocol import MAX_NODES
+from grader.sandbox.child.frames import MAX_NODES
 from grader.sandbox.child.seeding import CallSeeds, kept_generator_seed
 
 DEFAULT_MAX_RECORDED_STEPS = 5_000_000
@@ -64,7 +64,7 @@ class EpisodeRecord:
     short_as_lists: bool = True
 
     def to_plain(self) -> dict[str, Any]:
-        """The wire layout parsed by `grader.sandbox.episodes.episodes_from_plain`.
+        """The wire layout parsed by `grader.sandbox.episode_log.episodes_from_plain`.
 
         Per-step columns are compact numpy arrays, or plain lists for episodes of at most
         `SHORT_EPISODE_STEPS` steps (a Blackjack game), where four arrays would cost more to encode and
@@ -178,7 +178,7 @@ class Recorder:
 
         Short episodes send their columns as lists unless that would take the call's log past
         `LIST_NODE_BUDGET` elements; then every episode sends arrays (an element count that grows with
-        the episodes, not with their steps, as `grader.sandbox.child.protocol.MAX_NODES` requires).
+        the episodes, not with their steps, as `grader.sandbox.child.frames.MAX_NODES` requires).
         """
         self.recording = False
         self.record_call = False

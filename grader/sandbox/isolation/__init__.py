@@ -9,8 +9,8 @@ from grader.sandbox.isolation import landlock
 from grader.sandbox.isolation.bubblewrap import BubblewrapLayer
 from grader.sandbox.isolation.cgroup import CgroupLayer
 from grader.sandbox.isolation.filesystem import python_paths
+from grader.sandbox.isolation.layer import IsolationReport, Layer, LayerReport
 from grader.sandbox.isolation.privileges import PrivilegesLayer, running_as_root
-from grader.sandbox.isolation.protocol import IsolationReport, Layer, LayerReport
 from grader.sandbox.isolation.rlimits import RlimitsLayer
 from grader.sandbox.isolation.seccomp import SeccompLayer
 

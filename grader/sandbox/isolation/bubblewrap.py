@@ -12,8 +12,8 @@ import subprocess
 from pathlib import Path
 
 from grader.sandbox.isolation.filesystem import PythonPaths
+from grader.sandbox.isolation.layer import LayerReport
 from grader.sandbox.isolation.privileges import running_as_root
-from grader.sandbox.isolation.protocol import LayerReport
 
 HARNESS_DIR = "/gymgrade"
 SUBMISSION_DIR = "/submission"

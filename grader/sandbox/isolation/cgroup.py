@@ -10,7 +10,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grader.sandbox.isolation.protocol import LayerReport
+from grader.sandbox.isolation.layer import LayerReport
 from grader.sandbox.isolation.scope import forget_cgroup, record_cgroup
 
 CGROUP_ROOT = Path("/sys/fs/cgroup")

@@ -13,7 +13,7 @@ from pathlib import Path
 from grader.sandbox.isolation import bubblewrap, privileges
 from grader.sandbox.isolation.cgroup import JobCgroup, create_job_cgroup
 from grader.sandbox.isolation.filesystem import harness_tree, python_paths
-from grader.sandbox.isolation.protocol import IsolationReport
+from grader.sandbox.isolation.layer import IsolationReport
 from grader.sandbox.isolation.rlimits import rlimit_table
 from grader.sandbox.isolation.scope import temp_root
 from grader.sandbox.isolation.seccomp import compile_filter

@@ -6,7 +6,7 @@ import os
 import pwd
 import shutil
 
-from grader.sandbox.isolation.protocol import LayerReport
+from grader.sandbox.isolation.layer import LayerReport
 
 SANDBOX_UID = 65534
 """`nobody` on Debian and most distributions."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import resource
 
-from grader.sandbox.isolation.protocol import LayerReport
+from grader.sandbox.isolation.layer import LayerReport
 from grader.sandbox.limits import Limits
 
 CPU_GRACE_SECONDS = 5

@@ -8,7 +8,7 @@ import os
 import sys
 from types import ModuleType
 
-from grader.sandbox.isolation.protocol import LayerReport
+from grader.sandbox.isolation.layer import LayerReport
 
 DEBIAN_BINDINGS = "/usr/lib/python3/dist-packages"
 _REMEDY = (

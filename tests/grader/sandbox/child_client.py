@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import grader
-from grader.sandbox.child import protocol
+from grader.sandbox.child import frames
 
 HARNESS = Path(grader.__file__).resolve().parent / "sandbox" / "child" / "__main__.py"
 
@@ -54,7 +54,7 @@ class ChildClient:
 
     def read(self) -> dict[str, Any] | None:
         """The next frame on the result channel, None at its end."""
-        return protocol.read_frame(self._results)
+        return frames.read_frame(self._results)
 
     def call(
         self,
@@ -72,14 +72,14 @@ class ChildClient:
             "id": self._next_id,
             "nonce": f"n{self._next_id}",
             "function": function,
-            "args": protocol.encode_value(list(args)),
-            "kwargs": protocol.encode_value(kwargs),
+            "args": frames.encode_value(list(args)),
+            "kwargs": frames.encode_value(kwargs),
             "seed": seed,
             "record": record,
             "budget": budget,
         }
         try:
-            protocol.write_frame(self._requests, frame)
+            frames.write_frame(self._requests, frame)
         except BrokenPipeError:
             return None
         return self.read()

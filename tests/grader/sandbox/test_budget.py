@@ -20,7 +20,7 @@ from grader.sandbox.child.budget import (
     frame_limits,
     structural_count,
 )
-from grader.sandbox.child.protocol import MAX_NODES
+from grader.sandbox.child.frames import MAX_NODES
 
 MAX_FRAME = 256 << 20
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from child_client import ChildClient, write_submission
 
-from grader.sandbox.child.protocol import decode_value
+from grader.sandbox.child.frames import decode_value
 
 STUDENT = textwrap.dedent("""
     import os

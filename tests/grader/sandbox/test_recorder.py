@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from child_client import ChildClient, write_submission
 
-from grader.sandbox.child.protocol import MAX_NODES, decode_value, encode_value
+from grader.sandbox.child.frames import MAX_NODES, decode_value, encode_value
 from grader.sandbox.child.recorder import SHORT_EPISODE_STEPS, EpisodeRecord, Recorder
 from grader.sandbox.child.seeding import derive_call_seed, reset_seeds
-from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
+from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
 from grader.sandbox.replay import verify_reset_seeds
 
 STUDENT = textwrap.dedent("""

@@ -16,7 +16,7 @@ from grader.sandbox import replay
 from grader.sandbox.batched import BatchedReplayer, BlackjackReplayer, CartPoleReplayer, TaxiReplayer
 from grader.sandbox.batched.draws import SeededDraws
 from grader.sandbox.child.seeding import reset_seeds
-from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
+from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
 from grader.sandbox.replay import Replay, replay_episode, replay_episodes, verify_reset_seeds
 
 HONEST = textwrap.dedent("""

@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from grader.sandbox.child.protocol import parse_payload
+from grader.sandbox.child.frames import parse_payload
 from grader.sandbox.text import clean_plain, clean_text
 
 SURROGATE = chr(0xD800)

@@ -13,7 +13,7 @@ from grader.sandbox.replay import not_replayed, replay_episodes, verify_reset_se
 
 if TYPE_CHECKING:
     from grader.games import GameRules
-    from grader.sandbox.episodes import EpisodeLog
+    from grader.sandbox.episode_log import EpisodeLog
     from grader.sandbox.outcome import CallOutcome
     from grader.sandbox.replay import Replay
 

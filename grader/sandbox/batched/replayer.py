@@ -10,7 +10,7 @@ from typing import Any, Protocol
 import gymnasium
 import numpy as np
 
-from grader.sandbox.episodes import EpisodeLog
+from grader.sandbox.episode_log import EpisodeLog
 
 MAX_HORIZON = 10_000
 """Longest time limit a batch accepts; episodes of envs without a time limit are replayed one by one."""

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from grader.sandbox.child.errors import InvalidEpisodeLogError
-from grader.sandbox.child.protocol import encode_frame, encode_value, parse_payload
+from grader.sandbox.child.frames import encode_frame, encode_value, parse_payload
 from grader.sandbox.child.recorder import SHORT_EPISODE_STEPS, EpisodeRecord
-from grader.sandbox.episodes import EpisodeLog, episodes_from_plain
+from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
 from grader.sandbox.outcome import CallBudget
 
 STEPS = [(1, -1.0), (4, -10.0), (5, 20.0)]

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
-from grader.sandbox.child.protocol import MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
+from grader.sandbox.child.frames import MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
 from grader.sandbox.outcome import CallBudget
 from grader.sandbox.text import clean_plain, clean_text
 

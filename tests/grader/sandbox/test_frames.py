@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from grader.sandbox.child import protocol
+from grader.sandbox.child import frames
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
 
 
@@ -45,10 +45,10 @@ class ListSubclass(list):  # type: ignore[type-arg]
 
 def wire(value: Any) -> Any:
     """Encode, pass through a real frame, decode: what the parent sees."""
-    frame = protocol.encode_frame({"type": "value", "value": protocol.encode_value(value)})
-    message = protocol.read_frame(io.BytesIO(frame))
+    frame = frames.encode_frame({"type": "value", "value": frames.encode_value(value)})
+    message = frames.read_frame(io.BytesIO(frame))
     assert message is not None
-    return protocol.decode_value(message["value"])
+    return frames.decode_value(message["value"])
 
 
 ROUND_TRIPS = [
@@ -82,7 +82,7 @@ def test_plain_values_round_trip_with_exact_types(value: Any, expected: Any) -> 
 
 @pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf], ids=["nan", "inf", "-inf"])
 def test_non_finite_floats_are_tagged_and_restored(value: float) -> None:
-    encoded = protocol.encode_value(value)
+    encoded = frames.encode_value(value)
     decoded = wire(value)
 
     assert encoded == {"$float": repr(value)}
@@ -143,7 +143,7 @@ REFUSED = [
 )
 def test_values_that_are_not_exactly_plain_are_refused_with_their_type(value: Any, message: str) -> None:
     with pytest.raises(InvalidValueError) as caught:
-        protocol.encode_value(value, "the value")
+        frames.encode_value(value, "the value")
 
     assert message in caught.value.message
     assert "is not plain data" in caught.value.message
@@ -151,7 +151,7 @@ def test_values_that_are_not_exactly_plain_are_refused_with_their_type(value: An
 
 def test_refusal_message_names_the_function_and_the_fix() -> None:
     with pytest.raises(InvalidValueError) as caught:
-        protocol.encode_value(RiggedFloat(0.4), "the value returned by blackjack()")
+        frames.encode_value(RiggedFloat(0.4), "the value returned by blackjack()")
 
     assert caught.value.message == (
         "the value returned by blackjack() is not plain data: found test_protocol.RiggedFloat, a subclass of "
@@ -163,19 +163,19 @@ def test_refusal_message_names_the_function_and_the_fix() -> None:
 
 def test_huge_lists_are_refused() -> None:
     with pytest.raises(InvalidValueError, match="more than 2000000 elements"):
-        protocol.encode_value([0] * (protocol.MAX_NODES + 1))
+        frames.encode_value([0] * (frames.MAX_NODES + 1))
 
 
 def test_deep_nesting_and_cycles_are_refused() -> None:
     deep: list[Any] = []
-    for _ in range(protocol.MAX_DEPTH + 5):
+    for _ in range(frames.MAX_DEPTH + 5):
         deep = [deep]
     cycle: list[Any] = []
     cycle.append(cycle)
 
     for value in (deep, cycle):
         with pytest.raises(InvalidValueError, match="nested more than 64 levels"):
-            protocol.encode_value(value)
+            frames.encode_value(value)
 
 
 DECODE_REFUSED = [
@@ -203,16 +203,16 @@ DECODE_REFUSED = [
 )
 def test_decoding_refuses_forged_tagged_objects(data: Any, message: str) -> None:
     with pytest.raises(InvalidValueError, match=message):
-        protocol.decode_value(data)
+        frames.decode_value(data)
 
 
 def test_decoding_refuses_too_deep_data() -> None:
     deep: Any = 0
-    for _ in range(protocol.MAX_DEPTH + 2):
+    for _ in range(frames.MAX_DEPTH + 2):
         deep = [deep]
 
     with pytest.raises(InvalidValueError, match="too large or too deeply nested"):
-        protocol.decode_value(deep)
+        frames.decode_value(deep)
 
 
 def frame(payload: bytes) -> io.BytesIO:
@@ -239,24 +239,24 @@ FRAME_ERRORS = [
 )
 def test_malformed_frames_are_refused(stream: io.BytesIO, message: str) -> None:
     with pytest.raises(ProtocolError, match=message):
-        protocol.read_frame(stream)
+        frames.read_frame(stream)
 
 
 def test_oversized_frames_are_refused_before_reading_the_payload() -> None:
     stream = io.BytesIO(struct.pack(">I", 2**31) + b"{}")
 
     with pytest.raises(FrameTooLargeError, match="2147483648 bytes exceeds the limit of 1024"):
-        protocol.read_frame(stream, max_frame=1024)
+        frames.read_frame(stream, max_frame=1024)
 
 
 def test_encoding_a_frame_over_the_limit_is_refused() -> None:
     with pytest.raises(FrameTooLargeError):
-        protocol.encode_frame({"data": "x" * 2048}, max_frame=1024)
+        frames.encode_frame({"data": "x" * 2048}, max_frame=1024)
 
 
 def test_frames_follow_each_other_and_end_cleanly() -> None:
-    stream = io.BytesIO(protocol.encode_frame({"n": 1}) + protocol.encode_frame({"n": 2}))
+    stream = io.BytesIO(frames.encode_frame({"n": 1}) + frames.encode_frame({"n": 2}))
 
-    assert protocol.read_frame(stream) == {"n": 1}
-    assert protocol.read_frame(stream) == {"n": 2}
-    assert protocol.read_frame(stream) is None
+    assert frames.read_frame(stream) == {"n": 1}
+    assert frames.read_frame(stream) == {"n": 2}
+    assert frames.read_frame(stream) is None
