@@ -13,6 +13,10 @@ class PlanError(GraderError, ValueError):
     """Raised when a check is asked to plan calls with a configuration of another problem."""
 
 
+class UnknownProblem(GraderError, ValueError):
+    """Raised when a problem id (e.g. in `--only`) is none of the registry's; the message lists them."""
+
+
 class ExecutorUnavailable(GraderError):
     """Raised when a configured batch executor (e.g. the distributed one) cannot be reached or used."""
 
