@@ -94,14 +94,18 @@ def _with_defaults(problem: Problem[Any], table: object) -> object:
     return {**problem.table_defaults(), **table} if isinstance(table, dict) else table
 
 
+def _bound(problem_id: ProblemId, settings: ProblemConfig) -> ProblemConfig:
+    return settings.for_problem(problem_id)
+
+
 def _table(problem: Problem[Any]) -> tuple[Any, Any]:
     """A problem's `[problems.<id>]` field: its settings model, the registry's defaults, bound to its id."""
     annotation: Any = Annotated[
         problem.config,
         BeforeValidator(partial(_with_defaults, problem)),
-        AfterValidator(lambda settings: settings.for_problem(problem.id)),
+        AfterValidator(partial(_bound, problem.id)),
     ]
-    description = f"{problem.title}: {problem.config.__doc__ or problem.config.__name__}"
+    description = f"{problem.title}. {problem.config.__doc__ or problem.config.__name__}"
     if problem.enabled:
         return annotation, Field(description=description)
     optional = f"{description} Optional (disabled unless its table says enabled = true)."

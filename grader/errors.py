@@ -10,7 +10,7 @@ class ConfigError(GraderError, ValueError):
 
 
 class PlanError(GraderError, ValueError):
-    """Raised when a check is asked to plan calls with a configuration of another problem."""
+    """Raised when a problem gets settings of another problem's model, or settings never loaded for one."""
 
 
 class UnknownProblem(GraderError, ValueError):

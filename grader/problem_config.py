@@ -46,7 +46,7 @@ class ProblemConfig(StrictModel):
     _problem: ProblemId | None = PrivateAttr(default=None)
 
     @property
-    def problem(self) -> ProblemId:
+    def problem_id(self) -> ProblemId:
         """The id of the problem these settings were loaded for.
 
         Raises:
@@ -59,14 +59,14 @@ class ProblemConfig(StrictModel):
             )
         return self._problem
 
-    def for_problem(self, problem: ProblemId) -> Self:
+    def for_problem(self, problem_id: ProblemId) -> Self:
         """These settings bound to the problem they configure (what the loader does with every table).
 
         Raises:
             ValueError: A setting does not suit the problem (the loader reports it under the table).
         """
         bound = self.model_copy()
-        bound._problem = problem
+        bound._problem = problem_id
         return bound
 
     def game_rules(self) -> GameRules | None:
@@ -84,19 +84,19 @@ class PlayedProblemConfig(ProblemConfig):
         "absent = all of them.",
     )
 
-    def for_problem(self, problem: ProblemId) -> Self:
+    def for_problem(self, problem_id: ProblemId) -> Self:
         """These settings bound to their problem, once `accepted_envs` names only games it accepts."""
-        accepted = accepted_game_names(problem)
+        accepted = accepted_game_names(problem_id)
         chosen = self.accepted_envs
         if chosen is not None and (not chosen or not set(chosen) <= set(accepted)):
             raise ValueError(
                 f"accepted_envs must be a non-empty list of {', '.join(accepted)}; found {chosen}"
             )
-        return super().for_problem(problem)
+        return super().for_problem(problem_id)
 
     def game_rules(self) -> GameRules:
         """The games the problem's episodes must be played in (`accepted_envs`, else all it accepts)."""
-        return allowed_games(self.problem, self.accepted_envs)
+        return allowed_games(self.problem_id, self.accepted_envs)
 
 
 class CountedStepsConfig(PlayedProblemConfig):

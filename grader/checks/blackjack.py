@@ -45,7 +45,7 @@ def exact_best_n(*, sab: bool = False) -> int:
 
 
 class BlackjackConfig(PlayedProblemConfig):
-    """Problem 2: `blackjack(n)`."""
+    """The settings of `blackjack(n)`."""
 
     thresholds: list[Annotated[int, Field(ge=0, le=21)]] = Field(
         min_length=1, description="The values of n blackjack(n) is called with, one call each."

@@ -18,7 +18,7 @@ EPISODE_STEPS = 1_000
 
 
 class CarConfig(CountedStepsConfig):
-    """Problem 4: `car()`."""
+    """The settings of `car()`."""
 
     calls: int = Field(ge=1, description="How many times car() is called (one episode each).")
     max_mean_steps: float = Field(gt=0.0, description="The mean episode length must be strictly below this.")

@@ -18,7 +18,7 @@ EPISODE_STEPS = 1_000
 
 
 class CartpoleConfig(CountedStepsConfig):
-    """Problem 3: `cartpole()`."""
+    """The settings of `cartpole()`."""
 
     calls: int = Field(ge=1, description="How many times cartpole() is called (one episode each).")
     min_mean_steps: float = Field(ge=0.0, description="The mean episode length must be at least this.")

@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 
 
 class RandomBlackjackConfig(PlayedProblemConfig):
-    """Problem 1: `random_blackjack(n)`."""
+    """The settings of `random_blackjack(n)`."""
 
     games: int = Field(ge=100, description="The n passed to random_blackjack(n): games the student plays.")
     win_rate_alpha: Probability = Field(

@@ -41,7 +41,7 @@ _POSITIONAL = frozenset({"POSITIONAL_ONLY", "POSITIONAL_OR_KEYWORD", "VAR_POSITI
 
 
 class TaxiConfig(PlayedProblemConfig):
-    """Problem 5: `taxi()` or `taxi(q_table)`."""
+    """The settings of `taxi()` or `taxi(q_table)`."""
 
     gamma: float = Field(
         gt=0.0,

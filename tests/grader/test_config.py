@@ -12,6 +12,7 @@ from grader.config import AssignmentConfig, ConfigError, load_config
 from grader.errors import PlanError, UnknownProblem
 from grader.problem_config import ProblemConfig
 from grader.problems import PROBLEM_IDS, PROBLEMS, problem
+from grader.registry import Registry
 from grader.sandbox.limits import Limits
 from grader.stats import binomial_acceptance, mean_tolerance
 from reference.oracles import random_policy_outcome, random_policy_return, threshold_policy_outcome
@@ -49,10 +50,16 @@ def test_every_field_is_described(model: type[BaseModel]) -> None:
     assert undescribed == []
 
 
-def test_the_file_has_a_table_per_registered_problem_in_registry_order() -> None:
-    tables = config_module.assignment_file_model(WITH_ECHO).model_fields["problems"].annotation
-    assert list(tables.model_fields) == [*PROBLEM_IDS, "echo"]
-    assert tables.model_fields["echo"].description.startswith("Problem E: echo: `echo(n)`")
+@pytest.mark.parametrize(
+    ("registry", "required"), [(WITH_ECHO, [*PROBLEM_IDS, "echo"]), (WITH_OPTIONAL_ECHO, list(PROBLEM_IDS))]
+)
+def test_the_file_has_a_table_per_registered_problem_in_registry_order(
+    registry: Registry, required: list[str]
+) -> None:
+    schema = config_module.assignment_file_model(registry).model_json_schema()
+    tables = schema["$defs"]["ProblemTable"]
+    assert (list(tables["properties"]), tables["required"]) == ([*PROBLEM_IDS, "echo"], required)
+    assert tables["properties"]["echo"]["description"].startswith("Problem E: echo. `echo(n)`: every field")
 
 
 def test_titles_points_and_enabled_default_to_the_registry(tmp_path: Path) -> None:
@@ -94,7 +101,7 @@ def test_settings_are_typed_by_the_registry_and_bound_to_their_problem() -> None
     config = load_config()
     settings = problem("blackjack").settings(config)
     assert isinstance(settings, BlackjackConfig)
-    assert settings.problem == "blackjack"
+    assert settings.problem_id == "blackjack"
     assert [game.name for game in settings.game_rules().games] == ["Blackjack-v0", "Blackjack-v1"]
     assert config.problem("find_qvalues").game_rules() is None
 
@@ -115,8 +122,8 @@ def test_settings_of_another_registry_are_refused_with_what_to_do(tmp_path: Path
 def test_settings_built_by_hand_say_how_to_bind_them() -> None:
     loose = ProblemConfig(title="t", points=1.0, call_seconds=1.0, expected_seconds=1.0)
     with pytest.raises(PlanError, match=r"unbound settings: load them with grader\.config\.load_config"):
-        _ = loose.problem
-    assert loose.for_problem("car").problem == "car"
+        _ = loose.problem_id
+    assert loose.for_problem("car").problem_id == "car"
 
 
 def test_accepted_envs_restrict_the_games(tmp_path: Path) -> None:
