@@ -1,8 +1,9 @@
 """The assignment configuration: each registered problem's settings and the sandbox limits, loaded from TOML.
 
-The file's shape derives from a `grader.registry.Registry` (the lab's `grader.problems.PROBLEMS` unless told
-otherwise): one `[problems.<id>]` table per problem, parsed with the problem's own settings model, whose
-`title`, `points` and `enabled` default to the registry's; a problem disabled by default may be left out.
+The file's shape derives from a `grader.problem_registry.Registry` (the lab's `grader.problems.PROBLEMS`
+unless told otherwise): one `[problems.<id>]` table per problem, parsed with the problem's own settings
+model, whose `title`, `points` and `enabled` default to the registry's; a problem disabled by default may
+be left out.
 """
 
 from __future__ import annotations
@@ -26,8 +27,8 @@ from pydantic import (
 
 from grader.errors import ConfigError, UnknownProblem
 from grader.problem_config import ProblemConfig, StrictModel
+from grader.problem_registry import Problem, ProblemId, Registry
 from grader.problems import PROBLEMS
-from grader.registry import Problem, ProblemId, Registry
 from grader.sandbox.limits import Limits
 
 DEFAULT_CONFIG_PATH = Path(__file__).with_name("assignment.toml")

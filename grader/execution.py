@@ -12,7 +12,7 @@ from pydantic import JsonValue
 from grader.checks.base import CallRecord, Verdict
 from grader.checks.integrity import replay_call, settled_by
 from grader.config import AssignmentConfig
-from grader.registry import ProblemId
+from grader.problem_registry import ProblemId
 from grader.report import ProblemResult, ProblemRun, Timings, cap_output, plain_json
 from grader.sandbox import CallOutcome, IsolationPolicy, IsolationReport, Sandbox
 from grader.showcase import showcase_episode

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import gymnasium
 from gymnasium.envs.registration import load_env_creator
 
-from grader.registry import ProblemId
+from grader.problem_registry import ProblemId
 
 if TYPE_CHECKING:
     from grader.sandbox.episode_log import EpisodeLog

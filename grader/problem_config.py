@@ -8,7 +8,7 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr
 
 from grader.errors import PlanError
 from grader.games import GameRules, accepted_game_names, allowed_games
-from grader.registry import ProblemId
+from grader.problem_registry import ProblemId
 from grader.report import Visibility
 
 Probability = Annotated[float, Field(gt=0.0, lt=1.0)]

@@ -12,7 +12,7 @@ from grader.checks.cartpole import CartpoleCheck, CartpoleConfig
 from grader.checks.find_qvalues import FindQvaluesCheck, FindQvaluesConfig
 from grader.checks.random_blackjack import RandomBlackjackCheck, RandomBlackjackConfig
 from grader.checks.taxi import TaxiCheck, TaxiConfig
-from grader.registry import Problem, ProblemId, Registry
+from grader.problem_registry import Problem, ProblemId, Registry
 
 __all__ = ["PROBLEMS", "PROBLEM_IDS", "ProblemId", "problem"]
 

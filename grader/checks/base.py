@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal, ParamSpec, Protocol, TypeVar
 
 from grader.problem_config import ProblemConfig
-from grader.registry import ProblemId
+from grader.problem_registry import ProblemId
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, PlainValue
 
 if TYPE_CHECKING:
@@ -57,7 +57,7 @@ class Verdict:
 class ProblemCheck(Protocol[ConfigT_contra]):
     """Plans the calls one problem needs and judges their outcomes (pure: no I/O), typed by its settings.
 
-    The registry entry (`grader.registry.Problem`) pairs a check with its settings model, and
+    The registry entry (`grader.problem_registry.Problem`) pairs a check with its settings model, and
     `Problem.settings` hands it settings of exactly that model: a check never narrows its configuration.
     """
 

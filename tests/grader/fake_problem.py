@@ -10,8 +10,8 @@ from pydantic import Field
 from grader.checks.base import CallRecord, Verdict, outcome_verdict
 from grader.checks.integrity import NO_EPISODES
 from grader.problem_config import ProblemConfig
+from grader.problem_registry import Problem, Registry
 from grader.problems import PROBLEMS
-from grader.registry import Problem, Registry
 from grader.sandbox.outcome import Call, FunctionInfo
 
 ECHO_SOURCE = "def echo(n):\n    return n\n"

@@ -11,8 +11,8 @@ from grader.checks.blackjack import BlackjackConfig
 from grader.config import AssignmentConfig, ConfigError, load_config
 from grader.errors import PlanError, UnknownProblem
 from grader.problem_config import ProblemConfig
+from grader.problem_registry import Registry
 from grader.problems import PROBLEM_IDS, PROBLEMS, problem
-from grader.registry import Registry
 from grader.sandbox.limits import Limits
 from grader.stats import binomial_acceptance, mean_tolerance
 from reference.oracles import random_policy_outcome, random_policy_return, threshold_policy_outcome

@@ -10,8 +10,8 @@ from fake_problem import ECHO, ECHO_SOURCE, WITH_ECHO
 from grader.config import DEFAULT_CONFIG_PATH, load_config
 from grader.errors import UnknownProblem
 from grader.execution import run_problem
+from grader.problem_registry import Problem, Registry
 from grader.problems import PROBLEMS
-from grader.registry import Problem, Registry
 from grader.sandbox import IsolationPolicy
 
 LAB_IDS = "random_blackjack, blackjack, cartpole, car, taxi, find_qvalues"
