@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import atexit
+import contextlib
 import functools
 import os
 import shutil
@@ -25,6 +26,7 @@ _ISOLATION_DIR = Path(__file__).resolve().parent
 _CHILD_SIDE_FILES = ("bootstrap.py", "landlock_syscalls.py")
 """Stdlib-only files of this package the child runs before the harness (at the top of the tree)."""
 SCRATCH_PREFIX = "gymgrade-scratch-"
+_SUBMISSION_SUBDIR = ".submission"
 TREE_PREFIX = "gymgrade-harness-"
 """Harness trees are temporary directories named gymgrade-harness-<grader pid>-<random>, inside the
 grading's scope when there is one (`grader.sandbox.isolation.scope`), which removes them with it."""
@@ -76,12 +78,12 @@ def host_view(tree: Path, submission: bytes, submission_name: str) -> ChildView:
     scratch = Path(tempfile.mkdtemp(prefix=SCRATCH_PREFIX, dir=temp_root()))
     try:
         os.chmod(scratch, 0o1777)
-        submission_dir = scratch / ".submission"
+        submission_dir = scratch / _SUBMISSION_SUBDIR
         submission_dir.mkdir()
         (submission_dir / submission_name).write_bytes(submission)
         os.chmod(submission_dir, 0o555)
     except BaseException:
-        shutil.rmtree(scratch, ignore_errors=True)
+        remove_host_scratch(scratch)
         raise
     return ChildView(
         scratch=str(scratch),
@@ -90,6 +92,22 @@ def host_view(tree: Path, submission: bytes, submission_name: str) -> ChildView:
         host_scratch=scratch,
         cwd=str(scratch),
     )
+
+
+def remove_host_scratch(scratch: Path) -> None:
+    """Removes a host view's scratch directory with everything in it.
+
+    Its read-only submission directory is made writable first: without root, nothing inside a read-only
+    directory can be removed. Opened without following links, since a child running as the grader's
+    own uid may have replaced it.
+    """
+    with contextlib.suppress(OSError):
+        descriptor = os.open(scratch / _SUBMISSION_SUBDIR, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
+        try:
+            os.fchmod(descriptor, 0o700)
+        finally:
+            os.close(descriptor)
+    shutil.rmtree(scratch, ignore_errors=True)
 
 
 @functools.cache

@@ -6,14 +6,20 @@ import contextlib
 import dataclasses
 import json
 import os
-import shutil
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from grader.sandbox.isolation import registry
 from grader.sandbox.isolation.cgroup import JobCgroup
-from grader.sandbox.isolation.filesystem import ChildView, PythonPaths, harness_tree, host_view, python_paths
+from grader.sandbox.isolation.filesystem import (
+    ChildView,
+    PythonPaths,
+    harness_tree,
+    host_view,
+    python_paths,
+    remove_host_scratch,
+)
 from grader.sandbox.isolation.layer import IsolationReport
 from grader.sandbox.limits import Limits
 
@@ -56,7 +62,7 @@ class Launch:
         self.close_descriptors()
         clean = self.cgroup.remove() if self.cgroup is not None else True
         if self.scratch is not None:
-            shutil.rmtree(self.scratch, ignore_errors=True)
+            remove_host_scratch(self.scratch)
         return clean
 
 
