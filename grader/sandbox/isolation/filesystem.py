@@ -25,7 +25,7 @@ _HARNESS_SOURCES = ("sandbox/child", "compat")
 _ISOLATION_DIR = Path(__file__).resolve().parent
 _CHILD_SIDE_FILES = ("bootstrap.py", "landlock_syscalls.py")
 """Stdlib-only files of this package the child runs before the harness (at the top of the tree)."""
-SCRATCH_PREFIX = "gymgrade-scratch-"
+_SCRATCH_PREFIX = "gymgrade-scratch-"
 _SUBMISSION_SUBDIR = ".submission"
 TREE_PREFIX = "gymgrade-harness-"
 """Harness trees are temporary directories named gymgrade-harness-<grader pid>-<random>, inside the
@@ -75,7 +75,7 @@ class ChildView:
 def host_view(tree: Path, submission: bytes, submission_name: str) -> ChildView:
     """The view without a private file system: a scratch directory on the host (in the grading's scope)
     holding a read-only copy of the submission, and the harness tree where it is."""
-    scratch = Path(tempfile.mkdtemp(prefix=SCRATCH_PREFIX, dir=temp_root()))
+    scratch = Path(tempfile.mkdtemp(prefix=_SCRATCH_PREFIX, dir=temp_root()))
     try:
         os.chmod(scratch, 0o1777)
         submission_dir = scratch / _SUBMISSION_SUBDIR
