@@ -5,7 +5,7 @@ from __future__ import annotations
 import signal
 from dataclasses import dataclass
 
-from grader.sandbox.isolation.launch import JOIN_FAILED_EXIT
+from grader.sandbox.isolation.cgroup import JOIN_FAILED_EXIT
 from grader.sandbox.limits import Limits
 from grader.sandbox.outcome import OutcomeStatus
 from grader.sandbox.process import ChildProcess
@@ -64,7 +64,7 @@ def classify_exit(child: ChildProcess, function: str | None, limits: Limits) -> 
             f"{_during(function)} used more than {limits.memory_bytes // (1 << 20)} MiB of memory "
             "and was stopped; use less memory (smaller arrays, fewer stored episodes)",
         )
-    uses_signal_codes = child.launch.uses_bubblewrap
+    uses_signal_codes = child.launch.signals_in_exit_status
     number = -code if code < 0 else 0
     if uses_signal_codes and _SIGNAL_BASE < code < _SIGNAL_BASE + 64:
         number = code - _SIGNAL_BASE
