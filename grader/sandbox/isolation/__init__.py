@@ -35,8 +35,8 @@ def _landlock_report(bubblewrap_active: bool) -> LayerReport:
     return LayerReport(
         "landlock",
         True,
-        f"fallback (ABI {abi}): reads limited to the interpreter and libraries, writes to "
-        f"the scratch directory, {network}",
+        f"fallback (ABI {abi}): "
+        f"reads limited to the interpreter and libraries, writes to the scratch directory, {network}",
         required=False,
     )
 
@@ -55,8 +55,8 @@ def _privileges_report(report: LayerReport, bubblewrap_active: bool) -> LayerRep
         return LayerReport(
             "privileges",
             False,
-            "running as root without bubblewrap, and the interpreter is not readable by an "
-            "unprivileged uid: the child keeps root",
+            "running as root without bubblewrap, and the interpreter is not readable by an unprivileged uid: "
+            "the child keeps root",
             "install bubblewrap, or install Python where every user can read it",
         )
     return report

@@ -20,10 +20,7 @@ SUBMISSION_DIR = "/submission"
 SCRATCH_DIR = "/tmp"
 LOCAL_DIR = "/usr/local"
 SYSTEM_DIRS = ("/usr", "/bin", "/sbin", "/lib", "/lib64", "/lib32")
-_REMEDY = (
-    "install bubblewrap >= 0.8 (`apt-get install bubblewrap`) and allow user namespaces "
-    "(`sysctl kernel.unprivileged_userns_clone=1`, or run as root)"
-)
+_REMEDY = "install bubblewrap >= 0.8 (`apt-get install bubblewrap`) and allow user namespaces (`sysctl kernel.unprivileged_userns_clone=1`, or run as root)"  # noqa: E501
 
 
 def _namespaces() -> list[str]:
@@ -134,6 +131,5 @@ class BubblewrapLayer:
         return LayerReport(
             self.name,
             True,
-            "all namespaces unshared (no network, own PID space), read-only minimal file "
-            "system, size-limited scratch tmpfs, die-with-parent, cleared environment",
+            "all namespaces unshared (no network, own PID space), read-only minimal file system, size-limited scratch tmpfs, die-with-parent, cleared environment",  # noqa: E501
         )

@@ -12,8 +12,8 @@ from grader.sandbox.isolation.layer import LayerReport
 
 DEBIAN_BINDINGS = "/usr/lib/python3/dist-packages"
 _REMEDY = (
-    "install the seccomp bindings: `apt-get install python3-seccomp` (Debian/Ubuntu) "
-    "or `pip install pyseccomp`"
+    "install the seccomp bindings: "
+    "`apt-get install python3-seccomp` (Debian/Ubuntu) or `pip install pyseccomp`"
 )
 
 AF_UNIX = 1
@@ -130,6 +130,5 @@ class SeccompLayer:
         return LayerReport(
             self.name,
             True,
-            f"{len(DENIED_SYSCALLS)} syscalls denied (ptrace, mount, namespaces, bpf, keyctl, ...), "
-            "sockets limited to AF_UNIX",
+            f"{len(DENIED_SYSCALLS)} syscalls denied (ptrace, mount, namespaces, bpf, keyctl, ...), sockets limited to AF_UNIX",  # noqa: E501
         )
