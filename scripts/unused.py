@@ -1,6 +1,6 @@
-"""List top-level names of `grader/` and `api/` that no code outside `tests/` uses.
+"""List the module-level names (and methods) of `grader/` and `api/` that no code outside `tests/` uses.
 
-A name (function, class or constant defined at module level) counts as used when code outside `tests/`
+A name (function, class or constant defined at module level, or a method of such a class) counts as used when code outside `tests/`
 reads it: its own module past the definition, or any module of `grader/`, `api/`, `reference/`,
 `bench/` or `scripts/`. Only reads count: `from x import name` and `__all__` entries merely pass a name
 on, so a name that the package re-exports and only the tests read is listed. Matching is by name
@@ -10,8 +10,9 @@ live name is taken as used: the list can miss dead code, not flag live code by m
 Each listed name says where it is still read (the tests, or nowhere) and what may keep it alive
 without a read: a decorator (routes, pytest hooks, validators register by decoration), a method of a
 subclass (`ast.NodeVisitor.visit_*`, pytest and xdist protocols), a `pytest_`, `test_` or dunder name
-(found by pytest or Python), a mention in `pyproject.toml` (entry points) or in a template,
-or in `ARCHITECTURE.md` (documented public API). Those need a person's judgement; the rest are dead.
+(found by pytest or Python), a module of the student-facing shims (read by submissions), a mention in
+`pyproject.toml` (entry points), a template or `ARCHITECTURE.md` (documented public API), or a reason
+recorded in `KEPT`. Those need a person's judgement; the rest are dead.
 
 Run: `python scripts/unused.py` (prints one line per name; exit status 0).
 """
@@ -30,6 +31,8 @@ READING = ("grader", "api", "reference", "bench", "scripts")
 TESTS = ("tests",)
 DOCUMENTS = ("ARCHITECTURE.md", "pyproject.toml")
 TEMPLATE_SUFFIXES = (".html", ".mako", ".js", ".ini", ".toml")
+STUDENT_APIS = ("grader/compat/shim", "grader/compat/fallback")
+"""Modules student code imports (`gym`, `gym_toytext`, `IPython`): their names are read by submissions."""
 KEPT = {
     "add_serve_command": "entry point gymgrade.commands (pyproject.toml)",
     "add_worker_command": "entry point gymgrade.commands (pyproject.toml)",
@@ -49,6 +52,7 @@ KEPT = {
     "branch_labels": "read by alembic",
     "depends_on": "read by alembic",
     "downgrade": "called by alembic",
+    "lab_ids": "the lab ids grader.compat maps; tests/grader/compat/test_ids.py checks that each resolves",
 }
 """Names listed on purpose, and why (a person's judgement recorded; printed with the name)."""
 
@@ -63,8 +67,8 @@ class Definition:
     decorated: bool
 
 
-def _python_files(folders: tuple[str, ...]) -> list[Path]:
-    return sorted(path for folder in folders for path in (ROOT / folder).rglob("*.py"))
+def _python_files(root: Path, folders: tuple[str, ...]) -> list[Path]:
+    return sorted(path for folder in folders for path in (root / folder).rglob("*.py"))
 
 
 def definitions(path: Path) -> list[Definition]:
@@ -95,7 +99,17 @@ def definitions(path: Path) -> list[Definition]:
 def reads(path: Path) -> Counter[str]:
     """How often each name is read in a module (names and attributes; imports and `__all__` excluded)."""
     counts: Counter[str] = Counter()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    exported = {
+        id(node)
+        for statement in tree.body
+        if isinstance(statement, ast.Assign)
+        and any(isinstance(target, ast.Name) and target.id == "__all__" for target in statement.targets)
+        for node in ast.walk(statement.value)
+    }
+    for node in ast.walk(tree):
+        if id(node) in exported:
+            continue
         if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load):
             counts[node.id] += 1
         elif isinstance(node, ast.Attribute):
@@ -115,8 +129,8 @@ def unused(root: Path = ROOT) -> list[tuple[Definition, str, list[str]]]:
     Returns:
         (definition, where it is still read: "tests" or "nowhere", what may keep it alive).
     """
-    own_reads = {path: reads(path) for path in _python_files(READING)}
-    test_reads: Counter[str] = sum((reads(path) for path in _python_files(TESTS)), Counter())
+    own_reads = {path: reads(path) for path in _python_files(root, READING)}
+    test_reads: Counter[str] = sum((reads(path) for path in _python_files(root, TESTS)), Counter())
     documents = _texts([root / name for name in DOCUMENTS])
     templates = _texts(
         [
@@ -127,7 +141,7 @@ def unused(root: Path = ROOT) -> list[tuple[Definition, str, list[str]]]:
         ]
     )
     listed = []
-    for path in _python_files(DEFINING):
+    for path in _python_files(root, DEFINING):
         for definition in definitions(path):
             name = definition.name
             if (
@@ -144,6 +158,8 @@ def unused(root: Path = ROOT) -> list[tuple[Definition, str, list[str]]]:
                 keepers.append("named in ARCHITECTURE.md or pyproject.toml")
             if re.search(rf"\b{re.escape(name)}\b", templates):
                 keepers.append("named in a template or data file")
+            if definition.path.relative_to(root).as_posix().startswith(STUDENT_APIS):
+                keepers.append("student-facing shim API")
             if name in KEPT:
                 keepers.insert(0, f"kept: {KEPT[name]}")
             listed.append((definition, "tests" if test_reads[name] else "nowhere", keepers))
