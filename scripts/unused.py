@@ -1,11 +1,11 @@
 """List the module-level names (and methods) of `grader/` and `api/` that no code outside `tests/` uses.
 
-A name (function, class or constant defined at module level, or a method of such a class) counts as used when code outside `tests/`
-reads it: its own module past the definition, or any module of `grader/`, `api/`, `reference/`,
-`bench/` or `scripts/`. Only reads count: `from x import name` and `__all__` entries merely pass a name
-on, so a name that the package re-exports and only the tests read is listed. Matching is by name
-(`stats.normal_cdf` and `normal_cdf` both read `normal_cdf`), so a name shared with another module's
-live name is taken as used: the list can miss dead code, not flag live code by mistake.
+A name (function, class or constant defined at module level, or a method of such a class) counts as used
+when code outside `tests/` reads it: its own module past the definition, or any module of `grader/`,
+`api/`, `reference/`, `bench/` or `scripts/`. Only reads count: `from x import name` and `__all__`
+entries merely pass a name on, so a name that the package re-exports and only the tests read is listed.
+Matching is by name (`stats.normal_cdf` and `normal_cdf` both read `normal_cdf`), so a name shared with
+another module's live name is taken as used: the list can miss dead code, not flag live code by mistake.
 
 Each listed name says where it is still read (the tests, or nowhere) and what may keep it alive
 without a read: a decorator (routes, pytest hooks, validators register by decoration), a method of a
