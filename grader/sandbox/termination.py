@@ -27,8 +27,9 @@ class Ending:
 def forged_message(detail: str) -> str:
     """The message for data on the result channel that the harness did not send."""
     return (
-        f"the result channel carried data the harness did not send ({detail}); do not write to the "
-        "grader's file descriptors or imitate its messages: return your result from the function"
+        f"the result channel carried data the harness did not send ({detail}); "
+        "do not write to the grader's file descriptors or imitate its messages: "
+        "return your result from the function"
     )
 
 
@@ -61,8 +62,8 @@ def classify_exit(child: ChildProcess, function: str | None, limits: Limits) -> 
     if child.oom_killed():
         return Ending(
             OutcomeStatus.MEMORY_LIMIT,
-            f"{_during(function)} used more than {limits.memory_bytes // (1 << 20)} MiB of memory "
-            "and was stopped; use less memory (smaller arrays, fewer stored episodes)",
+            f"{_during(function)} used more than {limits.memory_bytes // (1 << 20)} MiB of memory and was stopped; "  # noqa: E501
+            "use less memory (smaller arrays, fewer stored episodes)",
         )
     uses_signal_codes = child.launch.signals_in_exit_status
     number = -code if code < 0 else 0

@@ -24,10 +24,7 @@ HARNESS_DIR = "/gymgrade"
 SUBMISSION_DIR = "/submission"
 SCRATCH_DIR = "/tmp"
 LOCAL_DIR = "/usr/local"
-_REMEDY = (
-    "install bubblewrap >= 0.8 (`apt-get install bubblewrap`) and allow user namespaces "
-    "(`sysctl kernel.unprivileged_userns_clone=1`, or run as root)"
-)
+_REMEDY = "install bubblewrap >= 0.8 (`apt-get install bubblewrap`) and allow user namespaces (`sysctl kernel.unprivileged_userns_clone=1`, or run as root)"  # noqa: E501
 
 
 def _namespaces() -> list[str]:
@@ -135,8 +132,7 @@ def _probe_machine() -> LayerReport:
     return LayerReport(
         name,
         True,
-        "all namespaces unshared (no network, own PID space), read-only minimal file "
-        "system, size-limited scratch tmpfs, die-with-parent, cleared environment",
+        "all namespaces unshared (no network, own PID space), read-only minimal file system, size-limited scratch tmpfs, die-with-parent, cleared environment",  # noqa: E501
     )
 
 

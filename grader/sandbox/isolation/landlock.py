@@ -44,8 +44,8 @@ class LandlockLayer:
         return LayerReport(
             self.name,
             True,
-            f"fallback (ABI {abi}): reads limited to the interpreter and libraries, writes to "
-            f"the scratch directory, {network}",
+            f"fallback (ABI {abi}): "
+            f"reads limited to the interpreter and libraries, writes to the scratch directory, {network}",
             required=False,
         )
 

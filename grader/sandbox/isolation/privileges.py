@@ -84,8 +84,8 @@ class PrivilegesLayer:
             return LayerReport(
                 self.name,
                 False,
-                "running as root without bubblewrap, and the interpreter is not readable by an "
-                "unprivileged uid: the child keeps root",
+                "running as root without bubblewrap, and the interpreter is not readable by an unprivileged uid: "  # noqa: E501
+                "the child keeps root",
                 "install bubblewrap, or install Python where every user can read it",
             )
         return report

@@ -17,8 +17,8 @@ if TYPE_CHECKING:
 
 DEBIAN_BINDINGS = "/usr/lib/python3/dist-packages"
 _REMEDY = (
-    "install the seccomp bindings: `apt-get install python3-seccomp` (Debian/Ubuntu) "
-    "or `pip install pyseccomp`"
+    "install the seccomp bindings: "
+    "`apt-get install python3-seccomp` (Debian/Ubuntu) or `pip install pyseccomp`"
 )
 
 AF_UNIX = 1
@@ -131,8 +131,7 @@ def _probe_machine() -> LayerReport:
     return LayerReport(
         SeccompLayer.name,
         True,
-        f"{len(DENIED_SYSCALLS)} syscalls denied (ptrace, mount, namespaces, bpf, keyctl, ...), "
-        "sockets limited to AF_UNIX",
+        f"{len(DENIED_SYSCALLS)} syscalls denied (ptrace, mount, namespaces, bpf, keyctl, ...), sockets limited to AF_UNIX",  # noqa: E501
     )
 
 

@@ -7,11 +7,11 @@ import pytest
 
 from grader.checks import CHECKS
 from grader.checks.base import CallRecord
-from grader.checks.behaviours import cartpole, velocity_policy
 from grader.checks.integrity import games_budget, integrity_problem, played_episodes, replay_call, settled_by
 from grader.games import allowed_games
 from grader.sandbox.outcome import CallBudget
 from grader.sandbox.replay import replay_episode
+from grader.testing.behaviours import cartpole, velocity_policy
 
 from .support import grade, simulate, small_config
 
