@@ -93,6 +93,7 @@ TAXI = Game(
     {"is_rainy": False, "fickle_passenger": False},
     description="Taxi-v3",
 )
+GUESSING_GAME = Game("GuessingGame-v0", ("GuessingGame-v0",), description="GuessingGame-v0")
 
 ACCEPTED_GAMES: Mapping[ProblemId, tuple[Game, ...]] = {
     "random_blackjack": (BLACKJACK_V0, BLACKJACK_V1),
@@ -100,6 +101,7 @@ ACCEPTED_GAMES: Mapping[ProblemId, tuple[Game, ...]] = {
     "cartpole": (CARTPOLE_V0, CARTPOLE_V1),
     "car": (MOUNTAIN_CAR,),
     "taxi": (TAXI,),
+    "guessing_game": (GUESSING_GAME,),
 }
 """Every game each problem that plays episodes accepts by default; the first is the classic lab's."""
 

@@ -1,0 +1,200 @@
+"""guessing_game: counts equal the replayed games, every guess is a midpoint, the exact total holds.
+
+Simulated students play real GuessingGame-v0 games, replayed for real. False-fail probability of the
+passing tests: the exact `false_fail` of each acceptance (below 1e-6, asserted).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+
+from grader.checks import CHECKS
+from grader.checks.base import Verdict
+from grader.checks.guessing_game import MIDPOINT_SLACK, _guess_value, total_acceptance
+from grader.checks.simulation import Lab, function_infos, simulate_calls
+from grader.compat import register_envs
+from grader.config import GuessingGameConfig, load_config
+from reference.oracles.guessing_game import midpoint_guess_counts
+
+Guesser = Callable[[float, float, int, Lab], float]
+"""(low, high, guesses made, lab) -> the next guess."""
+
+
+def midpoint(low: float, high: float, _made: int, _lab: Lab) -> float:
+    return (low + high) / 2
+
+
+def _settings(**updates: Any) -> GuessingGameConfig:
+    settings = load_config().problems["guessing_game"]
+    assert isinstance(settings, GuessingGameConfig)
+    return settings.model_copy(update={"enabled": True, "calls": 40, **updates})
+
+
+def play(
+    lab: Lab,
+    guesser: Guesser = midpoint,
+    *,
+    low: float = -1000.0,
+    high: float = 1000.0,
+    margin: float = 0.0,
+    counted_from: int = 0,
+    until_equal: bool = False,
+) -> int:
+    """One game: guess, move the end the observation points at (by `margin` past the guess), count."""
+    env = lab.make("GuessingGame-v0")
+    env.reset()
+    guesses, done, observation = counted_from, False, 0
+    while (observation != 2 if until_equal else not done) and guesses < 300:
+        guess = guesser(low, high, guesses, lab)
+        observation, _, terminated, truncated, _ = env.step(np.array([guess]))
+        guesses, done = guesses + 1, terminated or truncated
+        if observation == 1:
+            low = guess + margin
+        elif observation == 3:
+            high = guess - margin
+    return guesses
+
+
+def judge(student: Callable[[Lab], Any], seed: int, settings: GuessingGameConfig | None = None) -> Verdict:
+    register_envs()
+    settings = settings or _settings()
+    functions = {"guessing_game": student}
+    check = CHECKS["guessing_game"]
+    calls = check.plan(settings, function_infos(functions))
+    return check.judge(settings, simulate_calls(calls, functions, seed, replay=True))
+
+
+@pytest.mark.parametrize(
+    "student",
+    [
+        play,
+        lambda lab: play(lab, lambda low, high, _made, _lab: (low + high) // 2),
+        lambda lab: play(lab, lambda low, high, _made, _lab: (low + high) // 2, margin=1.0),
+        lambda lab: play(lab, margin=10.0),
+    ],
+    ids=["exact", "integer-midpoint", "integer-bounds", "tolerance-aware"],
+)
+def test_midpoint_searches_pass(student: Callable[[Lab], int], seed: int) -> None:
+    verdict = judge(student, seed)
+    assert verdict.status == "passed", verdict.feedback
+    assert verdict.feedback.startswith("guessing_game(): your 40 replayed games took ")
+    assert "every guess the midpoint of the interval left; the midpoint search takes 5.806 guesses" in (
+        verdict.feedback
+    )
+    assert verdict.measurements["games_off_midpoint"] == 0
+    assert verdict.measurements["false_fail"] <= 1e-6  # type: ignore[operator]
+
+
+@pytest.mark.parametrize(
+    ("student", "diagnosis"),
+    [
+        (
+            lambda lab: play(lab, lambda low, _high, _made, _lab: low + 20),
+            "your guesses step by 20 each time, a linear search",
+        ),
+        (
+            lambda lab: play(lab, lambda _low, _high, _made, lab: lab.random.uniform(-10_000, 10_000)),
+            "it lies outside the interval the target is still in, as a random guess would",
+        ),
+        (
+            lambda lab: play(lab, low=-10_000, high=10_000),
+            "the guess space (env.action_space), but the target lies in [-1000, 1000)",
+        ),
+        (
+            lambda lab: play(
+                lab, lambda low, high, made, _lab: (low + high) / 2 if made < 1 else -(low + high) / 2
+            ),
+            "you moved the wrong way: 1 means the guess was below the target",
+        ),
+        (
+            lambda lab: play(lab, lambda low, high, _made, _lab: low + (high - low) / 3),
+            "guess the midpoint (low + high) / 2 of the interval the target is still in",
+        ),
+    ],
+    ids=["linear", "random", "guess-space", "swapped-codes", "thirds"],
+)
+def test_other_searches_fail_with_their_cause(
+    student: Callable[[Lab], int], diagnosis: str, seed: int
+) -> None:
+    verdict = judge(student, seed)
+    assert verdict.status == "failed"
+    assert "of your 40 replayed games left the midpoint search (game " in verdict.feedback
+    assert diagnosis in verdict.feedback
+
+
+def test_a_count_missing_the_winning_guess_is_off_by_one(seed: int) -> None:
+    verdict = judge(lambda lab: play(lab, counted_from=-1), seed)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith(
+        "guessing_game(): every count you returned is 1 short of the guesses its replayed game took (off by "
+        "one"
+    )
+
+
+def test_a_count_with_one_guess_too_many_is_off_by_one(seed: int) -> None:
+    verdict = judge(lambda lab: play(lab, counted_from=1), seed)
+    assert verdict.status == "failed"
+    assert "it is off by one" in verdict.feedback
+
+
+def test_guessing_on_until_exactly_equal_is_named(seed: int) -> None:
+    verdict = judge(lambda lab: play(lab, until_equal=True), seed)
+    assert verdict.status == "failed"
+    assert "kept stepping after the game was over" in verdict.feedback
+    assert verdict.feedback.endswith("observation 2 (exactly equal) almost never comes, so stop on `done`.")
+
+
+def test_midpoints_leaning_toward_the_target_take_too_few_guesses(seed: int) -> None:
+    def peeking(lab: Lab) -> int:
+        env = lab.make("GuessingGame-v0")
+        env.reset()
+        low, high, guesses, done, target = -1000.0, 1000.0, 0, False, None
+        while not done:
+            middle = (low + high) / 2
+            lean = 0.0 if target is None else np.sign(target - middle) * (MIDPOINT_SLACK - 0.01)
+            observation, _, terminated, truncated, info = env.step(np.array([middle + lean]))
+            guesses, done, target = guesses + 1, terminated or truncated, info["number"]
+            low, high = (middle + lean, high) if observation == 1 else (low, middle + lean)
+        return guesses
+
+    verdict = judge(peeking, seed, _settings(calls=100))
+    assert verdict.status == "failed", verdict.feedback
+    assert (
+        "the guesses used something the observations do not say (such as info['number']" in verdict.feedback
+    )
+
+
+def test_the_total_acceptance_is_exact() -> None:
+    one = total_acceptance(1, 0.02)
+    assert (one.low, one.high) == (2, 7)
+    assert one.false_fail == pytest.approx(0.01 + 0.005625)
+    hundred = total_acceptance(100, 1e-6)
+    mean = midpoint_guess_counts().mean
+    assert hundred.low < 100 * mean < hundred.high
+    assert 0 < hundred.false_fail <= 1e-6
+    with pytest.raises(ValueError, match="expected 1 <= games <= 10000"):
+        total_acceptance(0, 0.5)
+
+
+def test_the_problem_is_off_unless_a_configuration_enables_it() -> None:
+    settings = load_config().problems["guessing_game"]
+    assert isinstance(settings, GuessingGameConfig)
+    assert not settings.enabled and settings.calls == 100 and settings.count_alpha == 1e-6
+
+
+@pytest.mark.parametrize(
+    ("action", "value"),
+    [(5.5, 5.5), (3, 3.0), ([2.5], 2.5), (np.array([1.5]), 1.5), (np.array(4.0), 4.0), (np.float32(2), 2.0)],
+    ids=["float", "int", "list", "array", "0-d array", "numpy scalar"],
+)
+def test_every_form_of_a_guess_is_read(action: object, value: float) -> None:
+    assert _guess_value(action) == value
+
+
+@pytest.mark.parametrize("action", [True, "1", [1.0, 2.0], np.zeros(2), None, {}], ids=repr)
+def test_anything_else_is_not_a_guess(action: object) -> None:
+    assert _guess_value(action) is None
