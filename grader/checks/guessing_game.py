@@ -29,8 +29,9 @@ MIDPOINT_SLACK = float(TOLERANCE)
 Integer midpoints (`(low + high) // 2`), ends moved one past the guess (`low = guess + 1`) or by the
 tolerance (`low = guess + 10`) stay within 5 of the midpoint of the interval the observations leave."""
 GUESS_TOO_LOW = 1
+GUESS_EQUAL = 2
 GUESS_TOO_HIGH = 3
-"""GuessingGame-v0's observations after a guess below / above the target (2: equal)."""
+"""GuessingGame-v0's observations after a guess below the target, equal to it, above it."""
 GUESS_SPACE = 10_000
 """The guess space is [-10000, 10000] (`env.action_space`), wider than the targets' [-1000, 1000)."""
 
@@ -156,6 +157,27 @@ def first_deviation(episode: Episode) -> Deviation | None:
     return None
 
 
+def _guesses_outside(episode: Episode) -> tuple[int, int]:
+    """How many of a game's guesses lie outside the interval the earlier observations left, of how many."""
+    low, high, outside = float(TARGET_LOW), float(TARGET_HIGH), 0
+    observations = episode.replay.observations[1 : episode.length + 1]
+    for action, observation in zip(episode.actions, observations, strict=False):
+        guess = _guess_value(action)
+        if guess is None or not low <= guess <= high:
+            outside += 1
+            continue
+        if int(observation) == GUESS_TOO_LOW:
+            low = guess
+        elif int(observation) == GUESS_TOO_HIGH:
+            high = guess
+    return outside, len(episode.actions)
+
+
+def _observation_after(deviation: Deviation) -> int | None:
+    observations = deviation.episode.replay.observations
+    return int(observations[deviation.number]) if deviation.number < len(observations) else None
+
+
 def _linear_step(episode: Episode) -> float | None:
     """The constant step of a game's guesses when they form a linear search of 3 or more guesses."""
     values = [_guess_value(action) for action in episode.actions]
@@ -172,6 +194,17 @@ def deviation_cause(deviation: Deviation) -> str:
     guess, episode = deviation.guess, deviation.episode
     if guess is None:
         return "each guess must be one number (or a one-element list or array)"
+    if _observation_after(deviation) == GUESS_EQUAL:
+        return (
+            "it is exactly the target, which no observation reveals: info['number'] shows the target for "
+            "display; play from the observations alone"
+        )
+    if deviation.number > 1 and _guess_value(episode.actions[deviation.number - 2]) == guess:
+        return (
+            f"it repeats your previous guess: observation {deviation.last_observation} did not move an end "
+            "of your interval. The game answers 1 (guess below the target: raise the lower end), 2 (equal) "
+            "or 3 (above: lower the upper end), not the lab text's 0/1/2"
+        )
     step = _linear_step(episode)
     if step is not None:
         return (
@@ -193,10 +226,12 @@ def deviation_cause(deviation: Deviation) -> str:
             "below the target (raise the lower end to it), 3 above (lower the upper end), 2 equal (the lab "
             "text's 0/1/2 codes are not the game's)"
         )
-    if not deviation.low <= guess <= deviation.high:
+    outside, guesses = _guesses_outside(episode)
+    if 2 * outside >= guesses or not deviation.low <= guess <= deviation.high:
         return (
-            "it lies outside the interval the target is still in, as a random guess would: keep the "
-            "interval, guess its midpoint, and move the end the observation points at"
+            f"{outside} of the game's {guesses} guesses lie outside the interval the target is still in, as "
+            "random guesses would: keep the interval, guess its midpoint, and move the end the observation "
+            "points at"
         )
     return "guess the midpoint (low + high) / 2 of the interval the target is still in"
 
@@ -286,11 +321,11 @@ class GuessingGameCheck:
         if not acceptance.accepts(total):
             fewer = total < acceptance.low
             sooner = (
-                "every guess was near a midpoint, yet the games ended sooner than the observations allow: "
+                "Every guess was near a midpoint, yet the games ended sooner than the observations allow: "
                 "the guesses used something the observations do not say (such as info['number'], the target)"
             )
             later = (
-                "every guess was near a midpoint, yet the games lasted longer than halving allows: guess the "
+                "Every guess was near a midpoint, yet the games lasted longer than halving allows: guess the "
                 "exact midpoint (low + high) / 2"
             )
             cause = sooner if fewer else later

@@ -89,6 +89,34 @@ def test_midpoint_searches_pass(student: Callable[[Lab], int], seed: int) -> Non
     assert verdict.measurements["false_fail"] <= 1e-6  # type: ignore[operator]
 
 
+def lab_text_codes(lab: Lab) -> int:
+    """Reads the lab text's codes (0 too high, 1 on target, 2 too low): the ends never move."""
+    env = lab.make("GuessingGame-v0")
+    env.reset()
+    low, high, guesses, done = -1000.0, 1000.0, 0, False
+    while not done:
+        guess = (low + high) / 2
+        observation, _, terminated, truncated, _ = env.step(np.array([guess]))
+        guesses, done = guesses + 1, terminated or truncated
+        if observation == 0:
+            high = guess
+        elif observation == 2:
+            low = guess
+    return guesses
+
+
+def reads_target(lab: Lab) -> int:
+    """Guesses 0, then the target the first step's info shows."""
+    env = lab.make("GuessingGame-v0")
+    env.reset()
+    _, _, done, _, info = env.step(np.array([0.0]))
+    guesses = 1
+    while not done:
+        _, _, terminated, truncated, info = env.step(np.array([info["number"]]))
+        guesses, done = guesses + 1, terminated or truncated
+    return guesses
+
+
 @pytest.mark.parametrize(
     ("student", "diagnosis"),
     [
@@ -98,7 +126,7 @@ def test_midpoint_searches_pass(student: Callable[[Lab], int], seed: int) -> Non
         ),
         (
             lambda lab: play(lab, lambda _low, _high, _made, lab: lab.random.uniform(-10_000, 10_000)),
-            "it lies outside the interval the target is still in, as a random guess would",
+            "lie outside the interval the target is still in, as random guesses would",
         ),
         (
             lambda lab: play(lab, low=-10_000, high=10_000),
@@ -114,8 +142,10 @@ def test_midpoint_searches_pass(student: Callable[[Lab], int], seed: int) -> Non
             lambda lab: play(lab, lambda low, high, _made, _lab: low + (high - low) / 3),
             "guess the midpoint (low + high) / 2 of the interval the target is still in",
         ),
+        (lab_text_codes, "not the lab text's 0/1/2"),
+        (reads_target, "it is exactly the target, which no observation reveals"),
     ],
-    ids=["linear", "random", "guess-space", "swapped-codes", "thirds"],
+    ids=["linear", "random", "guess-space", "swapped-codes", "thirds", "lab-text-codes", "reads-target"],
 )
 def test_other_searches_fail_with_their_cause(
     student: Callable[[Lab], int], diagnosis: str, seed: int
