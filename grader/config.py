@@ -174,7 +174,7 @@ class GuessingGameConfig(PlayedProblemConfig):
     call_seconds: float = Field(default=30.0, gt=0.0, description="Wall-clock limit of ONE call.")
     expected_seconds: float = Field(default=3.0, ge=0.0, description="Typical total time of the calls.")
     calls: int = Field(
-        default=100, ge=1, le=10_000, description="How many times guessing_game() is called (one game each)."
+        default=100, ge=1, le=1_000, description="How many times guessing_game() is called (one game each)."
     )
     count_alpha: Probability = Field(
         default=1e-6,

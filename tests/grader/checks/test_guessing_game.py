@@ -206,8 +206,9 @@ def test_the_total_acceptance_is_exact() -> None:
     mean = midpoint_guess_counts().mean
     assert hundred.low < 100 * mean < hundred.high
     assert 0 < hundred.false_fail <= 1e-6
-    with pytest.raises(ValueError, match="expected 1 <= games <= 10000"):
+    with pytest.raises(ValueError, match="expected 1 <= games <= 1000"):
         total_acceptance(0, 0.5)
+    assert total_acceptance(1_000, 1e-6).false_fail <= 1e-6
 
 
 def test_the_problem_is_off_unless_a_configuration_enables_it() -> None:
