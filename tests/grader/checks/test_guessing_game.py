@@ -13,11 +13,15 @@ import numpy as np
 import pytest
 
 from grader.checks import CHECKS
-from grader.checks.base import Verdict
-from grader.checks.guessing_game import MIDPOINT_SLACK, _guess_value, total_acceptance
+from grader.checks.base import CallRecord, Verdict
+from grader.checks.guessing_game import MIDPOINT_SLACK, _guess_value, first_deviation, total_acceptance
+from grader.checks.integrity import Episode, games_budget
 from grader.checks.simulation import Lab, function_infos, simulate_calls
 from grader.compat import register_envs
 from grader.config import GuessingGameConfig, load_config
+from grader.sandbox.episode_log import EpisodeLog
+from grader.sandbox.outcome import CallOutcome, OutcomeStatus
+from grader.sandbox.replay import Replay
 from reference.oracles.guessing_game import midpoint_guess_counts
 
 Guesser = Callable[[float, float, int, Lab], float]
@@ -229,3 +233,49 @@ def test_every_form_of_a_guess_is_read(action: object, value: float) -> None:
 @pytest.mark.parametrize("action", [True, "1", [1.0, 2.0], np.zeros(2), None, {}], ids=repr)
 def test_anything_else_is_not_a_guess(action: object) -> None:
     assert _guess_value(action) is None
+
+
+def _episode(guesses: list[Any], observations: list[int]) -> Episode:
+    """A hand-made game: the guesses logged, the observations the trusted replay answered."""
+    steps = len(guesses)
+    won = [False] * (steps - 1) + [True]
+    log = EpisodeLog(0, "GuessingGame-v0", "GuessingGame-v0", {}, 1, None, guesses, [0.0] * steps, won,
+                     [False] * steps)  # fmt: skip
+    replay = Replay([0, *observations], [0.0] * (steps - 1) + [1.0], won, [False] * steps, steps, True, 0,
+                    None, None)  # fmt: skip
+    return Episode(0, 0, log, replay)
+
+
+def test_a_bisection_of_the_observed_interval_has_no_deviation() -> None:
+    assert first_deviation(_episode([[0.0], [500.0], [250.0], [375.0]], [1, 3, 1, 2])) is None
+
+
+@pytest.mark.parametrize(
+    ("guesses", "observations", "number", "interval"),
+    [
+        ([[0.0], [600.0]], [1, 3], 2, (0.0, 1000.0)),
+        ([[0.0], [-500.0], [-750.0]], [3, 1, 2], 3, (-500.0, 0.0)),
+        ([[11.0]], [2], 1, (-1000.0, 1000.0)),
+        ([[0.0], ["500"]], [1, 2], 2, (0.0, 1000.0)),
+    ],
+    ids=["off-midpoint", "wrong-side", "first-guess", "not-a-number"],
+)
+def test_the_first_guess_off_the_midpoint_is_found(
+    guesses: list[Any], observations: list[int], number: int, interval: tuple[float, float]
+) -> None:
+    deviation = first_deviation(_episode(guesses, observations))
+    assert deviation is not None
+    assert (deviation.number, (deviation.low, deviation.high)) == (number, interval)
+
+
+def test_a_missing_function_is_missing_before_anything_is_judged() -> None:
+    settings = _settings(calls=2)
+    calls = CHECKS["guessing_game"].plan(settings, {})
+    assert [(call.function, call.budget) for call in calls] == [("guessing_game", games_budget(1, 400))] * 2
+    outcome = CallOutcome(calls[0], OutcomeStatus.MISSING_FUNCTION, None, [], [], "", "",
+                          "your file defines no function named `guessing_game`", 0.0, 1)  # fmt: skip
+    verdict = CHECKS["guessing_game"].judge(settings, [CallRecord(outcome, [])] * 2)
+    assert (verdict.status, verdict.feedback) == (
+        "missing",
+        "your file defines no function named `guessing_game`",
+    )
