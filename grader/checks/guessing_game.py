@@ -15,6 +15,7 @@ from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
 from grader.checks.integrity import Episode, games_budget, played_episodes
 from grader.checks.lengths import LengthRuns, judge_lengths
 from grader.checks.values import chance_text
+from grader.compat.envs.guessing_game import GUESS_EQUAL, GUESS_TOO_HIGH, GUESS_TOO_LOW
 from grader.config import GuessingGameConfig, ProblemConfig
 from grader.errors import PlanError
 from grader.games import allowed_games
@@ -28,10 +29,6 @@ MIDPOINT_SLACK = float(TOLERANCE)
 
 Integer midpoints (`(low + high) // 2`), ends moved one past the guess (`low = guess + 1`) or by the
 tolerance (`low = guess + 10`) stay within 5 of the midpoint of the interval the observations leave."""
-GUESS_TOO_LOW = 1
-GUESS_EQUAL = 2
-GUESS_TOO_HIGH = 3
-"""GuessingGame-v0's observations after a guess below the target, equal to it, above it."""
 GUESS_SPACE = 10_000
 """The guess space is [-10000, 10000] (`env.action_space`), wider than the targets' [-1000, 1000)."""
 

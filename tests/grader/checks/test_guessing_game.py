@@ -14,10 +14,16 @@ import pytest
 
 from grader.checks import CHECKS
 from grader.checks.base import CallRecord, Verdict
-from grader.checks.guessing_game import MIDPOINT_SLACK, _guess_value, first_deviation, total_acceptance
+from grader.checks.guessing_game import (
+    GUESS_SPACE,
+    MIDPOINT_SLACK,
+    _guess_value,
+    first_deviation,
+    total_acceptance,
+)
 from grader.checks.integrity import Episode, games_budget
 from grader.checks.simulation import Lab, function_infos, simulate_calls
-from grader.compat import register_envs
+from grader.compat import GuessingGameEnv, register_envs
 from grader.config import GuessingGameConfig, load_config
 from grader.sandbox.episode_log import EpisodeLog
 from grader.sandbox.outcome import CallOutcome, OutcomeStatus
@@ -213,6 +219,10 @@ def test_the_total_acceptance_is_exact() -> None:
     with pytest.raises(ValueError, match="expected 1 <= games <= 1000"):
         total_acceptance(0, 0.5)
     assert total_acceptance(1_000, 1e-6).false_fail <= 1e-6
+
+
+def test_the_guess_space_is_the_games() -> None:
+    assert GuessingGameEnv().bounds == GUESS_SPACE
 
 
 def test_the_problem_is_off_unless_a_configuration_enables_it() -> None:
