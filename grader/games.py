@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import gymnasium
 from gymnasium.envs.registration import load_env_creator
 
+from grader.compat import register_envs
 from grader.problem_registry import ProblemId
 
 if TYPE_CHECKING:
@@ -93,6 +94,7 @@ TAXI = Game(
     {"is_rainy": False, "fickle_passenger": False},
     description="Taxi-v3",
 )
+GUESSING_GAME = Game("GuessingGame-v0", ("GuessingGame-v0",), description="GuessingGame-v0")
 
 ACCEPTED_GAMES: Mapping[ProblemId, tuple[Game, ...]] = {
     "random_blackjack": (BLACKJACK_V0, BLACKJACK_V1),
@@ -100,6 +102,7 @@ ACCEPTED_GAMES: Mapping[ProblemId, tuple[Game, ...]] = {
     "cartpole": (CARTPOLE_V0, CARTPOLE_V1),
     "car": (MOUNTAIN_CAR,),
     "taxi": (TAXI,),
+    "guessing_game": (GUESSING_GAME,),
 }
 """Every game each problem that plays episodes accepts by default; the first is the classic lab's."""
 
@@ -137,13 +140,13 @@ class GameRules:
         same_id = [game for game in self.games if log.env_id in game.gymnasium_ids]
         if not same_id:
             return (
-                f"the episodes must be played in {self.names}, but you made {log.requested_id!r} "
-                f"(gymnasium {log.env_id}), a different game: use gym.make({self.lab_id!r})"
+                f"the episodes must be played in {self.names}, but you made {log.requested_id!r} (gymnasium {log.env_id}), a different game: "  # noqa: E501
+                f"use gym.make({self.lab_id!r})"
             )
         reason = same_id[0].mismatch(log)
         return (
-            f"{reason}, which changes the game: this assignment accepts {self.names}; make the "
-            f"environment with gym.make({same_id[0].name!r}) and no extra arguments"
+            f"{reason}, which changes the game: this assignment accepts {self.names}; "
+            f"make the environment with gym.make({same_id[0].name!r}) and no extra arguments"
         )
 
     def played_game(self, logs: Iterable[EpisodeLog]) -> Game | str:
@@ -159,8 +162,9 @@ class GameRules:
         if len(played) > 1:
             games = " and ".join(game.description for game in played.values())
             return (
-                f"your episodes were played in {games}; each problem is graded against one game's exact "
-                "results: make every environment of the problem the same way"
+                f"your episodes were played in {games}; "
+                "each problem is graded against one game's exact results: "
+                "make every environment of the problem the same way"
             )
         return next(iter(played.values()), self.games[0])
 
@@ -190,7 +194,11 @@ def allowed_games(problem: ProblemId, names: Sequence[str] | None = None) -> Gam
 
 @cache
 def default_kwargs(env_id: str) -> dict[str, Any]:
-    """The arguments an env gets when made without any: registered kwargs over constructor defaults."""
+    """The arguments an env gets when made without any: registered kwargs over constructor defaults.
+
+    The ids gymgrade registers itself (`GuessingGame-v0`, ...) are registered first.
+    """
+    register_envs()
     spec = gymnasium.spec(env_id)
     creator = load_env_creator(spec.entry_point) if isinstance(spec.entry_point, str) else spec.entry_point
     parameters = inspect.signature(creator).parameters.values() if creator is not None else []

@@ -40,8 +40,8 @@ class ProblemConfig(StrictModel):
     )
     visibility: Visibility = Field(
         default="visible",
-        description="When students see this problem's result and feedback in the service: 'visible' (at "
-        "once), 'after_due_date' (once GYMGRADE_DUE_DATE has passed) or 'hidden' (instructors only).",
+        description="When students see this problem's result and feedback in the service: "
+        "'visible' (at once), 'after_due_date' (once GYMGRADE_DUE_DATE has passed) or 'hidden' (instructors only).",  # noqa: E501
     )
     _problem: ProblemId | None = PrivateAttr(default=None)
 
@@ -79,8 +79,7 @@ class PlayedProblemConfig(ProblemConfig):
 
     accepted_envs: list[str] | None = Field(
         default=None,
-        description="The games the episodes may be played in, by id (grader/games.py lists each "
-        "problem's: Blackjack-v0/Blackjack-v1, CartPole-v0/CartPole-v1, MountainCar-v0, Taxi-v3); "
+        description="The games the episodes may be played in, by id (grader/games.py lists each problem's: Blackjack-v0/Blackjack-v1, CartPole-v0/CartPole-v1, MountainCar-v0, Taxi-v3); "  # noqa: E501
         "absent = all of them.",
     )
 
@@ -106,7 +105,6 @@ class CountedStepsConfig(PlayedProblemConfig):
         default=0.0,
         ge=0.0,
         le=1.0,
-        description="Share of the problem's points deducted when every returned count misses exactly the "
-        "steps taken before the counted loop (the lab-era 'one random step first' pattern); the verdict "
-        "follows the replayed episodes either way.",
+        description="Share of the problem's points deducted when every returned count misses exactly the steps taken before the counted loop (the lab-era 'one random step first' pattern); "  # noqa: E501
+        "the verdict follows the replayed episodes either way.",
     )

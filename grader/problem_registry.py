@@ -87,10 +87,8 @@ class Registry:
         repeated = sorted({problem for problem in ids if ids.count(problem) > 1})
         invalid = [problem for problem in ids if not problem.isidentifier()]
         if repeated or invalid or not ids:
-            raise ValueError(
-                f"expected a non-empty registry of distinct identifiers; found repeated {repeated}, "
-                f"invalid {invalid} in {ids}"
-            )
+            found = f"repeated {repeated}, invalid {invalid} in {ids}"
+            raise ValueError(f"expected a non-empty registry of distinct identifiers; found {found}")
 
     def __iter__(self) -> Iterator[Problem[Any]]:
         return iter(self.problems)

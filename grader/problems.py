@@ -1,4 +1,4 @@
-"""The problems of the OpenGym AI lab, declared once each, in the order the lab poses them.
+"""The problems of the OpenGym AI lab, declared once each, as the lab poses them, then the optional ones.
 
 Everything that lists problems derives from `PROBLEMS`: the assignment configuration's tables
 (`grader.config`), `--only`, the acceptance modules (`grader/acceptance/test_<id>.py`), the report's titles
@@ -10,6 +10,7 @@ from grader.checks.blackjack import BlackjackCheck, BlackjackConfig
 from grader.checks.car import CarCheck, CarConfig
 from grader.checks.cartpole import CartpoleCheck, CartpoleConfig
 from grader.checks.find_qvalues import FindQvaluesCheck, FindQvaluesConfig
+from grader.checks.guessing_game import GuessingGameCheck, GuessingGameConfig
 from grader.checks.random_blackjack import RandomBlackjackCheck, RandomBlackjackConfig
 from grader.checks.taxi import TaxiCheck, TaxiConfig
 from grader.problem_registry import Problem, ProblemId, Registry
@@ -60,9 +61,17 @@ PROBLEMS = Registry(
             config=FindQvaluesConfig,
             check=FindQvaluesCheck(),
         ),
+        Problem(
+            id="guessing_game",
+            title="Optional: GuessingGame",
+            points=1.0,
+            config=GuessingGameConfig,
+            check=GuessingGameCheck(),
+            enabled=False,
+        ),
     )
 )
-"""The lab's problems; the configuration, the CLI, the acceptance tests and the report follow this order."""
+"""The lab's problems, then the optional ones (disabled by default); every list of problems follows it."""
 
 PROBLEM_IDS: tuple[ProblemId, ...] = PROBLEMS.ids
 problem = PROBLEMS.problem

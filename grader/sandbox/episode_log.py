@@ -173,8 +173,7 @@ def _episode(item: Any, number: int) -> EpisodeLog:
     actions = _actions(item["actions"], f"{where}: actions")
     if not len(actions) == len(rewards) == len(terminated) == len(truncated):
         raise InvalidEpisodeLogError(
-            f"{where}: actions, rewards, terminated and truncated must have one entry per step, found "
-            f"{len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"
+            f"{where}: actions, rewards, terminated and truncated must have one entry per step, found {len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"  # noqa: E501
         )
     reset_options = item["reset_options"]
     return EpisodeLog(

@@ -17,6 +17,7 @@ from grader.sandbox.limits import Limits
 from grader.stats import binomial_acceptance, mean_tolerance
 from reference.oracles import random_policy_outcome, random_policy_return, threshold_policy_outcome
 
+LAB_REQUIRED = [problem.id for problem in PROBLEMS if problem.enabled]
 BUNDLED = config_module.DEFAULT_CONFIG_PATH.read_text(encoding="utf-8")
 
 
@@ -51,7 +52,7 @@ def test_every_field_is_described(model: type[BaseModel]) -> None:
 
 
 @pytest.mark.parametrize(
-    ("registry", "required"), [(WITH_ECHO, [*PROBLEM_IDS, "echo"]), (WITH_OPTIONAL_ECHO, list(PROBLEM_IDS))]
+    ("registry", "required"), [(WITH_ECHO, [*LAB_REQUIRED, "echo"]), (WITH_OPTIONAL_ECHO, LAB_REQUIRED)]
 )
 def test_the_file_has_a_table_per_registered_problem_in_registry_order(
     registry: Registry, required: list[str]
@@ -242,6 +243,7 @@ def test_visibility_defaults_to_visible_and_can_be_set_per_problem(tmp_path: Pat
         "car": "after_due_date",
         "taxi": "visible",
         "find_qvalues": "visible",
+        "guessing_game": "visible",
     }
 
 
@@ -303,3 +305,13 @@ def test_taxi_random_mean_tolerance() -> None:
     )
     assert tolerance.half_width < 5.0
     assert tolerance.pass_probability(moments.mean + 10.0) < 1e-6
+
+
+def test_the_optional_guessing_game_is_off_by_default_and_may_be_left_out(tmp_path: Path) -> None:
+    assert not load_config().problems["guessing_game"].enabled
+    table = BUNDLED[BUNDLED.index("[problems.guessing_game]") : BUNDLED.index("[sandbox]")]
+    config = load_config(_write(tmp_path, BUNDLED.replace(table, "")))
+    assert not config.problems["guessing_game"].enabled
+    assert config.problems["guessing_game"] == load_config().problems["guessing_game"]
+    enabled = load_config(_write(tmp_path, BUNDLED.replace("enabled = false", "enabled = true")))
+    assert enabled.problems["guessing_game"].enabled

@@ -11,10 +11,10 @@ from grader.config import DEFAULT_CONFIG_PATH, load_config
 from grader.errors import UnknownProblem
 from grader.execution import run_problem
 from grader.problem_registry import Problem, Registry
-from grader.problems import PROBLEMS
+from grader.problems import PROBLEM_IDS, PROBLEMS
 from grader.sandbox import IsolationPolicy
 
-LAB_IDS = "random_blackjack, blackjack, cartpole, car, taxi, find_qvalues"
+LAB_IDS = ", ".join(PROBLEM_IDS)
 
 
 @pytest.mark.parametrize(

@@ -5,10 +5,10 @@ from functools import partial
 from typing import Any
 
 from grader.checks.base import CallRecord, ProblemId, Verdict
-from grader.checks.simulation import StudentFunction, function_infos, simulate_calls
 from grader.config import load_config
 from grader.problem_config import ProblemConfig
 from grader.problems import PROBLEMS
+from grader.testing.simulation import StudentFunction, function_infos, simulate_calls
 
 # Samples smaller than the assignment's so the suite stays fast; every threshold is derived from them.
 TEST_SIZES: dict[ProblemId, dict[str, Any]] = {

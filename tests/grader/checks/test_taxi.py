@@ -6,10 +6,10 @@ False-fail probability of each passing test: 3e-6 (two z-tests and one chi-squar
 import numpy as np
 import pytest
 
-from grader.checks.behaviours import taxi
 from grader.checks.taxi import takes_q_table
 from grader.problems import PROBLEMS
 from grader.sandbox.outcome import FunctionInfo, ParameterInfo
+from grader.testing.behaviours import taxi
 from reference.oracles import optimal_q_table
 
 from .support import grade, small_config
