@@ -1,7 +1,7 @@
 """Calibrate the optional guessing_game check: regrade the midpoint search and each mistake on fresh seeds.
 
 Every regrade plans the check's calls (the bundled settings, the problem enabled), plays them in-process on
-real GuessingGame-v0 games (`grader.checks.simulation`), replays every game for real and judges with the
+real GuessingGame-v0 games (`grader.testing.simulation`), replays every game for real and judges with the
 real check. Prints the reference's false-fail rate, each mistake's detection rate, and the exact figures
 behind the statistic (`reference.oracles.guessing_game`).
 
@@ -26,9 +26,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from grader.checks import CHECKS
 from grader.checks.guessing_game import MIDPOINT_SLACK, total_acceptance
-from grader.checks.simulation import Lab, function_infos, simulate_calls
 from grader.compat import register_envs
 from grader.config import GuessingGameConfig, load_config
+from grader.testing.simulation import Lab, function_infos, simulate_calls
 from reference.oracles.guessing_game import midpoint_guess_counts
 
 Guesser = Callable[[float, float, int, Lab, Any], float]

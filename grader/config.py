@@ -171,8 +171,7 @@ class GuessingGameConfig(PlayedProblemConfig):
     )
     count_alpha: Probability = Field(
         default=1e-6,
-        description="False-fail probability of the exact two-sided test of the total number of guesses "
-        "against the exact distribution of the midpoint search's guess count.",
+        description="False-fail probability of the exact two-sided test of the total number of guesses against the exact distribution of the midpoint search's guess count.",  # noqa: E501
     )
 
 
@@ -235,8 +234,7 @@ class AssignmentConfig(_Strict):
     """The whole assignment: one entry per problem plus the sandbox limits."""
 
     problems: dict[ProblemId, ProblemConfig] = Field(
-        description="Every problem id (random_blackjack, blackjack, cartpole, car, taxi, find_qvalues, "
-        "guessing_game)."
+        description="Every problem id (random_blackjack, blackjack, cartpole, car, taxi, find_qvalues, guessing_game)."  # noqa: E501
     )
     sandbox: SandboxConfig = Field(description="Resource limits of the sandbox.")
 

@@ -22,12 +22,12 @@ from grader.checks.guessing_game import (
     total_acceptance,
 )
 from grader.checks.integrity import Episode, games_budget
-from grader.checks.simulation import Lab, function_infos, simulate_calls
 from grader.compat import GuessingGameEnv, register_envs
 from grader.config import GuessingGameConfig, load_config
 from grader.sandbox.episode_log import EpisodeLog
 from grader.sandbox.outcome import CallOutcome, OutcomeStatus
 from grader.sandbox.replay import Replay
+from grader.testing.simulation import Lab, function_infos, simulate_calls
 from reference.oracles.guessing_game import midpoint_guess_counts
 
 Guesser = Callable[[float, float, int, Lab], float]
