@@ -238,11 +238,7 @@ def plot_guess_counts(result: ProblemResult, config: AssignmentConfig) -> tuple[
               label="midpoint search (exact expectation)")  # fmt: skip
     axes.set(xlabel="guesses in the game", ylabel="games")
     axes.legend(loc="upper left", fontsize=8)
-    caption = (
-        f"guessing_game(): how many guesses each of your {len(counts)} replayed games took (bars), against "
-        f"the number of games the midpoint search is expected to finish in each count (exact, "
-        f"{oracle.mean:.3f} guesses on average)."
-    )
+    caption = f"guessing_game(): how many guesses each of your {len(counts)} replayed games took (bars), against the number of games the midpoint search is expected to finish in each count (exact, {oracle.mean:.3f} guesses on average)."  # noqa: E501
     return "GuessingGame guesses per game", caption, figure
 
 

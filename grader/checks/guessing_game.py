@@ -199,10 +199,7 @@ def deviation_cause(deviation: Deviation) -> str:
     if guess is None:
         return "each guess must be one number (or a one-element list or array)"
     if _observation_after(deviation) == GUESS_EQUAL:
-        return (
-            "it is exactly the target, which no observation reveals: info['number'] shows the target for "
-            "display; play from the observations alone"
-        )
+        return "it is exactly the target, which no observation reveals: info['number'] shows the target for display; play from the observations alone"  # noqa: E501
     if deviation.number > 1 and _guess_value(episode.actions[deviation.number - 2]) == guess:
         return (
             f"it repeats your previous guess: observation {deviation.last_observation} did not move an end "
@@ -216,11 +213,7 @@ def deviation_cause(deviation: Deviation) -> str:
             "says: guess the midpoint of the interval the target is still in, and halve it with every answer"
         )
     if deviation.number == 2 and abs(abs(guess) - GUESS_SPACE / 2) <= MIDPOINT_SLACK:
-        return (
-            f"it is the midpoint of half of [-{GUESS_SPACE}, {GUESS_SPACE}], the guess space "
-            f"(env.action_space), but the target lies in [{TARGET_LOW}, {TARGET_HIGH}): start from the "
-            f"interval [{TARGET_LOW}, {TARGET_HIGH}]"
-        )
+        return f"it is the midpoint of half of [-{GUESS_SPACE}, {GUESS_SPACE}], the guess space (env.action_space), but the target lies in [{TARGET_LOW}, {TARGET_HIGH}): start from the interval [{TARGET_LOW}, {TARGET_HIGH}]"  # noqa: E501
     wrong_side = (deviation.last_observation == GUESS_TOO_LOW and guess < deviation.low) or (
         deviation.last_observation == GUESS_TOO_HIGH and guess > deviation.high
     )
@@ -232,11 +225,7 @@ def deviation_cause(deviation: Deviation) -> str:
         )
     outside, guesses = _guesses_outside(episode)
     if 2 * outside >= guesses or not deviation.low <= guess <= deviation.high:
-        return (
-            f"{outside} of the game's {guesses} guesses lie outside the interval the target is still in, as "
-            "random guesses would: keep the interval, guess its midpoint, and move the end the observation "
-            "points at"
-        )
+        return f"{outside} of the game's {guesses} guesses lie outside the interval the target is still in, as random guesses would: keep the interval, guess its midpoint, and move the end the observation points at"  # noqa: E501
     return "guess the midpoint (low + high) / 2 of the interval the target is still in"
 
 
@@ -250,10 +239,7 @@ def _strategy_verdict(runs: LengthRuns, measurements: dict[str, PlainValue]) -> 
     return Verdict(
         "failed",
         0.0,
-        f"guessing_game(): {len(deviations)} of your {len(runs.episodes)} replayed games left the midpoint "
-        f"search (game {first.episode.call_index + 1}: guess {first.number} was {shown}, but the "
-        f"observations so far leave the target in [{first.low:g}, {first.high:g}], whose midpoint is "
-        f"{first.midpoint:g}); {deviation_cause(first)}.",
+        f"guessing_game(): {len(deviations)} of your {len(runs.episodes)} replayed games left the midpoint search (game {first.episode.call_index + 1}: guess {first.number} was {shown}, but the observations so far leave the target in [{first.low:g}, {first.high:g}], whose midpoint is {first.midpoint:g}); {deviation_cause(first)}.",  # noqa: E501
         measurements,
     )
 
@@ -264,9 +250,7 @@ def _counting_verdict(runs: LengthRuns, measurements: dict[str, PlainValue]) -> 
     return Verdict(
         "failed",
         0.0,
-        f"guessing_game(): every count you returned is {runs.uncounted_steps} short of the guesses its "
-        "replayed game took (off by one: the winning guess, or a guess before the counting loop, was not "
-        "counted). Return the number of env.step() calls, the last one included.",
+        f"guessing_game(): every count you returned is {runs.uncounted_steps} short of the guesses its replayed game took (off by one: the winning guess, or a guess before the counting loop, was not counted). Return the number of env.step() calls, the last one included.",  # noqa: E501
         measurements,
     )
 
@@ -275,10 +259,7 @@ def _stopping_hint(records: Sequence[CallRecord]) -> str:
     episodes = played_episodes(records)
     if not any(episode.replay.steps_after_done > 0 for episode in episodes):
         return ""
-    return (
-        " In GuessingGame-v0 the game is won and over (done is True, reward 1) as soon as a guess is within "
-        "10 of the target; observation 2 (exactly equal) almost never comes, so stop on `done`."
-    )
+    return " In GuessingGame-v0 the game is won and over (done is True, reward 1) as soon as a guess is within 10 of the target; observation 2 (exactly equal) almost never comes, so stop on `done`."  # noqa: E501
 
 
 @dataclass(frozen=True)
@@ -324,10 +305,7 @@ class GuessingGameCheck:
                 "Every guess was near a midpoint, yet the games ended sooner than the observations allow: "
                 "the guesses used something the observations do not say (such as info['number'], the target)"
             )
-            later = (
-                "Every guess was near a midpoint, yet the games lasted longer than halving allows: guess the "
-                "exact midpoint (low + high) / 2"
-            )
+            later = "Every guess was near a midpoint, yet the games lasted longer than halving allows: guess the exact midpoint (low + high) / 2"  # noqa: E501
             cause = sooner if fewer else later
             return Verdict("failed", 0.0, f"guessing_game(): {measured}; {bar}. {cause}.", measurements)
         return Verdict(
