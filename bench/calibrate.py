@@ -33,9 +33,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from grader.checks import CHECKS
 from grader.checks.base import ProblemId, Status
-from grader.config import CartpoleConfig, ProblemConfig, TaxiConfig, load_config
+from grader.checks.cartpole import CartpoleConfig
+from grader.checks.taxi import TaxiConfig
+from grader.config import load_config
+from grader.problem_config import ProblemConfig
+from grader.problems import PROBLEMS
 from grader.stats import normal_cdf
 from grader.testing.behaviours import MISTAKES, REFERENCE, velocity_policy
 from grader.testing.simulation import StudentFunction, function_infos, simulate_calls
@@ -100,7 +103,7 @@ def run_job(job: Job) -> Result:
             name: partial(function, episodes=config.episodes_per_scenario)
             for name, function in functions.items()
         }
-    check = CHECKS[problem]
+    check = PROBLEMS.problem(problem).check
     started = time.perf_counter()
     calls = check.plan(config, function_infos(functions))
     records = simulate_calls(calls, functions, job.seed, fast=problem in ("random_blackjack", "blackjack"))
@@ -333,9 +336,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     cartpole_episodes = _chosen(arguments.cartpole_episodes, 2000 if quick else 20_000)
     taxi_episodes = 1000 if quick else None
     problems = [problem for problem in arguments.only.split(",") if problem]
-    unknown = [problem for problem in problems if problem not in CHECKS]
+    unknown = [problem for problem in problems if problem not in PROBLEMS.ids]
     if unknown:
-        parser.error(f"unknown problem ids {unknown}; expected some of {list(CHECKS)}")
+        parser.error(f"unknown problem ids {unknown}; expected some of {list(PROBLEMS.ids)}")
     jobs = plan_jobs(problems, regrades, taxi_regrades, mistake_regrades, arguments.start)  # type: ignore[arg-type]
     if arguments.table_from:
         results = [

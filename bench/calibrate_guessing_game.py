@@ -24,10 +24,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from grader.checks import CHECKS
-from grader.checks.guessing_game import MIDPOINT_SLACK, total_acceptance
+from grader.checks.guessing_game import MIDPOINT_SLACK, GuessingGameConfig, total_acceptance
 from grader.compat import register_envs
-from grader.config import GuessingGameConfig, load_config
+from grader.config import load_config
+from grader.problems import PROBLEMS
 from grader.testing.simulation import Lab, function_infos, simulate_calls
 from reference.oracles.guessing_game import midpoint_guess_counts
 
@@ -114,7 +114,7 @@ def regrade(behaviour: str, index: int, settings: GuessingGameConfig) -> tuple[b
     """One regrade on a seed derived from (behaviour, index): (as expected, status, seconds)."""
     student, expected, feedback = BEHAVIOURS[behaviour]
     functions = {"guessing_game": student}
-    check = CHECKS["guessing_game"]
+    check = PROBLEMS.problem("guessing_game").check
     started = time.perf_counter()
     calls = check.plan(settings, function_infos(functions))
     seed = zlib.crc32(behaviour.encode()) * 1_000_003 + index

@@ -10,9 +10,9 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError
+from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError, UnknownProblem
 from grader.notebook import NotebookSummary
-from grader.problems import PROBLEM_IDS
+from grader.problems import PROBLEMS
 from grader.progress import ProgressBar, result_line
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
@@ -33,13 +33,10 @@ Handler = Callable[[argparse.Namespace], int]
 
 
 def _problem_ids(text: str) -> list[str]:
-    names = [name.strip() for name in text.split(",") if name.strip()]
-    unknown = [name for name in names if name not in PROBLEM_IDS]
-    if unknown or not names:
-        raise argparse.ArgumentTypeError(
-            f"unknown problem {', '.join(unknown) or '(none)'}; expected ids among {', '.join(PROBLEM_IDS)}"
-        )
-    return names
+    try:
+        return list(PROBLEMS.select(text.split(",")))
+    except UnknownProblem as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def _positive(text: str) -> int:
@@ -66,7 +63,7 @@ def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
         type=_problem_ids,
         default=None,
         metavar="ID[,ID...]",
-        help=f"grade only these problems ({', '.join(PROBLEM_IDS)})",
+        help=f"grade only these problems ({', '.join(PROBLEMS.ids)})",
     )
     parser.add_argument(
         "--config",

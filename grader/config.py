@@ -1,192 +1,40 @@
-"""The assignment configuration: points, time limits, sample sizes and thresholds, loaded from TOML."""
+"""The assignment configuration: each registered problem's settings and the sandbox limits, loaded from TOML.
+
+The file's shape derives from a `grader.problem_registry.Registry` (the lab's `grader.problems.PROBLEMS`
+unless told otherwise): one `[problems.<id>]` table per problem, parsed with the problem's own settings
+model, whose `title`, `points` and `enabled` default to the registry's; a problem disabled by default may
+be left out.
+"""
 
 from __future__ import annotations
 
 import tomllib
+from functools import cache, partial
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    Field,
+    PrivateAttr,
+    SerializeAsAny,
+    ValidationError,
+    create_model,
+    model_validator,
+)
 
-from grader.errors import ConfigError
-from grader.games import accepted_game_names
-from grader.problems import PROBLEM_IDS, ProblemId
-from grader.report import Visibility
+from grader.errors import ConfigError, UnknownProblem
+from grader.problem_config import ProblemConfig, StrictModel
+from grader.problem_registry import Problem, ProblemId, Registry
+from grader.problems import PROBLEMS
 from grader.sandbox.limits import Limits
 
 DEFAULT_CONFIG_PATH = Path(__file__).with_name("assignment.toml")
 
-Probability = Annotated[float, Field(gt=0.0, lt=1.0)]
 
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class ProblemConfig(_Strict):
-    """Settings every problem has."""
-
-    title: str = Field(description="Heading shown in the report, e.g. 'Problem 1: random Blackjack'.")
-    points: float = Field(ge=0.0, description="Points the problem is worth; 0 reports it without scoring.")
-    enabled: bool = Field(default=True, description="False skips the problem entirely (no calls, no points).")
-    call_seconds: float = Field(gt=0.0, description="Wall-clock limit of ONE call of the student's function.")
-    expected_seconds: float = Field(
-        ge=0.0, description="Typical total time of the problem's calls; slowest problems are started first."
-    )
-    visibility: Visibility = Field(
-        default="visible",
-        description="When students see this problem's result and feedback in the service: "
-        "'visible' (at once), 'after_due_date' (once GYMGRADE_DUE_DATE has passed) or 'hidden' (instructors only).",  # noqa: E501
-    )
-
-
-class PlayedProblemConfig(ProblemConfig):
-    """Settings of a problem whose function plays episodes in an environment."""
-
-    accepted_envs: list[str] | None = Field(
-        default=None,
-        description="The games the episodes may be played in, by id (grader/games.py lists each problem's: Blackjack-v0/Blackjack-v1, CartPole-v0/CartPole-v1, MountainCar-v0, Taxi-v3); "  # noqa: E501
-        "absent = all of them.",
-    )
-
-    @model_validator(mode="after")
-    def _known_games(self) -> PlayedProblemConfig:
-        problem: ProblemId = getattr(self, "kind")  # noqa: B009 (every subclass declares its kind)
-        accepted = accepted_game_names(problem)
-        chosen = self.accepted_envs
-        if chosen is not None and (not chosen or not set(chosen) <= set(accepted)):
-            raise ValueError(
-                f"accepted_envs must be a non-empty list of {', '.join(accepted)}; found {chosen}"
-            )
-        return self
-
-
-class CountedStepsConfig(PlayedProblemConfig):
-    """Settings of a problem whose function returns the length of the episode it played."""
-
-    uncounted_steps_deduction: float = Field(
-        default=0.0,
-        ge=0.0,
-        le=1.0,
-        description="Share of the problem's points deducted when every returned count misses exactly the steps taken before the counted loop (the lab-era 'one random step first' pattern); "  # noqa: E501
-        "the verdict follows the replayed episodes either way.",
-    )
-
-
-class RandomBlackjackConfig(PlayedProblemConfig):
-    """Problem 1: `random_blackjack(n)`."""
-
-    kind: Literal["random_blackjack"] = "random_blackjack"
-    games: int = Field(ge=100, description="The n passed to random_blackjack(n): games the student plays.")
-    win_rate_alpha: Probability = Field(
-        description="False-fail probability of the exact two-sided binomial test of the win count against the exact random-policy win probability."  # noqa: E501
-    )
-    action_alpha: Probability = Field(
-        description="False-fail probability of EACH of the two random-action tests (hit frequency = 1/2; "
-        "actions independent of the player's sum)."
-    )
-
-
-class BlackjackConfig(PlayedProblemConfig):
-    """Problem 2: `blackjack(n)`."""
-
-    kind: Literal["blackjack"] = "blackjack"
-    thresholds: list[Annotated[int, Field(ge=0, le=21)]] = Field(
-        min_length=1, description="The values of n blackjack(n) is called with, one call each."
-    )
-    games_per_call: int = Field(
-        ge=1, description="Games each call must play (the lab says 10000); 0 is not allowed."
-    )
-    win_rate_alpha: Probability = Field(
-        description="False-fail probability of the exact two-sided binomial test of EACH call's win count against the exact threshold-policy win probability."  # noqa: E501
-    )
-
-    @field_validator("thresholds")
-    @classmethod
-    def _distinct(cls, thresholds: list[int]) -> list[int]:
-        if len(set(thresholds)) != len(thresholds):
-            raise ValueError(f"expected distinct values of n, found {thresholds}")
-        return thresholds
-
-
-class CartpoleConfig(CountedStepsConfig):
-    """Problem 3: `cartpole()`."""
-
-    kind: Literal["cartpole"] = "cartpole"
-    calls: int = Field(ge=1, description="How many times cartpole() is called (one episode each).")
-    min_mean_steps: float = Field(ge=0.0, description="The mean episode length must be at least this.")
-    min_steps: int = Field(ge=0, description="Every episode must last at least this many steps.")
-
-
-class CarConfig(CountedStepsConfig):
-    """Problem 4: `car()`."""
-
-    kind: Literal["car"] = "car"
-    calls: int = Field(ge=1, description="How many times car() is called (one episode each).")
-    max_mean_steps: float = Field(gt=0.0, description="The mean episode length must be strictly below this.")
-
-
-class TaxiConfig(PlayedProblemConfig):
-    """Problem 5: `taxi()` or `taxi(q_table)`."""
-
-    kind: Literal["taxi"] = "taxi"
-    gamma: float = Field(
-        gt=0.0,
-        lt=1.0,
-        description="Discount of the exact optimal Q-table passed when taxi takes a parameter.",
-    )
-    episodes_per_scenario: int = Field(
-        ge=1, description="Episodes each scenario (random, Q-table) must play (the lab says 10000)."
-    )
-    mean_alpha: Probability = Field(
-        description="False-fail probability of EACH two-sided z-test of a returned mean against its exact expectation (variance from the exact oracle)."  # noqa: E501
-    )
-    action_alpha: Probability = Field(
-        description="False-fail probability of the chi-square test that the random scenario's actions are uniform over the 6 actions."  # noqa: E501
-    )
-    trained_slack: float = Field(
-        ge=0.0,
-        description="When taxi() trains its own table, its Q mean may fall this far below the optimal greedy return (on top of the z-test tolerance).",  # noqa: E501
-    )
-
-
-class FindQvaluesConfig(ProblemConfig):
-    """The lab-provided `find_qvalues(env)`: reported, weight 0 by default."""
-
-    kind: Literal["find_qvalues"] = "find_qvalues"
-    env_id: str = Field(description="The environment id find_qvalues is called with (the lab's Taxi-v3).")
-
-
-class GuessingGameConfig(PlayedProblemConfig):
-    """Optional problem: `guessing_game()`, the lab's midpoint search; off unless a config enables it."""
-
-    kind: Literal["guessing_game"] = "guessing_game"
-    title: str = Field(default="Optional: GuessingGame", description="Heading shown in the report.")
-    points: float = Field(default=1.0, ge=0.0, description="Points the problem is worth when enabled.")
-    enabled: bool = Field(default=False, description="Off by default: true grades guessing_game().")
-    call_seconds: float = Field(default=30.0, gt=0.0, description="Wall-clock limit of ONE call.")
-    expected_seconds: float = Field(default=3.0, ge=0.0, description="Typical total time of the calls.")
-    calls: int = Field(
-        default=100, ge=1, le=1_000, description="How many times guessing_game() is called (one game each)."
-    )
-    count_alpha: Probability = Field(
-        default=1e-6,
-        description="False-fail probability of the exact two-sided test of the total number of guesses against the exact distribution of the midpoint search's guess count.",  # noqa: E501
-    )
-
-
-_PROBLEM_CLASSES: dict[ProblemId, type[ProblemConfig]] = {
-    "random_blackjack": RandomBlackjackConfig,
-    "blackjack": BlackjackConfig,
-    "cartpole": CartpoleConfig,
-    "car": CarConfig,
-    "taxi": TaxiConfig,
-    "find_qvalues": FindQvaluesConfig,
-    "guessing_game": GuessingGameConfig,
-}
-
-
-class SandboxConfig(_Strict):
+class SandboxConfig(StrictModel):
     """Resource limits of the sandbox (per child process); `call_seconds` comes from each problem."""
 
     import_seconds: float = Field(gt=0.0, description="Wall-clock limit for importing the submission.")
@@ -208,48 +56,17 @@ class SandboxConfig(_Strict):
         return Limits(call_seconds=call_seconds, **self.model_dump())
 
 
-class ProblemTable(_Strict):
-    """The `[problems.X]` tables of the file, each parsed with its problem's settings."""
+class AssignmentConfig(StrictModel):
+    """The whole assignment: the settings of every problem of its registry, in order, and the sandbox limits.
 
-    random_blackjack: RandomBlackjackConfig = Field(description="Problem 1: random_blackjack(n).")
-    blackjack: BlackjackConfig = Field(description="Problem 2: blackjack(n).")
-    cartpole: CartpoleConfig = Field(description="Problem 3: cartpole().")
-    car: CarConfig = Field(description="Problem 4: car().")
-    taxi: TaxiConfig = Field(description="Problem 5: taxi() or taxi(q_table).")
-    find_qvalues: FindQvaluesConfig = Field(description="The lab-provided find_qvalues(env).")
-    guessing_game: GuessingGameConfig = Field(
-        default_factory=GuessingGameConfig,
-        description="Optional: guessing_game() (absent = disabled).",
-    )
+    Made by `load_config`, which also records the registry it was loaded with (`registry`).
+    """
 
-
-class AssignmentFile(_Strict):
-    """The TOML file as written (validation errors name `problems.<id>.<field>`)."""
-
-    problems: ProblemTable = Field(description="One table per problem.")
-    sandbox: SandboxConfig = Field(description="Resource limits of the sandbox.")
-
-
-class AssignmentConfig(_Strict):
-    """The whole assignment: one entry per problem plus the sandbox limits."""
-
-    problems: dict[ProblemId, ProblemConfig] = Field(
-        description="Every problem id (random_blackjack, blackjack, cartpole, car, taxi, find_qvalues, guessing_game)."  # noqa: E501
+    problems: dict[ProblemId, SerializeAsAny[ProblemConfig]] = Field(
+        description="Each problem's settings (its own model), by id, in the registry's order."
     )
     sandbox: SandboxConfig = Field(description="Resource limits of the sandbox.")
-
-    @field_validator("problems")
-    @classmethod
-    def _every_problem(cls, problems: dict[ProblemId, ProblemConfig]) -> dict[ProblemId, ProblemConfig]:
-        missing = [problem for problem in PROBLEM_IDS if problem not in problems]
-        if missing:
-            raise ValueError(f"expected settings for every problem; missing: {', '.join(missing)}")
-        wrong = [
-            problem for problem in PROBLEM_IDS if not isinstance(problems[problem], _PROBLEM_CLASSES[problem])
-        ]
-        if wrong:
-            raise ValueError(f"expected each problem's own settings class; wrong for: {', '.join(wrong)}")
-        return {problem: problems[problem] for problem in PROBLEM_IDS}
+    _registry: Registry = PrivateAttr(default=PROBLEMS)
 
     @model_validator(mode="after")
     def _scoring(self) -> AssignmentConfig:
@@ -257,15 +74,69 @@ class AssignmentConfig(_Strict):
             raise ValueError("expected at least one enabled problem worth points; found none")
         return self
 
-    @classmethod
-    def from_file(cls, parsed: AssignmentFile) -> AssignmentConfig:
-        """The configuration of a parsed file."""
-        problems = {problem: getattr(parsed.problems, problem) for problem in PROBLEM_IDS}
-        return cls(problems=problems, sandbox=parsed.sandbox)
+    @property
+    def registry(self) -> Registry:
+        """The problems this configuration was loaded for (the lab's unless `load_config` was told)."""
+        return self._registry
 
     def problem(self, problem_id: ProblemId) -> ProblemConfig:
-        """The settings of one problem."""
-        return self.problems[problem_id]
+        """The settings of one problem; `registry.problem(problem_id).settings(self)` gives them typed.
+
+        Raises:
+            UnknownProblem: The id is not one of the registry's problems.
+        """
+        found = self.problems.get(problem_id)
+        if found is None:
+            raise UnknownProblem(self._registry.unknown_message([problem_id]))
+        return found
+
+
+def _with_defaults(problem: Problem[Any], table: object) -> object:
+    return {**problem.table_defaults(), **table} if isinstance(table, dict) else table
+
+
+def _bound(problem_id: ProblemId, settings: ProblemConfig) -> ProblemConfig:
+    return settings.for_problem(problem_id)
+
+
+def _table(problem: Problem[Any]) -> tuple[Any, Any]:
+    """A problem's `[problems.<id>]` field: its settings model, the registry's defaults, bound to its id."""
+    annotation: Any = Annotated[
+        problem.config,
+        BeforeValidator(partial(_with_defaults, problem)),
+        AfterValidator(partial(_bound, problem.id)),
+    ]
+    description = f"{problem.title}. {problem.config.__doc__ or problem.config.__name__}"
+    if problem.enabled:
+        return annotation, Field(description=description)
+    optional = f"{description} Optional (disabled unless its table says enabled = true)."
+    return annotation, Field(default_factory=dict, validate_default=True, description=optional)
+
+
+@cache
+def assignment_file_model(registry: Registry) -> type[BaseModel]:
+    """The model of an assignment TOML file for a registry (validation errors name `problems.<id>.<field>`).
+
+    Args:
+        registry: The problems the file configures.
+
+    Returns:
+        A model with `problems` (one field per problem, in order) and `sandbox`.
+    """
+    fields: dict[str, Any] = {problem.id: _table(problem) for problem in registry}
+    tables = create_model(
+        "ProblemTable",
+        __base__=StrictModel,
+        __doc__="The [problems.<id>] tables of the file, each parsed with its problem's settings.",
+        **fields,
+    )
+    return create_model(
+        "AssignmentFile",
+        __base__=StrictModel,
+        __doc__="The TOML file as written.",
+        problems=(tables, Field(description="One table per problem.")),
+        sandbox=(SandboxConfig, Field(description="Resource limits of the sandbox.")),
+    )
 
 
 def _describe(error: ValidationError, path: Path) -> str:
@@ -280,11 +151,12 @@ def _describe(error: ValidationError, path: Path) -> str:
     return "\n".join(lines)
 
 
-def load_config(path: Path | None = None) -> AssignmentConfig:
+def load_config(path: Path | None = None, registry: Registry = PROBLEMS) -> AssignmentConfig:
     """Load and validate the assignment configuration.
 
     Args:
         path: A TOML file; the bundled `grader/assignment.toml` when None.
+        registry: The problems it configures; the lab's by default.
 
     Returns:
         The validated configuration.
@@ -303,6 +175,9 @@ def load_config(path: Path | None = None) -> AssignmentConfig:
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
         raise ConfigError(f"{source} is not valid UTF-8 TOML ({error}): fix the syntax") from None
     try:
-        return AssignmentConfig.from_file(AssignmentFile.model_validate(raw))
+        parsed = dict(assignment_file_model(registry).model_validate(raw))
+        config = AssignmentConfig(problems=dict(parsed["problems"]), sandbox=parsed["sandbox"])
     except ValidationError as error:
         raise ConfigError(_describe(error, source)) from None
+    config._registry = registry
+    return config

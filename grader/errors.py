@@ -10,7 +10,11 @@ class ConfigError(GraderError, ValueError):
 
 
 class PlanError(GraderError, ValueError):
-    """Raised when a check is asked to plan calls with a configuration of another problem."""
+    """Raised when a problem gets settings of another problem's model, or settings never loaded for one."""
+
+
+class UnknownProblem(GraderError, ValueError):
+    """Raised when a problem id (e.g. in `--only`) is none of the registry's; the message lists them."""
 
 
 class ExecutorUnavailable(GraderError):

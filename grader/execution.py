@@ -9,12 +9,10 @@ from pathlib import Path
 
 from pydantic import JsonValue
 
-from grader.checks import CHECKS
 from grader.checks.base import CallRecord, Verdict
 from grader.checks.integrity import replay_call, settled_by
-from grader.config import AssignmentConfig, PlayedProblemConfig
-from grader.games import allowed_games
-from grader.problems import ProblemId
+from grader.config import AssignmentConfig
+from grader.problem_registry import ProblemId
 from grader.report import ProblemResult, ProblemRun, Timings, cap_output, plain_json
 from grader.sandbox import CallOutcome, IsolationPolicy, IsolationReport, Sandbox
 from grader.showcase import showcase_episode
@@ -57,7 +55,7 @@ def run_problem(
 
     Args:
         submission: The student's file.
-        problem: Which problem to grade.
+        problem: Which problem to grade (one of the configuration's registry).
         config: The assignment configuration.
         grading_seed: The grading seed; the problem's sandbox seed derives from it and the problem id.
         policy: Whether weaker isolation than full is acceptable.
@@ -69,13 +67,11 @@ def run_problem(
         grader.sandbox.errors.IsolationUnavailable: Full isolation was required and is not available.
     """
     started = time.perf_counter()
-    check = CHECKS[problem]
-    settings = config.problem(problem)
+    entry = config.registry.problem(problem)
+    check, settings = entry.check, entry.settings(config)
     seed = problem_seed(grading_seed, problem)
     limits = config.sandbox.to_limits(settings.call_seconds)
-    games = (
-        allowed_games(problem, settings.accepted_envs) if isinstance(settings, PlayedProblemConfig) else None
-    )
+    games = settings.game_rules()
     records: list[CallRecord] = []
     stopped: str | None = None
     with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:

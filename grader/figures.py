@@ -24,7 +24,10 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure as PlotFigure
 from PIL import Image
 
-from grader.config import AssignmentConfig, BlackjackConfig, CarConfig, CartpoleConfig
+from grader.checks.blackjack import BlackjackConfig
+from grader.checks.car import CarConfig
+from grader.checks.cartpole import CartpoleConfig
+from grader.config import AssignmentConfig
 from grader.report import EpisodeReplay, ProblemResult
 from grader.stats import binomial_acceptance
 

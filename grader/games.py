@@ -19,7 +19,7 @@ import gymnasium
 from gymnasium.envs.registration import load_env_creator
 
 from grader.compat import register_envs
-from grader.problems import ProblemId
+from grader.problem_registry import ProblemId
 
 if TYPE_CHECKING:
     from grader.sandbox.episode_log import EpisodeLog

@@ -1,17 +1,77 @@
-"""The problem identifiers of the lab, in the order the lab poses them, then the optional ones."""
+"""The problems of the OpenGym AI lab, declared once each, as the lab poses them, then the optional ones.
 
-from typing import Literal
+Everything that lists problems derives from `PROBLEMS`: the assignment configuration's tables
+(`grader.config`), `--only`, the acceptance modules (`grader/acceptance/test_<id>.py`), the report's titles
+and points. Adding a problem is one entry here, its module in `grader/checks/` (settings model + check), its
+acceptance module and its `[problems.<id>]` table (ARCHITECTURE.md, "Adding a problem for a later RL lab").
+"""
 
-ProblemId = Literal[
-    "random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues", "guessing_game"
-]
+from grader.checks.blackjack import BlackjackCheck, BlackjackConfig
+from grader.checks.car import CarCheck, CarConfig
+from grader.checks.cartpole import CartpoleCheck, CartpoleConfig
+from grader.checks.find_qvalues import FindQvaluesCheck, FindQvaluesConfig
+from grader.checks.guessing_game import GuessingGameCheck, GuessingGameConfig
+from grader.checks.random_blackjack import RandomBlackjackCheck, RandomBlackjackConfig
+from grader.checks.taxi import TaxiCheck, TaxiConfig
+from grader.problem_registry import Problem, ProblemId, Registry
 
-PROBLEM_IDS: tuple[ProblemId, ...] = (
-    "random_blackjack",
-    "blackjack",
-    "cartpole",
-    "car",
-    "taxi",
-    "find_qvalues",
-    "guessing_game",
+__all__ = ["PROBLEMS", "PROBLEM_IDS", "ProblemId", "problem"]
+
+PROBLEMS = Registry(
+    (
+        Problem(
+            id="random_blackjack",
+            title="Problem 1: random Blackjack",
+            points=1.0,
+            config=RandomBlackjackConfig,
+            check=RandomBlackjackCheck(),
+        ),
+        Problem(
+            id="blackjack",
+            title="Problem 2: threshold Blackjack",
+            points=1.0,
+            config=BlackjackConfig,
+            check=BlackjackCheck(),
+        ),
+        Problem(
+            id="cartpole",
+            title="Problem 3: CartPole",
+            points=1.0,
+            config=CartpoleConfig,
+            check=CartpoleCheck(),
+        ),
+        Problem(
+            id="car",
+            title="Problem 4: MountainCar",
+            points=1.0,
+            config=CarConfig,
+            check=CarCheck(),
+        ),
+        Problem(
+            id="taxi",
+            title="Problem 5: Taxi",
+            points=1.0,
+            config=TaxiConfig,
+            check=TaxiCheck(),
+        ),
+        Problem(
+            id="find_qvalues",
+            title="find_qvalues (provided by the lab)",
+            points=0.0,
+            config=FindQvaluesConfig,
+            check=FindQvaluesCheck(),
+        ),
+        Problem(
+            id="guessing_game",
+            title="Optional: GuessingGame",
+            points=1.0,
+            config=GuessingGameConfig,
+            check=GuessingGameCheck(),
+            enabled=False,
+        ),
+    )
 )
+"""The lab's problems, then the optional ones (disabled by default); every list of problems follows it."""
+
+PROBLEM_IDS: tuple[ProblemId, ...] = PROBLEMS.ids
+problem = PROBLEMS.problem

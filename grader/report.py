@@ -71,7 +71,7 @@ class ProblemResult(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    id: str = Field(description="Problem id: random_blackjack, blackjack, cartpole, car, taxi, find_qvalues.")
+    id: str = Field(description="Problem id, one of the registry's (grader/problems.py lists the lab's).")
     title: str = Field(description="The problem's title in the lab.")
     status: Status = Field(description="passed, failed, error, timeout or missing.")
     score: float = Field(description="Points earned.")

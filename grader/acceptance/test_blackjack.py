@@ -1,9 +1,9 @@
 """Problem 2: blackjack(n) follows 'draw while sum <= n' and wins as often as that policy does."""
 
 from grader.plugin import GradeCase, ProblemCase
-from grader.problems import ProblemId
+from grader.problems import PROBLEMS
 
-PROBLEM: ProblemId = "blackjack"
+PROBLEM = PROBLEMS.acceptance_problem(__name__)
 
 
 def test_blackjack(problem_case: ProblemCase, grade: GradeCase) -> None:

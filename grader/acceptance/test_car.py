@@ -1,9 +1,9 @@
 """Problem 4: car() reaches the goal fast enough; every returned length is its replayed episode's."""
 
 from grader.plugin import GradeCase, ProblemCase
-from grader.problems import ProblemId
+from grader.problems import PROBLEMS
 
-PROBLEM: ProblemId = "car"
+PROBLEM = PROBLEMS.acceptance_problem(__name__)
 
 
 def test_car(problem_case: ProblemCase, grade: GradeCase) -> None:

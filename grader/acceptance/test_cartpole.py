@@ -1,9 +1,9 @@
 """Problem 3: cartpole() balances long enough; every returned length is its replayed episode's."""
 
 from grader.plugin import GradeCase, ProblemCase
-from grader.problems import ProblemId
+from grader.problems import PROBLEMS
 
-PROBLEM: ProblemId = "cartpole"
+PROBLEM = PROBLEMS.acceptance_problem(__name__)
 
 
 def test_cartpole(problem_case: ProblemCase, grade: GradeCase) -> None:

@@ -1,9 +1,9 @@
 """The lab-provided find_qvalues(env): it trains, and its greedy policy's exact return is reported."""
 
 from grader.plugin import GradeCase, ProblemCase
-from grader.problems import ProblemId
+from grader.problems import PROBLEMS
 
-PROBLEM: ProblemId = "find_qvalues"
+PROBLEM = PROBLEMS.acceptance_problem(__name__)
 
 
 def test_find_qvalues(problem_case: ProblemCase, grade: GradeCase) -> None:

@@ -1,9 +1,9 @@
 """Optional: guessing_game() bisects to the target; every returned count is its replayed game's guesses."""
 
 from grader.plugin import GradeCase, ProblemCase
-from grader.problems import ProblemId
+from grader.problems import PROBLEMS
 
-PROBLEM: ProblemId = "guessing_game"
+PROBLEM = PROBLEMS.acceptance_problem(__name__)
 
 
 def test_guessing_game(problem_case: ProblemCase, grade: GradeCase) -> None:

@@ -1,9 +1,9 @@
 """Problem 1: random_blackjack(n) wins as often as random play does, backed by its replayed games."""
 
 from grader.plugin import GradeCase, ProblemCase
-from grader.problems import ProblemId
+from grader.problems import PROBLEMS
 
-PROBLEM: ProblemId = "random_blackjack"
+PROBLEM = PROBLEMS.acceptance_problem(__name__)
 
 
 def test_random_blackjack(problem_case: ProblemCase, grade: GradeCase) -> None:

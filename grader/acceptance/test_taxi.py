@@ -1,9 +1,9 @@
 """Problem 5: taxi() returns random and Q-table means matching their exact expectations."""
 
 from grader.plugin import GradeCase, ProblemCase
-from grader.problems import ProblemId
+from grader.problems import PROBLEMS
 
-PROBLEM: ProblemId = "taxi"
+PROBLEM = PROBLEMS.acceptance_problem(__name__)
 
 
 def test_taxi(problem_case: ProblemCase, grade: GradeCase) -> None:

@@ -8,19 +8,20 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal, ParamSpec, Protocol, TypeVar
 
-from grader.problems import PROBLEM_IDS, ProblemId
+from grader.problem_config import ProblemConfig
+from grader.problem_registry import ProblemId
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, PlainValue
 
 if TYPE_CHECKING:
-    from grader.config import ProblemConfig
     from grader.sandbox.replay import Replay
 
-__all__ = ["PROBLEM_IDS", "CallRecord", "ProblemCheck", "ProblemId", "Status", "Verdict", "outcome_verdict"]
+__all__ = ["CallRecord", "ProblemCheck", "ProblemId", "Status", "Verdict", "outcome_verdict"]
 
 Status = Literal["passed", "failed", "error", "timeout", "missing"]
 
 P = ParamSpec("P")
 R = TypeVar("R")
+ConfigT_contra = TypeVar("ConfigT_contra", bound=ProblemConfig, contravariant=True)
 
 
 @dataclass(frozen=True)
@@ -53,17 +54,18 @@ class Verdict:
     measurements: dict[str, PlainValue] = field(default_factory=dict)
 
 
-class ProblemCheck(Protocol):
-    """Plans the calls one problem needs and judges their outcomes (pure: no I/O)."""
+class ProblemCheck(Protocol[ConfigT_contra]):
+    """Plans the calls one problem needs and judges their outcomes (pure: no I/O), typed by its settings.
 
-    id: ProblemId
-    title: str
+    The registry entry (`grader.problem_registry.Problem`) pairs a check with its settings model, and
+    `Problem.settings` hands it settings of exactly that model: a check never narrows its configuration.
+    """
 
-    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: ConfigT_contra, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The calls to run, given the functions the submission defines."""
         ...
 
-    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+    def judge(self, settings: ConfigT_contra, records: Sequence[CallRecord]) -> Verdict:
         """The verdict for the planned calls' records (same order as planned)."""
         ...
 

@@ -5,9 +5,11 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Annotated, NamedTuple
 
-from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
+from pydantic import Field, field_validator
+
+from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, HIT, count_games, player_sum
 from grader.checks.integrity import (
     Episode,
@@ -18,9 +20,8 @@ from grader.checks.integrity import (
     repeated_seed_problem,
 )
 from grader.checks.values import as_number, chance_text, describe, rate_mismatch_cause, read_rate
-from grader.config import BlackjackConfig, ProblemConfig
-from grader.errors import PlanError
-from grader.games import Game, allowed_games
+from grader.games import Game
+from grader.problem_config import PlayedProblemConfig, Probability
 from grader.sandbox.outcome import Call, FunctionInfo
 from grader.stats import binomial_acceptance
 from reference.oracles import threshold_policy_outcome
@@ -43,10 +44,25 @@ def exact_best_n(*, sab: bool = False) -> int:
     return max(curve, key=lambda n: (curve[n], -n))
 
 
-def _settings(config: ProblemConfig) -> BlackjackConfig:
-    if not isinstance(config, BlackjackConfig):
-        raise PlanError(f"expected the blackjack settings, found {type(config).__name__}")
-    return config
+class BlackjackConfig(PlayedProblemConfig):
+    """The settings of `blackjack(n)`."""
+
+    thresholds: list[Annotated[int, Field(ge=0, le=21)]] = Field(
+        min_length=1, description="The values of n blackjack(n) is called with, one call each."
+    )
+    games_per_call: int = Field(
+        ge=1, description="Games each call must play (the lab says 10000); 0 is not allowed."
+    )
+    win_rate_alpha: Probability = Field(
+        description="False-fail probability of the exact two-sided binomial test of EACH call's win count against the exact threshold-policy win probability."  # noqa: E501
+    )
+
+    @field_validator("thresholds")
+    @classmethod
+    def _distinct(cls, thresholds: list[int]) -> list[int]:
+        if len(set(thresholds)) != len(thresholds):
+            raise ValueError(f"expected distinct values of n, found {thresholds}")
+        return thresholds
 
 
 class _Decision(NamedTuple):
@@ -109,28 +125,23 @@ def policy_deviation(decisions: Sequence[_Decision], n: int) -> str | None:
     return f"{len(wrong)} of {len(decisions)} decisions broke {rule} (e.g. game {example.game + 1}, decision {example.step + 1}: sum {example.total}, you {did})"  # noqa: E501
 
 
-@dataclass
+@dataclass(frozen=True)
 class BlackjackCheck:
     """blackjack(n) for several n: the threshold rule in every replayed decision, exact win rates."""
 
-    id: ProblemId = "blackjack"
-    title: str = "Problem 2: threshold Blackjack"
-
-    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: BlackjackConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """One call blackjack(n) per configured n."""
-        settings = _settings(config)
         budget = games_budget(settings.games_per_call, GAME_STEPS)
         return [Call("blackjack", (n,), budget=budget) for n in settings.thresholds]
 
     @paused_gc
-    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+    def judge(self, settings: BlackjackConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge every call's rule, game count, returned rate and exact win probability."""
-        settings = _settings(config)
         early = outcome_verdict(records)
         if early is not None:
             return early
         episodes = played_episodes(records)
-        rules = allowed_games(self.id, settings.accepted_envs)
+        rules = settings.game_rules()
         problem = integrity_problem(records, episodes, rules)
         if problem:
             return Verdict("failed", 0.0, f"blackjack: {problem}.", {})

@@ -5,41 +5,38 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
+from pydantic import Field
+
+from grader.checks.base import CallRecord, Verdict, paused_gc
 from grader.checks.integrity import games_budget
 from grader.checks.lengths import judge_lengths
-from grader.config import CarConfig, ProblemConfig
-from grader.errors import PlanError
-from grader.games import allowed_games
+from grader.problem_config import CountedStepsConfig
 from grader.sandbox.outcome import Call, FunctionInfo
 
 EPISODE_STEPS = 1_000
 """Steps recorded per game: MountainCar-v0 ends at 200; room for steps after the end to be diagnosed."""
 
 
-def _settings(config: ProblemConfig) -> CarConfig:
-    if not isinstance(config, CarConfig):
-        raise PlanError(f"expected the car settings, found {type(config).__name__}")
-    return config
+class CarConfig(CountedStepsConfig):
+    """The settings of `car()`."""
+
+    calls: int = Field(ge=1, description="How many times car() is called (one episode each).")
+    max_mean_steps: float = Field(gt=0.0, description="The mean episode length must be strictly below this.")
 
 
-@dataclass
+@dataclass(frozen=True)
 class CarCheck:
     """car() called many times: each return is its replayed length, every run reaches the goal, mean < bar."""
 
-    id: ProblemId = "car"
-    title: str = "Problem 4: MountainCar"
-
-    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: CarConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of car() calls."""
         budget = games_budget(1, EPISODE_STEPS)
-        return [Call("car", budget=budget) for _ in range(_settings(config).calls)]
+        return [Call("car", budget=budget) for _ in range(settings.calls)]
 
     @paused_gc
-    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+    def judge(self, settings: CarConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned lengths against the replays, then the goal and the mean against the bar."""
-        settings = _settings(config)
-        runs = judge_lengths("car", allowed_games(self.id, settings.accepted_envs), records)
+        runs = judge_lengths("car", settings.game_rules(), records)
         if isinstance(runs, Verdict):
             return runs
         measurements = runs.measurements()

@@ -5,41 +5,39 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
+from pydantic import Field
+
+from grader.checks.base import CallRecord, Verdict, paused_gc
 from grader.checks.integrity import games_budget
 from grader.checks.lengths import judge_lengths
-from grader.config import CartpoleConfig, ProblemConfig
-from grader.errors import PlanError
-from grader.games import allowed_games
+from grader.problem_config import CountedStepsConfig
 from grader.sandbox.outcome import Call, FunctionInfo
 
 EPISODE_STEPS = 1_000
 """Steps recorded per game: CartPole-v0 ends at 200 (v1 at 500); room for steps after the end."""
 
 
-def _settings(config: ProblemConfig) -> CartpoleConfig:
-    if not isinstance(config, CartpoleConfig):
-        raise PlanError(f"expected the cartpole settings, found {type(config).__name__}")
-    return config
+class CartpoleConfig(CountedStepsConfig):
+    """The settings of `cartpole()`."""
+
+    calls: int = Field(ge=1, description="How many times cartpole() is called (one episode each).")
+    min_mean_steps: float = Field(ge=0.0, description="The mean episode length must be at least this.")
+    min_steps: int = Field(ge=0, description="Every episode must last at least this many steps.")
 
 
-@dataclass
+@dataclass(frozen=True)
 class CartpoleCheck:
     """cartpole() called many times: each return is its replayed episode's length; the lab's bar holds."""
 
-    id: ProblemId = "cartpole"
-    title: str = "Problem 3: CartPole"
-
-    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: CartpoleConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of cartpole() calls."""
         budget = games_budget(1, EPISODE_STEPS)
-        return [Call("cartpole", budget=budget) for _ in range(_settings(config).calls)]
+        return [Call("cartpole", budget=budget) for _ in range(settings.calls)]
 
     @paused_gc
-    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+    def judge(self, settings: CartpoleConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned lengths against the replays, then mean and minimum against the bar."""
-        settings = _settings(config)
-        runs = judge_lengths("cartpole", allowed_games(self.id, settings.accepted_envs), records)
+        runs = judge_lengths("cartpole", settings.game_rules(), records)
         if isinstance(runs, Verdict):
             return runs
         measurements = runs.measurements()

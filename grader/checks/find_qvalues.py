@@ -6,39 +6,35 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from pydantic import Field
 
-from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.checks.integrity import NO_EPISODES
 from grader.checks.values import describe
-from grader.config import FindQvaluesConfig, ProblemConfig
-from grader.errors import PlanError
+from grader.problem_config import ProblemConfig
 from grader.sandbox.outcome import Call, FunctionInfo
 from reference.oracles import greedy_policy_return, optimal_return
 
 TAXI_SHAPE = (500, 6)
 
 
-def _settings(config: ProblemConfig) -> FindQvaluesConfig:
-    if not isinstance(config, FindQvaluesConfig):
-        raise PlanError(f"expected the find_qvalues settings, found {type(config).__name__}")
-    return config
+class FindQvaluesConfig(ProblemConfig):
+    """The lab-provided `find_qvalues(env)`: reported, weight 0 by default."""
+
+    env_id: str = Field(description="The environment id find_qvalues is called with (the lab's Taxi-v3).")
 
 
-@dataclass
+@dataclass(frozen=True)
 class FindQvaluesCheck:
     """find_qvalues("Taxi-v3"): a finite (500, 6) table; its greedy policy's exact return is reported."""
 
-    id: ProblemId = "find_qvalues"
-    title: str = "find_qvalues (provided by the lab)"
-
-    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: FindQvaluesConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """One unrecorded call (100 000 training episodes are not worth logging)."""
-        return [Call("find_qvalues", (_settings(config).env_id,), record_episodes=False, budget=NO_EPISODES)]
+        return [Call("find_qvalues", (settings.env_id,), record_episodes=False, budget=NO_EPISODES)]
 
     @paused_gc
-    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+    def judge(self, settings: FindQvaluesConfig, records: Sequence[CallRecord]) -> Verdict:
         """Validate the table and report the exact expected return of acting greedily on it."""
-        _settings(config)
         early = outcome_verdict(records)
         if early is not None:
             return early

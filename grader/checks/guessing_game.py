@@ -10,15 +10,14 @@ from functools import cache
 from typing import Any
 
 import numpy as np
+from pydantic import Field
 
-from grader.checks.base import CallRecord, ProblemId, Verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, paused_gc
 from grader.checks.integrity import Episode, games_budget, played_episodes
 from grader.checks.lengths import LengthRuns, judge_lengths
 from grader.checks.values import chance_text
 from grader.compat.envs.guessing_game import GUESS_EQUAL, GUESS_TOO_HIGH, GUESS_TOO_LOW
-from grader.config import GuessingGameConfig, ProblemConfig
-from grader.errors import PlanError
-from grader.games import allowed_games
+from grader.problem_config import PlayedProblemConfig, Probability
 from grader.sandbox.outcome import Call, FunctionInfo, PlainValue
 from reference.oracles.guessing_game import TARGET_HIGH, TARGET_LOW, TOLERANCE, midpoint_guess_counts
 
@@ -33,10 +32,18 @@ GUESS_SPACE = 10_000
 """The guess space is [-10000, 10000] (`env.action_space`), wider than the targets' [-1000, 1000)."""
 
 
-def _settings(config: ProblemConfig) -> GuessingGameConfig:
-    if not isinstance(config, GuessingGameConfig):
-        raise PlanError(f"expected the guessing_game settings, found {type(config).__name__}")
-    return config
+class GuessingGameConfig(PlayedProblemConfig):
+    """The settings of `guessing_game()`, the lab's midpoint search; every field has a default (optional)."""
+
+    call_seconds: float = Field(default=30.0, gt=0.0, description="Wall-clock limit of ONE call.")
+    expected_seconds: float = Field(default=3.0, ge=0.0, description="Typical total time of the calls.")
+    calls: int = Field(
+        default=100, ge=1, le=1_000, description="How many times guessing_game() is called (one game each)."
+    )
+    count_alpha: Probability = Field(
+        default=1e-6,
+        description="False-fail probability of the exact two-sided test of the total number of guesses against the exact distribution of the midpoint search's guess count.",  # noqa: E501
+    )
 
 
 @dataclass(frozen=True)
@@ -255,23 +262,19 @@ def _stopping_hint(records: Sequence[CallRecord]) -> str:
     return " In GuessingGame-v0 the game is won and over (done is True, reward 1) as soon as a guess is within 10 of the target; observation 2 (exactly equal) almost never comes, so stop on `done`."  # noqa: E501
 
 
-@dataclass
+@dataclass(frozen=True)
 class GuessingGameCheck:
     """guessing_game() called many times: returns its replayed game's guesses; midpoint play; exact total."""
 
-    id: ProblemId = "guessing_game"
-    title: str = "Optional: GuessingGame"
-
-    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: GuessingGameConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of guessing_game() calls."""
         budget = games_budget(1, EPISODE_STEPS)
-        return [Call("guessing_game", budget=budget) for _ in range(_settings(config).calls)]
+        return [Call("guessing_game", budget=budget) for _ in range(settings.calls)]
 
     @paused_gc
-    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+    def judge(self, settings: GuessingGameConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge counts against the replays, each guess against the midpoint, the total against the oracle."""
-        settings = _settings(config)
-        runs = judge_lengths("guessing_game", allowed_games(self.id, settings.accepted_envs), records)
+        runs = judge_lengths("guessing_game", settings.game_rules(), records)
         if isinstance(runs, Verdict):
             if runs.status != "failed":
                 return runs

@@ -6,7 +6,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
+from pydantic import Field
+
+from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, count_games, hits_by_sum
 from grader.checks.integrity import (
     all_resets,
@@ -16,9 +18,7 @@ from grader.checks.integrity import (
     repeated_seed_problem,
 )
 from grader.checks.values import as_number, chance_text, describe, rate_mismatch_cause, read_rate
-from grader.config import ProblemConfig, RandomBlackjackConfig
-from grader.errors import PlanError
-from grader.games import allowed_games
+from grader.problem_config import PlayedProblemConfig, Probability
 from grader.sandbox.outcome import Call, FunctionInfo
 from grader.stats import binomial_acceptance, grouped_binomial_fit, mean_tolerance
 from reference.oracles import random_policy_outcome
@@ -27,28 +27,31 @@ if TYPE_CHECKING:
     from grader.sandbox.outcome import PlainValue
 
 
-def _settings(config: ProblemConfig) -> RandomBlackjackConfig:
-    if not isinstance(config, RandomBlackjackConfig):
-        raise PlanError(f"expected the random_blackjack settings, found {type(config).__name__}")
-    return config
+class RandomBlackjackConfig(PlayedProblemConfig):
+    """The settings of `random_blackjack(n)`."""
+
+    games: int = Field(ge=100, description="The n passed to random_blackjack(n): games the student plays.")
+    win_rate_alpha: Probability = Field(
+        description="False-fail probability of the exact two-sided binomial test of the win count against the exact random-policy win probability."  # noqa: E501
+    )
+    action_alpha: Probability = Field(
+        description="False-fail probability of EACH of the two random-action tests (hit frequency = 1/2; "
+        "actions independent of the player's sum)."
+    )
 
 
-@dataclass
+@dataclass(frozen=True)
 class RandomBlackjackCheck:
     """random_blackjack(n): n completed games, random actions, and the exact random-policy win rate."""
 
-    id: ProblemId = "random_blackjack"
-    title: str = "Problem 1: random Blackjack"
-
-    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: RandomBlackjackConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """One call, random_blackjack(games)."""
-        games = _settings(config).games
+        games = settings.games
         return [Call("random_blackjack", (games,), budget=games_budget(games, GAME_STEPS))]
 
     @paused_gc
-    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+    def judge(self, settings: RandomBlackjackConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the call against its replayed games and the exact random-policy win probability."""
-        settings = _settings(config)
         early = outcome_verdict(records)
         if early is not None:
             return early
@@ -59,7 +62,7 @@ class RandomBlackjackCheck:
                 f"{call} returned {describe(records[0].outcome.value)}; expected the win rate as a number."
             )
         episodes = played_episodes(records)
-        rules = allowed_games(self.id, settings.accepted_envs)
+        rules = settings.game_rules()
         problem = integrity_problem(records, episodes, rules) or repeated_seed_problem(
             all_resets(records), across_calls=False
         )

@@ -8,8 +8,9 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from pydantic import Field
 
-from grader.checks.base import CallRecord, ProblemId, Verdict, outcome_verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.checks.integrity import (
     Episode,
     all_resets,
@@ -21,9 +22,7 @@ from grader.checks.integrity import (
 )
 from grader.checks.truncation import ignored_truncation
 from grader.checks.values import as_number, describe, same_number
-from grader.config import ProblemConfig, TaxiConfig
-from grader.errors import PlanError
-from grader.games import allowed_games
+from grader.problem_config import PlayedProblemConfig, Probability
 from grader.sandbox.outcome import Call, CallBudget, FunctionInfo
 from grader.stats import goodness_of_fit, mean_tolerance
 from reference.oracles import greedy_policy_return, optimal_q_table, optimal_return, random_policy_return
@@ -41,10 +40,27 @@ TRAINING_STEPS = 4_000_000
 _POSITIONAL = frozenset({"POSITIONAL_ONLY", "POSITIONAL_OR_KEYWORD", "VAR_POSITIONAL"})
 
 
-def _settings(config: ProblemConfig) -> TaxiConfig:
-    if not isinstance(config, TaxiConfig):
-        raise PlanError(f"expected the taxi settings, found {type(config).__name__}")
-    return config
+class TaxiConfig(PlayedProblemConfig):
+    """The settings of `taxi()` or `taxi(q_table)`."""
+
+    gamma: float = Field(
+        gt=0.0,
+        lt=1.0,
+        description="Discount of the exact optimal Q-table passed when taxi takes a parameter.",
+    )
+    episodes_per_scenario: int = Field(
+        ge=1, description="Episodes each scenario (random, Q-table) must play (the lab says 10000)."
+    )
+    mean_alpha: Probability = Field(
+        description="False-fail probability of EACH two-sided z-test of a returned mean against its exact expectation (variance from the exact oracle)."  # noqa: E501
+    )
+    action_alpha: Probability = Field(
+        description="False-fail probability of the chi-square test that the random scenario's actions are uniform over the 6 actions."  # noqa: E501
+    )
+    trained_slack: float = Field(
+        ge=0.0,
+        description="When taxi() trains its own table, its Q mean may fall this far below the optimal greedy return (on top of the z-test tolerance).",  # noqa: E501
+    )
 
 
 def takes_q_table(functions: Mapping[str, FunctionInfo]) -> bool:
@@ -109,16 +125,12 @@ def _mismatch_cause(episodes: Sequence[Episode], random_mean: float, greedy_mean
     )
 
 
-@dataclass
+@dataclass(frozen=True)
 class TaxiCheck:
     """taxi: both scenarios backed by replay, each mean near its exact expectation, Q beats random."""
 
-    id: ProblemId = "taxi"
-    title: str = "Problem 5: Taxi"
-
-    def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: TaxiConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """taxi(optimal Q-table) when taxi takes a parameter, else taxi()."""
-        settings = _settings(config)
         games = 2 * settings.episodes_per_scenario
         evaluation = games_budget(games, EPISODE_STEPS)
         if takes_q_table(functions):
@@ -129,9 +141,8 @@ class TaxiCheck:
         return [Call("taxi", budget=budget)]
 
     @paused_gc
-    def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+    def judge(self, settings: TaxiConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned means against the replayed scenarios and the exact expectations."""
-        settings = _settings(config)
         early = outcome_verdict(records)
         if early is not None:
             return early
@@ -144,9 +155,9 @@ class TaxiCheck:
             )
         random_mean, greedy_mean = float(means[0]), float(means[1])  # type: ignore[arg-type]
         episodes = played_episodes(records)
-        problem = integrity_problem(
-            records, episodes, allowed_games(self.id, settings.accepted_envs)
-        ) or repeated_seed_problem(all_resets(records), across_calls=False)
+        problem = integrity_problem(records, episodes, settings.game_rules()) or repeated_seed_problem(
+            all_resets(records), across_calls=False
+        )
         if problem:
             # An altered log is named as such; otherwise a loop that ignored `truncated` is named as that.
             diagnosis = None if seed_problem(records) else ignored_truncation(episodes)

@@ -13,9 +13,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from fake_problem import WITH_ECHO
 from grading_support import CLASSIC_COMPLETE, FAST_OVERRIDES, SUBMISSIONS, write_config
 
 from grader import cli
+from grader.problems import PROBLEMS
 from grader.report import Report
 
 
@@ -134,6 +136,26 @@ def test_argument_errors_exit_2(argv: list[str], message: str, capsys: pytest.Ca
         cli.main(argv)
     assert exit_info.value.code == cli.EXIT_ERROR
     assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("registry", [PROBLEMS, WITH_ECHO], ids=["lab", "with-echo"])
+def test_only_derives_its_help_ids_and_message_from_the_registry(
+    registry: Any, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setattr(cli, "PROBLEMS", registry)
+    parser = cli.build_parser()
+    last = registry.ids[-1]
+    parsed = parser.parse_args(["check", "opengym.py", "--only", f"{last},car"])
+    assert parsed.only == ["car", last]
+    with pytest.raises(SystemExit):
+        parser.parse_args(["check", "opengym.py", "--help"])
+    assert f"grade only these problems ({', '.join(registry.ids)})" in " ".join(
+        capsys.readouterr().out.split()
+    )
+    with pytest.raises(SystemExit):
+        parser.parse_args(["check", "opengym.py", "--only", "blackjak"])
+    expected = f"unknown problem blackjak; expected ids among {', '.join(registry.ids)}"
+    assert expected in capsys.readouterr().err
 
 
 def test_grade_writes_reports_and_grades_csv_with_plain_progress(

@@ -3,15 +3,21 @@
 from pathlib import Path
 
 import pytest
+from fake_problem import WITH_ECHO, WITH_OPTIONAL_ECHO, EchoConfig
 from pydantic import BaseModel
 
 from grader import config as config_module
+from grader.checks.blackjack import BlackjackConfig
 from grader.config import AssignmentConfig, ConfigError, load_config
-from grader.problems import PROBLEM_IDS
+from grader.errors import PlanError, UnknownProblem
+from grader.problem_config import ProblemConfig
+from grader.problem_registry import Registry
+from grader.problems import PROBLEM_IDS, PROBLEMS, problem
 from grader.sandbox.limits import Limits
 from grader.stats import binomial_acceptance, mean_tolerance
 from reference.oracles import random_policy_outcome, random_policy_return, threshold_policy_outcome
 
+LAB_REQUIRED = [problem.id for problem in PROBLEMS if problem.enabled]
 BUNDLED = config_module.DEFAULT_CONFIG_PATH.read_text(encoding="utf-8")
 
 
@@ -29,30 +35,106 @@ def test_bundled_configuration_loads_with_every_problem() -> None:
 
 
 def _models() -> list[type[BaseModel]]:
+    file_model = config_module.assignment_file_model(PROBLEMS)
     return [
         AssignmentConfig,
-        config_module.AssignmentFile,
-        config_module.ProblemTable,
+        file_model,
+        file_model.model_fields["problems"].annotation,
         config_module.SandboxConfig,
-        *config_module._PROBLEM_CLASSES.values(),
+        *(entry.config for entry in PROBLEMS),
     ]
 
 
 @pytest.mark.parametrize("model", _models(), ids=lambda model: model.__name__)
 def test_every_field_is_described(model: type[BaseModel]) -> None:
-    undescribed = [
-        name for name, field in model.model_fields.items() if name != "kind" and not field.description
-    ]
+    undescribed = [name for name, field in model.model_fields.items() if not field.description]
     assert undescribed == []
 
 
+@pytest.mark.parametrize(
+    ("registry", "required"), [(WITH_ECHO, [*LAB_REQUIRED, "echo"]), (WITH_OPTIONAL_ECHO, LAB_REQUIRED)]
+)
+def test_the_file_has_a_table_per_registered_problem_in_registry_order(
+    registry: Registry, required: list[str]
+) -> None:
+    schema = config_module.assignment_file_model(registry).model_json_schema()
+    tables = schema["$defs"]["ProblemTable"]
+    assert (list(tables["properties"]), tables["required"]) == ([*PROBLEM_IDS, "echo"], required)
+    assert tables["properties"]["echo"]["description"].startswith("Problem E: echo. `echo(n)`: every field")
+
+
+def test_titles_points_and_enabled_default_to_the_registry(tmp_path: Path) -> None:
+    config = load_config()
+    assert [config.problem(entry.id).title for entry in PROBLEMS] == [entry.title for entry in PROBLEMS]
+    assert [config.problem(entry.id).points for entry in PROBLEMS] == [entry.points for entry in PROBLEMS]
+    unscored = BUNDLED.replace("points = 1.0\nenabled = true\n", "", 1)
+    assert load_config(_write(tmp_path, unscored)).problem("random_blackjack").points == 1.0
+
+
+def test_a_title_in_the_file_still_overrides_the_registry(tmp_path: Path) -> None:
+    renamed = BUNDLED.replace("[problems.car]\n", '[problems.car]\ntitle = "Aufgabe 4: MountainCar"\n', 1)
+    assert load_config(_write(tmp_path, renamed)).problem("car").title == "Aufgabe 4: MountainCar"
+
+
+def test_the_digest_covers_every_problem_s_own_settings(tmp_path: Path) -> None:
+    """The config_sha256 of reports hashes model_dump_json(): a changed threshold must change it."""
+    changed = BUNDLED.replace("thresholds = [12, 13, 14, 20]", "thresholds = [12, 13, 14, 19]", 1)
+    dumped, other = load_config().model_dump_json(), load_config(_write(tmp_path, changed)).model_dump_json()
+    assert '"thresholds":[12,13,14,20]' in dumped
+    assert dumped != other
+
+
+def test_a_problem_disabled_by_default_may_be_left_out() -> None:
+    config = load_config(registry=WITH_OPTIONAL_ECHO)
+    echo = WITH_OPTIONAL_ECHO.problem("echo").settings(config)
+    assert isinstance(echo, EchoConfig)
+    assert (echo.enabled, echo.title, echo.points, echo.answer) == (False, "Problem E: echo", 2.0, 42)
+    assert tuple(config.problems) == (*PROBLEM_IDS, "echo")
+    assert config.registry is WITH_OPTIONAL_ECHO
+
+
+def test_a_problem_enabled_by_default_may_not_be_left_out() -> None:
+    with pytest.raises(ConfigError, match=r"problems\.echo: Field required \(add it to the file\)"):
+        load_config(registry=WITH_ECHO)
+
+
+def test_settings_are_typed_by_the_registry_and_bound_to_their_problem() -> None:
+    config = load_config()
+    settings = problem("blackjack").settings(config)
+    assert isinstance(settings, BlackjackConfig)
+    assert settings.problem_id == "blackjack"
+    assert [game.name for game in settings.game_rules().games] == ["Blackjack-v0", "Blackjack-v1"]
+    assert config.problem("find_qvalues").game_rules() is None
+
+
+def test_settings_of_another_registry_are_refused_with_what_to_do(tmp_path: Path) -> None:
+    echo_table = "[problems.echo]\nanswer = 7\n"
+    config = load_config(_write(tmp_path, BUNDLED + echo_table), registry=WITH_ECHO)
+    assert WITH_ECHO.problem("echo").settings(config).answer == 7
+    with pytest.raises(UnknownProblem, match="unknown problem echo; expected ids among random_blackjack, "):
+        load_config().problem("echo")
+    foreign = config.model_copy(update={"problems": {**config.problems, "car": config.problem("echo")}})
+    with pytest.raises(
+        PlanError, match="expected CarConfig settings for problem car, found EchoConfig: load"
+    ):
+        problem("car").settings(foreign)
+
+
+def test_settings_built_by_hand_say_how_to_bind_them() -> None:
+    loose = ProblemConfig(title="t", points=1.0, call_seconds=1.0, expected_seconds=1.0)
+    with pytest.raises(PlanError, match=r"unbound settings: load them with grader\.config\.load_config"):
+        _ = loose.problem_id
+    assert loose.for_problem("car").problem_id == "car"
+
+
 def test_accepted_envs_restrict_the_games(tmp_path: Path) -> None:
-    assert load_config().problems["blackjack"].accepted_envs is None  # type: ignore[attr-defined]
+    assert problem("blackjack").settings(load_config()).accepted_envs is None
     restricted = BUNDLED.replace(
         "games_per_call = 10000", 'games_per_call = 10000\naccepted_envs = ["Blackjack-v1"]'
     )
-    config = load_config(_write(tmp_path, restricted))
-    assert config.problems["blackjack"].accepted_envs == ["Blackjack-v1"]  # type: ignore[attr-defined]
+    settings = problem("blackjack").settings(load_config(_write(tmp_path, restricted)))
+    assert settings.accepted_envs == ["Blackjack-v1"]
+    assert [game.name for game in settings.game_rules().games] == ["Blackjack-v1"]
 
 
 def test_sandbox_settings_become_limits() -> None:
@@ -185,25 +267,25 @@ def test_not_toml_says_so(tmp_path: Path) -> None:
 
 
 def test_random_blackjack_sample_size_detects_a_shifted_win_rate() -> None:
-    settings = load_config().problems["random_blackjack"]
+    settings = problem("random_blackjack").settings(load_config())
     exact = random_policy_outcome().win
-    acceptance = binomial_acceptance(settings.games, exact, settings.win_rate_alpha)  # type: ignore[attr-defined]
+    acceptance = binomial_acceptance(settings.games, exact, settings.win_rate_alpha)
     assert acceptance.false_fail <= 1e-6
     assert acceptance.pass_probability(exact - 0.04) < 1e-3
     assert acceptance.pass_probability(exact + 0.04) < 1e-3
 
 
 def test_random_blackjack_hit_test_detects_a_biased_coin() -> None:
-    settings = load_config().problems["random_blackjack"]
+    settings = problem("random_blackjack").settings(load_config())
     # At least 1.3 decisions per game (measured 1.37): every game has one, and half of the first draws go on.
-    decisions = int(1.3 * settings.games)  # type: ignore[attr-defined]
-    tolerance = mean_tolerance(0.5, 0.25, decisions, settings.action_alpha)  # type: ignore[attr-defined]
+    decisions = int(1.3 * settings.games)
+    tolerance = mean_tolerance(0.5, 0.25, decisions, settings.action_alpha)
     assert tolerance.pass_probability(0.45) < 1e-3
     assert tolerance.pass_probability(0.55) < 1e-3
 
 
 def test_blackjack_thresholds_include_the_best_n_and_both_its_sides() -> None:
-    thresholds = load_config().problems["blackjack"].thresholds  # type: ignore[attr-defined]
+    thresholds = problem("blackjack").settings(load_config()).thresholds
     wins = {n: threshold_policy_outcome(n).win for n in range(22)}
     best = max(wins, key=wins.__getitem__)
     assert {best - 1, best, best + 1} <= set(thresholds)
@@ -213,14 +295,14 @@ def test_blackjack_thresholds_include_the_best_n_and_both_its_sides() -> None:
 
 
 def test_taxi_random_mean_tolerance() -> None:
-    settings = load_config().problems["taxi"]
+    settings = problem("taxi").settings(load_config())
     moments = random_policy_return()
     tolerance = mean_tolerance(
         moments.mean,
         moments.variance,
-        settings.episodes_per_scenario,  # type: ignore[attr-defined]
+        settings.episodes_per_scenario,
         settings.mean_alpha,
-    )  # type: ignore[attr-defined]
+    )
     assert tolerance.half_width < 5.0
     assert tolerance.pass_probability(moments.mean + 10.0) < 1e-6
 

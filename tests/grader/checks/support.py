@@ -4,9 +4,10 @@ import inspect
 from functools import partial
 from typing import Any
 
-from grader.checks import CHECKS
 from grader.checks.base import CallRecord, ProblemId, Verdict
-from grader.config import ProblemConfig, load_config
+from grader.config import load_config
+from grader.problem_config import ProblemConfig
+from grader.problems import PROBLEMS
 from grader.testing.simulation import StudentFunction, function_infos, simulate_calls
 
 # Samples smaller than the assignment's so the suite stays fast; every threshold is derived from them.
@@ -46,7 +47,7 @@ def simulate(
     """Plan the problem's calls, run them on the simulated functions, replay every episode for real."""
     settings = settings or small_config(problem)
     sized = {name: _sized(function, settings) for name, function in functions.items()}
-    calls = CHECKS[problem].plan(settings, function_infos(sized))
+    calls = PROBLEMS.problem(problem).check.plan(settings, function_infos(sized))
     return simulate_calls(calls, sized, seed, replay=replay)
 
 
@@ -58,4 +59,4 @@ def grade(
 ) -> Verdict:
     """Simulate and judge one problem."""
     settings = settings or small_config(problem)
-    return CHECKS[problem].judge(settings, simulate(problem, functions, seed, settings))
+    return PROBLEMS.problem(problem).check.judge(settings, simulate(problem, functions, seed, settings))

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from grader.checks import CHECKS
 from grader.checks.base import CallRecord
+from grader.problems import PROBLEMS
 from grader.sandbox.outcome import Call, CallOutcome, OutcomeStatus
 from reference.oracles import optimal_q_table
 
@@ -13,7 +13,7 @@ from .support import small_config
 
 def _judge(value: object):  # type: ignore[no-untyped-def]
     settings = small_config("find_qvalues")
-    (call,) = CHECKS["find_qvalues"].plan(settings, {})
+    (call,) = PROBLEMS.problem("find_qvalues").check.plan(settings, {})
     assert (call.function, call.args, call.record_episodes) == ("find_qvalues", ("Taxi-v3",), False)
     outcome = CallOutcome(
         Call("find_qvalues", ("Taxi-v3",), record_episodes=False),
@@ -27,7 +27,7 @@ def _judge(value: object):  # type: ignore[no-untyped-def]
         1.0,
         3,
     )
-    return CHECKS["find_qvalues"].judge(settings, [CallRecord(outcome, [])])
+    return PROBLEMS.problem("find_qvalues").check.judge(settings, [CallRecord(outcome, [])])
 
 
 def test_optimal_table_reports_the_optimal_return() -> None:

@@ -12,18 +12,19 @@ from typing import Any
 import numpy as np
 import pytest
 
-from grader.checks import CHECKS
 from grader.checks.base import CallRecord, Verdict
 from grader.checks.guessing_game import (
     GUESS_SPACE,
     MIDPOINT_SLACK,
+    GuessingGameConfig,
     _guess_value,
     first_deviation,
     total_acceptance,
 )
 from grader.checks.integrity import Episode, games_budget
 from grader.compat import GuessingGameEnv, register_envs
-from grader.config import GuessingGameConfig, load_config
+from grader.config import load_config
+from grader.problems import PROBLEMS
 from grader.sandbox.episode_log import EpisodeLog
 from grader.sandbox.outcome import CallOutcome, OutcomeStatus
 from grader.sandbox.replay import Replay
@@ -73,7 +74,7 @@ def judge(student: Callable[[Lab], Any], seed: int, settings: GuessingGameConfig
     register_envs()
     settings = settings or _settings()
     functions = {"guessing_game": student}
-    check = CHECKS["guessing_game"]
+    check = PROBLEMS.problem("guessing_game").check
     calls = check.plan(settings, function_infos(functions))
     return check.judge(settings, simulate_calls(calls, functions, seed, replay=True))
 
@@ -280,11 +281,11 @@ def test_the_first_guess_off_the_midpoint_is_found(
 
 def test_a_missing_function_is_missing_before_anything_is_judged() -> None:
     settings = _settings(calls=2)
-    calls = CHECKS["guessing_game"].plan(settings, {})
+    calls = PROBLEMS.problem("guessing_game").check.plan(settings, {})
     assert [(call.function, call.budget) for call in calls] == [("guessing_game", games_budget(1, 400))] * 2
     outcome = CallOutcome(calls[0], OutcomeStatus.MISSING_FUNCTION, None, [], [], "", "",
                           "your file defines no function named `guessing_game`", 0.0, 1)  # fmt: skip
-    verdict = CHECKS["guessing_game"].judge(settings, [CallRecord(outcome, [])] * 2)
+    verdict = PROBLEMS.problem("guessing_game").check.judge(settings, [CallRecord(outcome, [])] * 2)
     assert (verdict.status, verdict.feedback) == (
         "missing",
         "your file defines no function named `guessing_game`",

@@ -5,10 +5,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from grader.checks import CHECKS
 from grader.checks.base import CallRecord
 from grader.checks.integrity import games_budget, integrity_problem, played_episodes, replay_call, settled_by
 from grader.games import allowed_games
+from grader.problems import PROBLEMS
 from grader.sandbox.outcome import CallBudget
 from grader.sandbox.replay import replay_episode
 from grader.testing.behaviours import cartpole, velocity_policy
@@ -87,7 +87,7 @@ def test_two_episodes_in_one_cartpole_call_fail(seed: int) -> None:
 
 
 def test_plans_name_the_functions() -> None:
-    calls = CHECKS["cartpole"].plan(small_config("cartpole"), {})
+    calls = PROBLEMS.problem("cartpole").check.plan(small_config("cartpole"), {})
     assert [call.function for call in calls] == ["cartpole"] * 100
     assert velocity_policy([0, 0, 0, 0.1]) == 1
 
@@ -216,5 +216,5 @@ def test_an_honest_call_does_not_settle_the_verdict(seed: int) -> None:
 
 def test_budgets_leave_room_for_diagnoses() -> None:
     assert games_budget(1, 1_000) == CallBudget(max_episodes=10, max_steps=9_000)
-    calls = CHECKS["car"].plan(small_config("car"), {})
+    calls = PROBLEMS.problem("car").check.plan(small_config("car"), {})
     assert {call.budget for call in calls} == {games_budget(1, 1_000)}

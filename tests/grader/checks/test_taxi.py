@@ -6,8 +6,8 @@ False-fail probability of each passing test: 3e-6 (two z-tests and one chi-squar
 import numpy as np
 import pytest
 
-from grader.checks import CHECKS
 from grader.checks.taxi import takes_q_table
+from grader.problems import PROBLEMS
 from grader.sandbox.outcome import FunctionInfo, ParameterInfo
 from grader.testing.behaviours import taxi
 from reference.oracles import optimal_q_table
@@ -38,7 +38,7 @@ def test_plan_passes_the_optimal_table_only_when_taxi_takes_one(
     functions: dict[str, FunctionInfo], takes: bool
 ) -> None:
     assert takes_q_table(functions) is takes
-    (call,) = CHECKS["taxi"].plan(small_config("taxi"), functions)
+    (call,) = PROBLEMS.problem("taxi").check.plan(small_config("taxi"), functions)
     assert call.function == "taxi"
     if takes:
         np.testing.assert_array_equal(call.args[0], optimal_q_table(0.6))

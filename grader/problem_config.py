@@ -1,0 +1,110 @@
+"""Settings every `[problems.<id>]` table has, and the shared kinds a problem's own settings model extends."""
+
+from __future__ import annotations
+
+from typing import Annotated, Self
+
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr
+
+from grader.errors import PlanError
+from grader.games import GameRules, accepted_game_names, allowed_games
+from grader.problem_registry import ProblemId
+from grader.report import Visibility
+
+Probability = Annotated[float, Field(gt=0.0, lt=1.0)]
+
+
+class StrictModel(BaseModel):
+    """A frozen model that refuses unknown fields (a misspelt setting is an error, never ignored)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class ProblemConfig(StrictModel):
+    """Settings every problem has."""
+
+    title: str = Field(
+        description="Heading shown in the report; default: the problem's title in grader/problems.py."
+    )
+    points: float = Field(
+        ge=0.0,
+        description="Points the problem is worth; 0 reports it without scoring. Default: grader/problems.py.",
+    )
+    enabled: bool = Field(
+        default=True,
+        description="False skips the problem entirely (no calls, no points). Default: grader/problems.py.",
+    )
+    call_seconds: float = Field(gt=0.0, description="Wall-clock limit of ONE call of the student's function.")
+    expected_seconds: float = Field(
+        ge=0.0, description="Typical total time of the problem's calls; slowest problems are started first."
+    )
+    visibility: Visibility = Field(
+        default="visible",
+        description="When students see this problem's result and feedback in the service: "
+        "'visible' (at once), 'after_due_date' (once GYMGRADE_DUE_DATE has passed) or 'hidden' (instructors only).",  # noqa: E501
+    )
+    _problem: ProblemId | None = PrivateAttr(default=None)
+
+    @property
+    def problem_id(self) -> ProblemId:
+        """The id of the problem these settings were loaded for.
+
+        Raises:
+            PlanError: The settings were built by hand, not loaded (use `for_problem`).
+        """
+        if self._problem is None:
+            raise PlanError(
+                f"expected {type(self).__name__} loaded for a problem, found unbound settings: load them "
+                "with grader.config.load_config or bind them with .for_problem(id)"
+            )
+        return self._problem
+
+    def for_problem(self, problem_id: ProblemId) -> Self:
+        """These settings bound to the problem they configure (what the loader does with every table).
+
+        Raises:
+            ValueError: A setting does not suit the problem (the loader reports it under the table).
+        """
+        bound = self.model_copy()
+        bound._problem = problem_id
+        return bound
+
+    def game_rules(self) -> GameRules | None:
+        """The games the problem's episodes must be played in; None: its calls play none."""
+        return None
+
+
+class PlayedProblemConfig(ProblemConfig):
+    """Settings of a problem whose function plays episodes in an environment."""
+
+    accepted_envs: list[str] | None = Field(
+        default=None,
+        description="The games the episodes may be played in, by id (grader/games.py lists each problem's: Blackjack-v0/Blackjack-v1, CartPole-v0/CartPole-v1, MountainCar-v0, Taxi-v3); "  # noqa: E501
+        "absent = all of them.",
+    )
+
+    def for_problem(self, problem_id: ProblemId) -> Self:
+        """These settings bound to their problem, once `accepted_envs` names only games it accepts."""
+        accepted = accepted_game_names(problem_id)
+        chosen = self.accepted_envs
+        if chosen is not None and (not chosen or not set(chosen) <= set(accepted)):
+            raise ValueError(
+                f"accepted_envs must be a non-empty list of {', '.join(accepted)}; found {chosen}"
+            )
+        return super().for_problem(problem_id)
+
+    def game_rules(self) -> GameRules:
+        """The games the problem's episodes must be played in (`accepted_envs`, else all it accepts)."""
+        return allowed_games(self.problem_id, self.accepted_envs)
+
+
+class CountedStepsConfig(PlayedProblemConfig):
+    """Settings of a problem whose function returns the length of the episode it played."""
+
+    uncounted_steps_deduction: float = Field(
+        default=0.0,
+        ge=0.0,
+        le=1.0,
+        description="Share of the problem's points deducted when every returned count misses exactly the steps taken before the counted loop (the lab-era 'one random step first' pattern); "  # noqa: E501
+        "the verdict follows the replayed episodes either way.",
+    )
