@@ -10,7 +10,7 @@ the runner handles a result frame, with the call's budget:
     (`episode_log.episodes_from_plain`), both as of OLD_REVISION (read with `git show`);
   * new: `parse_payload`, `messages.result_message` and `episode_log.episodes_from_plain` (`WireEpisode`).
 
-Wall time is the median of `--repetitions` runs; peak memory is tracemalloc's peak of one more run
+Wall time is the least of `--repetitions` runs; peak memory is tracemalloc's peak of one more run
 (tracing slows parsing). With msgspec installed, the validation of the episodes' structure alone (no
 array decoding) is also timed with msgspec Structs against the pydantic model, the choice this bench
 informed. Captured frames are kept in `--frames DIR` (default: a temporary directory).
@@ -23,7 +23,6 @@ from __future__ import annotations
 import argparse
 import ast
 import json
-import statistics
 import subprocess
 import sys
 import tempfile
@@ -141,7 +140,8 @@ def measure_once(mode: str, path: Path, budget: tuple[int, int], trace: bool) ->
 
 
 def measure(mode: str, path: Path, budget: tuple[int, int], repetitions: int) -> dict[str, Any]:
-    """Median seconds over fresh subprocesses, and the traced peak of one more."""
+    """The least seconds over fresh subprocesses (the load of other jobs only adds), and the traced peak of
+    one more."""
 
     def run(trace: bool) -> dict[str, Any]:
         command = [sys.executable, __file__, "--measure", mode, str(path), json.dumps(budget)]
@@ -153,7 +153,7 @@ def measure(mode: str, path: Path, budget: tuple[int, int], repetitions: int) ->
     runs = [run(trace=False) for _ in range(repetitions)]
     traced = run(trace=True)
     return {
-        "seconds": statistics.median(run["seconds"] for run in runs),
+        "seconds": min(run["seconds"] for run in runs),
         "peak_mib": traced["peak_mib"],
         "episodes": traced["episodes"],
     }
