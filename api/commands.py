@@ -23,8 +23,9 @@ def add_serve_command(subparsers: argparse._SubParsersAction[argparse.ArgumentPa
     parser = subparsers.add_parser(
         "serve",
         help="run the HTTP submission service (settings from GYMGRADE_* variables)",
-        description="Run the HTTP submission service with uvicorn. Configure it with GYMGRADE_* environment "
-        "variables; GYMGRADE_INSTRUCTOR_TOKEN is required.",
+        description="Run the HTTP submission service with uvicorn. "
+        "Configure it with GYMGRADE_* environment variables; "
+        "GYMGRADE_INSTRUCTOR_TOKEN is required.",
     )
     parser.add_argument("--host", default=DEFAULT_HOST, help=f"address to listen on (default {DEFAULT_HOST})")
     parser.add_argument(
@@ -38,9 +39,8 @@ def add_worker_command(subparsers: argparse._SubParsersAction[argparse.ArgumentP
     parser = subparsers.add_parser(
         "worker",
         help="grade queued submissions in this process (a Celery worker when GYMGRADE_BROKER_URL is set)",
-        description="Grade queued submissions until Ctrl-C or SIGTERM: from the service's database next to "
-        "`gymgrade serve` with GYMGRADE_WORKERS=0, or, with GYMGRADE_BROKER_URL=redis://HOST:PORT/N, as a "
-        "Celery worker of the cluster (it needs the broker, the database and full isolation).",
+        description="Grade queued submissions until Ctrl-C or SIGTERM: "
+        "from the service's database next to `gymgrade serve` with GYMGRADE_WORKERS=0, or, with GYMGRADE_BROKER_URL=redis://HOST:PORT/N, as a Celery worker of the cluster (it needs the broker, the database and full isolation).",  # noqa: E501
     )
     parser.add_argument(
         "--workers",

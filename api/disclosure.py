@@ -109,6 +109,6 @@ def _withheld_note(visibility: str, due_date: datetime | None) -> str:
             "The total score is shown then too."
         )
     return (
-        "This problem's result is hidden from students (your instructor sees it); the total score is "
-        "hidden with it."
+        "This problem's result is hidden from students (your instructor sees it); "
+        "the total score is hidden with it."
     )

@@ -203,8 +203,8 @@ def _from_http_exception(request: Request, error: HTTPException) -> ServiceError
     path = request.url.path
     if error.status_code == 400:
         return MalformedBody(
-            f"the request body could not be parsed ({error.detail}); send multipart/form-data for "
-            "uploads and JSON for everything else, as this operation documents"
+            f"the request body could not be parsed ({error.detail}); "
+            "send multipart/form-data for uploads and JSON for everything else, as this operation documents"
         )
     if error.status_code == 404:
         return PathNotFound(f"nothing is at {path}; the API's operations are listed at /docs")
@@ -247,8 +247,8 @@ def install_error_handlers(app: FastAPI) -> None:
         return error_response(
             request,
             InternalError(
-                "the service failed on this request and logged why; try again, and tell the instructor "
-                "if it keeps failing"
+                "the service failed on this request and logged why; "
+                "try again, and tell the instructor if it keeps failing"
             ),
         )
 

@@ -17,8 +17,9 @@ from api.settings import Settings, load_settings
 from api.web import STATIC_DIR
 
 DESCRIPTION = (
-    "Students upload `opengym.py` and get their grade; the instructor creates students, sees every "
-    "submission and exports the gradebook. Authenticate with `Authorization: Bearer <token>`."
+    "Students upload `opengym.py` and get their grade; "
+    "the instructor creates students, sees every submission and exports the gradebook. "
+    "Authenticate with `Authorization: Bearer <token>`."
 )
 
 

@@ -32,8 +32,7 @@ class StudentCreate(BaseModel):
 
     name: str = Field(
         description=(
-            f"Unique display name: 1 to {MAX_NAME_CHARS} characters once whitespace around it is trimmed, "
-            "none of them a control, format (bidi, zero-width), private-use or line-separator character."
+            f"Unique display name: 1 to {MAX_NAME_CHARS} characters once whitespace around it is trimmed, none of them a control, format (bidi, zero-width), private-use or line-separator character."  # noqa: E501
         ),
         examples=["Ada Lovelace"],
     )
@@ -80,9 +79,8 @@ class SubmissionDetail(SubmissionSummary):
     )
     report: dict[str, Any] | None = Field(
         default=None,
-        description="The grader's report, when status is done. Students see null seeds unless released, "
-        "and problems withheld by their visibility (hidden, after_due_date before the due date) with "
-        "status 'withheld', a note for feedback and a null score, as is then the total.",
+        description="The grader's report, when status is done. "
+        "Students see null seeds unless released, and problems withheld by their visibility (hidden, after_due_date before the due date) with status 'withheld', a note for feedback and a null score, as is then the total.",  # noqa: E501
     )
     error: str | None = Field(default=None, description="Why grading failed, when status is failed.")
 

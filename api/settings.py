@@ -37,20 +37,20 @@ class BrokerSettings(BaseSettings):
 
     broker_url: str | None = Field(
         default=None,
-        description="redis://HOST:PORT/N of the Celery broker: `serve` enqueues gradings there, `worker` "
-        "runs a Celery worker, `grade` sends batches to the cluster. Unset: the embedded database queue.",
+        description="redis://HOST:PORT/N of the Celery broker: "
+        "`serve` enqueues gradings there, `worker` runs a Celery worker, `grade` sends batches to the cluster. "  # noqa: E501
+        "Unset: the embedded database queue.",
     )
     visibility_timeout_seconds: float = Field(
         default=3600.0,
         gt=0,
-        description="A task taken by a worker that vanished is delivered again after this long; must "
-        "exceed GRADING_TIMEOUT_SECONDS (the longest grading).",
+        description="A task taken by a worker that vanished is delivered again after this long; "
+        "must exceed GRADING_TIMEOUT_SECONDS (the longest grading).",
     )
     reconcile_seconds: float = Field(
         default=30.0,
         gt=0,
-        description="How often the server re-enqueues queued jobs whose task is gone (broker restart or "
-        "flush) and running jobs whose worker stopped renewing its lease.",
+        description="How often the server re-enqueues queued jobs whose task is gone (broker restart or flush) and running jobs whose worker stopped renewing its lease.",  # noqa: E501
     )
 
     @field_validator("broker_url")
@@ -97,19 +97,19 @@ class Settings(BrokerSettings):
     )
     seed_policy: SeedPolicy = Field(
         default=SeedPolicy.RANDOM,
-        description="random: a fresh held-out seed per submission, stored in its row (an instructor regrades "
-        "with it); fixed: every submission graded with SEED (never the public practice seed 0).",
+        description="random: a fresh held-out seed per submission, stored in its row (an instructor regrades with it); "  # noqa: E501
+        "fixed: every submission graded with SEED (never the public practice seed 0).",
     )
     seed: int = Field(default=0, ge=0, description="The grading seed under the fixed seed policy.")
     release_seeds: bool = Field(
         default=False,
-        description="Show students the grading seed and per-problem seeds of their reports (instructors "
-        "always see them); false keeps the starts unforeseeable.",
+        description="Show students the grading seed and per-problem seeds of their reports (instructors always see them); "  # noqa: E501
+        "false keeps the starts unforeseeable.",
     )
     due_date: datetime | None = Field(
         default=None,
-        description="The assignment's due date (ISO 8601; UTC when no offset is given): students see "
-        "problems marked after_due_date from then on; unset, never.",
+        description="The assignment's due date (ISO 8601; UTC when no offset is given): "
+        "students see problems marked after_due_date from then on; unset, never.",
     )
     gradebook_policy: GradebookPolicy = Field(
         default=GradebookPolicy.LATEST, description="latest or best graded submission per student."
@@ -151,24 +151,21 @@ class Settings(BrokerSettings):
     def _refuse_unsafe_values(self) -> Settings:
         if self.broker_url is not None and self.visibility_timeout_seconds <= self.grading_timeout_seconds:
             raise ValueError(
-                f"GYMGRADE_VISIBILITY_TIMEOUT_SECONDS must exceed GYMGRADE_GRADING_TIMEOUT_SECONDS "
-                f"({self.grading_timeout_seconds:g}), found {self.visibility_timeout_seconds:g}: a task "
-                "would be delivered to a second worker while the first is still grading it"
+                f"GYMGRADE_VISIBILITY_TIMEOUT_SECONDS must exceed GYMGRADE_GRADING_TIMEOUT_SECONDS ({self.grading_timeout_seconds:g}), found {self.visibility_timeout_seconds:g}: "  # noqa: E501
+                "a task would be delivered to a second worker while the first is still grading it"
             )
         if self.development:
             return self
         if self.seed_policy is SeedPolicy.FIXED and self.seed == PRACTICE_SEED:
             raise ValueError(
-                f"GYMGRADE_SEED_POLICY=fixed with GYMGRADE_SEED={PRACTICE_SEED}: that is the public practice "
-                "seed of `gymgrade check`, so a file could memorise every start; expected the random "
-                "policy (the default) or a secret GYMGRADE_SEED (e.g. `python -c 'import secrets; "
-                "print(secrets.randbelow(2**31))'`)"
+                f"GYMGRADE_SEED_POLICY=fixed with GYMGRADE_SEED={PRACTICE_SEED}: "
+                "that is the public practice seed of `gymgrade check`, so a file could memorise every start; "
+                "expected the random policy (the default) or a secret GYMGRADE_SEED (e.g. `python -c 'import secrets; print(secrets.randbelow(2**31))'`)"  # noqa: E501
             )
         if self.instructor_token is None:
             raise ValueError(
-                "GYMGRADE_INSTRUCTOR_TOKEN is not set; expected a long random token "
-                "(e.g. `python -c 'import secrets; print(secrets.token_urlsafe(32))'`), "
-                "or GYMGRADE_DEVELOPMENT=1 for local development"
+                "GYMGRADE_INSTRUCTOR_TOKEN is not set; "
+                "expected a long random token (e.g. `python -c 'import secrets; print(secrets.token_urlsafe(32))'`), or GYMGRADE_DEVELOPMENT=1 for local development"  # noqa: E501
             )
         problem = token_weakness(self.instructor_token.get_secret_value())
         if problem is not None:

@@ -58,10 +58,8 @@ def upload_rules(max_bytes: int) -> tuple[dict[str, Any], dict[str, Any]]:
         "maxLength": max_bytes,
         "pattern": SOURCE_TEXT_PATTERN,
         "description": (
-            f"The student's opengym.py (Python source) or opengym.ipynb (a Jupyter notebook), UTF-8, at "
-            f"most {max_bytes} bytes (maxLength counts "
-            "characters; each non-ASCII character takes 2 to 4 of the bytes), without NUL bytes, "
-            "not empty or blank. Syntax errors are accepted: the grader reports them."
+            f"The student's opengym.py (Python source) or opengym.ipynb (a Jupyter notebook), UTF-8, at most {max_bytes} bytes (maxLength counts characters; each non-ASCII character takes 2 to 4 of the bytes), without NUL bytes, not empty or blank. "  # noqa: E501
+            "Syntax errors are accepted: the grader reports them."
         ),
     }
     encoding = {
@@ -69,8 +67,8 @@ def upload_rules(max_bytes: int) -> tuple[dict[str, Any], dict[str, Any]]:
         "headers": {
             "Content-Disposition": {
                 "description": (
-                    "The part's file name must end in .py or .ipynb (like opengym.py); only its last path "
-                    "component is kept, as a sanitised display name."
+                    "The part's file name must end in .py or .ipynb (like opengym.py); "
+                    "only its last path component is kept, as a sanitised display name."
                 ),
                 "required": True,
                 "schema": {"type": "string", "pattern": CONTENT_DISPOSITION_PATTERN},
@@ -135,8 +133,7 @@ def check_upload(client_name: str | None, content: bytes, *, max_bytes: int) -> 
     suffix = _suffix(name)
     if not suffix or name.lower() == suffix:
         raise InvalidUpload(
-            "expected a Python file named like opengym.py or a notebook named like opengym.ipynb, "
-            f"found the name {name or '(none)'!r}"
+            f"expected a Python file named like opengym.py or a notebook named like opengym.ipynb, found the name {name or '(none)'!r}"  # noqa: E501
         )
     if not content.strip():
         raise InvalidUpload(f"{name} is empty; upload the file with your functions in it")

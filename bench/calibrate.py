@@ -1,6 +1,6 @@
 """Calibrate the checks: regrade the reference and every typical mistake many times with fresh seeds.
 
-Every regrade runs the problem's planned calls in-process (`grader.checks.simulation`: gymnasium envs,
+Every regrade runs the problem's planned calls in-process (`grader.testing.simulation`: gymnasium envs,
 episodes logged like the sandbox logs them, judged as played) and judges them with the real check.
 Prints, per check, the reference's false-fail rate and each mistake's detection rate, and the CartPole
 rule analysis (the velocity policy's length distribution; pass probability of worse policies).
@@ -35,10 +35,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from grader.checks import CHECKS
 from grader.checks.base import ProblemId, Status
-from grader.checks.behaviours import MISTAKES, REFERENCE, velocity_policy
-from grader.checks.simulation import StudentFunction, function_infos, simulate_calls
 from grader.config import CartpoleConfig, ProblemConfig, TaxiConfig, load_config
 from grader.stats import normal_cdf
+from grader.testing.behaviours import MISTAKES, REFERENCE, velocity_policy
+from grader.testing.simulation import StudentFunction, function_infos, simulate_calls
 
 CHEAP: tuple[ProblemId, ...] = ("random_blackjack", "blackjack", "cartpole", "car")
 

@@ -257,8 +257,7 @@ def summary(report: Report) -> str:
         f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
     )
     lines.append(
-        f"Practice seed {report.seed}: your instructor grades on different, unseen starts (a held-out "
-        "seed), so code that only does well from these starts will fail there."
+        f"Practice seed {report.seed}: your instructor grades on different, unseen starts (a held-out seed), so code that only does well from these starts will fail there."  # noqa: E501
     )
     lines += isolation_lines(report.isolation)
     lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
@@ -268,8 +267,8 @@ def summary(report: Report) -> str:
 def notebook_lines(notebook: NotebookSummary) -> list[str]:
     """What of a notebook ran at import, and every statement that did not, cell by cell."""
     lines = [
-        f"Notebook: {notebook.kept_statements} imports, definitions and constants from "
-        f"{notebook.code_cells} code cells ran at import; {len(notebook.skipped)} statements did not:"
+        f"Notebook: {notebook.kept_statements} imports, definitions and constants from {notebook.code_cells} code cells ran at import; "  # noqa: E501
+        f"{len(notebook.skipped)} statements did not:"
     ]
     for entry in notebook.skipped:
         label = f"In [{entry.execution_count}]" if entry.execution_count is not None else "no run"
@@ -285,8 +284,8 @@ def isolation_lines(isolation: IsolationSummary | None) -> list[str]:
         names = ", ".join(layer.name for layer in isolation.layers if layer.active)
         return [f"Sandbox: full isolation ({names})."]
     lines = [
-        "Sandbox: weaker isolation on this machine (fine for checking your own code; instructors grade "
-        "with full isolation). Missing:"
+        "Sandbox: weaker isolation on this machine (fine for checking your own code; instructors grade with full isolation). "  # noqa: E501
+        "Missing:"
     ]
     lines += [
         f"  - {layer.name}: {layer.detail}" + (f" (to fix: {layer.remedy})" if layer.remedy else "")
@@ -357,8 +356,8 @@ def run_grade(args: argparse.Namespace) -> int:
         bar.total = max(len(outcome.graded) * len(problems_of(args)), 1)
         if outcome.reused:
             print(
-                f"Resuming in {args.out}: {len(outcome.reused)} of {len(paths)} submissions are already "
-                f"graded there (same file, seed and configuration); grading {len(outcome.graded)}.",
+                f"Resuming in {args.out}: {len(outcome.reused)} of {len(paths)} submissions are already graded there (same file, seed and configuration); "  # noqa: E501
+                f"grading {len(outcome.graded)}.",
                 file=sys.stderr,
             )
         if executor is not None:
@@ -383,10 +382,10 @@ def run_grade(args: argparse.Namespace) -> int:
         )
     except BatchInterrupted as interruption:
         print(
-            f"\ngymgrade grade: interrupted. {interruption.finished} of {interruption.total} submissions are "
-            f"graded in {args.out} (their reports and grades.csv are kept). Run the same command again "
-            f"(same --out, --seed, --only and --config) to grade the other "
-            f"{interruption.total - interruption.finished}; the finished ones are skipped.",
+            "\ngymgrade grade: interrupted. "
+            f"{interruption.finished} of {interruption.total} submissions are graded in {args.out} (their reports and grades.csv are kept). "  # noqa: E501
+            f"Run the same command again (same --out, --seed, --only and --config) to grade the other {interruption.total - interruption.finished}; "  # noqa: E501
+            "the finished ones are skipped.",
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED

@@ -35,8 +35,8 @@ class ProblemConfig(_Strict):
     )
     visibility: Visibility = Field(
         default="visible",
-        description="When students see this problem's result and feedback in the service: 'visible' (at "
-        "once), 'after_due_date' (once GYMGRADE_DUE_DATE has passed) or 'hidden' (instructors only).",
+        description="When students see this problem's result and feedback in the service: "
+        "'visible' (at once), 'after_due_date' (once GYMGRADE_DUE_DATE has passed) or 'hidden' (instructors only).",  # noqa: E501
     )
 
 
@@ -45,8 +45,7 @@ class PlayedProblemConfig(ProblemConfig):
 
     accepted_envs: list[str] | None = Field(
         default=None,
-        description="The games the episodes may be played in, by id (grader/games.py lists each "
-        "problem's: Blackjack-v0/Blackjack-v1, CartPole-v0/CartPole-v1, MountainCar-v0, Taxi-v3); "
+        description="The games the episodes may be played in, by id (grader/games.py lists each problem's: Blackjack-v0/Blackjack-v1, CartPole-v0/CartPole-v1, MountainCar-v0, Taxi-v3); "  # noqa: E501
         "absent = all of them.",
     )
 
@@ -69,9 +68,8 @@ class CountedStepsConfig(PlayedProblemConfig):
         default=0.0,
         ge=0.0,
         le=1.0,
-        description="Share of the problem's points deducted when every returned count misses exactly the "
-        "steps taken before the counted loop (the lab-era 'one random step first' pattern); the verdict "
-        "follows the replayed episodes either way.",
+        description="Share of the problem's points deducted when every returned count misses exactly the steps taken before the counted loop (the lab-era 'one random step first' pattern); "  # noqa: E501
+        "the verdict follows the replayed episodes either way.",
     )
 
 
@@ -81,8 +79,7 @@ class RandomBlackjackConfig(PlayedProblemConfig):
     kind: Literal["random_blackjack"] = "random_blackjack"
     games: int = Field(ge=100, description="The n passed to random_blackjack(n): games the student plays.")
     win_rate_alpha: Probability = Field(
-        description="False-fail probability of the exact two-sided binomial test of the win count against "
-        "the exact random-policy win probability."
+        description="False-fail probability of the exact two-sided binomial test of the win count against the exact random-policy win probability."  # noqa: E501
     )
     action_alpha: Probability = Field(
         description="False-fail probability of EACH of the two random-action tests (hit frequency = 1/2; "
@@ -101,8 +98,7 @@ class BlackjackConfig(PlayedProblemConfig):
         ge=1, description="Games each call must play (the lab says 10000); 0 is not allowed."
     )
     win_rate_alpha: Probability = Field(
-        description="False-fail probability of the exact two-sided binomial test of EACH call's win count "
-        "against the exact threshold-policy win probability."
+        description="False-fail probability of the exact two-sided binomial test of EACH call's win count against the exact threshold-policy win probability."  # noqa: E501
     )
 
     @field_validator("thresholds")
@@ -143,17 +139,14 @@ class TaxiConfig(PlayedProblemConfig):
         ge=1, description="Episodes each scenario (random, Q-table) must play (the lab says 10000)."
     )
     mean_alpha: Probability = Field(
-        description="False-fail probability of EACH two-sided z-test of a returned mean against its exact "
-        "expectation (variance from the exact oracle)."
+        description="False-fail probability of EACH two-sided z-test of a returned mean against its exact expectation (variance from the exact oracle)."  # noqa: E501
     )
     action_alpha: Probability = Field(
-        description="False-fail probability of the chi-square test that the random scenario's actions are "
-        "uniform over the 6 actions."
+        description="False-fail probability of the chi-square test that the random scenario's actions are uniform over the 6 actions."  # noqa: E501
     )
     trained_slack: float = Field(
         ge=0.0,
-        description="When taxi() trains its own table, its Q mean may fall this far below the optimal "
-        "greedy return (on top of the z-test tolerance).",
+        description="When taxi() trains its own table, its Q mean may fall this far below the optimal greedy return (on top of the z-test tolerance).",  # noqa: E501
     )
 
 

@@ -135,8 +135,8 @@ def _stopped_early(verdict: Verdict, reason: str, made: int, planned: int) -> Ve
     """The verdict of a problem whose calls stopped once it could no longer change, saying so."""
     measurements = {**verdict.measurements, "calls_planned": planned, "calls_made": made}
     note = (
-        f" Grading stopped after call {made} of {planned}: {reason}, so no later call could change the "
-        "verdict."
+        f" Grading stopped after call {made} of {planned}: "
+        f"{reason}, so no later call could change the verdict."
     )
     feedback = verdict.feedback if verdict.feedback.endswith((".", "!", "?")) else f"{verdict.feedback}."
     return Verdict(verdict.status, verdict.fraction, feedback + note, measurements)

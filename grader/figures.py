@@ -85,11 +85,7 @@ def problem_figures(result: ProblemResult, config: AssignmentConfig) -> list[Fig
     if result.replay is not None:
         started = time.perf_counter()
         gif, shown = replay_gif(result.replay)
-        caption = (
-            f"Replay of {result.replay.label}: {result.replay.length} steps, total reward "
-            f"{result.replay.total_reward:g}, re-played by the grader from the episode's seed and your "
-            f"actions ({shown} frames shown)."
-        )
+        caption = f"Replay of {result.replay.label}: {result.replay.length} steps, total reward {result.replay.total_reward:g}, re-played by the grader from the episode's seed and your actions ({shown} frames shown)."  # noqa: E501
         figures.append(
             Figure(result.id, f"Replay: {result.replay.env_id}", caption, "image/gif", gif, _since(started))
         )
@@ -146,9 +142,8 @@ def plot_blackjack(result: ProblemResult, config: AssignmentConfig) -> tuple[str
     )
     axes.legend(loc="lower left", fontsize=8)
     caption = (
-        "blackjack(n): the line is the exact probability of winning when drawing on hands up to n; each dot "
-        f"is what your function returned, and its shaded band the win rates {settings.games_per_call:,} "
-        f"games of a correct policy land in with probability 1 - {settings.win_rate_alpha:g}."
+        "blackjack(n): the line is the exact probability of winning when drawing on hands up to n; "
+        f"each dot is what your function returned, and its shaded band the win rates {settings.games_per_call:,} games of a correct policy land in with probability 1 - {settings.win_rate_alpha:g}."  # noqa: E501
     )
     return "Blackjack win rate against n", caption, figure
 
@@ -190,10 +185,7 @@ def plot_lengths(result: ProblemResult, config: AssignmentConfig) -> tuple[str, 
         return None
     axes.set(xlabel="steps in the episode", ylabel="episodes")
     axes.legend(loc="upper left", fontsize=8)
-    caption = (
-        f"{game} episode lengths ({rule}): your {len(lengths)} replayed episodes, the lab's bars in red, "
-        f"and {len(reference)} episodes of the reference solution in grey."
-    )
+    caption = f"{game} episode lengths ({rule}): your {len(lengths)} replayed episodes, the lab's bars in red, and {len(reference)} episodes of the reference solution in grey."  # noqa: E501
     return f"{game} episode lengths", caption, figure
 
 
@@ -222,10 +214,7 @@ def plot_taxi(result: ProblemResult, config: AssignmentConfig) -> tuple[str, str
         spread = max(abs(returned - exact), tolerance) * 1.6
         axes.set(title=label, xticks=[], ylim=(exact - spread, exact + spread), ylabel="mean total reward")
         axes.legend(loc="lower right", fontsize=7)
-    caption = (
-        "taxi(): the average total rewards your function returned, against the exact expected return of "
-        "random play and of the Q-table's greedy policy, with the band a correct answer lands in."
-    )
+    caption = "taxi(): the average total rewards your function returned, against the exact expected return of random play and of the Q-table's greedy policy, with the band a correct answer lands in."  # noqa: E501
     return "Taxi average returns", caption, figure
 
 

@@ -137,13 +137,13 @@ class GameRules:
         same_id = [game for game in self.games if log.env_id in game.gymnasium_ids]
         if not same_id:
             return (
-                f"the episodes must be played in {self.names}, but you made {log.requested_id!r} "
-                f"(gymnasium {log.env_id}), a different game: use gym.make({self.lab_id!r})"
+                f"the episodes must be played in {self.names}, but you made {log.requested_id!r} (gymnasium {log.env_id}), a different game: "  # noqa: E501
+                f"use gym.make({self.lab_id!r})"
             )
         reason = same_id[0].mismatch(log)
         return (
-            f"{reason}, which changes the game: this assignment accepts {self.names}; make the "
-            f"environment with gym.make({same_id[0].name!r}) and no extra arguments"
+            f"{reason}, which changes the game: this assignment accepts {self.names}; "
+            f"make the environment with gym.make({same_id[0].name!r}) and no extra arguments"
         )
 
     def played_game(self, logs: Iterable[EpisodeLog]) -> Game | str:
@@ -159,8 +159,9 @@ class GameRules:
         if len(played) > 1:
             games = " and ".join(game.description for game in played.values())
             return (
-                f"your episodes were played in {games}; each problem is graded against one game's exact "
-                "results: make every environment of the problem the same way"
+                f"your episodes were played in {games}; "
+                "each problem is graded against one game's exact results: "
+                "make every environment of the problem the same way"
             )
         return next(iter(played.values()), self.games[0])
 

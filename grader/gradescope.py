@@ -128,8 +128,8 @@ def pick_submission(directory: Path) -> Path | str:
         return preferred[0]
     found = ", ".join(str(path.relative_to(directory)) for path in candidates) or "no .py or .ipynb file"
     return (
-        f"Expected one Python file (.py) or Jupyter notebook (.ipynb) with your functions, ideally named "
-        f"{PREFERRED_STEM}.py; found {found}. Submit exactly one such file."
+        f"Expected one Python file (.py) or Jupyter notebook (.ipynb) with your functions, ideally named {PREFERRED_STEM}.py; "  # noqa: E501
+        f"found {found}. Submit exactly one such file."
     )
 
 

@@ -80,10 +80,9 @@ class UnboundGlobal(BaseModel):
     def note(self) -> str:
         """The sentence added to the feedback of the problem named after ``function``."""
         return (
-            f"Notebook: {self.function}() reads the global `{self.name}`, which only a skipped top-level "
-            f"statement sets (cell {self.cell}, line {self.line}: `{self.code}`). The grader runs only "
-            "imports, definitions and simple constants of a notebook, so there is no "
-            f"`{self.name}` when {self.function}() is called: compute it inside the function."
+            f"Notebook: {self.function}() reads the global `{self.name}`, which only a skipped top-level statement sets (cell {self.cell}, line {self.line}: `{self.code}`). "  # noqa: E501
+            f"The grader runs only imports, definitions and simple constants of a notebook, so there is no `{self.name}` when {self.function}() is called: "  # noqa: E501
+            "compute it inside the function."
         )
 
 
@@ -180,9 +179,9 @@ def build_module(data: bytes, name: str) -> NotebookModule | FileVerdict:
     if builder.kept_statements == 0:
         return FileVerdict(
             "missing",
-            f"{name} has code cells, but none of them defines anything: only imports and top-level demo "
-            "statements. Put your functions (random_blackjack, blackjack, cartpole, car, taxi) in "
-            "`def` statements and submit again.",
+            f"{name} has code cells, but none of them defines anything: "
+            "only imports and top-level demo statements. "
+            "Put your functions (random_blackjack, blackjack, cartpole, car, taxi) in `def` statements and submit again.",  # noqa: E501
         )
     source = "\n".join([*builder.future, *builder.kept]) + "\n"
     verdict = check_source(source.encode(), name)
@@ -221,8 +220,8 @@ def _read_cells(data: bytes, name: str) -> list[_Cell] | FileVerdict:
         detail = str(error).splitlines()[0][:200] if str(error) else type(error).__name__
         return FileVerdict(
             "error",
-            f"{name} is not a readable notebook: it is not valid JSON ({detail}). Open it in Jupyter, "
-            "save it again (File > Save) and submit the saved .ipynb, or submit your code as a .py file.",
+            f"{name} is not a readable notebook: it is not valid JSON ({detail}). "
+            "Open it in Jupyter, save it again (File > Save) and submit the saved .ipynb, or submit your code as a .py file.",  # noqa: E501
         )
     except nbformat.ValidationError as error:
         return _invalid(name, error)
@@ -236,8 +235,9 @@ def _read_cells(data: bytes, name: str) -> list[_Cell] | FileVerdict:
     if version != 4:
         return FileVerdict(
             "error",
-            f"{name} is a notebook in format version {version}; the grader reads nbformat 4 (Jupyter "
-            "since 2015). Open it in a current Jupyter, save it, and submit again.",
+            f"{name} is a notebook in format version {version}; "
+            "the grader reads nbformat 4 (Jupyter since 2015). "
+            "Open it in a current Jupyter, save it, and submit again.",
         )
     try:
         with warnings.catch_warnings():
@@ -268,8 +268,8 @@ def _invalid(name: str, error: Exception) -> FileVerdict:
     detail = str(getattr(error, "message", error)).splitlines()[0][:200]
     return FileVerdict(
         "error",
-        f"{name} is not a valid nbformat 4 notebook: {detail}. Open it in Jupyter, save it again and "
-        "submit the saved file.",
+        f"{name} is not a valid nbformat 4 notebook: {detail}. "
+        "Open it in Jupyter, save it again and submit the saved file.",
     )
 
 
@@ -297,8 +297,8 @@ def _add_cell(builder: _Builder, cell: _Cell, name: str) -> FileVerdict | None:
                 "error",
                 f"{name}: code cell {cell.number}"
                 + (f" (In [{cell.execution_count}])" if cell.execution_count is not None else "")
-                + f" is not valid Python: {error.msg} (line {error.lineno} of the cell). Fix the cell, "
-                "save the notebook and submit again.",
+                + f" is not valid Python: {error.msg} (line {error.lineno} of the cell). "
+                "Fix the cell, save the notebook and submit again.",
             )
         except (ValueError, RecursionError, MemoryError) as error:
             return FileVerdict("error", f"{name}: code cell {cell.number} cannot be parsed ({error}).")

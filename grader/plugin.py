@@ -67,8 +67,8 @@ class GradingOptions:
             unknown = [name for name in names if name not in PROBLEM_IDS]
             if unknown:
                 raise pytest.UsageError(
-                    f"--only: unknown problem {', '.join(unknown)}; expected ids among "
-                    f"{', '.join(PROBLEM_IDS)}"
+                    f"--only: unknown problem {', '.join(unknown)}; "
+                    f"expected ids among {', '.join(PROBLEM_IDS)}"
                 )
             only = tuple(problem for problem in PROBLEM_IDS if problem in names)
         config_path = config.getoption("assignment_config")

@@ -186,8 +186,9 @@ class ProblemRun(BaseModel):
             result.status = "error"
             result.score = 0.0
             result.feedback = (
-                f"{result.feedback}\n\nYour code's output or values held text that cannot be stored "
-                f"({type(error).__name__}); unencodable characters were replaced and this problem scored 0. "
+                f"{result.feedback}\n\n"
+                f"Your code's output or values held text that cannot be stored ({type(error).__name__}); "
+                "unencodable characters were replaced and this problem scored 0. "
                 "Print and return plain text only."
             )
             return cleaned.model_dump_json()

@@ -58,8 +58,7 @@ RULES: dict[str, _Rule] = {
         frozenset({"Taxi-v3", "Taxi-v4"}),
         _last,
         lambda count: (
-            f"the last of the {count} Taxi episodes of your first call (the lab plays the "
-            "Q-table's episodes last)"
+            f"the last of the {count} Taxi episodes of your first call (the lab plays the Q-table's episodes last)"  # noqa: E501
         ),
     ),
 }

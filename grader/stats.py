@@ -6,22 +6,24 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
+from statistics import NormalDist
 
 _SQRT2 = math.sqrt(2.0)
+_STANDARD_NORMAL = NormalDist()
 
 
 def normal_cdf(z: float) -> float:
-    """P(Z <= z) for a standard normal Z."""
+    """P(Z <= z) for a standard normal Z, to full relative precision far in the lower tail.
+
+    By hand from `math.erfc` rather than `NormalDist().cdf`, which computes 0.5 * (1 + erf(z / sqrt 2))
+    and so loses the lower tail to cancellation (measured: 1.8% off at z = -8, 0 instead of 7.6e-24
+    at z = -10); calibration reports lower-tail false-fail probabilities with it.
+    """
     return 0.5 * math.erfc(-z / _SQRT2)
 
 
-def normal_sf(z: float) -> float:
-    """P(Z > z) for a standard normal Z (accurate far in the upper tail)."""
-    return 0.5 * math.erfc(z / _SQRT2)
-
-
 def normal_quantile(probability: float) -> float:
-    """The z with P(Z <= z) = probability, by bisection on `normal_cdf` (accurate to ~1e-12).
+    """The z with P(Z <= z) = probability (`NormalDist.inv_cdf`, Wichura's AS241, ~1e-16 relative).
 
     Args:
         probability: In (0, 1).
@@ -31,18 +33,7 @@ def normal_quantile(probability: float) -> float:
     """
     if not 0.0 < probability < 1.0:
         raise ValueError(f"expected a probability strictly between 0 and 1, found {probability}")
-    if probability > 0.5:
-        return -normal_quantile(1.0 - probability)
-    low, high = -40.0, 0.0
-    for _ in range(200):
-        middle = (low + high) / 2
-        if normal_cdf(middle) < probability:
-            low = middle
-        else:
-            high = middle
-        if high - low < 1e-13:
-            break
-    return (low + high) / 2
+    return _STANDARD_NORMAL.inv_cdf(probability)
 
 
 def binomial_log_pmf(k: int, n: int, p: float) -> float:
@@ -62,15 +53,6 @@ def binomial_cdf(k: int, n: int, p: float) -> float:
     if k >= n:
         return 1.0
     return math.fsum(math.exp(binomial_log_pmf(i, n, p)) for i in range(0, k + 1))
-
-
-def binomial_sf(k: int, n: int, p: float) -> float:
-    """P(K >= k) for K ~ Binomial(n, p), by exact summation."""
-    if k <= 0:
-        return 1.0
-    if k > n:
-        return 0.0
-    return math.fsum(math.exp(binomial_log_pmf(i, n, p)) for i in range(k, n + 1))
 
 
 @dataclass(frozen=True)
@@ -134,13 +116,6 @@ def binomial_acceptance(trials: int, probability: float, alpha: float) -> Binomi
     return BinomialAcceptance(trials, probability, low, high, math.fsum([lower_tail, upper_tail]))
 
 
-def binomial_two_sided_p_value(count: int, trials: int, probability: float) -> float:
-    """Twice the smaller exact tail probability of `count` (capped at 1)."""
-    lower = binomial_cdf(count, trials, probability)
-    upper = binomial_sf(count, trials, probability)
-    return min(1.0, 2.0 * min(lower, upper))
-
-
 @dataclass(frozen=True)
 class MeanTolerance:
     """A two-sided z-test of a sample mean whose variance is known exactly.
@@ -158,13 +133,6 @@ class MeanTolerance:
     samples: int
     alpha: float
     half_width: float
-
-    def z_score(self, mean: float) -> float:
-        """The standardised distance of a sample mean from the expectation."""
-        standard_error = math.sqrt(self.variance / self.samples)
-        if standard_error > 0:
-            return (mean - self.expected) / standard_error
-        return 0.0 if mean == self.expected else math.copysign(math.inf, mean - self.expected)
 
     def accepts(self, mean: float) -> bool:
         """Whether a sample mean is within the tolerance."""
@@ -244,22 +212,6 @@ def chi_square_sf(statistic: float, degrees_of_freedom: int) -> float:
     return _regularized_gamma_q(degrees_of_freedom / 2, statistic / 2)
 
 
-def chi_square_critical(degrees_of_freedom: int, alpha: float) -> float:
-    """The statistic c with P(X >= c) = alpha for X ~ chi-square(degrees_of_freedom), by bisection."""
-    if not 0.0 < alpha < 1.0:
-        raise ValueError(f"expected alpha in (0, 1), found {alpha}")
-    low, high = 0.0, float(degrees_of_freedom)
-    while chi_square_sf(high, degrees_of_freedom) > alpha:
-        high *= 2
-    for _ in range(200):
-        middle = (low + high) / 2
-        if chi_square_sf(middle, degrees_of_freedom) > alpha:
-            low = middle
-        else:
-            high = middle
-    return high
-
-
 @dataclass(frozen=True)
 class ChiSquareResult:
     """A chi-square test's outcome.
@@ -321,11 +273,3 @@ def grouped_binomial_fit(groups: Sequence[tuple[int, int]], probability: float) 
         for successes, trials in used
     )
     return ChiSquareResult(statistic, len(used), chi_square_sf(statistic, len(used)))
-
-
-def union_false_fail(probabilities: Sequence[float]) -> float:
-    """Exact false-fail probability of independent tests, any of which failing fails the check."""
-    passing = 1.0
-    for probability in probabilities:
-        passing *= 1.0 - probability
-    return 1.0 - passing

@@ -38,22 +38,21 @@ def check_source(data: bytes, name: str, *, max_bytes: int = MAX_SUBMISSION_BYTE
     if len(data) > max_bytes:
         return FileVerdict(
             "error",
-            f"{name} is {len(data):,} bytes; a submission may be at most {max_bytes:,} "
-            "bytes. Submit only your solution's .py file.",
+            f"{name} is {len(data):,} bytes; a submission may be at most {max_bytes:,} bytes. "
+            "Submit only your solution's .py file.",
         )
     if not data.strip():
         return FileVerdict(
             "missing",
-            f"{name} is empty: nothing to grade. Submit the .py file holding your "
-            "functions (random_blackjack, blackjack, cartpole, car, taxi).",
+            f"{name} is empty: nothing to grade. "
+            "Submit the .py file holding your functions (random_blackjack, blackjack, cartpole, car, taxi).",
         )
     nul = data.find(b"\0")
     if nul >= 0:
         return FileVerdict(
             "error",
             f"{name} is not a text file (it contains a NUL byte at offset {nul}): "
-            "submit the Python source (.py), not a notebook export, archive or "
-            "compiled file.",
+            "submit the Python source (.py), not a notebook export, archive or compiled file.",
         )
     try:
         data.decode("utf-8")
@@ -61,8 +60,8 @@ def check_source(data: bytes, name: str, *, max_bytes: int = MAX_SUBMISSION_BYTE
         line = data[: error.start].count(b"\n") + 1
         return FileVerdict(
             "error",
-            f"{name} is not UTF-8 text: byte 0x{data[error.start]:02x} on line {line} "
-            "cannot be decoded. Save the file as UTF-8 in your editor and submit again.",
+            f"{name} is not UTF-8 text: byte 0x{data[error.start]:02x} on line {line} cannot be decoded. "
+            "Save the file as UTF-8 in your editor and submit again.",
         )
     try:
         compile(data, name, "exec", dont_inherit=True)  # bytes, so a BOM is read exactly as import reads it
@@ -70,8 +69,8 @@ def check_source(data: bytes, name: str, *, max_bytes: int = MAX_SUBMISSION_BYTE
         where = f"line {error.lineno}" + (f", column {error.offset}" if error.offset else "")
         return FileVerdict(
             "error",
-            f"{name} is not valid Python: {error.msg} ({where}). Fix the syntax "
-            f"(`python -m py_compile {name}` shows it) and submit again.",
+            f"{name} is not valid Python: {error.msg} ({where}). "
+            f"Fix the syntax (`python -m py_compile {name}` shows it) and submit again.",
         )
     except (ValueError, RecursionError, MemoryError, OverflowError) as error:
         return FileVerdict(

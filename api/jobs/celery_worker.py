@@ -70,9 +70,8 @@ def startup_problem(settings: Settings) -> str | None:
             connection.execute(text("SELECT 1"))
     except Exception as error:
         return (
-            f"cannot reach the database at {engine.url.render_as_string(hide_password=True)} "
-            f"({type(error).__name__}); check GYMGRADE_DATABASE_URL and that the database accepts "
-            "connections from this machine"
+            f"cannot reach the database at {engine.url.render_as_string(hide_password=True)} ({type(error).__name__}); "  # noqa: E501
+            "check GYMGRADE_DATABASE_URL and that the database accepts connections from this machine"
         )
     finally:
         engine.dispose()
@@ -84,8 +83,8 @@ def startup_problem(settings: Settings) -> str | None:
     if not isolation.full:
         missing = "; ".join(f"{layer.name}: {layer.detail} ({layer.remedy})" for layer in isolation.missing)
         return (
-            f"this machine cannot isolate submissions as grading requires: {missing}. Install the missing "
-            "layers (see scripts/setup.sh), or set GYMGRADE_ALLOW_WEAK_ISOLATION=1 for a trial only"
+            f"this machine cannot isolate submissions as grading requires: {missing}. "
+            "Install the missing layers (see scripts/setup.sh), or set GYMGRADE_ALLOW_WEAK_ISOLATION=1 for a trial only"  # noqa: E501
         )
     return None
 

@@ -85,8 +85,8 @@ def broker_problem(settings: BrokerSettings) -> str | None:
         client.ping()
     except redis.RedisError as error:
         return (
-            f"cannot reach the Redis broker at {settings.broker_url} ({error}); start it "
-            "(e.g. `redis-server --port 6379`) or fix GYMGRADE_BROKER_URL"
+            f"cannot reach the Redis broker at {settings.broker_url} ({error}); "
+            "start it (e.g. `redis-server --port 6379`) or fix GYMGRADE_BROKER_URL"
         )
     finally:
         client.close()

@@ -77,14 +77,13 @@ def policy_deviation(decisions: Sequence[_Decision], n: int) -> str | None:
     if n > 0 and _follows(decisions, n - 1):
         stood = sum(1 for decision in wrong if decision.total == n)
         return (
-            f"your games stood on a sum of exactly {n} in {stood} hands, so they follow 'draw while the sum "
-            f"is < {n}': check `<` versus `<=`"
+            f"your games stood on a sum of exactly {n} in {stood} hands, so they follow 'draw while the sum is < {n}': "  # noqa: E501
+            "check `<` versus `<=`"
         )
     if n < 21 and _follows(decisions, n + 1):
         return (
-            f"your games drew on a sum of {n + 1} in {len(wrong)} hands, so they follow 'draw while the sum "
-            "is "
-            f"<= {n + 1}': the threshold is off by one"
+            f"your games drew on a sum of {n + 1} in {len(wrong)} hands, so they follow 'draw while the sum is <= {n + 1}': "  # noqa: E501
+            "the threshold is off by one"
         )
     if all(decision.step == 0 for decision in wrong):
         if all(decision.hit for decision in wrong):
@@ -102,15 +101,12 @@ def policy_deviation(decisions: Sequence[_Decision], n: int) -> str | None:
     other = next((m for m in THRESHOLDS if _follows(decisions, m)), None)
     if other is not None:
         return (
-            f"your games follow 'draw while the sum is <= {other}' whatever n is: use the parameter n, "
-            f"not a fixed number"
+            f"your games follow 'draw while the sum is <= {other}' whatever n is: "
+            "use the parameter n, not a fixed number"
         )
     example = wrong[0]
     did = "drew" if example.hit else "stood"
-    return (
-        f"{len(wrong)} of {len(decisions)} decisions broke {rule} (e.g. game {example.game + 1}, decision "
-        f"{example.step + 1}: sum {example.total}, you {did})"
-    )
+    return f"{len(wrong)} of {len(decisions)} decisions broke {rule} (e.g. game {example.game + 1}, decision {example.step + 1}: sum {example.total}, you {did})"  # noqa: E501
 
 
 @dataclass
@@ -167,10 +163,9 @@ class BlackjackCheck:
         return Verdict(
             "passed",
             1.0,
-            f"Every replayed decision followed 'draw while the sum is <= n' and every win rate is within the "
-            f"tolerance of the exact one in {game.description} ({'; '.join(passed_lines)}). The exact best n "
-            f"is {best} "
-            f"(wins {curve[best]:.4f}); among the n tried, your rates peak at n = {peak}.",
+            f"Every replayed decision followed 'draw while the sum is <= n' and every win rate is within the tolerance of the exact one in {game.description} ({'; '.join(passed_lines)}). "  # noqa: E501
+            f"The exact best n is {best} (wins {curve[best]:.4f}); "
+            f"among the n tried, your rates peak at n = {peak}.",
             measurements,
         )
 
@@ -193,32 +188,30 @@ class BlackjackCheck:
         counts = count_games(episodes)
         if counts.games != settings.games_per_call:
             return (
-                f"{call} must play {settings.games_per_call} games (the lab's number); the replay shows "
-                f"{counts.games}. Play exactly {settings.games_per_call} games, one reset per game.",
+                f"{call} must play {settings.games_per_call} games (the lab's number); "
+                f"the replay shows {counts.games}. "
+                f"Play exactly {settings.games_per_call} games, one reset per game.",
                 "",
             )
         scale = read_rate(returned, counts)
         if scale is None:
             return (
-                f"{call} returned {returned:.6g}, but its {counts.games} replayed games won {counts.wins} "
-                f"({counts.win_fraction:.4f}); {rate_mismatch_cause(returned, counts)}.",
+                f"{call} returned {returned:.6g}, but its {counts.games} replayed games won {counts.wins} ({counts.win_fraction:.4f}); "  # noqa: E501
+                f"{rate_mismatch_cause(returned, counts)}.",
                 "",
             )
         curve[str(n)] = counts.win_fraction
         deviation = policy_deviation(_decisions(episodes), n)
         exact = exact_curve(sab=game.sab)[n]
         acceptance = binomial_acceptance(counts.games, exact, settings.win_rate_alpha)
-        expected = (
-            f"a player drawing on sums <= {n} wins {exact:.4f} of games ({acceptance.low}..{acceptance.high} "
-            f"of {counts.games})"
-        )
+        expected = f"a player drawing on sums <= {n} wins {exact:.4f} of games ({acceptance.low}..{acceptance.high} of {counts.games})"  # noqa: E501
         if deviation:
             return f"{call} returned {returned:.6g}; {expected}. {deviation[0].upper()}{deviation[1:]}.", ""
         if not acceptance.accepts(counts.wins):
             return (
-                f"{call}: {expected}; your replayed games won {counts.wins}. The decisions followed the "
-                "rule, so "
-                f"this is {chance_text(acceptance.false_fail)} or not the lab's game: regrade once.",
+                f"{call}: {expected}; your replayed games won {counts.wins}. "
+                f"The decisions followed the rule, so this is {chance_text(acceptance.false_fail)} or not the lab's game: "  # noqa: E501
+                "regrade once.",
                 "",
             )
         percentage = " as a percentage" if scale == "percentage" else ""

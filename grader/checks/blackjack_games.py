@@ -8,7 +8,6 @@ from grader.checks.integrity import Episode
 from grader.checks.values import GameCounts
 
 HIT = 1
-STICK = 0
 GAME_STEPS = 16
 """Steps recorded per game: a hand busts after at most ten draws; room for steps after the end."""
 

@@ -46,30 +46,22 @@ class CarCheck:
         note = runs.counting_note("car", settings.uncounted_steps_deduction)
         stuck = sum(1 for episode in runs.episodes if not episode.reached_terminal)
         measurements["runs_reaching_goal"] = len(runs.episodes) - stuck
-        bar = (
-            f"the lab asks for every run to reach the flag in fewer than {settings.max_mean_steps:g} steps "
-            f"on average"
-        )
-        measured = (
-            f"{len(runs.episodes) - stuck} of your {len(runs.episodes)} replayed runs reached the flag, "
-            f"taking {runs.mean:.1f} steps on average"
-        )
+        bar = f"the lab asks for every run to reach the flag in fewer than {settings.max_mean_steps:g} steps on average"  # noqa: E501
+        measured = f"{len(runs.episodes) - stuck} of your {len(runs.episodes)} replayed runs reached the flag, taking {runs.mean:.1f} steps on average"  # noqa: E501
         if stuck:
             return Verdict(
                 "failed",
                 0.0,
-                f"car(): {bar}; {measured}, and {stuck} ran out of time (200 steps) short of it. Build "
-                "momentum: "
-                "push (action 2 right, 0 left) in the direction the car is already moving "
-                f"(observation[1]).{note}",
+                f"car(): {bar}; {measured}, and {stuck} ran out of time (200 steps) short of it. "
+                f"Build momentum: push (action 2 right, 0 left) in the direction the car is already moving (observation[1]).{note}",  # noqa: E501
                 measurements,
             )
         if runs.mean >= settings.max_mean_steps:
             return Verdict(
                 "failed",
                 0.0,
-                f"car(): {bar}; {measured}. Push in the direction of the velocity on every step to swing up "
-                f"faster.{note}",
+                f"car(): {bar}; {measured}. "
+                f"Push in the direction of the velocity on every step to swing up faster.{note}",
                 measurements,
             )
         fraction = 1.0 - (settings.uncounted_steps_deduction if runs.uncounted_steps else 0.0)

@@ -44,22 +44,15 @@ class CartpoleCheck:
             return runs
         measurements = runs.measurements()
         shortest = min(runs.lengths)
-        bar = (
-            f"the lab asks for at least {settings.min_steps} steps in every run and about 180 on average "
-            f"(graded: mean >= {settings.min_mean_steps:g} and every run >= {settings.min_steps})"
-        )
-        measured = (
-            f"your {len(runs.lengths)} replayed runs lasted {runs.mean:.1f} steps on average, "
-            f"the shortest {shortest} ({runs.game.description})"
-        )
+        bar = f"the lab asks for at least {settings.min_steps} steps in every run and about 180 on average (graded: mean >= {settings.min_mean_steps:g} and every run >= {settings.min_steps})"  # noqa: E501
+        measured = f"your {len(runs.lengths)} replayed runs lasted {runs.mean:.1f} steps on average, the shortest {shortest} ({runs.game.description})"  # noqa: E501
         note = runs.counting_note("cartpole", settings.uncounted_steps_deduction)
         if runs.mean < settings.min_mean_steps or shortest < settings.min_steps:
             return Verdict(
                 "failed",
                 0.0,
-                f"cartpole(): {bar}; {measured}. Push the cart the way the tip of the pole is moving: action "
-                "1 "
-                f"(right) when the pole's angular velocity observation[3] is positive, else 0.{note}",
+                f"cartpole(): {bar}; {measured}. Push the cart the way the tip of the pole is moving: "
+                f"action 1 (right) when the pole's angular velocity observation[3] is positive, else 0.{note}",  # noqa: E501
                 measurements,
             )
         fraction = 1.0 - (settings.uncounted_steps_deduction if runs.uncounted_steps else 0.0)

@@ -58,9 +58,8 @@ class FindQvaluesCheck:
             return Verdict(
                 "failed",
                 0.0,
-                f"find_qvalues('Taxi-v3') must return a finite {TAXI_SHAPE[0]} x {TAXI_SHAPE[1]} array of "
-                "numbers "
-                f"(one row per state, one column per action); it returned {found}.",
+                f"find_qvalues('Taxi-v3') must return a finite {TAXI_SHAPE[0]} x {TAXI_SHAPE[1]} array of numbers (one row per state, one column per action); "  # noqa: E501
+                f"it returned {found}.",
                 {},
             )
         greedy = greedy_policy_return(table.astype(np.float64))
@@ -68,8 +67,8 @@ class FindQvaluesCheck:
         return Verdict(
             "passed",
             1.0,
-            f"Acting greedily on your table earns {greedy.mean:.3f} per Taxi episode on average (exact, over "
-            f"all start states); the optimal policy earns {optimal.mean:.3f}.",
+            f"Acting greedily on your table earns {greedy.mean:.3f} per Taxi episode on average (exact, over all start states); "  # noqa: E501
+            f"the optimal policy earns {optimal.mean:.3f}.",
             {
                 "greedy_mean_return": greedy.mean,
                 "greedy_return_std": greedy.std,

@@ -179,9 +179,8 @@ def options_problem(logs: Sequence[EpisodeLog]) -> str | None:
     options = logs[chosen[0]].reset_options or {}
     shown = ", ".join(f"{name!r}: {value!r}" for name, value in list(options.items())[:4])[:200]
     return (
-        f"{len(chosen)} reset(s) passed options (e.g. reset {chosen[0] + 1}: options={{{shown}}}), which "
-        "choose the start of the game instead of letting the environment deal it. Every start must be the "
-        "grader's: call reset() without options"
+        f"{len(chosen)} reset(s) passed options (e.g. reset {chosen[0] + 1}: options={{{shown}}}), which choose the start of the game instead of letting the environment deal it. "  # noqa: E501
+        "Every start must be the grader's: call reset() without options"
     )
 
 
@@ -210,10 +209,9 @@ def scouting_problem(records: Sequence[CallRecord]) -> str | None:
             shown = ", ".join(str(position + 1) for position in unplayed[:5])
             more = ", ..." if len(unplayed) > 5 else ""
             return (
-                f"call {call_index + 1} reset its environment {total} times and left {len(unplayed)} "
-                f"of those games unplayed (resets {shown}{more} took no step before the next reset): "
-                "every reset deals a game that counts, and resetting until the start looks easy chooses "
-                "the games. Reset once per game and play every game you reset until `done` is True"
+                f"call {call_index + 1} reset its environment {total} times and left {len(unplayed)} of those games unplayed (resets {shown}{more} took no step before the next reset): "  # noqa: E501
+                "every reset deals a game that counts, and resetting until the start looks easy chooses the games. "  # noqa: E501
+                "Reset once per game and play every game you reset until `done` is True"
             )
     return None
 
@@ -258,28 +256,24 @@ def integrity_problem(
     for episode in episodes:
         if episode.replay.mismatch:
             return (
-                f"episode {_where(episode)} did not replay: {episode.replay.mismatch}. The grader replays "
-                "every "
-                f"episode in its own environment; results that the real game does not produce cannot count"
+                f"episode {_where(episode)} did not replay: {episode.replay.mismatch}. "
+                "The grader replays every episode in its own environment; "
+                "results that the real game does not produce cannot count"
             )
     after_done = [episode for episode in episodes if episode.replay.steps_after_done > 0]
     if after_done:
         first = after_done[0]
         return (
-            f"{len(after_done)} episode(s) kept stepping after the game was over (e.g. episode "
-            f"{_where(first)} ended after {first.length} steps and you took {first.replay.steps_after_done} "
-            "more). "
-            f"Stop as soon as `done` (terminated or truncated) is True"
+            f"{len(after_done)} episode(s) kept stepping after the game was over (e.g. episode {_where(first)} ended after {first.length} steps and you took {first.replay.steps_after_done} more). "  # noqa: E501
+            "Stop as soon as `done` (terminated or truncated) is True"
         )
     unfinished = [episode for episode in episodes if not episode.finished]
     if unfinished:
         first = unfinished[0]
         return (
-            f"{len(unfinished)} game(s) were abandoned before they ended (e.g. episode {_where(first)} "
-            "stopped "
-            f"after {first.length} steps without terminating): you reset (or stopped) in the middle of a "
-            "game. "
-            f"Play each game until `done` is True and reset only between games"
+            f"{len(unfinished)} game(s) were abandoned before they ended (e.g. episode {_where(first)} stopped after {first.length} steps without terminating): "  # noqa: E501
+            "you reset (or stopped) in the middle of a game. "
+            "Play each game until `done` is True and reset only between games"
         )
     return None
 
@@ -305,9 +299,8 @@ def repeated_seed_problem(episodes: Sequence[Episode], *, across_calls: bool) ->
         return None
     (_, seed), count = max(repeated, key=lambda item: item[1])
     return (
-        f"{count} episodes were reset with the same seed ({seed}), so outside the grader they are the same "
-        f"game played {count} times and their average says nothing: the runs are not independent. "
-        f"Call reset() without a seed (or seed only the first reset)"
+        f"{count} episodes were reset with the same seed ({seed}), so outside the grader they are the same game played {count} times and their average says nothing: "  # noqa: E501
+        "the runs are not independent. Call reset() without a seed (or seed only the first reset)"
     )
 
 

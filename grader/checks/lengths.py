@@ -73,8 +73,9 @@ class LengthRuns:
             uncounted = f"the {short} taken before the counted loop were"
         cost = f" ({deduction:.0%} of the points deducted)" if deduction else ""
         return (
-            f" Note: every count {function}() returned is {short} short of its replayed episode: {uncounted} "
-            f"not counted. The verdict follows the replayed episodes{cost}; count every env.step() call."
+            f" Note: every count {function}() returned is {short} short of its replayed episode: "
+            f"{uncounted} not counted. "
+            f"The verdict follows the replayed episodes{cost}; count every env.step() call."
         )
 
 
@@ -114,8 +115,8 @@ def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]
             return Verdict(
                 "failed",
                 0.0,
-                f"each call of {function}() must play exactly one episode and return its length; call "
-                f"{call_number} played {len(call_episodes)}. Reset once per call and play until done.",
+                f"each call of {function}() must play exactly one episode and return its length; "
+                f"call {call_number} played {len(call_episodes)}. Reset once per call and play until done.",
                 {},
             )
         returned = as_number(record.outcome.value)
@@ -136,9 +137,8 @@ def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]
             return Verdict(
                 "failed",
                 0.0,
-                f"call {call_number} of {function}() returned {describe(record.outcome.value)}, but the "
-                "episode it "
-                f"played lasted {episode.length} steps (replayed); {cause}.",
+                f"call {call_number} of {function}() returned {describe(record.outcome.value)}, but the episode it played lasted {episode.length} steps (replayed); "  # noqa: E501
+                f"{cause}.",
                 {"returned": returned, "replayed_steps": episode.length},
             )
     return LengthRuns(chosen, [episode.length for episode in chosen], game)

@@ -87,8 +87,8 @@ class RandomBlackjackCheck:
         measurements["read_as"] = scale
         if scale is None:
             return _fail(
-                f"{call} returned {returned:.6g}, but the {counts.games} replayed games won "
-                f"{counts.wins} ({counts.win_fraction:.4f}); {rate_mismatch_cause(returned, counts)}.",
+                f"{call} returned {returned:.6g}, but the {counts.games} replayed games won {counts.wins} ({counts.win_fraction:.4f}); "  # noqa: E501
+                f"{rate_mismatch_cause(returned, counts)}.",
                 measurements,
             )
         randomness = _random_action_problem(episodes, settings, measurements)
@@ -102,15 +102,12 @@ class RandomBlackjackCheck:
             "accepted_wins_high": acceptance.high,
             "false_fail_probability": acceptance.false_fail,
         }
-        expected = (
-            f"a random player wins {exact:.4f} of games of {game.description}, so {counts.games} games win "
-            "between "
-            f"{acceptance.low} and {acceptance.high} times"
-        )
+        expected = f"a random player wins {exact:.4f} of games of {game.description}, so {counts.games} games win between {acceptance.low} and {acceptance.high} times"  # noqa: E501
         if not acceptance.accepts(counts.wins):
             return _fail(
-                f"{call}: {expected}; your replayed games won {counts.wins}. The games are real, so this is "
-                f"either {chance_text(acceptance.false_fail)} or not the lab's game: regrade once.",
+                f"{call}: {expected}; your replayed games won {counts.wins}. "
+                f"The games are real, so this is either {chance_text(acceptance.false_fail)} or not the lab's game: "  # noqa: E501
+                "regrade once.",
                 measurements,
             )
         note = (
@@ -121,8 +118,8 @@ class RandomBlackjackCheck:
         return Verdict(
             "passed",
             1.0,
-            f"{call} returned {returned:.6g}{note}: {counts.wins} wins in {counts.games} random games, and "
-            f"{expected}.",
+            f"{call} returned {returned:.6g}{note}: "
+            f"{counts.wins} wins in {counts.games} random games, and {expected}.",
             measurements,
         )
 
@@ -146,9 +143,9 @@ def _random_action_problem(
     }
     if not frequency.accepts(hit_share):
         return (
-            f"random actions draw a card in half of all decisions (0.5 ± {frequency.half_width:.3f} over "
-            f"{decisions} decisions); yours drew in {hit_share:.3f}. Choose each action with "
-            f"env.action_space.sample() (or a fair coin), not a fixed or biased choice."
+            f"random actions draw a card in half of all decisions (0.5 ± {frequency.half_width:.3f} over {decisions} decisions); "  # noqa: E501
+            f"yours drew in {hit_share:.3f}. "
+            "Choose each action with env.action_space.sample() (or a fair coin), not a fixed or biased choice."  # noqa: E501
         )
     if by_sum.p_value < settings.action_alpha:
         shares = ", ".join(
@@ -156,9 +153,8 @@ def _random_action_problem(
             for label, (group_hits, group_decisions) in groups.items()
         )
         return (
-            f"random actions draw half the time whatever the hand, but your share of draws depends on the "
-            f"player's sum ({shares}; chi-square p = {by_sum.p_value:.1e}): the actions follow a strategy. "
-            f"Choose each action with env.action_space.sample()."
+            f"random actions draw half the time whatever the hand, but your share of draws depends on the player's sum ({shares}; chi-square p = {by_sum.p_value:.1e}): "  # noqa: E501
+            "the actions follow a strategy. Choose each action with env.action_space.sample()."
         )
     return None
 

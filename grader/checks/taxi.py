@@ -99,16 +99,13 @@ def _mismatch_cause(episodes: Sequence[Episode], random_mean: float, greedy_mean
     finals = [_mean([episode.final_reward for episode in part]) for part in halves]
     if any(same_number(returned, final) for returned in (random_mean, greedy_mean) for final in finals):
         return (
-            "a returned mean equals the average of the episodes' LAST reward: add up every step's reward of "
-            "an "
-            "episode (total reward), not just the final one"
+            "a returned mean equals the average of the episodes' LAST reward: "
+            "add up every step's reward of an episode (total reward), not just the final one"
         )
     totals = [_mean([episode.replay.total_reward for episode in part]) for part in halves]
     return (
-        f"the first and second half of your {len(episodes)} replayed episodes average {totals[0]:.3f} and "
-        f"{totals[1]:.3f} in total reward: return (mean total reward of the random episodes, mean total "
-        "reward "
-        f"of the Q-table episodes)"
+        f"the first and second half of your {len(episodes)} replayed episodes average {totals[0]:.3f} and {totals[1]:.3f} in total reward: "  # noqa: E501
+        "return (mean total reward of the random episodes, mean total reward of the Q-table episodes)"
     )
 
 
@@ -166,17 +163,15 @@ class TaxiCheck:
             scenarios = split_scenarios(episodes[-played:], random_mean, greedy_mean)
         if scenarios is None:
             return _fail(
-                f"taxi returned ({random_mean:.6g}, {greedy_mean:.6g}), which no split of the replayed "
-                "episodes "
-                f"supports; {_mismatch_cause(episodes, random_mean, greedy_mean)}.",
+                f"taxi returned ({random_mean:.6g}, {greedy_mean:.6g}), which no split of the replayed episodes supports; "  # noqa: E501
+                f"{_mismatch_cause(episodes, random_mean, greedy_mean)}.",
                 measurements,
             )
         for name, scenario in (("random", scenarios.random), ("Q-table", scenarios.greedy)):
             if len(scenario) != settings.episodes_per_scenario:
                 return _fail(
                     f"taxi must run each scenario {settings.episodes_per_scenario} times (the lab's number); "
-                    "the "
-                    f"replay shows {len(scenario)} {name} episodes.",
+                    f"the replay shows {len(scenario)} {name} episodes.",
                     measurements,
                 )
         q_table = outcome.call.args[0] if outcome.call.args else None
@@ -198,8 +193,8 @@ def _action_problem(
     if uniform.p_value < settings.action_alpha:
         shares = ", ".join(f"{count / sum(counts):.3f}" for count in counts)
         return (
-            f"random actions are uniform over the 6 actions, but your random episodes chose them with shares "
-            f"{shares} (chi-square p = {uniform.p_value:.1e}). Use env.action_space.sample()."
+            f"random actions are uniform over the 6 actions, but your random episodes chose them with shares {shares} (chi-square p = {uniform.p_value:.1e}). "  # noqa: E501
+            "Use env.action_space.sample()."
         )
     chosen: dict[int, int] = {}
     for episode in scenarios.greedy:
@@ -209,15 +204,13 @@ def _action_problem(
                 best = int(np.argmax(q_table[state]))
                 if action != best:
                     return (
-                        f"in a Q-table episode you chose action {action} in state {state}, but "
-                        f"argmax(q_table[{state}]) "
-                        f"is {best}: act with np.argmax(q_table[state]) on the table you were given."
+                        f"in a Q-table episode you chose action {action} in state {state}, but argmax(q_table[{state}]) is {best}: "  # noqa: E501
+                        "act with np.argmax(q_table[state]) on the table you were given."
                     )
             elif chosen.setdefault(state, action) != action:
                 return (
-                    f"your Q-table episodes chose actions {chosen[state]} and {action} in the same state "
-                    f"{state}: "
-                    f"acting greedily on one table always picks np.argmax(q_table[state])."
+                    f"your Q-table episodes chose actions {chosen[state]} and {action} in the same state {state}: "  # noqa: E501
+                    "acting greedily on one table always picks np.argmax(q_table[state])."
                 )
     return None
 
@@ -247,9 +240,9 @@ def _judge_means(
     expected_random = f"random actions average {random_exact.mean:.2f} ± {random_test.half_width:.2f}"
     if not random_test.accepts(random_mean):
         return _fail(
-            f"taxi: {expected_random} over {episodes} episodes; yours averaged {random_mean:.2f} (replayed). "
-            "The "
-            f"episodes are real, so this is a near-impossible chance or not the lab's game: regrade once.",
+            f"taxi: {expected_random} over {episodes} episodes; "
+            f"yours averaged {random_mean:.2f} (replayed). "
+            "The episodes are real, so this is a near-impossible chance or not the lab's game: regrade once.",
             measurements,
         )
     if given:
@@ -263,16 +256,15 @@ def _judge_means(
         greedy_ok = greedy_mean >= floor
     if not greedy_ok or greedy_mean <= random_mean:
         return _fail(
-            f"taxi: {expected_greedy} and beats random actions; your Q-table episodes averaged "
-            f"{greedy_mean:.3f} "
-            f"(replayed). Train with find_qvalues as the lab does, then act with np.argmax(q_table[state]).",
+            f"taxi: {expected_greedy} and beats random actions; "
+            f"your Q-table episodes averaged {greedy_mean:.3f} (replayed). "
+            "Train with find_qvalues as the lab does, then act with np.argmax(q_table[state]).",
             measurements,
         )
     return Verdict(
         "passed",
         1.0,
-        f"taxi returned ({random_mean:.2f}, {greedy_mean:.3f}), both backed by {2 * episodes} replayed "
-        "episodes: "
+        f"taxi returned ({random_mean:.2f}, {greedy_mean:.3f}), both backed by {2 * episodes} replayed episodes: "  # noqa: E501
         f"{expected_random}, and {expected_greedy}.",
         measurements,
     )

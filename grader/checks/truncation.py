@@ -36,10 +36,8 @@ def ignored_truncation(episodes: Sequence[Episode]) -> str | None:
     longest = max(ignored, key=lambda episode: episode.replay.steps_after_done)
     limited, unlimited = random_taxi_means()
     return (
-        f"{len(ignored)} episode(s) went on after Taxi's time limit had ended them (truncated=True after "
-        f"{longest.length} steps; e.g. episode {longest.position + 1} of call {longest.call_index + 1} took "
-        f"{longest.replay.steps_after_done} more steps). With gym 0.26's step(), an episode is over when "
-        "`terminated or truncated`; a loop that waits for `terminated` alone ignores the 200-step limit, so "
-        f"random episodes run until the passenger is delivered and average about {unlimited:,.0f} instead of "
-        f"{limited:,.0f}. End the loop with `if terminated or truncated: break`"
+        f"{len(ignored)} episode(s) went on after Taxi's time limit had ended them (truncated=True after {longest.length} steps; e.g. episode {longest.position + 1} of call {longest.call_index + 1} took {longest.replay.steps_after_done} more steps). "  # noqa: E501
+        "With gym 0.26's step(), an episode is over when `terminated or truncated`; "
+        f"a loop that waits for `terminated` alone ignores the 200-step limit, so random episodes run until the passenger is delivered and average about {unlimited:,.0f} instead of {limited:,.0f}. "  # noqa: E501
+        "End the loop with `if terminated or truncated: break`"
     )

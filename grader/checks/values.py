@@ -101,9 +101,8 @@ def step_count_mismatch_cause(returned: float, steps: int, wall_time: float) -> 
     if not float(returned).is_integer():
         if 0 <= returned <= max(10 * wall_time, 1.0):
             return (
-                f"it looks like elapsed time in seconds (the call ran {wall_time:.3g} s), not a number of "
-                "steps: "
-                f"count the env.step() calls instead of timing them"
+                f"it looks like elapsed time in seconds (the call ran {wall_time:.3g} s), not a number of steps: "  # noqa: E501
+                "count the env.step() calls instead of timing them"
             )
         return "a number of steps is a whole number: count the env.step() calls"
     return "it is not the length of the episode the call played: return the number of env.step() calls made"

@@ -95,8 +95,7 @@ class ClassicEnv:
             events.record(
                 events.STEP_BEFORE_RESET,
                 self.requested_id,
-                "step() was called before reset(); the layer reset the environment first, as classic "
-                "Blackjack had dealt a hand in its constructor",
+                "step() was called before reset(); the layer reset the environment first, as classic Blackjack had dealt a hand in its constructor",  # noqa: E501
             )
             self._reset(None, None)
         if self._discrete_actions and type(action) is not int:
@@ -105,8 +104,8 @@ class ClassicEnv:
             events.record(
                 events.STEP_AFTER_DONE,
                 self.requested_id,
-                "step() was called after the episode returned done=True and before reset(); the step "
-                "was passed to the environment as classic gym did, so what followed is undefined",
+                "step() was called after the episode returned done=True and before reset(); "
+                "the step was passed to the environment as classic gym did, so what followed is undefined",
             )
             with quiet_gymnasium(STEP_AFTER_TERMINATED):
                 observation, reward, terminated, truncated, info = self.env.step(action)
@@ -139,8 +138,8 @@ class ClassicEnv:
         events.record(
             events.LEGACY_SEED_CALL,
             self.requested_id,
-            "env.seed() is the classic API; the layer seeds the next reset() with it "
-            "(gymnasium: env.reset(seed=...))",
+            "env.seed() is the classic API; "
+            "the layer seeds the next reset() with it (gymnasium: env.reset(seed=...))",
         )
         self._next_seed = seed
         return [seed]
@@ -164,8 +163,8 @@ class ClassicEnv:
                 events.record(
                     events.RENDER_WITHOUT_MODE,
                     self.requested_id,
-                    f"render({'' if mode is None else repr(mode)}) would open a window; there is none, so "
-                    "nothing was drawn (pass render_mode='rgb_array' to gym.make to get frames)",
+                    f"render({'' if mode is None else repr(mode)}) would open a window; "
+                    "there is none, so nothing was drawn (pass render_mode='rgb_array' to gym.make to get frames)",  # noqa: E501
                 )
             return None
         return self._render_in(mode)
@@ -175,8 +174,8 @@ class ClassicEnv:
         supported = base.metadata.get("render_modes", [])
         if mode not in supported:
             raise UnsupportedRenderModeError(
-                f"{self.requested_id} cannot render in mode {mode!r}; it supports "
-                f"{', '.join(map(repr, supported)) or 'no mode at all'}. Use one of those."
+                f"{self.requested_id} cannot render in mode {mode!r}; "
+                f"it supports {', '.join(map(repr, supported)) or 'no mode at all'}. Use one of those."
             )
         previous = base.render_mode
         base.render_mode = mode

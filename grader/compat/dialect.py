@@ -88,15 +88,9 @@ def _resolve(frame: FrameType | None, site: tuple[CodeType, int], env_id: str) -
         return DEFAULT_API
     _announced.add((where, ""))
     if first is not None and first[2].conflict:
-        reason = (
-            f"the calling function shows no API of its own and its file uses both "
-            f"({first[2].explain(limit=2)}), so it got {DEFAULT_API.label}, the lab's API"
-        )
+        reason = f"the calling function shows no API of its own and its file uses both ({first[2].explain(limit=2)}), so it got {DEFAULT_API.label}, the lab's API"  # noqa: E501
     else:
-        reason = (
-            "no line shows which gym API it expects (no reset() or step() result unpacked), so it got "
-            f"{DEFAULT_API.label}, the lab's API"
-        )
+        reason = f"no line shows which gym API it expects (no reset() or step() result unpacked), so it got {DEFAULT_API.label}, the lab's API"  # noqa: E501
     events.record(events.API_DETECTED, env_id, f"{where}: {reason}")
     return DEFAULT_API
 
@@ -125,6 +119,6 @@ def _ambiguous(filename: str, scope: str, decision: Decision) -> AmbiguousApiErr
     return AmbiguousApiError(
         f"gymgrade cannot tell which gym API {where} in {Path(filename).name} expects: {lines}. "
         "Classic gym's reset() returns the observation and step() 4 values (obs, reward, done, info); "
-        "gym 0.26's reset() returns (obs, info) and step() 5 values (obs, reward, terminated, truncated, "
-        "info). Make these lines follow one of them."
+        "gym 0.26's reset() returns (obs, info) and step() 5 values (obs, reward, terminated, truncated, info). "  # noqa: E501
+        "Make these lines follow one of them."
     )

@@ -47,8 +47,8 @@ _LAB_TABLE: dict[str, _LabEntry] = {
     "Blackjack-v0": _LabEntry(
         "Blackjack-v1",
         {"natural": False, "sab": False},
-        "gymnasium calls it Blackjack-v1, whose registered default sab=True is a different game "
-        "(a player natural wins outright); natural=False, sab=False is classic Blackjack-v0",
+        "gymnasium calls it Blackjack-v1, whose registered default sab=True is a different game (a player natural wins outright); "  # noqa: E501
+        "natural=False, sab=False is classic Blackjack-v0",
     ),
     "Taxi-v3": _LabEntry(
         "Taxi-v4",
@@ -63,8 +63,8 @@ _LAB_TABLE: dict[str, _LabEntry] = {
     "Pendulum-v0": _LabEntry(
         "Pendulum-v1",
         {},
-        "gymnasium calls it Pendulum-v1; not identical: v0 advanced the angle with the velocity before "
-        "clipping it to [-8, 8] and v1 after, so trajectories differ once the pendulum spins that fast",
+        "gymnasium calls it Pendulum-v1; not identical: "
+        "v0 advanced the angle with the velocity before clipping it to [-8, 8] and v1 after, so trajectories differ once the pendulum spins that fast",  # noqa: E501
     ),
     "FrozenLake-v0": _LabEntry(
         "FrozenLake-v1",
@@ -118,8 +118,8 @@ def resolve_env_id(env_id: str) -> EnvTarget:
     """
     if not isinstance(env_id, str):
         raise UnknownEnvironmentError(
-            f"gym.make expects an environment id string such as 'Taxi-v3', found {type(env_id).__name__} "
-            f"{env_id!r}. Pass the id as a string."
+            f"gym.make expects an environment id string such as 'Taxi-v3', found {type(env_id).__name__} {env_id!r}. "  # noqa: E501
+            "Pass the id as a string."
         )
     entry = _LAB_TABLE.get(env_id)
     if entry is not None:
@@ -164,9 +164,9 @@ def _wrong_version(env_id: str, name: str, version: int | None, family: list[str
         )
     newest = max(family, key=lambda known: _split(known)[1] or 0)
     return RetiredEnvironmentError(
-        f"gym.make({env_id!r}): {env_id} is not available in gymnasium {gymnasium.__version__}, which "
-        f"has {', '.join(sorted(family))}. The lab does not use this game; if you need it, read the "
-        f"documentation of {newest} first: its rules may differ from {env_id}'s."
+        f"gym.make({env_id!r}): {env_id} is not available in gymnasium {gymnasium.__version__}, which has {', '.join(sorted(family))}. "  # noqa: E501
+        f"The lab does not use this game; if you need it, read the documentation of {newest} first: "
+        f"its rules may differ from {env_id}'s."
     )
 
 
@@ -182,6 +182,6 @@ def _unknown(env_id: str) -> UnknownEnvironmentError:
     else:
         hint = "The lab uses " + ", ".join(_LAB_FAMILY_ID.values()) + "."
     return UnknownEnvironmentError(
-        f"gym.make({env_id!r}): no environment of this lab or of gymnasium {gymnasium.__version__} is "
-        f"called {env_id!r}. {hint}"
+        f"gym.make({env_id!r}): "
+        f"no environment of this lab or of gymnasium {gymnasium.__version__} is called {env_id!r}. {hint}"
     )

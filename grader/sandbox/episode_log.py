@@ -233,8 +233,7 @@ def _episode(episode: WireEpisode, where: str) -> EpisodeLog:
     truncated = _flags(episode["truncated"], f"{where}: truncated")
     if not len(actions) == len(rewards) == len(terminated) == len(truncated):
         raise InvalidEpisodeLogError(
-            f"{where}: actions, rewards, terminated and truncated must have one entry per step, found "
-            f"{len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"
+            f"{where}: actions, rewards, terminated and truncated must have one entry per step, found {len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"  # noqa: E501
         )
     reset_options = episode["reset_options"]
     return EpisodeLog(

@@ -142,8 +142,8 @@ def verify_reset_seeds(logs: Sequence[EpisodeLog], call_seed: int) -> str | None
     for number, (log, expected) in enumerate(zip(logs, reset_seeds(call_seed, len(logs)), strict=True)):
         if log.reset_seed != expected:
             return (
-                f"episode {number + 1} was reset with seed {log.reset_seed}, but the grader's seed stream "
-                f"gives {expected}: the episode log was altered"
+                f"episode {number + 1} was reset with seed {log.reset_seed}, but the grader's seed stream gives {expected}: "  # noqa: E501
+                "the episode log was altered"
             )
     return None
 
@@ -160,8 +160,8 @@ def _play(env: gymnasium.Env[Any, Any], log: EpisodeLog, observation: Any) -> Re
             observation, reward, terminated, truncated, _ = step(_as_action(action))
         except Exception as failure:
             mismatch = mismatch or (
-                f"step {index + 1} of the episode in {_env_name(log)}: the real environment "
-                f"refused the action {action!r}: {failure}"
+                f"step {index + 1} of the episode in {_env_name(log)}: "
+                f"the real environment refused the action {action!r}: {failure}"
             )
             break
         reward, terminated, truncated = float(reward), bool(terminated), bool(truncated)
@@ -252,12 +252,10 @@ def _same_step(log: EpisodeLog, index: int, reward: float, terminated: bool, tru
 
 def _describe_mismatch(log: EpisodeLog, index: int, reward: float, terminated: bool, truncated: bool) -> str:
     return (
-        f"step {index + 1} of the episode in {_env_name(log)} (reset seed {log.reset_seed}): your code saw "
-        f"reward={log.rewards[index]!r}, terminated={log.terminated[index]}, "
-        f"truncated={log.truncated[index]}, "
-        f"but the real environment gives reward={reward!r}, terminated={terminated}, truncated={truncated} "
-        "for the same actions. The environment your code played was modified (its dynamics, its time limit "
-        "or the log); play the environment gym.make returns, unmodified"
+        f"step {index + 1} of the episode in {_env_name(log)} (reset seed {log.reset_seed}): "
+        f"your code saw reward={log.rewards[index]!r}, terminated={log.terminated[index]}, truncated={log.truncated[index]}, but the real environment gives reward={reward!r}, terminated={terminated}, truncated={truncated} for the same actions. "  # noqa: E501
+        "The environment your code played was modified (its dynamics, its time limit or the log); "
+        "play the environment gym.make returns, unmodified"
     )
 
 

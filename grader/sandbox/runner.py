@@ -37,8 +37,8 @@ def _unavailable_message(report: IsolationReport) -> str:
     return (
         "full isolation is required to run untrusted submissions, but these layers are missing:\n"
         + "\n".join(lines)
-        + "\nInstall what is missing, or (only for your own code) pass IsolationPolicy.ALLOW_FALLBACK "
-        "(`gymgrade check` does; `gymgrade grade --allow-weak-isolation`)."
+        + "\n"
+        "Install what is missing, or (only for your own code) pass IsolationPolicy.ALLOW_FALLBACK (`gymgrade check` does; `gymgrade grade --allow-weak-isolation`)."  # noqa: E501
     )
 
 
@@ -161,9 +161,8 @@ class Sandbox:
         if wait.end is FrameEnd.FRAME and child.oom_killed():
             ending = Ending(
                 OutcomeStatus.MEMORY_LIMIT,
-                f"a process started by {call.function}() used more than "
-                f"{self.limits.memory_bytes >> 20} MiB of memory together with the others "
-                "and was stopped; use less memory",
+                f"a process started by {call.function}() used more than {self.limits.memory_bytes >> 20} MiB of memory together with the others and was stopped; "  # noqa: E501
+                "use less memory",
             )
             return self._fatal(call, seed, started, ending)
         if wait.end is FrameEnd.FRAME:
@@ -177,8 +176,7 @@ class Sandbox:
         elif wait.end is FrameEnd.TOO_LARGE:  # the harness reports oversized results in a small frame
             child.kill_tree()
             ending = _forged(
-                f"a frame announced {wait.size:,} bytes, more than this call's limit of "
-                f"{frame_limit.max_bytes:,} bytes"
+                f"a frame announced {wait.size:,} bytes, more than this call's limit of {frame_limit.max_bytes:,} bytes"  # noqa: E501
             )
         elif wait.end is FrameEnd.EXTRA_DATA:
             child.kill_tree()
@@ -286,8 +284,8 @@ class Sandbox:
             child.kill_tree()
             return Ending(
                 OutcomeStatus.TIMEOUT,
-                f"importing your file took more than {self.limits.import_seconds:g} seconds; move "
-                'long-running code into functions or under `if __name__ == "__main__":`',
+                f"importing your file took more than {self.limits.import_seconds:g} seconds; "
+                'move long-running code into functions or under `if __name__ == "__main__":`',
             )
         if wait.end is FrameEnd.CLOSED:
             return classify_exit(child, None, self.limits)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import signal
 from dataclasses import dataclass
 
-from grader.sandbox.isolation.launch import JOIN_FAILED_EXIT
+from grader.sandbox.isolation.cgroup import JOIN_FAILED_EXIT
 from grader.sandbox.limits import Limits
 from grader.sandbox.outcome import OutcomeStatus
 from grader.sandbox.process import ChildProcess
@@ -27,8 +27,9 @@ class Ending:
 def forged_message(detail: str) -> str:
     """The message for data on the result channel that the harness did not send."""
     return (
-        f"the result channel carried data the harness did not send ({detail}); do not write to the "
-        "grader's file descriptors or imitate its messages: return your result from the function"
+        f"the result channel carried data the harness did not send ({detail}); "
+        "do not write to the grader's file descriptors or imitate its messages: "
+        "return your result from the function"
     )
 
 
@@ -61,10 +62,10 @@ def classify_exit(child: ChildProcess, function: str | None, limits: Limits) -> 
     if child.oom_killed():
         return Ending(
             OutcomeStatus.MEMORY_LIMIT,
-            f"{_during(function)} used more than {limits.memory_bytes // (1 << 20)} MiB of memory "
-            "and was stopped; use less memory (smaller arrays, fewer stored episodes)",
+            f"{_during(function)} used more than {limits.memory_bytes // (1 << 20)} MiB of memory and was stopped; "  # noqa: E501
+            "use less memory (smaller arrays, fewer stored episodes)",
         )
-    uses_signal_codes = child.launch.uses_bubblewrap
+    uses_signal_codes = child.launch.signals_in_exit_status
     number = -code if code < 0 else 0
     if uses_signal_codes and _SIGNAL_BASE < code < _SIGNAL_BASE + 64:
         number = code - _SIGNAL_BASE

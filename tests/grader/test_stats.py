@@ -16,13 +16,28 @@ Z_975 = 1.959963984540054  # the 97.5% normal quantile to 15 digits
 )
 def test_normal_cdf(z: float, expected: float) -> None:
     assert stats.normal_cdf(z) == pytest.approx(expected, abs=1e-14)
-    assert stats.normal_sf(z) == pytest.approx(1 - expected, abs=1e-14)
+
+
+@pytest.mark.parametrize(
+    ("z", "expected"),
+    [(-5.0, 2.866515718791939e-07), (-5.326723886384500, 5e-8), (-10.0, 7.619853024160526e-24)],
+    ids=["minus-5", "alpha-1e-7", "minus-10"],
+)
+def test_normal_cdf_keeps_its_relative_precision_far_in_the_lower_tail(z: float, expected: float) -> None:
+    assert stats.normal_cdf(z) == pytest.approx(expected, rel=1e-12)
 
 
 @pytest.mark.parametrize(
     ("probability", "expected"),
-    [(0.975, Z_975), (0.025, -Z_975), (0.5, 0.0), (1 - 5e-7, 4.891638475698508)],
-    ids=["p975", "p025", "median", "two-sided-1e-6"],
+    [
+        (0.975, Z_975),
+        (0.025, -Z_975),
+        (0.5, 0.0),
+        (1 - 5e-7, 4.891638475698508),
+        (5e-7, -4.891638475698589),
+        (5e-10, -6.109410204869397),
+    ],
+    ids=["p975", "p025", "median", "two-sided-1e-6", "lower-1e-6", "lower-1e-9"],
 )
 def test_normal_quantile(probability: float, expected: float) -> None:
     assert stats.normal_quantile(probability) == pytest.approx(expected, abs=1e-10)
@@ -49,7 +64,6 @@ def test_normal_quantile_rejects_non_probabilities(probability: float) -> None:
 def test_binomial_cdf(k: int, n: int, p: float, cdf: float) -> None:
     # lgamma-based probabilities carry ~1e-15 relative rounding per term.
     assert stats.binomial_cdf(k, n, p) == pytest.approx(cdf, abs=1e-13)
-    assert stats.binomial_sf(k + 1, n, p) == pytest.approx(1 - cdf, abs=1e-13)
 
 
 def test_binomial_acceptance_of_ten_fair_coins() -> None:
@@ -72,15 +86,9 @@ def test_binomial_acceptance_rejects_bad_arguments() -> None:
         stats.binomial_acceptance(0, 0.5, 0.05)
 
 
-def test_binomial_two_sided_p_value() -> None:
-    assert stats.binomial_two_sided_p_value(0, 10, 0.5) == pytest.approx(2 / 1024, abs=1e-15)
-    assert stats.binomial_two_sided_p_value(5, 10, 0.5) == 1.0
-
-
 def test_mean_tolerance() -> None:
     tolerance = stats.mean_tolerance(expected=3.0, variance=4.0, samples=100, alpha=0.05)
     assert tolerance.half_width == pytest.approx(Z_975 * 0.2, abs=1e-8)
-    assert tolerance.z_score(3.4) == pytest.approx(2.0)
     assert tolerance.accepts(3.39) and not tolerance.accepts(3.4)
     assert tolerance.pass_probability(3.0) == pytest.approx(0.95, abs=1e-8)
 
@@ -88,7 +96,6 @@ def test_mean_tolerance() -> None:
 def test_mean_tolerance_of_deterministic_observations() -> None:
     tolerance = stats.mean_tolerance(expected=7.5, variance=0.0, samples=10, alpha=1e-6)
     assert tolerance.accepts(7.5) and not tolerance.accepts(7.51)
-    assert tolerance.z_score(7.5) == 0.0 and tolerance.z_score(8.0) == math.inf
 
 
 @pytest.mark.parametrize(
@@ -105,10 +112,6 @@ def test_mean_tolerance_of_deterministic_observations() -> None:
 )
 def test_chi_square_sf(statistic: float, df: int, expected: float) -> None:
     assert stats.chi_square_sf(statistic, df) == pytest.approx(expected, rel=1e-10)
-
-
-def test_chi_square_critical_inverts_the_tail() -> None:
-    assert stats.chi_square_critical(2, 1e-6) == pytest.approx(-2 * math.log(1e-6), rel=1e-9)
 
 
 def test_goodness_of_fit() -> None:
@@ -131,7 +134,3 @@ def test_grouped_binomial_fit() -> None:
 def test_grouped_binomial_fit_rejects_impossible_counts() -> None:
     with pytest.raises(ValueError, match="0 <= successes <= trials"):
         stats.grouped_binomial_fit([(5, 3)], 0.5)
-
-
-def test_union_false_fail() -> None:
-    assert stats.union_false_fail([0.1, 0.2]) == pytest.approx(0.28)

@@ -94,7 +94,6 @@ class GuessingGameEnv(Env[Any, Any]):
             values = np.empty(0, dtype=object)
         if values.size != 1 or values.dtype.kind not in "iuf" or not abs(float(values[0])) <= self.bounds:
             raise InvalidActionError(
-                f"GuessingGame-v0 expects one guess in [-{self.bounds}, {self.bounds}] (a number, a "
-                f"one-element list or an array of shape (1,)), found {action!r}."
+                f"GuessingGame-v0 expects one guess in [-{self.bounds}, {self.bounds}] (a number, a one-element list or an array of shape (1,)), found {action!r}."  # noqa: E501
             )
         return float(values[0])

@@ -9,9 +9,6 @@ from gymnasium import spaces
 
 from ..errors import InvalidActionError
 
-FORWARD = 0
-BACKWARD = 1
-
 
 class NChainEnv(gymnasium.Env[Any, Any]):
     """n-Chain: walk a chain of states for a large reward at its end, or go back for a small one.

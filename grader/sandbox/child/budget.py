@@ -72,16 +72,10 @@ class FrameLimits:
     def excess(self, payload: bytes) -> str:
         """Why `payload` exceeds these limits, or "" when it does not (counted without parsing it)."""
         if len(payload) > self.max_bytes:
-            return (
-                f"a result frame of {len(payload):,} bytes exceeds this call's limit of {self.max_bytes:,} "
-                "bytes"
-            )
+            return f"a result frame of {len(payload):,} bytes exceeds this call's limit of {self.max_bytes:,} bytes"  # noqa: E501
         nodes = structural_count(payload)
         if nodes > self.max_nodes:
-            return (
-                f"a result frame with {nodes:,} elements exceeds this call's limit of {self.max_nodes:,} "
-                "elements"
-            )
+            return f"a result frame with {nodes:,} elements exceeds this call's limit of {self.max_nodes:,} elements"  # noqa: E501
         return ""
 
 

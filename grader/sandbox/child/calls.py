@@ -94,8 +94,8 @@ def run_call(
     elif result["status"] == "ok" and recorder.overflowed:
         result = _status(
             "output_too_large",
-            f"{request.function}() took more than {recorder.max_recorded_steps} environment steps while "
-            "the grader records episodes; play fewer episodes",
+            f"{request.function}() took more than {recorder.max_recorded_steps} environment steps while the grader records episodes; "  # noqa: E501
+            "play fewer episodes",
             wall_time=result["wall_time"],
         )
     if result["status"] == "ok":
@@ -107,8 +107,8 @@ def run_call(
         except FrameTooLargeError as error:
             result = _status(
                 "output_too_large",
-                f"the episodes {request.function}() played need about {error.size} bytes, more than the "
-                f"limit of {error.limit} bytes; play fewer episodes",
+                f"the episodes {request.function}() played need about {error.size} bytes, more than the limit of {error.limit} bytes; "  # noqa: E501
+                "play fewer episodes",
                 wall_time=result["wall_time"],
             )
         except MemoryError:
@@ -134,14 +134,12 @@ def _budget_message(function: str, recorder: Recorder) -> str:
         return ""
     if recorder.exceeded == "episodes":
         return (
-            f"{function}() reset its environment {recorder.resets:,} times in one call; the grader records "
-            f"at most {budget.max_episodes:,} resets per call of {function}() — reset once per game and "
-            "don't reset to look for an easy start"
+            f"{function}() reset its environment {recorder.resets:,} times in one call; "
+            f"the grader records at most {budget.max_episodes:,} resets per call of {function}() — reset once per game and don't reset to look for an easy start"  # noqa: E501
         )
     return (
-        f"{function}() took {recorder.steps:,} environment steps in one call; the grader records at most "
-        f"{budget.max_steps:,} steps per call of {function}() — play only the games {function}() is asked "
-        "to play and end each one when `terminated` or `truncated` is true"
+        f"{function}() took {recorder.steps:,} environment steps in one call; "
+        f"the grader records at most {budget.max_steps:,} steps per call of {function}() — play only the games {function}() is asked to play and end each one when `terminated` or `truncated` is true"  # noqa: E501
     )
 
 
@@ -151,15 +149,14 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
     if function is None:
         return _status(
             "missing_function",
-            f"your file defines no function named `{name}`; define `def {name}(...):` at the top "
-            'level of the file (not inside another function or an `if __name__ == "__main__":` '
-            "block)",
+            f"your file defines no function named `{name}`; "
+            f'define `def {name}(...):` at the top level of the file (not inside another function or an `if __name__ == "__main__":` block)',  # noqa: E501
         )
     if not callable(function):
         return _status(
             "missing_function",
-            f"`{name}` in your file is a {type(function).__name__}, not a function; define "
-            f"`def {name}(...):`",
+            f"`{name}` in your file is a {type(function).__name__}, not a function; "
+            f"define `def {name}(...):`",
         )
     mismatch = _signature_mismatch(name, function, request)
     if mismatch:
@@ -190,8 +187,8 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
     except FrameTooLargeError as error:
         return _status(
             "output_too_large",
-            f"{name}() returned about {error.size} bytes of data, more than the limit of {error.limit} "
-            "bytes; return less data",
+            f"{name}() returned about {error.size} bytes of data, more than the limit of {error.limit} bytes; "  # noqa: E501
+            "return less data",
             wall_time=wall_time,
         )
     except MemoryError:
@@ -246,8 +243,8 @@ def _payload(result: dict[str, Any], request: CallRequest, limits: FrameLimits) 
     small = {
         **_status(
             "output_too_large",
-            f"{request.function}() produced too much data ({excess.removeprefix('a ')}); {culprit} is too "
-            "large: return less data or play fewer episodes",
+            f"{request.function}() produced too much data ({excess.removeprefix('a ')}); "
+            f"{culprit} is too large: return less data or play fewer episodes",
             wall_time=result["wall_time"],
         ),
         "compat_events": result["compat_events"][:20],

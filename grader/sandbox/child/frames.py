@@ -32,10 +32,7 @@ MAX_INT_BITS = 256
 FLOAT_TAG = "$float"
 NDARRAY_TAG = "$ndarray"
 
-PLAIN_TYPES_HINT = (
-    "only plain data can be returned: None, bool, int, float, str, list, tuple, dict with str keys, "
-    "numpy numbers and numpy arrays of bool/int/float"
-)
+PLAIN_TYPES_HINT = "only plain data can be returned: None, bool, int, float, str, list, tuple, dict with str keys, numpy numbers and numpy arrays of bool/int/float"  # noqa: E501
 _NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
 _INTEGER_SCALARS = ("int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64", "longlong")
 _NUMPY_SCALARS: dict[type, Callable[[Any], Any]] = {
@@ -245,8 +242,8 @@ def _encode_array(array: np.ndarray, what: str, where: str) -> dict[str, Any]:
         raise _invalid(
             what,
             where,
-            f"found a numpy array of dtype {array.dtype}; only bool, int, uint and float arrays can be "
-            "returned (convert with `.astype(float)`, or return a list)",
+            f"found a numpy array of dtype {array.dtype}; "
+            "only bool, int, uint and float arrays can be returned (convert with `.astype(float)`, or return a list)",  # noqa: E501
         )
     if array.ndim > MAX_DEPTH:
         raise _invalid(what, where, f"the array has {array.ndim} dimensions")

@@ -24,8 +24,8 @@ class _SockFprog(ctypes.Structure):
 
 
 def _apply_landlock(rules: dict[str, list[str]]) -> None:
-    location = os.path.join(os.path.dirname(os.path.abspath(__file__)), "landlock.py")
-    spec = importlib.util.spec_from_file_location("_gymgrade_landlock", location)
+    location = os.path.join(os.path.dirname(os.path.abspath(__file__)), "landlock_syscalls.py")
+    spec = importlib.util.spec_from_file_location("_gymgrade_landlock_syscalls", location)
     if spec is None or spec.loader is None:
         raise OSError(f"cannot load {location}")
     module = importlib.util.module_from_spec(spec)

@@ -6,24 +6,25 @@ tree at /gymgrade, its own file at /submission, a private /proc and /dev, and a 
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 import subprocess
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from grader.sandbox.isolation.filesystem import PythonPaths
-from grader.sandbox.isolation.layer import LayerReport
+from grader.sandbox.isolation.filesystem import SYSTEM_DIRS, ChildView, PythonPaths
+from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 from grader.sandbox.isolation.privileges import running_as_root
+
+if TYPE_CHECKING:
+    from grader.sandbox.isolation.launch import LaunchSpec
 
 HARNESS_DIR = "/gymgrade"
 SUBMISSION_DIR = "/submission"
 SCRATCH_DIR = "/tmp"
 LOCAL_DIR = "/usr/local"
-SYSTEM_DIRS = ("/usr", "/bin", "/sbin", "/lib", "/lib64", "/lib32")
-_REMEDY = (
-    "install bubblewrap >= 0.8 (`apt-get install bubblewrap`) and allow user namespaces "
-    "(`sysctl kernel.unprivileged_userns_clone=1`, or run as root)"
-)
+_REMEDY = "install bubblewrap >= 0.8 (`apt-get install bubblewrap`) and allow user namespaces (`sysctl kernel.unprivileged_userns_clone=1`, or run as root)"  # noqa: E501
 
 
 def _namespaces() -> list[str]:
@@ -112,28 +113,64 @@ def bwrap_argv(
     return [*argv, "--"]
 
 
+@functools.cache
+def _probe_machine() -> LayerReport:
+    """Runs `true` in a sandbox like the children's to see that bwrap and its namespaces work (once)."""
+    name = BubblewrapLayer.name
+    binary = shutil.which("bwrap")
+    if binary is None:
+        return LayerReport(name, False, "bubblewrap (bwrap) is not installed", _REMEDY)
+    argv = [binary, *_namespaces(), "--die-with-parent", "--clearenv"]
+    argv += _system_binds()
+    argv += ["--proc", "/proc", "--dev", "/dev", *_scratch(1 << 20), "--", "true"]
+    try:
+        result = subprocess.run(argv, capture_output=True, text=True, timeout=10, check=False)
+    except (OSError, subprocess.TimeoutExpired) as error:
+        return LayerReport(name, False, f"bwrap could not run ({error})", _REMEDY)
+    if result.returncode != 0:
+        return LayerReport(name, False, f"bwrap failed: {result.stderr.strip()}", _REMEDY)
+    return LayerReport(
+        name,
+        True,
+        "all namespaces unshared (no network, own PID space), read-only minimal file system, size-limited scratch tmpfs, die-with-parent, cleared environment",  # noqa: E501
+    )
+
+
+def private_view(submission_name: str) -> ChildView:
+    """Where the child sees its scratch tmpfs, the harness tree and the submission inside bwrap."""
+    return ChildView(SCRATCH_DIR, HARNESS_DIR, f"{SUBMISSION_DIR}/{submission_name}")
+
+
 class BubblewrapLayer:
     """Namespaces (no network, own PID space), a minimal read-only file system, `--die-with-parent`."""
 
     name = "bubblewrap"
 
-    def probe(self) -> LayerReport:
-        """Runs `true` in a sandbox like the children's to see that bwrap and its namespaces work."""
-        binary = shutil.which("bwrap")
-        if binary is None:
-            return LayerReport(self.name, False, "bubblewrap (bwrap) is not installed", _REMEDY)
-        argv = [binary, *_namespaces(), "--die-with-parent", "--clearenv"]
-        argv += _system_binds()
-        argv += ["--proc", "/proc", "--dev", "/dev", *_scratch(1 << 20), "--", "true"]
-        try:
-            result = subprocess.run(argv, capture_output=True, text=True, timeout=10, check=False)
-        except (OSError, subprocess.TimeoutExpired) as error:
-            return LayerReport(self.name, False, f"bwrap could not run ({error})", _REMEDY)
-        if result.returncode != 0:
-            return LayerReport(self.name, False, f"bwrap failed: {result.stderr.strip()}", _REMEDY)
-        return LayerReport(
-            self.name,
-            True,
-            "all namespaces unshared (no network, own PID space), read-only minimal file "
-            "system, size-limited scratch tmpfs, die-with-parent, cleared environment",
-        )
+    def probe(self, outer: IsolationReport) -> LayerReport:
+        """Whether bwrap and its namespaces work here (checked once per process)."""
+        return _probe_machine()
+
+    def apply(self, spec: LaunchSpec) -> None:
+        """Gives the child its private file system and wraps it in bwrap, which clears the environment,
+        sets the child's own and installs the syscall filter itself (taking that step from the bootstrap)."""
+        submission_fd = os.memfd_create("gymgrade-submission", 0)
+        spec.launch.pass_fds.append(submission_fd)
+        os.write(submission_fd, spec.submission)
+        os.lseek(submission_fd, 0, os.SEEK_SET)
+        spec.provide_view(private_view(spec.submission_name))
+        spec.process_env = {}
+        spec.launch.signals_in_exit_status = True
+
+        def wrapper(finished: LaunchSpec) -> list[str]:
+            seccomp_fd, finished.bootstrap.seccomp_fd = finished.bootstrap.seccomp_fd, None
+            return bwrap_argv(
+                finished.paths,
+                finished.tree,
+                submission_fd=submission_fd,
+                submission_name=finished.submission_name,
+                seccomp_fd=seccomp_fd,
+                scratch_bytes=finished.limits.scratch_bytes,
+                env=finished.child_environment(),
+            )
+
+        spec.wrappers.append(wrapper)

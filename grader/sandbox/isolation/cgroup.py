@@ -3,15 +3,20 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import secrets
 import signal
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from grader.sandbox.isolation.layer import LayerReport
+from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 from grader.sandbox.isolation.scope import forget_cgroup, record_cgroup
+
+if TYPE_CHECKING:
+    from grader.sandbox.isolation.launch import LaunchSpec
 
 CGROUP_ROOT = Path("/sys/fs/cgroup")
 CONTROLLERS = ("memory", "pids", "cpu")
@@ -20,6 +25,9 @@ JOB_PREFIX = "gymgrade-"
 _REMEDY = (
     "run as root, or in a delegated cgroup (e.g. `systemd-run --user --scope -p Delegate=yes gymgrade ...`)"
 )
+_JOIN_CGROUPS = 'for f do [ "$f" = -- ] && break; echo $$ > "$f" || exit 125; shift; done; shift; exec "$@"'
+JOIN_FAILED_EXIT = 125
+"""Exit status of the start-up wrapper when the child could not join its cgroups."""
 
 
 @dataclass
@@ -240,28 +248,47 @@ def _write_limits(job: JobCgroup, memory_bytes: int, max_pids: int, cpus: float)
                 group.write("cpu.max", f"{int(period * cpus)} {period}")
 
 
+@functools.cache
+def _probe_machine() -> LayerReport:
+    """Creates and removes a throw-away job cgroup to see which controllers can be used (once)."""
+    try:
+        job = create_job_cgroup(memory_bytes=1 << 30, max_pids=16)
+    except OSError as error:
+        detail = f"the cgroup tree is not writable here ({error})"
+        return LayerReport(CgroupLayer.name, False, detail, _REMEDY)
+    limited = job.limited
+    versions = sorted({f"v{group.version}" for group in job.groups})
+    job.remove()
+    missing = [c for c in CONTROLLERS if c not in limited]
+    if missing:
+        return LayerReport(
+            CgroupLayer.name,
+            False,
+            f"controllers {', '.join(missing)} are not available",
+            "mount the cgroup controllers or delegate them to this user (" + _REMEDY + ")",
+        )
+    return LayerReport(
+        CgroupLayer.name, True, f"cgroup {'+'.join(versions)}: memory, pids and cpu limited per child"
+    )
+
+
+def join_argv(job: JobCgroup) -> list[str]:
+    """The outermost wrapper: a shell writes its pid into every group of `job`, then execs the rest
+    (exit status `JOIN_FAILED_EXIT` when it cannot join)."""
+    return ["/bin/sh", "-c", _JOIN_CGROUPS, "gymgrade-join", *map(str, job.procs_files), "--"]
+
+
 class CgroupLayer:
     """Memory, process-count and CPU limits for the child's whole tree, and killing that tree."""
 
     name = "cgroup"
 
-    def probe(self) -> LayerReport:
-        """Creates and removes a throw-away job cgroup to see which controllers can be used."""
-        try:
-            job = create_job_cgroup(memory_bytes=1 << 30, max_pids=16)
-        except OSError as error:
-            return LayerReport(self.name, False, f"the cgroup tree is not writable here ({error})", _REMEDY)
-        limited = job.limited
-        versions = sorted({f"v{group.version}" for group in job.groups})
-        job.remove()
-        missing = [c for c in CONTROLLERS if c not in limited]
-        if missing:
-            return LayerReport(
-                self.name,
-                False,
-                f"controllers {', '.join(missing)} are not available",
-                "mount the cgroup controllers or delegate them to this user (" + _REMEDY + ")",
-            )
-        return LayerReport(
-            self.name, True, f"cgroup {'+'.join(versions)}: memory, pids and cpu limited per child"
-        )
+    def probe(self, outer: IsolationReport) -> LayerReport:
+        """Whether a job cgroup with every controller can be made here (checked once per process)."""
+        return _probe_machine()
+
+    def apply(self, spec: LaunchSpec) -> None:
+        """Creates the child's job cgroup with its limits; the child joins it before anything else runs."""
+        job = create_job_cgroup(spec.limits.memory_bytes, spec.limits.max_pids)
+        spec.launch.cgroup = job
+        spec.wrappers.append(lambda _spec: join_argv(job))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import atexit
+import contextlib
 import functools
 import os
 import shutil
@@ -14,12 +15,18 @@ from pathlib import Path
 
 from grader.sandbox.isolation.scope import temp_root
 
+SYSTEM_DIRS = ("/usr", "/bin", "/sbin", "/lib", "/lib64", "/lib32")
+"""System directories the child may read (bubblewrap binds them, Landlock allows reading them)."""
 PROJECT_PACKAGES = ("grader", "reference", "api")
 """Top-level packages of the project; hidden wherever an installed copy would make them importable."""
 
 _GRADER_ROOT = Path(__file__).resolve().parents[2]
 _HARNESS_SOURCES = ("sandbox/child", "compat")
 _ISOLATION_DIR = Path(__file__).resolve().parent
+_CHILD_SIDE_FILES = ("bootstrap.py", "landlock_syscalls.py")
+"""Stdlib-only files of this package the child runs before the harness (at the top of the tree)."""
+_SCRATCH_PREFIX = "gymgrade-scratch-"
+_SUBMISSION_SUBDIR = ".submission"
 TREE_PREFIX = "gymgrade-harness-"
 """Harness trees are temporary directories named gymgrade-harness-<grader pid>-<random>, inside the
 grading's scope when there is one (`grader.sandbox.isolation.scope`), which removes them with it."""
@@ -43,6 +50,64 @@ class PythonPaths:
     stdlib: tuple[str, ...]
     site_dirs: tuple[str, ...]
     hidden: tuple[Path, ...]
+
+
+@dataclass(frozen=True)
+class ChildView:
+    """Where one child finds its scratch directory, the harness tree and the submission (paths it sees).
+
+    Attributes:
+        scratch: Its writable directory (also HOME and TMPDIR).
+        harness: The harness tree (`harness_tree()`).
+        submission: The submission's read-only file.
+        host_scratch: The scratch directory on the host, removed after the child (None when the scratch
+            is private to the child).
+        cwd: The working directory of the first process (None when a wrapper sets the child's own).
+    """
+
+    scratch: str
+    harness: str
+    submission: str
+    host_scratch: Path | None = None
+    cwd: str | None = None
+
+
+def host_view(tree: Path, submission: bytes, submission_name: str) -> ChildView:
+    """The view without a private file system: a scratch directory on the host (in the grading's scope)
+    holding a read-only copy of the submission, and the harness tree where it is."""
+    scratch = Path(tempfile.mkdtemp(prefix=_SCRATCH_PREFIX, dir=temp_root()))
+    try:
+        os.chmod(scratch, 0o1777)
+        submission_dir = scratch / _SUBMISSION_SUBDIR
+        submission_dir.mkdir()
+        (submission_dir / submission_name).write_bytes(submission)
+        os.chmod(submission_dir, 0o555)
+    except BaseException:
+        remove_host_scratch(scratch)
+        raise
+    return ChildView(
+        scratch=str(scratch),
+        harness=str(tree),
+        submission=str(submission_dir / submission_name),
+        host_scratch=scratch,
+        cwd=str(scratch),
+    )
+
+
+def remove_host_scratch(scratch: Path) -> None:
+    """Removes a host view's scratch directory with everything in it.
+
+    Its read-only submission directory is made writable first: without root, nothing inside a read-only
+    directory can be removed. Opened without following links, since a child running as the grader's
+    own uid may have replaced it.
+    """
+    with contextlib.suppress(OSError):
+        descriptor = os.open(scratch / _SUBMISSION_SUBDIR, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
+        try:
+            os.fchmod(descriptor, 0o700)
+        finally:
+            os.close(descriptor)
+    shutil.rmtree(scratch, ignore_errors=True)
 
 
 @functools.cache
@@ -83,7 +148,7 @@ def remove_stale_trees() -> None:
 def harness_tree() -> Path:
     """A private, read-only copy of what the child imports from the project, built once per process.
 
-    Layout: ``bootstrap.py`` and ``landlock.py`` at the top, and under ``lib/`` an empty
+    Layout: ``bootstrap.py`` and ``landlock_syscalls.py`` at the top, and under ``lib/`` an empty
     ``grader/__init__.py`` and ``grader/sandbox/__init__.py`` with ``grader/sandbox/child`` and
     ``grader/compat``. Nothing else of the project (not `reference`, not the assignment config).
     """
@@ -100,7 +165,7 @@ def harness_tree() -> Path:
             lib / "grader" / relative,
             ignore=shutil.ignore_patterns("__pycache__", "*.pyc"),
         )
-    for name in ("bootstrap.py", "landlock.py"):
+    for name in _CHILD_SIDE_FILES:
         shutil.copy2(_ISOLATION_DIR / name, root / name)
     for directory, _, files in os.walk(root):
         os.chmod(directory, 0o755)

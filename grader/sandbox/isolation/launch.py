@@ -1,27 +1,30 @@
-"""Composes the probed layers into the command that starts one child, and cleans up after it."""
+"""One child's start: the active layers each add their part to a `LaunchSpec`, composed into a `Launch`."""
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import os
-import shutil
-import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grader.sandbox.isolation import bubblewrap, privileges
-from grader.sandbox.isolation.cgroup import JobCgroup, create_job_cgroup
-from grader.sandbox.isolation.filesystem import harness_tree, python_paths
+from grader.sandbox.isolation import registry
+from grader.sandbox.isolation.cgroup import JobCgroup
+from grader.sandbox.isolation.filesystem import (
+    ChildView,
+    PythonPaths,
+    harness_tree,
+    host_view,
+    python_paths,
+    remove_host_scratch,
+)
 from grader.sandbox.isolation.layer import IsolationReport
-from grader.sandbox.isolation.rlimits import rlimit_table
-from grader.sandbox.isolation.scope import temp_root
-from grader.sandbox.isolation.seccomp import compile_filter
 from grader.sandbox.limits import Limits
 
-_JOIN_CGROUPS = 'for f do [ "$f" = -- ] && break; echo $$ > "$f" || exit 125; shift; done; shift; exec "$@"'
-JOIN_FAILED_EXIT = 125
-"""Exit status of the start-up wrapper when the child could not join its cgroups."""
+Wrapper = Callable[["LaunchSpec"], list[str]]
+"""A command prefix (ending in its own ``--``), built from the finished spec when the launch is composed."""
 
 
 @dataclass
@@ -33,8 +36,9 @@ class Launch:
         env: The environment given to the first process of `argv`.
         pass_fds: Descriptors the first process inherits (besides the request/result pipes).
         cgroup: The child's job cgroup, when the cgroup layer is active.
-        scratch: The host directory used as scratch when bubblewrap is not available.
-        uses_bubblewrap: Whether the child runs under bubblewrap (its exit status then encodes signals).
+        scratch: The host directory used as scratch when no layer gives the child a private one.
+        signals_in_exit_status: Whether the outermost wrapper exits with 128 + N when the child was
+            killed by signal N (bubblewrap does).
         cwd: The working directory of the first process (the scratch without bubblewrap).
     """
 
@@ -43,7 +47,7 @@ class Launch:
     pass_fds: list[int] = field(default_factory=list)
     cgroup: JobCgroup | None = None
     scratch: Path | None = None
-    uses_bubblewrap: bool = False
+    signals_in_exit_status: bool = False
     cwd: str | None = None
 
     def close_descriptors(self) -> None:
@@ -58,20 +62,106 @@ class Launch:
         self.close_descriptors()
         clean = self.cgroup.remove() if self.cgroup is not None else True
         if self.scratch is not None:
-            shutil.rmtree(self.scratch, ignore_errors=True)
+            remove_host_scratch(self.scratch)
         return clean
 
 
-def _child_env(scratch: str) -> dict[str, str]:
-    return {
-        "PATH": "/usr/bin:/bin",
-        "HOME": scratch,
-        "TMPDIR": scratch,
-        "LANG": "C.UTF-8",
-        "PYTHONHASHSEED": "0",
-        "PYTHONDONTWRITEBYTECODE": "1",
-        "MPLCONFIGDIR": f"{scratch}/.matplotlib",
-    }
+@dataclass
+class BootstrapSteps:
+    """The child-side steps bootstrap.py knows, run in this order before the harness; off until set.
+
+    Attributes:
+        rlimits: (name, soft, hard) resource limits the child sets on itself.
+        landlock: Landlock rules ({"read": [...], "write": [...]}) the child restricts itself to.
+        seccomp_fd: A descriptor holding a BPF program the child installs.
+    """
+
+    rlimits: list[tuple[str, int, int]] = field(default_factory=list)
+    landlock: dict[str, list[str]] | None = None
+    seccomp_fd: int | None = None
+
+
+@dataclass
+class LaunchSpec:
+    """One child's start while the active layers add their parts, outermost layer first.
+
+    Layers read the first six attributes and add to the others.
+
+    Attributes:
+        isolation: The probed layers (a layer that depends on another asks `isolation.is_active`).
+        limits: The limits in force.
+        paths: The interpreter and its directories (`python_paths()`).
+        tree: The harness tree on the host (`harness_tree()`).
+        submission: The submission's bytes.
+        submission_name: The submission's file name as the child sees it.
+        wrappers: Command prefixes, outermost first (cgroup join, bwrap, setpriv), built when composed.
+        environment: Variables the layers add to the child's environment.
+        bootstrap: The child-side steps bootstrap.py runs before the harness (a wrapper that performs
+            one itself, earlier, takes it from here).
+        view: The child's file system as chosen by a layer (`child_view()` falls back to the host's).
+        process_env: The first process's environment when a wrapper sets the child's own (None: the
+            child's environment itself).
+        launch: The resources to release afterwards (descriptors, cgroup, scratch) and the result.
+    """
+
+    isolation: IsolationReport
+    limits: Limits
+    paths: PythonPaths
+    tree: Path
+    submission: bytes
+    submission_name: str
+    wrappers: list[Wrapper] = field(default_factory=list)
+    environment: dict[str, str] = field(default_factory=dict)
+    bootstrap: BootstrapSteps = field(default_factory=BootstrapSteps)
+    view: ChildView | None = None
+    process_env: dict[str, str] | None = None
+    launch: Launch = field(default_factory=lambda: Launch(argv=[], env={}))
+
+    def provide_view(self, view: ChildView) -> None:
+        """Gives the child a private file system (one layer may; before any layer reads `child_view()`)."""
+        if self.view is not None:
+            raise RuntimeError(
+                f"a second view of the file system was provided ({view.scratch}) after {self.view.scratch}; "
+                "only one layer may give the child its file system, listed before the layers reading it"
+            )
+        self.view = view
+
+    def child_view(self) -> ChildView:
+        """The child's file system: the one a layer provided, else (made on first use) the host's."""
+        if self.view is None:
+            self.view = host_view(self.tree, self.submission, self.submission_name)
+            self.launch.scratch = self.view.host_scratch
+        return self.view
+
+    def child_environment(self) -> dict[str, str]:
+        """The whole environment of the child: the base for its scratch, then what layers added."""
+        scratch = self.child_view().scratch
+        return {
+            "PATH": "/usr/bin:/bin",
+            "HOME": scratch,
+            "TMPDIR": scratch,
+            "LANG": "C.UTF-8",
+            "PYTHONHASHSEED": "0",
+            "PYTHONDONTWRITEBYTECODE": "1",
+            "MPLCONFIGDIR": f"{scratch}/.matplotlib",
+            **self.environment,
+        }
+
+    def compose(self, harness_argv: list[str]) -> Launch:
+        """The finished launch: the wrappers (built first: they may take steps), then the interpreter
+        running the bootstrap with the remaining steps and the harness's arguments."""
+        view = self.child_view()
+        prefix = [argument for wrapper in self.wrappers for argument in wrapper(self)]
+        config = {
+            "sys_path": [f"{view.harness}/lib", *self.paths.stdlib, *self.paths.site_dirs],
+            **dataclasses.asdict(self.bootstrap),
+            "harness_argv": harness_argv,
+        }
+        inner = [str(self.paths.executable), "-S", "-B", f"{view.harness}/bootstrap.py", json.dumps(config)]
+        self.launch.argv = [*prefix, *inner]
+        self.launch.env = self.child_environment() if self.process_env is None else self.process_env
+        self.launch.cwd = view.cwd
+        return self.launch
 
 
 def build_launch(
@@ -84,99 +174,30 @@ def build_launch(
     results_fd: int,
     import_seed: int,
 ) -> Launch:
-    """The command starting one child with every active layer of `report` applied.
+    """The command starting one child: every active layer of `report` applied in order, outermost first.
 
     Raises:
         OSError: when a layer that was probed as active fails now (the caller reports a sandbox error).
     """
-    paths = python_paths()
-    tree = harness_tree()
-    use_bwrap = report.is_active("bubblewrap")
-    drop_uid = privileges.running_as_root() and report.is_active("privileges")
-    launch = Launch(argv=[], env={})
+    spec = LaunchSpec(report, limits, python_paths(), harness_tree(), submission, submission_name)
+    active = {layer.name for layer in report.layers if layer.active}
     try:
-        if report.is_active("cgroup"):
-            launch.cgroup = create_job_cgroup(limits.memory_bytes, limits.max_pids)
-        seccomp_fd = compile_filter() if report.is_active("seccomp") else None
-        if seccomp_fd is not None:
-            launch.pass_fds.append(seccomp_fd)
-        launch.uses_bubblewrap = use_bwrap
-        if use_bwrap:
-            submission_fd = os.memfd_create("gymgrade-submission", 0)
-            launch.pass_fds.append(submission_fd)
-            os.write(submission_fd, submission)
-            os.lseek(submission_fd, 0, os.SEEK_SET)
-            scratch = bubblewrap.SCRATCH_DIR
-            harness_dir = bubblewrap.HARNESS_DIR
-            submission_path = f"{bubblewrap.SUBMISSION_DIR}/{submission_name}"
-            launch.env = {}
-            outer = bubblewrap.bwrap_argv(
-                paths,
-                tree,
-                submission_fd=submission_fd,
-                submission_name=submission_name,
-                seccomp_fd=seccomp_fd,
-                scratch_bytes=limits.scratch_bytes,
-                env=_child_env(scratch),
-            )
-            bootstrap_seccomp = None
-        else:
-            launch.scratch = Path(tempfile.mkdtemp(prefix="gymgrade-scratch-", dir=temp_root()))
-            os.chmod(launch.scratch, 0o1777)
-            submission_dir = launch.scratch / ".submission"
-            submission_dir.mkdir()
-            (submission_dir / submission_name).write_bytes(submission)
-            os.chmod(submission_dir, 0o555)
-            scratch, harness_dir = str(launch.scratch), str(tree)
-            submission_path = str(submission_dir / submission_name)
-            launch.env = _child_env(scratch)
-            launch.cwd = scratch
-            outer = []
-            bootstrap_seccomp = seccomp_fd
-        landlock = None
-        if report.is_active("landlock") and not use_bwrap:
-            read = [
-                *map(str, paths.roots),
-                *bubblewrap.SYSTEM_DIRS,
-                str(tree),
-                "/dev/null",
-                "/dev/urandom",
-                "/proc/self",
-                "/etc/ld.so.cache",
-                "/etc/localtime",
-            ]
-            landlock = {"read": read, "write": [scratch]}
-        config = {
-            "sys_path": [f"{harness_dir}/lib", *paths.stdlib, *paths.site_dirs],
-            "rlimits": rlimit_table(
-                limits,
-                dropped_uid=drop_uid,
-                own_user_namespace=use_bwrap and not privileges.running_as_root(),
-            ),
-            "landlock": landlock,
-            "seccomp_fd": bootstrap_seccomp,
-            "harness_argv": [
-                "--submission",
-                submission_path,
-                "--requests",
-                str(requests_fd),
-                "--results",
-                str(results_fd),
-                "--max-frame",
-                str(limits.frame_bytes),
-                "--seed",
-                str(import_seed),
-            ],
-        }
-        inner = [str(paths.executable), "-S", "-B", f"{harness_dir}/bootstrap.py", json.dumps(config)]
-        drop = privileges.drop_argv() if drop_uid else []
-        join = (
-            ["/bin/sh", "-c", _JOIN_CGROUPS, "gymgrade-join", *map(str, launch.cgroup.procs_files), "--"]
-            if launch.cgroup is not None
-            else []
-        )
-        launch.argv = [*join, *outer, *drop, *inner]
+        for layer in registry.LAYERS:
+            if layer.name in active:
+                layer.apply(spec)
+        harness_argv = [
+            "--submission",
+            spec.child_view().submission,
+            "--requests",
+            str(requests_fd),
+            "--results",
+            str(results_fd),
+            "--max-frame",
+            str(limits.frame_bytes),
+            "--seed",
+            str(import_seed),
+        ]
+        return spec.compose(harness_argv)
     except BaseException:
-        launch.cleanup()
+        spec.launch.cleanup()
         raise
-    return launch

@@ -1,9 +1,12 @@
-"""What every isolation layer reports at start-up, and the report assembled from all of them."""
+"""The isolation layer plug-in contract (`Layer`: probe, then apply), what a layer reports, and the report."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:  # launch.py reads the layer list, whose modules implement this protocol
+    from grader.sandbox.isolation.launch import LaunchSpec
 
 
 @dataclass(frozen=True)
@@ -26,12 +29,28 @@ class LayerReport:
 
 
 class Layer(Protocol):
-    """One isolation layer: probed once per process, then applied to every child it starts."""
+    """One isolation layer: probed on this machine, then applied to the start of every child while active.
+
+    Implementations are listed once, outermost first, in `grader.sandbox.isolation.registry.LAYERS`.
+    """
 
     name: str
 
-    def probe(self) -> LayerReport:
-        """Checks on this machine whether the layer can be enforced (without side effects left behind)."""
+    def probe(self, outer: IsolationReport) -> LayerReport:
+        """What the layer can enforce here and, when nothing, the remedy (no side effects left behind).
+
+        Args:
+            outer: The reports of the layers listed before this one, already switched off as the caller
+                asked (a layer that depends on another reads it here). Costly machine checks are cached.
+        """
+        ...
+
+    def apply(self, spec: LaunchSpec) -> None:
+        """Adds the layer's part to one child's start (called only while the layer is active).
+
+        Raises:
+            OSError: when the layer, probed as active, cannot be applied now.
+        """
         ...
 
 

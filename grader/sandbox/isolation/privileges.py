@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import pwd
 import shutil
+from typing import TYPE_CHECKING
 
-from grader.sandbox.isolation.layer import LayerReport
+from grader.sandbox.isolation.filesystem import python_paths
+from grader.sandbox.isolation.layer import IsolationReport, LayerReport
+
+if TYPE_CHECKING:
+    from grader.sandbox.isolation.launch import LaunchSpec
 
 SANDBOX_UID = 65534
 """`nobody` on Debian and most distributions."""
@@ -32,30 +38,60 @@ def drop_argv() -> list[str]:
     ]
 
 
+@functools.cache
+def _probe_machine() -> LayerReport:
+    """When root, checks that `setpriv` exists; otherwise the grader's own uid is already unprivileged."""
+    layer = PrivilegesLayer.name
+    if not running_as_root():
+        return LayerReport(
+            layer, True, f"runs as the grader's own unprivileged uid {os.geteuid()}, no-new-privileges"
+        )
+    if shutil.which("setpriv") is None:
+        return LayerReport(
+            layer,
+            False,
+            "running as root and `setpriv` is missing",
+            "install util-linux (`apt-get install util-linux`)",
+        )
+    try:
+        name = pwd.getpwuid(SANDBOX_UID).pw_name
+    except KeyError:
+        name = "unnamed"
+    return LayerReport(
+        layer, True, f"root drops to uid {SANDBOX_UID} ({name}), no capabilities, no-new-privileges"
+    )
+
+
+def _interpreter_readable_by_others() -> bool:
+    return all(
+        os.stat(root).st_mode & 0o005 == 0o005
+        and all(os.stat(parent).st_mode & 0o001 for parent in root.parents)
+        for root in python_paths().roots
+    )
+
+
 class PrivilegesLayer:
     """Unprivileged uid, no capabilities, no-new-privileges."""
 
     name = "privileges"
 
-    def probe(self) -> LayerReport:
-        """When root, checks that `setpriv` exists; otherwise the grader's own uid is already unprivileged."""
-        if not running_as_root():
-            return LayerReport(
-                self.name,
-                True,
-                f"runs as the grader's own unprivileged uid {os.geteuid()}, no-new-privileges",
-            )
-        if shutil.which("setpriv") is None:
+    def probe(self, outer: IsolationReport) -> LayerReport:
+        """Whether the child can run unprivileged; as root without bubblewrap (read from `outer`), only
+        if the dropped uid can still read the interpreter on the host."""
+        report = _probe_machine()
+        unreachable = not outer.is_active("bubblewrap") and not _interpreter_readable_by_others()
+        if report.active and running_as_root() and unreachable:
             return LayerReport(
                 self.name,
                 False,
-                "running as root and `setpriv` is missing",
-                "install util-linux (`apt-get install util-linux`)",
+                "running as root without bubblewrap, and the interpreter is not readable by an unprivileged uid: "  # noqa: E501
+                "the child keeps root",
+                "install bubblewrap, or install Python where every user can read it",
             )
-        try:
-            name = pwd.getpwuid(SANDBOX_UID).pw_name
-        except KeyError:
-            name = "unnamed"
-        return LayerReport(
-            self.name, True, f"root drops to uid {SANDBOX_UID} ({name}), no capabilities, no-new-privileges"
-        )
+        return report
+
+    def apply(self, spec: LaunchSpec) -> None:
+        """As root, `setpriv` drops to `SANDBOX_UID` just before the interpreter (inside bwrap, if any);
+        the bootstrap sets no-new-privileges for every child as its first step."""
+        if running_as_root():
+            spec.wrappers.append(lambda _spec: drop_argv())

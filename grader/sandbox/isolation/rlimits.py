@@ -3,9 +3,14 @@
 from __future__ import annotations
 
 import resource
+from typing import TYPE_CHECKING
 
-from grader.sandbox.isolation.layer import LayerReport
+from grader.sandbox.isolation.layer import IsolationReport, LayerReport
+from grader.sandbox.isolation.privileges import running_as_root
 from grader.sandbox.limits import Limits
+
+if TYPE_CHECKING:
+    from grader.sandbox.isolation.launch import LaunchSpec
 
 CPU_GRACE_SECONDS = 5
 """Between the soft CPU limit (SIGXCPU) and the hard one (SIGKILL)."""
@@ -41,7 +46,7 @@ class RlimitsLayer:
 
     name = "rlimits"
 
-    def probe(self) -> LayerReport:
+    def probe(self, outer: IsolationReport) -> LayerReport:
         """Checks that the resource module offers every limit used."""
         table = rlimit_table(Limits(), dropped_uid=True, own_user_namespace=False)
         missing = [name for name, _, _ in table if not hasattr(resource, name)]
@@ -53,3 +58,13 @@ class RlimitsLayer:
                 "grade on Linux, where every limit exists",
             )
         return LayerReport(self.name, True, "CPU time, address space, file size, open files, no core dumps")
+
+    def apply(self, spec: LaunchSpec) -> None:
+        """Asks the bootstrap to set the limits; RLIMIT_NPROC depends on the uid and user namespace the
+        privileges and bubblewrap layers give the child."""
+        root = running_as_root()
+        spec.bootstrap.rlimits = rlimit_table(
+            spec.limits,
+            dropped_uid=root and spec.isolation.is_active("privileges"),
+            own_user_namespace=spec.isolation.is_active("bubblewrap") and not root,
+        )

@@ -3,17 +3,22 @@
 from __future__ import annotations
 
 import errno
+import functools
 import importlib
 import os
 import sys
 from types import ModuleType
+from typing import TYPE_CHECKING
 
-from grader.sandbox.isolation.layer import LayerReport
+from grader.sandbox.isolation.layer import IsolationReport, LayerReport
+
+if TYPE_CHECKING:
+    from grader.sandbox.isolation.launch import LaunchSpec
 
 DEBIAN_BINDINGS = "/usr/lib/python3/dist-packages"
 _REMEDY = (
-    "install the seccomp bindings: `apt-get install python3-seccomp` (Debian/Ubuntu) "
-    "or `pip install pyseccomp`"
+    "install the seccomp bindings: "
+    "`apt-get install python3-seccomp` (Debian/Ubuntu) or `pip install pyseccomp`"
 )
 
 AF_UNIX = 1
@@ -114,22 +119,34 @@ def compile_filter() -> int:
     return descriptor
 
 
+@functools.cache
+def _probe_machine() -> LayerReport:
+    """Compiles the filter once to see that the bindings work."""
+    try:
+        os.close(compile_filter())
+    except OSError as error:
+        return LayerReport(
+            SeccompLayer.name, False, f"cannot build the syscall filter ({error.strerror})", _REMEDY
+        )
+    return LayerReport(
+        SeccompLayer.name,
+        True,
+        f"{len(DENIED_SYSCALLS)} syscalls denied (ptrace, mount, namespaces, bpf, keyctl, ...), sockets limited to AF_UNIX",  # noqa: E501
+    )
+
+
 class SeccompLayer:
-    """A syscall filter installed by bubblewrap (`--seccomp FD`) before the child starts."""
+    """A syscall filter installed before any student code runs: by bubblewrap (`--seccomp FD`) before
+    the child starts, else by the child's bootstrap."""
 
     name = "seccomp"
 
-    def probe(self) -> LayerReport:
-        """Compiles the filter once to see that the bindings work."""
-        try:
-            os.close(compile_filter())
-        except OSError as error:
-            return LayerReport(
-                self.name, False, f"cannot build the syscall filter ({error.strerror})", _REMEDY
-            )
-        return LayerReport(
-            self.name,
-            True,
-            f"{len(DENIED_SYSCALLS)} syscalls denied (ptrace, mount, namespaces, bpf, keyctl, ...), "
-            "sockets limited to AF_UNIX",
-        )
+    def probe(self, outer: IsolationReport) -> LayerReport:
+        """Whether the filter can be built here (checked once per process)."""
+        return _probe_machine()
+
+    def apply(self, spec: LaunchSpec) -> None:
+        """Compiles the filter into a descriptor the child inherits and asks the bootstrap to install it."""
+        descriptor = compile_filter()
+        spec.launch.pass_fds.append(descriptor)
+        spec.bootstrap.seccomp_fd = descriptor

@@ -6,8 +6,8 @@ from typing import Any
 
 from grader.checks import CHECKS
 from grader.checks.base import CallRecord, ProblemId, Verdict
-from grader.checks.simulation import StudentFunction, function_infos, simulate_calls
 from grader.config import ProblemConfig, load_config
+from grader.testing.simulation import StudentFunction, function_infos, simulate_calls
 
 # Samples smaller than the assignment's so the suite stays fast; every threshold is derived from them.
 TEST_SIZES: dict[ProblemId, dict[str, Any]] = {

@@ -103,7 +103,7 @@ def test_fixed_threshold_student_is_told_to_use_n(seed: int) -> None:
 
 
 def test_too_few_games_fail_with_the_lab_number(seed: int) -> None:
-    from grader.checks.behaviours import blackjack
+    from grader.testing.behaviours import blackjack
 
     settings = small_config("blackjack")
     verdict = grade("blackjack", {"blackjack": lambda lab, n: blackjack(lab, n, games=100)}, seed, settings)
@@ -114,7 +114,7 @@ def test_too_few_games_fail_with_the_lab_number(seed: int) -> None:
 
 
 def test_measurements_hold_both_curves(seed: int) -> None:
-    from grader.checks.behaviours import REFERENCE
+    from grader.testing.behaviours import REFERENCE
 
     verdict = grade("blackjack", REFERENCE["blackjack"], seed)
     assert verdict.status == "passed"
@@ -124,7 +124,7 @@ def test_measurements_hold_both_curves(seed: int) -> None:
 
 
 def test_a_failing_student_still_gets_the_whole_curve(seed: int) -> None:
-    from grader.checks.behaviours import MISTAKES
+    from grader.testing.behaviours import MISTAKES
 
     (less_than,) = [mistake for mistake in MISTAKES if mistake.name == "blackjack_less_than"]
     verdict = grade("blackjack", less_than.functions, seed)

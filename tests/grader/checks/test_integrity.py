@@ -7,11 +7,11 @@ import pytest
 
 from grader.checks import CHECKS
 from grader.checks.base import CallRecord
-from grader.checks.behaviours import cartpole, velocity_policy
 from grader.checks.integrity import games_budget, integrity_problem, played_episodes, replay_call, settled_by
 from grader.games import allowed_games
 from grader.sandbox.outcome import CallBudget
 from grader.sandbox.replay import replay_episode
+from grader.testing.behaviours import cartpole, velocity_policy
 
 from .support import grade, simulate, small_config
 
@@ -126,7 +126,9 @@ def _honest_reset_patterns():  # type: ignore[no-untyped-def]
 @pytest.mark.parametrize("pattern", list(_honest_reset_patterns()))
 def test_the_lab_s_unplayed_resets_are_tolerated(pattern: str, seed: int) -> None:
     function = _honest_reset_patterns()[pattern]
-    verdict = grade("cartpole", {"cartpole": function}, seed, small_config("cartpole", calls=5))
+    # Only the integrity rules are under test: the step bars are lowered so 5 runs never miss them by chance.
+    settings = small_config("cartpole", calls=5, min_mean_steps=100.0, min_steps=50)
+    verdict = grade("cartpole", {"cartpole": function}, seed, settings)
     assert verdict.status == "passed", verdict.feedback
 
 

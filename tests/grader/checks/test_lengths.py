@@ -5,7 +5,7 @@ False-fail probability of the passing tests: see bench/RESULTS.md (## Calibratio
 
 from functools import partial
 
-from grader.checks.behaviours import _episode_length, _random_step_first, car_policy
+from grader.testing.behaviours import _episode_length, _random_step_first, car_policy
 
 from .support import grade, small_config
 

@@ -7,7 +7,7 @@ tests (random_blackjack 3e-6, blackjack 4e-6, taxi 3e-6; cartpole/car: see bench
 import pytest
 
 from grader.checks.base import ProblemId
-from grader.checks.behaviours import MISTAKES, REFERENCE, Behaviour
+from grader.testing.behaviours import MISTAKES, REFERENCE, Behaviour
 
 from .support import grade
 

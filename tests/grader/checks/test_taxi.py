@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from grader.checks import CHECKS
-from grader.checks.behaviours import taxi
 from grader.checks.taxi import takes_q_table
 from grader.sandbox.outcome import FunctionInfo, ParameterInfo
+from grader.testing.behaviours import taxi
 from reference.oracles import optimal_q_table
 
 from .support import grade, small_config

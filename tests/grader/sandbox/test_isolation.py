@@ -24,7 +24,7 @@ from grader.sandbox import (
     Sandbox,
     probe_isolation,
 )
-from grader.sandbox.isolation import landlock
+from grader.sandbox.isolation import landlock_syscalls
 from grader.sandbox.isolation.cgroup import create_job_cgroup
 from grader.sandbox.isolation.filesystem import TREE_PREFIX, harness_tree, python_paths, remove_stale_trees
 from grader.sandbox.isolation.privileges import SANDBOX_UID, running_as_root
@@ -166,7 +166,7 @@ def test_each_fallback_still_runs_times_out_and_states_what_is_missing(
     hidden = "bubblewrap" not in disabled or report.is_active("landlock")
     assert (seen.value["reference"] != 0) == hidden
     assert (seen.value["inet"] == errno.EAFNOSUPPORT) == ("seccomp" not in disabled)
-    landlock_tcp = report.is_active("landlock") and landlock.abi_version() >= 4
+    landlock_tcp = report.is_active("landlock") and landlock_syscalls.abi_version() >= 4
     network_closed = not {"bubblewrap", "seccomp"} <= set(disabled) or landlock_tcp
     assert (seen.value["connect"] != 0) == network_closed, "only rlimits-only fallbacks reach the network"
     assert seen.value["write_scratch"] == 0
@@ -301,7 +301,7 @@ def test_the_harness_tree_holds_only_the_harness_and_the_compat_layer() -> None:
     files = {path.relative_to(tree).as_posix() for path in tree.rglob("*") if path.is_file()}
     assert {
         "bootstrap.py",
-        "landlock.py",
+        "landlock_syscalls.py",
         "lib/grader/__init__.py",
         "lib/grader/sandbox/__init__.py",
     } <= files

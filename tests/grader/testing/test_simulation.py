@@ -2,10 +2,10 @@
 
 import pytest
 
-from grader.checks.behaviours import REFERENCE, cartpole
-from grader.checks.simulation import function_infos, simulate_call, simulate_calls
 from grader.sandbox.outcome import Call, OutcomeStatus
 from grader.sandbox.replay import verify_reset_seeds
+from grader.testing.behaviours import REFERENCE, cartpole
+from grader.testing.simulation import function_infos, simulate_call, simulate_calls
 
 
 def test_function_infos_hide_the_lab_parameter() -> None:

@@ -1,6 +1,6 @@
 """Simulated students: the reference's policies and the typical mistakes, for calibration and tests.
 
-Each behaviour maps function names to functions run by `grader.checks.simulation` (first argument:
+Each behaviour maps function names to functions run by `grader.testing.simulation` (first argument:
 the simulated `Lab`). `BEHAVIOURS` names every behaviour with the problem it is about and the status the
 checks must give it; `submissions/mistakes/` holds the same mistakes as real student files.
 """
@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from grader.checks.base import ProblemId, Status
-from grader.checks.simulation import Lab, LabEnv, StudentFunction
+from grader.testing.simulation import Lab, LabEnv, StudentFunction
 
 BLACKJACK_GAMES = 10_000
 TAXI_EPISODES = 10_000
