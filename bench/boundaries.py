@@ -161,36 +161,10 @@ def measure(mode: str, path: Path, budget: tuple[int, int], repetitions: int) ->
 
 def structure_only(paths: dict[str, Path], repetitions: int) -> list[str]:
     """Validating the episodes' structure (no array decoded): pydantic `WireEpisode` against msgspec."""
-    try:
-        import msgspec
-    except ImportError:
+    if msgspec is None:
         return ["(msgspec is not installed: `pip install msgspec` to compare it)"]
     from grader.sandbox.child.frames import parse_payload, paused_gc
     from grader.sandbox.episode_log import _EPISODES
-
-    class Spec(msgspec.Struct, forbid_unknown_fields=True):
-        dtype: str
-        shape: list[int]
-        data: str
-
-    class Tagged(msgspec.Struct, forbid_unknown_fields=True):
-        spec: Spec = msgspec.field(name="$ndarray")
-
-    class NonFinite(msgspec.Struct, forbid_unknown_fields=True):
-        tag: str = msgspec.field(name="$float")
-
-    class Episode(msgspec.Struct, forbid_unknown_fields=True):
-        env_index: int
-        requested_id: str
-        env_id: str
-        env_kwargs: dict[str, Any]
-        reset_seed: int
-        student_seed: int | None
-        reset_options: dict[str, Any] | None
-        actions: list[Any] | Tagged
-        rewards: list[float | NonFinite] | Tagged
-        terminated: list[bool] | Tagged
-        truncated: list[bool] | Tagged
 
     def best(function: Any, data: Any) -> float:
         times = []
@@ -205,9 +179,44 @@ def structure_only(paths: dict[str, Path], repetitions: int) -> list[str]:
     for name, path in paths.items():
         episodes = parse_payload(path.read_bytes())["episodes"]
         pydantic_seconds = best(_EPISODES.validate_python, episodes)
-        msgspec_seconds = best(lambda data: msgspec.convert(data, list[Episode], strict=True), episodes)
+        msgspec_seconds = best(
+            lambda data: msgspec.convert(data, list[MsgspecEpisode], strict=True), episodes
+        )
         lines.append(f"| {name} | {pydantic_seconds * 1e3:.1f} ms | {msgspec_seconds * 1e3:.1f} ms |")
     return lines
+
+
+try:
+    import msgspec
+except ImportError:  # the comparison is optional; msgspec is not a dependency
+    msgspec = None
+else:
+
+    class MsgspecArraySpec(msgspec.Struct, forbid_unknown_fields=True):
+        dtype: str
+        shape: list[int]
+        data: str
+
+    class MsgspecTaggedArray(msgspec.Struct, forbid_unknown_fields=True):
+        spec: MsgspecArraySpec = msgspec.field(name="$ndarray")
+
+    class MsgspecNonFinite(msgspec.Struct, forbid_unknown_fields=True):
+        tag: str = msgspec.field(name="$float")
+
+    class MsgspecEpisode(msgspec.Struct, forbid_unknown_fields=True):
+        """`WireEpisode` as msgspec Structs (the same structure, without the bounds and cleaning)."""
+
+        env_index: int
+        requested_id: str
+        env_id: str
+        env_kwargs: dict[str, Any]
+        reset_seed: int
+        student_seed: int | None
+        reset_options: dict[str, Any] | None
+        actions: list[Any] | MsgspecTaggedArray
+        rewards: list[float | MsgspecNonFinite] | MsgspecTaggedArray
+        terminated: list[bool] | MsgspecTaggedArray
+        truncated: list[bool] | MsgspecTaggedArray
 
 
 def main() -> None:
@@ -217,6 +226,7 @@ def main() -> None:
     parser.add_argument("--repetitions", type=int, default=5)
     parser.add_argument("--frames", type=Path, default=None)
     parser.add_argument("--measure", nargs=4, help=argparse.SUPPRESS)
+    parser.add_argument("--structure-only", action="store_true", help="only the pydantic/msgspec table")
     arguments = parser.parse_args()
     if arguments.measure:
         mode, path, budget, trace = arguments.measure
@@ -226,6 +236,9 @@ def main() -> None:
         directory = arguments.frames or Path(temporary)
         directory.mkdir(parents=True, exist_ok=True)
         paths = capture(directory)
+        if arguments.structure_only:
+            print("\n".join(structure_only(paths, arguments.repetitions)))
+            return
         print("| frame | size | episodes | old: time | old: peak | new: time | new: peak | new / old |")
         print("|---|---|---|---|---|---|---|---|")
         for name, path in paths.items():

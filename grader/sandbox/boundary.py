@@ -8,17 +8,39 @@ where, what was found).
 
 from __future__ import annotations
 
+import reprlib
 from collections.abc import Sequence
 from typing import Any, cast
 
 import numpy as np
-from pydantic import ConfigDict, GetPydanticSchema, ValidationError
-from pydantic_core import core_schema
+from pydantic import BeforeValidator, ConfigDict, GetPydanticSchema, ValidationError
+from pydantic_core import PydanticCustomError, core_schema
 
 STRICT = ConfigDict(strict=True, extra="forbid")
 """Exact JSON types (no bool where an int is expected, no str for a number) and no undeclared fields."""
 SHOWN_CHARS = 60
 """Characters of a refused value quoted in a message."""
+_REPR = reprlib.Repr()
+_REPR.maxstring = _REPR.maxother = SHOWN_CHARS  # a bounded repr, however large the refused value
+
+
+def at_most(limit: int) -> BeforeValidator:
+    """Refuse a list or dict of more than `limit` entries before any entry is validated.
+
+    Pydantic's `max_length` is checked after the entries, so a forged frame could make it validate
+    millions of them first. Use as `Annotated[list[X], at_most(100)]`.
+    """
+
+    def check(value: Any) -> Any:
+        if type(value) in (list, dict) and len(value) > limit:
+            raise PydanticCustomError(
+                "too_long",
+                "should hold at most {limit} entries, found {found}",
+                {"limit": limit, "found": len(value)},
+            )
+        return value
+
+    return BeforeValidator(check)
 
 
 def one_of(expected: str) -> GetPydanticSchema:
@@ -50,6 +72,8 @@ def problem(error: ValidationError, where: str, skip: int = 0) -> str:
         return f"{_place(where, parts[:-1])}: the field {parts[-1]!r} is missing"
     if first["type"] == "extra_forbidden":
         return f"{_place(where, parts[:-1])}: {parts[-1]!r} is not one of its fields"
+    if first["type"] == "too_long":
+        return f"{_place(where, parts)}: {first['msg']}"
     return f"{_place(where, parts)}: {_lowered(first['msg'])}, found {describe(first['input'])}"
 
 
@@ -57,7 +81,7 @@ def describe(value: Any) -> str:
     """A refused value in a few words: its type and the start of its repr (arrays by dtype and shape)."""
     if type(value) is np.ndarray:
         return f"an array of dtype {value.dtype} and shape {value.shape}"
-    return f"{type(value).__name__} {repr(value)[:SHOWN_CHARS]}"
+    return f"{type(value).__name__} {_REPR.repr(value)[:SHOWN_CHARS]}"
 
 
 def _place(where: str, parts: Sequence[int | str]) -> str:

@@ -14,7 +14,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, Field, TypeAdapter, ValidationError, field_validator
 
-from grader.sandbox.boundary import STRICT, problem
+from grader.sandbox.boundary import STRICT, at_most, problem
 from grader.sandbox.child.calls import MAX_COMPAT_EVENTS
 from grader.sandbox.child.importer import MAX_LISTED_NAMES, MAX_LISTED_PARAMETERS
 from grader.sandbox.outcome import CompatEventRecord, FunctionInfo, OutcomeStatus, ParameterInfo
@@ -52,7 +52,7 @@ class ParameterMessage(_Message):
 class FunctionMessage(_Message):
     """A top-level name of the submission: callable or not, and its parameters."""
 
-    parameters: Annotated[list[ParameterMessage], Field(max_length=MAX_LISTED_PARAMETERS)]
+    parameters: Annotated[list[ParameterMessage], at_most(MAX_LISTED_PARAMETERS)]
     is_callable: bool
 
 
@@ -60,7 +60,7 @@ class ReadyMessage(_Message):
     """The submission was imported; these are its top-level names."""
 
     type: Literal["ready"]
-    functions: Annotated[dict[str, FunctionMessage], Field(max_length=MAX_LISTED_NAMES)]
+    functions: Annotated[dict[str, FunctionMessage], at_most(MAX_LISTED_NAMES)]
 
     def function_table(self) -> dict[str, FunctionInfo]:
         """The names (cleaned) and their signatures as the runner exposes them."""
@@ -95,7 +95,7 @@ class ResultMessage(_Message):
     message: Text
     traceback: Text
     episodes: Any
-    compat_events: Annotated[list[CompatEventRecord], Field(max_length=MAX_COMPAT_EVENTS)]
+    compat_events: Annotated[list[CompatEventRecord], at_most(MAX_COMPAT_EVENTS)]
     wall_time: Annotated[float, Field(ge=0, lt=1e9)]
 
     @field_validator("compat_events")

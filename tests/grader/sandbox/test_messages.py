@@ -3,6 +3,7 @@ refused with a sentence saying where and what, strings are cleaned on the way in
 
 from __future__ import annotations
 
+import time
 from typing import Any, get_args
 
 import pytest
@@ -98,7 +99,7 @@ FORGED_FIRST = [
             **READY,
             "functions": {f"f{number}": {"parameters": [], "is_callable": True} for number in range(2001)},
         },
-        "the first frame: ready.functions: Dictionary should have at most",
+        "the first frame: ready.functions: should hold at most 500 entries, found 2001",
     ),
     (
         {"type": "import_error", "message": "x"},
@@ -169,10 +170,20 @@ FORGED_RESULT = [
     ),
     (
         {"compat_events": [{"kind": "k", "env_id": "e", "detail": "d"}] * (MAX_COMPAT_EVENTS + 1)},
-        "a result frame: compat_events: List should have at most 100 items",
+        "a result frame: compat_events: should hold at most 100 entries, found 101",
     ),
     ({"extra": 1}, "a result frame: 'extra' is not one of its fields"),
 ]
+
+
+def test_too_many_events_are_refused_before_any_is_validated() -> None:
+    events = [{"kind": "k", "env_id": "e", "detail": "d"}] * 1_000_000
+    started = time.perf_counter()
+
+    problem = result_message({**RESULT, "compat_events": events})
+
+    assert problem == "a result frame: compat_events: should hold at most 100 entries, found 1000000"
+    assert time.perf_counter() - started < 0.5
 
 
 @pytest.mark.parametrize(
