@@ -244,3 +244,15 @@ def test_logs_within_the_calls_budget_decode() -> None:
     data = encode_value([recorded(LONG).to_plain(), recorded().to_plain()])
 
     assert len(episodes_from_plain(data, CallBudget(max_episodes=2, max_steps=3 * LONG + 3))) == 2
+
+
+def test_a_bad_array_is_named_by_its_episode_and_column() -> None:
+    data = encode_value([recorded(LONG).to_plain() for _ in range(3)])
+    data[1]["truncated"]["$ndarray"]["data"] = "!" * len(data[1]["truncated"]["$ndarray"]["data"])
+
+    with pytest.raises(InvalidEpisodeLogError) as caught:
+        episodes_from_plain(data)
+
+    assert str(caught.value) == (
+        "the episode log (episode 1: truncated) is not plain data: array data is not valid base64"
+    )
