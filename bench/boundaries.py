@@ -10,10 +10,10 @@ the runner handles a result frame, with the call's budget:
     (`episode_log.episodes_from_plain`), both as of OLD_REVISION (read with `git show`);
   * new: `parse_payload`, `messages.result_message` and `episode_log.episodes_from_plain` (`WireEpisode`).
 
-Wall time is the least of `--repetitions` runs; peak memory is tracemalloc's peak of one more run
-(tracing slows parsing). With msgspec installed, the validation of the episodes' structure alone (no
-array decoding) is also timed with msgspec Structs against the pydantic model, the choice this bench
-informed. Captured frames are kept in `--frames DIR` (default: a temporary directory).
+Old and new alternate; wall time is the least of `--repetitions` runs; peak memory is tracemalloc's peak
+of one more run (tracing slows parsing). With msgspec installed, the validation of the episodes'
+structure alone (no array decoding) is also timed with msgspec Structs against the pydantic model, the
+choice this bench informed. Captured frames are kept in `--frames DIR` (default: a temporary directory).
 
     python bench/boundaries.py [--repetitions 5] [--frames /tmp/frames]
 """
@@ -139,23 +139,25 @@ def measure_once(mode: str, path: Path, budget: tuple[int, int], trace: bool) ->
     return {"seconds": seconds, "peak_mib": peak, "episodes": episodes}
 
 
-def measure(mode: str, path: Path, budget: tuple[int, int], repetitions: int) -> dict[str, Any]:
-    """The least seconds over fresh subprocesses (the load of other jobs only adds), and the traced peak of
-    one more."""
+def run(mode: str, path: Path, budget: tuple[int, int], trace: bool) -> dict[str, Any]:
+    """`measure_once` in a fresh subprocess."""
+    command = [sys.executable, __file__, "--measure", mode, str(path), json.dumps(budget)]
+    output = subprocess.run(
+        [*command, "trace" if trace else "time"], check=True, capture_output=True, text=True
+    ).stdout
+    return json.loads(output)  # type: ignore[no-any-return]
 
-    def run(trace: bool) -> dict[str, Any]:
-        command = [sys.executable, __file__, "--measure", mode, str(path), json.dumps(budget)]
-        output = subprocess.run(
-            [*command, "trace" if trace else "time"], check=True, capture_output=True, text=True
-        ).stdout
-        return json.loads(output)  # type: ignore[no-any-return]
 
-    runs = [run(trace=False) for _ in range(repetitions)]
-    traced = run(trace=True)
+def compare(path: Path, budget: tuple[int, int], repetitions: int) -> dict[str, dict[str, Any]]:
+    """Old and new alternated `repetitions` times (the least time of each: the machine's load only adds),
+    then the traced peak of one more run of each."""
+    times: dict[str, list[float]] = {"old": [], "new": []}
+    for _ in range(repetitions):
+        for mode, seconds in times.items():
+            seconds.append(run(mode, path, budget, trace=False)["seconds"])
     return {
-        "seconds": min(run["seconds"] for run in runs),
-        "peak_mib": traced["peak_mib"],
-        "episodes": traced["episodes"],
+        mode: {**run(mode, path, budget, trace=True), "seconds": min(seconds)}
+        for mode, seconds in times.items()
     }
 
 
@@ -243,8 +245,8 @@ def main() -> None:
         print("|---|---|---|---|---|---|---|---|")
         for name, path in paths.items():
             budget = budget_of(name)
-            old = measure("old", path, budget, arguments.repetitions)
-            new = measure("new", path, budget, arguments.repetitions)
+            result = compare(path, budget, arguments.repetitions)
+            old, new = result["old"], result["new"]
             print(
                 f"| {name} | {path.stat().st_size / 1e6:.2f} MB | {new['episodes']:,} | "
                 f"{old['seconds'] * 1e3:.1f} ms | {old['peak_mib']:.0f} MiB | "

@@ -26,6 +26,8 @@ from grader.sandbox.text import clean_plain, clean_text
 
 MAX_ID_LENGTH = 200
 MAX_SEED = 2**64
+ARRAY_BATCH = 256
+"""Array columns decoded by one `decode_value` call."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -197,7 +199,7 @@ def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[Epi
             raise InvalidEpisodeLogError(_problem(error)) from None
         if budget is not None:
             _check_steps(episodes, budget)
-        arrays = iter(_decoded_arrays(episodes))
+        arrays = _decoded_arrays(episodes)
         return [_episode(episode, f"episode {number}", arrays) for number, episode in enumerate(episodes)]
 
 
@@ -228,21 +230,25 @@ def _length(column: list[Any] | PlainList | TaggedArray) -> int:
     return shape[0] if shape else 0
 
 
-def _decoded_arrays(episodes: list[WireEpisode]) -> list[np.ndarray]:
-    """Every array column of the log, decoded in one pass (one decoder, not one per column), episode by
-    episode in `EPISODE_COLUMNS` order: the order `_episode` takes them in."""
+def _decoded_arrays(episodes: list[WireEpisode]) -> Iterator[np.ndarray]:
+    """Every array column of the log, episode by episode in `EPISODE_COLUMNS` order (the order `_episode`
+    takes them in), decoded `ARRAY_BATCH` at a time: one decoder per batch, not one per column, and only a
+    batch of arrays alive at once."""
     columns = [
         (number, name, column["spec"])
         for number, episode in enumerate(episodes)
         for name in EPISODE_COLUMNS
         if isinstance(column := episode[name], dict)  # type: ignore[literal-required]
     ]
-    try:
-        return decode_value([{NDARRAY_TAG: spec} for _, _, spec in columns], "the episode log")  # type: ignore[no-any-return]
-    except InvalidValueError:
-        for number, name, spec in columns:  # the first bad one again, for a message that names it
-            _decoded({NDARRAY_TAG: spec}, f"episode {number}: {name}")
-        raise
+    for start in range(0, len(columns), ARRAY_BATCH):
+        batch = columns[start : start + ARRAY_BATCH]
+        try:
+            arrays: list[np.ndarray] = decode_value([{NDARRAY_TAG: spec} for _, _, spec in batch], "the log")
+        except InvalidValueError:
+            for number, name, spec in batch:  # the first bad one again, for a message that names it
+                _decoded({NDARRAY_TAG: spec}, f"episode {number}: {name}")
+            raise
+        yield from arrays
 
 
 def _episode(episode: WireEpisode, where: str, arrays: Iterator[np.ndarray]) -> EpisodeLog:
