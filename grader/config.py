@@ -157,6 +157,24 @@ class FindQvaluesConfig(ProblemConfig):
     env_id: str = Field(description="The environment id find_qvalues is called with (the lab's Taxi-v3).")
 
 
+class GuessingGameConfig(PlayedProblemConfig):
+    """Optional problem: `guessing_game()`, the lab's midpoint search; off unless a config enables it."""
+
+    kind: Literal["guessing_game"] = "guessing_game"
+    title: str = Field(default="Optional: GuessingGame", description="Heading shown in the report.")
+    points: float = Field(default=1.0, ge=0.0, description="Points the problem is worth when enabled.")
+    enabled: bool = Field(default=False, description="Off by default: true grades guessing_game().")
+    call_seconds: float = Field(default=30.0, gt=0.0, description="Wall-clock limit of ONE call.")
+    expected_seconds: float = Field(default=3.0, ge=0.0, description="Typical total time of the calls.")
+    calls: int = Field(
+        default=100, ge=1, le=1_000, description="How many times guessing_game() is called (one game each)."
+    )
+    count_alpha: Probability = Field(
+        default=1e-6,
+        description="False-fail probability of the exact two-sided test of the total number of guesses against the exact distribution of the midpoint search's guess count.",  # noqa: E501
+    )
+
+
 _PROBLEM_CLASSES: dict[ProblemId, type[ProblemConfig]] = {
     "random_blackjack": RandomBlackjackConfig,
     "blackjack": BlackjackConfig,
@@ -164,6 +182,7 @@ _PROBLEM_CLASSES: dict[ProblemId, type[ProblemConfig]] = {
     "car": CarConfig,
     "taxi": TaxiConfig,
     "find_qvalues": FindQvaluesConfig,
+    "guessing_game": GuessingGameConfig,
 }
 
 
@@ -198,6 +217,10 @@ class ProblemTable(_Strict):
     car: CarConfig = Field(description="Problem 4: car().")
     taxi: TaxiConfig = Field(description="Problem 5: taxi() or taxi(q_table).")
     find_qvalues: FindQvaluesConfig = Field(description="The lab-provided find_qvalues(env).")
+    guessing_game: GuessingGameConfig = Field(
+        default_factory=GuessingGameConfig,
+        description="Optional: guessing_game() (absent = disabled).",
+    )
 
 
 class AssignmentFile(_Strict):
@@ -211,7 +234,7 @@ class AssignmentConfig(_Strict):
     """The whole assignment: one entry per problem plus the sandbox limits."""
 
     problems: dict[ProblemId, ProblemConfig] = Field(
-        description="Every problem id (random_blackjack, blackjack, cartpole, car, taxi, find_qvalues)."
+        description="Every problem id (random_blackjack, blackjack, cartpole, car, taxi, find_qvalues, guessing_game)."  # noqa: E501
     )
     sandbox: SandboxConfig = Field(description="Resource limits of the sandbox.")
 

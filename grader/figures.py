@@ -218,11 +218,33 @@ def plot_taxi(result: ProblemResult, config: AssignmentConfig) -> tuple[str, str
     return "Taxi average returns", caption, figure
 
 
+def plot_guess_counts(result: ProblemResult, config: AssignmentConfig) -> tuple[str, str, PlotFigure] | None:
+    """The student's guesses per game against the exact distribution of the midpoint search's."""
+    from reference.oracles.guessing_game import midpoint_guess_counts
+
+    counts = [int(count) for count in _numbers(result.measurements.get("lengths"))]
+    if not counts:
+        return None
+    oracle = midpoint_guess_counts()
+    most = max(oracle.most, *counts)
+    guesses = np.arange(1, most + 1)
+    figure, axes = _new_plot()
+    axes.bar(guesses, [counts.count(int(k)) for k in guesses], color=STUDENT_COLOUR, alpha=0.7,
+             label="your games")  # fmt: skip
+    axes.plot(guesses, [len(counts) * oracle.probability(int(k)) for k in guesses], "o", color=EXACT_COLOUR,
+              label="midpoint search (exact expectation)")  # fmt: skip
+    axes.set(xlabel="guesses in the game", ylabel="games")
+    axes.legend(loc="upper left", fontsize=8)
+    caption = f"guessing_game(): how many guesses each of your {len(counts)} replayed games took (bars), against the number of games the midpoint search is expected to finish in each count (exact, {oracle.mean:.3f} guesses on average)."  # noqa: E501
+    return "GuessingGame guesses per game", caption, figure
+
+
 PLOTTERS: dict[str, Callable[[ProblemResult, AssignmentConfig], tuple[str, str, PlotFigure] | None]] = {
     "blackjack": plot_blackjack,
     "cartpole": plot_lengths,
     "car": plot_lengths,
     "taxi": plot_taxi,
+    "guessing_game": plot_guess_counts,
 }
 """The problems with a plot, and how each is drawn (the replays are chosen in grader.showcase)."""
 

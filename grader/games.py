@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import gymnasium
 from gymnasium.envs.registration import load_env_creator
 
+from grader.compat import register_envs
 from grader.problems import ProblemId
 
 if TYPE_CHECKING:
@@ -93,6 +94,7 @@ TAXI = Game(
     {"is_rainy": False, "fickle_passenger": False},
     description="Taxi-v3",
 )
+GUESSING_GAME = Game("GuessingGame-v0", ("GuessingGame-v0",), description="GuessingGame-v0")
 
 ACCEPTED_GAMES: Mapping[ProblemId, tuple[Game, ...]] = {
     "random_blackjack": (BLACKJACK_V0, BLACKJACK_V1),
@@ -100,6 +102,7 @@ ACCEPTED_GAMES: Mapping[ProblemId, tuple[Game, ...]] = {
     "cartpole": (CARTPOLE_V0, CARTPOLE_V1),
     "car": (MOUNTAIN_CAR,),
     "taxi": (TAXI,),
+    "guessing_game": (GUESSING_GAME,),
 }
 """Every game each problem that plays episodes accepts by default; the first is the classic lab's."""
 
@@ -191,7 +194,11 @@ def allowed_games(problem: ProblemId, names: Sequence[str] | None = None) -> Gam
 
 @cache
 def default_kwargs(env_id: str) -> dict[str, Any]:
-    """The arguments an env gets when made without any: registered kwargs over constructor defaults."""
+    """The arguments an env gets when made without any: registered kwargs over constructor defaults.
+
+    The ids gymgrade registers itself (`GuessingGame-v0`, ...) are registered first.
+    """
+    register_envs()
     spec = gymnasium.spec(env_id)
     creator = load_env_creator(spec.entry_point) if isinstance(spec.entry_point, str) else spec.entry_point
     parameters = inspect.signature(creator).parameters.values() if creator is not None else []

@@ -1,8 +1,10 @@
-"""The problem identifiers of the lab, in the order the lab poses them."""
+"""The problem identifiers of the lab, in the order the lab poses them, then the optional ones."""
 
 from typing import Literal
 
-ProblemId = Literal["random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues"]
+ProblemId = Literal[
+    "random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues", "guessing_game"
+]
 
 PROBLEM_IDS: tuple[ProblemId, ...] = (
     "random_blackjack",
@@ -11,4 +13,5 @@ PROBLEM_IDS: tuple[ProblemId, ...] = (
     "car",
     "taxi",
     "find_qvalues",
+    "guessing_game",
 )

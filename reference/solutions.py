@@ -3,7 +3,8 @@
 The lab's environment ids map to gymnasium as follows (see ARCHITECTURE.md):
 `Blackjack-v0` is `gym.make("Blackjack-v1", natural=False, sab=False)` (the registered default
 `sab=True` is a different game), `Taxi-v3` is `Taxi-v4`; `CartPole-v0` and `MountainCar-v0` are unchanged
-(both with a 200-step time limit).
+(both with a 200-step time limit). `GuessingGame-v0` is no longer part of gym or gymnasium: `guessing_game`
+needs it registered (gymgrade's `grader.compat.register_envs()` does, as `import gym_toytext` did).
 
 Win rates are returned as fractions in [0, 1], not percentages. Every function accepts an optional
 keyword `seed`; without it the run draws fresh randomness, exactly like the lab's plain calls.
@@ -28,6 +29,9 @@ BLACKJACK_KWARGS = {"natural": False, "sab": False}
 CARTPOLE_ID = "CartPole-v0"
 MOUNTAIN_CAR_ID = "MountainCar-v0"
 TAXI_ID = "Taxi-v4"
+GUESSING_GAME_ID = "GuessingGame-v0"
+GUESS_TOO_LOW = 1
+"""GuessingGame-v0's observation after a guess below the target (2: equal, 3: above)."""
 
 BLACKJACK_GAMES = 10_000
 TRAINING_EPISODES = 100_000
@@ -108,6 +112,35 @@ def car(*, seed: int | None = None) -> int:
     with gym.make(MOUNTAIN_CAR_ID) as env:
         steps = _episode_length(env, mountain_car_policy, seed)
     return steps
+
+
+def guessing_game(*, seed: int | None = None) -> int:
+    """Optional problem: find GuessingGame-v0's target by always guessing the midpoint of its interval.
+
+    The target lies in [-1000, 1000]; each observation says on which side of the guess it lies, so the
+    interval halves with every guess until a guess is within 10 of the target (at most 8 guesses; 5.81 on
+    average, `reference.oracles.guessing_game`).
+
+    Args:
+        seed: seeds the target.
+
+    Returns:
+        The number of guesses made, the winning one included.
+    """
+    low, high = -1000.0, 1000.0
+    with gym.make(GUESSING_GAME_ID) as env:
+        env.reset(seed=seed)
+        guesses = 0
+        terminated = truncated = False
+        while not (terminated or truncated):
+            guess = (low + high) / 2
+            observation, _, terminated, truncated, _ = env.step(np.array([guess]))
+            guesses += 1
+            if observation == GUESS_TOO_LOW:
+                low = guess
+            else:
+                high = guess
+    return guesses
 
 
 def find_qvalues(

@@ -7,6 +7,7 @@ from grader.checks.blackjack import BlackjackCheck
 from grader.checks.car import CarCheck
 from grader.checks.cartpole import CartpoleCheck
 from grader.checks.find_qvalues import FindQvaluesCheck
+from grader.checks.guessing_game import GuessingGameCheck
 from grader.checks.random_blackjack import RandomBlackjackCheck
 from grader.checks.taxi import TaxiCheck
 
@@ -19,6 +20,7 @@ CHECKS: Mapping[ProblemId, ProblemCheck] = {
         CarCheck(),
         TaxiCheck(),
         FindQvaluesCheck(),
+        GuessingGameCheck(),
     )
 }
 

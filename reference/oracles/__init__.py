@@ -6,6 +6,7 @@ from reference.oracles.blackjack import (
     random_policy_outcome,
     threshold_policy_outcome,
 )
+from reference.oracles.guessing_game import GuessCounts, midpoint_guess_counts
 from reference.oracles.taxi import (
     ReturnMoments,
     greedy_policy_return,
@@ -15,10 +16,12 @@ from reference.oracles.taxi import (
 )
 
 __all__ = [
+    "GuessCounts",
     "Outcome",
     "ReturnMoments",
     "evaluate_policy",
     "greedy_policy_return",
+    "midpoint_guess_counts",
     "optimal_q_table",
     "optimal_return",
     "random_policy_outcome",

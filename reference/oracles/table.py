@@ -10,6 +10,7 @@ from reference.oracles.blackjack import (
     random_policy_outcome,
     threshold_policy_outcome,
 )
+from reference.oracles.guessing_game import GuessCounts, midpoint_guess_counts
 from reference.oracles.taxi import (
     TIME_LIMIT,
     ReturnMoments,
@@ -25,7 +26,7 @@ TIE_TOLERANCE = 1e-12
 
 @dataclass(frozen=True)
 class OracleTable:
-    """Exact expectations for the lab's Blackjack and Taxi problems.
+    """Exact expectations for the lab's Blackjack and Taxi problems and the optional GuessingGame.
 
     Attributes:
         blackjack_random: outcome of the random player (Problem 1).
@@ -36,6 +37,7 @@ class OracleTable:
         taxi_optimal: best achievable return within the time limit.
         taxi_gamma: discount factor of `taxi_greedy_optimal_q`.
         taxi_greedy_optimal_q: return of acting greedily on the optimal Q-table for `taxi_gamma`.
+        guessing_game_midpoint: guesses per game of the midpoint search from [-1000, 1000].
     """
 
     blackjack_random: Outcome
@@ -46,6 +48,7 @@ class OracleTable:
     taxi_optimal: ReturnMoments
     taxi_gamma: float
     taxi_greedy_optimal_q: ReturnMoments
+    guessing_game_midpoint: GuessCounts
 
 
 def build_oracle_table(*, gamma: float = 0.6, max_steps: int = TIME_LIMIT) -> OracleTable:
@@ -71,6 +74,7 @@ def build_oracle_table(*, gamma: float = 0.6, max_steps: int = TIME_LIMIT) -> Or
         taxi_optimal=optimal_return(max_steps),
         taxi_gamma=gamma,
         taxi_greedy_optimal_q=greedy_policy_return(optimal_q_table(gamma), max_steps),
+        guessing_game_midpoint=midpoint_guess_counts(),
     )
 
 
@@ -99,12 +103,20 @@ def table_as_json_data(table: OracleTable) -> dict[str, object]:
             "optimal_policy": moments(table.taxi_optimal),
             "greedy_optimal_q": {"gamma": table.taxi_gamma, **moments(table.taxi_greedy_optimal_q)},
         },
+        "guessing_game": {
+            "game": "GuessingGame-v0 (registered by gymgrade), midpoint search from [-1000, 1000]",
+            "guess_count_probabilities": {
+                str(count): p for count, p in enumerate(table.guessing_game_midpoint.probabilities, 1)
+            },
+            "mean": table.guessing_game_midpoint.mean,
+            "std": table.guessing_game_midpoint.variance**0.5,
+        },
     }
 
 
 def format_oracle_table(table: OracleTable) -> str:
     """The table as aligned plain text for a terminal or a Markdown code block."""
-    random_outcome = table.blackjack_random
+    random_outcome, guesses = table.blackjack_random, table.guessing_game_midpoint
     lines = [
         "Blackjack (Blackjack-v1, natural=False, sab=False): exact probabilities per game",
         f"  random policy: win {random_outcome.win:.4f}  draw {random_outcome.draw:.4f}  "
@@ -122,5 +134,8 @@ def format_oracle_table(table: OracleTable) -> str:
         f"  optimal policy:           {table.taxi_optimal.mean:9.4f} ({table.taxi_optimal.std:.4f})",
         f"  greedy on Q* (gamma={table.taxi_gamma:g}): {table.taxi_greedy_optimal_q.mean:9.4f} "
         f"({table.taxi_greedy_optimal_q.std:.4f})",
+        "GuessingGame (GuessingGame-v0), midpoint search from [-1000, 1000]: guesses per game",
+        "  " + "  ".join(f"{k}: {p:.6g}" for k, p in enumerate(guesses.probabilities, 1)),
+        f"  mean {guesses.mean:.6f} (std {guesses.variance**0.5:.4f})",
     ]
     return "\n".join(lines)

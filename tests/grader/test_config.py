@@ -161,6 +161,7 @@ def test_visibility_defaults_to_visible_and_can_be_set_per_problem(tmp_path: Pat
         "car": "after_due_date",
         "taxi": "visible",
         "find_qvalues": "visible",
+        "guessing_game": "visible",
     }
 
 
@@ -222,3 +223,13 @@ def test_taxi_random_mean_tolerance() -> None:
     )  # type: ignore[attr-defined]
     assert tolerance.half_width < 5.0
     assert tolerance.pass_probability(moments.mean + 10.0) < 1e-6
+
+
+def test_the_optional_guessing_game_is_off_by_default_and_may_be_left_out(tmp_path: Path) -> None:
+    assert not load_config().problems["guessing_game"].enabled
+    table = BUNDLED[BUNDLED.index("[problems.guessing_game]") : BUNDLED.index("[sandbox]")]
+    config = load_config(_write(tmp_path, BUNDLED.replace(table, "")))
+    assert not config.problems["guessing_game"].enabled
+    assert config.problems["guessing_game"] == load_config().problems["guessing_game"]
+    enabled = load_config(_write(tmp_path, BUNDLED.replace("enabled = false", "enabled = true")))
+    assert enabled.problems["guessing_game"].enabled

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import shutil
 import warnings
 from collections.abc import Callable
@@ -123,3 +124,13 @@ def test_chromium_renders_every_figure_under_the_page_policy(report: Report, tmp
     assert decoded == [True] * 7
     assert styled == "832px"  # the page's own stylesheet applied: its CSP hash matches
     assert console == []
+
+
+def test_the_optional_guessing_game_gets_its_counts_plotted_against_the_exact_distribution() -> None:
+    result = ProblemResult(
+        id="guessing_game", title="Optional: GuessingGame", status="passed", score=1, max_score=1,
+        feedback="ok", measurements={"lengths": [6, 7, 7, 5, 4, 7, 6]},
+    )  # fmt: skip
+    [figure] = all_figures([result], load_config(None))["guessing_game"]
+    assert figure.mime == "image/png" and Image.open(io.BytesIO(figure.data)).size == (480, 256)
+    assert figure.caption.startswith("guessing_game(): how many guesses each of your 7 replayed games took")

@@ -33,6 +33,8 @@ def test_json_output(capsys: pytest.CaptureFixture[str]) -> None:
     assert data["taxi"]["random_policy"]["mean"] == pytest.approx(-771.09099945, abs=1e-6)
     assert data["taxi"]["optimal_policy"]["mean"] == pytest.approx(7.93, abs=1e-9)
     assert data["taxi"]["greedy_optimal_q"]["gamma"] == 0.6
+    assert data["guessing_game"]["guess_count_probabilities"]["8"] == pytest.approx(0.005625, abs=1e-15)
+    assert data["guessing_game"]["mean"] == pytest.approx(5.805625, abs=1e-12)
 
 
 def test_text_table_marks_the_best_threshold() -> None:
@@ -40,6 +42,7 @@ def test_text_table_marks_the_best_threshold() -> None:
     assert "    13  0.4180 0.0818 0.5003  -0.0823  <- best" in text.splitlines()
     assert text.count("<- best") == 1
     assert "  random policy:            -771.0910 (101.8264)" in text.splitlines()
+    assert "  mean 5.805625 (std 1.3263)" in text.splitlines()
 
 
 def test_json_data_is_plain() -> None:
