@@ -166,7 +166,7 @@ def structure_only(paths: dict[str, Path], repetitions: int) -> list[str]:
     if msgspec is None:
         return ["(msgspec is not installed: `pip install msgspec` to compare it)"]
     from grader.sandbox.child.frames import parse_payload, paused_gc
-    from grader.sandbox.episode_log import _EPISODES
+    from grader.sandbox.episode_log import WIRE_EPISODES
 
     def best(function: Any, data: Any) -> float:
         times = []
@@ -180,7 +180,7 @@ def structure_only(paths: dict[str, Path], repetitions: int) -> list[str]:
     lines = ["| frame | pydantic WireEpisode | msgspec Struct |", "|---|---|---|"]
     for name, path in paths.items():
         episodes = parse_payload(path.read_bytes())["episodes"]
-        pydantic_seconds = best(_EPISODES.validate_python, episodes)
+        pydantic_seconds = best(WIRE_EPISODES.validate_python, episodes)
         msgspec_seconds = best(
             lambda data: msgspec.convert(data, list[MsgspecEpisode], strict=True), episodes
         )

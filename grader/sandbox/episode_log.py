@@ -172,7 +172,10 @@ class WireEpisode(TypedDict):
     truncated: Flags
 
 
-_EPISODES: TypeAdapter[list[WireEpisode]] = TypeAdapter(Annotated[list[WireEpisode], Field(fail_fast=True)])
+WIRE_EPISODES: TypeAdapter[list[WireEpisode]] = TypeAdapter(
+    Annotated[list[WireEpisode], Field(fail_fast=True)]
+)
+"""Validates the `episodes` of a result frame, stopping at the first bad episode."""
 
 
 def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[EpisodeLog]:
@@ -194,7 +197,7 @@ def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[Epi
         )
     with paused_gc():
         try:
-            episodes = _EPISODES.validate_python(data)
+            episodes = WIRE_EPISODES.validate_python(data)
         except ValidationError as error:
             raise InvalidEpisodeLogError(_problem(error)) from None
         if budget is not None:
@@ -258,8 +261,7 @@ def _episode(episode: WireEpisode, where: str, arrays: Iterator[np.ndarray]) -> 
     truncated = _flags(episode["truncated"], arrays, f"{where}: truncated")
     if not len(actions) == len(rewards) == len(terminated) == len(truncated):
         raise InvalidEpisodeLogError(
-            f"{where}: actions, rewards, terminated and truncated must have one entry per step, found "
-            f"{len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"
+            f"{where}: actions, rewards, terminated and truncated must have one entry per step, found {len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"  # noqa: E501
         )
     reset_options = episode["reset_options"]
     return EpisodeLog(
