@@ -8,13 +8,13 @@ import sys
 from collections.abc import Callable, Sequence
 from importlib.metadata import entry_points
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError, UnknownProblem
 from grader.notebook import NotebookSummary
 from grader.problems import PROBLEMS
 from grader.progress import ProgressBar, result_line
-from grader.report import ProblemResult, Report
+from grader.report import IsolationSummary, ProblemResult, Report
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import SandboxError
 from grader.seeds import PRACTICE_SEED, held_out_seed
@@ -273,23 +273,21 @@ def notebook_lines(notebook: NotebookSummary) -> list[str]:
     return [*lines, ""]
 
 
-def isolation_lines(isolation: dict[str, Any]) -> list[str]:
+def isolation_lines(isolation: IsolationSummary | None) -> list[str]:
     """How the student's code was isolated: one line when fully, else each missing layer and its remedy."""
-    layers = isolation.get("layers")
-    if not isinstance(layers, list):
+    if isolation is None:
         return []
-    if isolation.get("full"):
-        names = ", ".join(str(layer["name"]) for layer in layers if layer.get("active"))
+    if isolation.full:
+        names = ", ".join(layer.name for layer in isolation.layers if layer.active)
         return [f"Sandbox: full isolation ({names})."]
     lines = [
         "Sandbox: weaker isolation on this machine (fine for checking your own code; instructors grade with full isolation). "  # noqa: E501
         "Missing:"
     ]
     lines += [
-        f"  - {layer['name']}: {layer['detail']}"
-        + (f" (to fix: {layer['remedy']})" if layer.get("remedy") else "")
-        for layer in layers
-        if layer.get("required") and not layer.get("active")
+        f"  - {layer.name}: {layer.detail}" + (f" (to fix: {layer.remedy})" if layer.remedy else "")
+        for layer in isolation.layers
+        if layer.required and not layer.active
     ]
     return lines
 

@@ -7,14 +7,20 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from pydantic import JsonValue
-
 from grader.checks.base import CallRecord, Verdict
 from grader.checks.integrity import replay_call, settled_by
 from grader.config import AssignmentConfig
 from grader.problem_registry import ProblemId
-from grader.report import ProblemResult, ProblemRun, Timings, cap_output, plain_json
-from grader.sandbox import CallOutcome, IsolationPolicy, IsolationReport, Sandbox
+from grader.report import (
+    IsolationSummary,
+    LayerSummary,
+    ProblemResult,
+    ProblemRun,
+    Timings,
+    cap_output,
+    plain_json,
+)
+from grader.sandbox import CallOutcome, CompatEventRecord, IsolationPolicy, IsolationReport, Sandbox
 from grader.showcase import showcase_episode
 
 MAX_COMPAT_EVENTS = 20
@@ -31,13 +37,22 @@ def problem_seed(grading_seed: int, problem: str) -> int:
     return int.from_bytes(digest[:8], "big") >> 1
 
 
-def isolation_summary(isolation: IsolationReport) -> dict[str, JsonValue]:
-    """The sandbox's isolation report as plain JSON data: ``full``, ``layers`` and a readable ``summary``."""
-    summary = plain_json(isolation.to_dict())
-    if not isinstance(summary, dict):
-        raise TypeError(f"IsolationReport.to_dict() must give a dict; found {type(summary).__name__}")
-    summary["summary"] = isolation.summary()
-    return summary
+def isolation_summary(isolation: IsolationReport) -> IsolationSummary:
+    """The sandbox's isolation report for the report: ``full``, ``layers`` and a readable ``summary``."""
+    return IsolationSummary(
+        full=isolation.full,
+        layers=[
+            LayerSummary(
+                name=layer.name,
+                active=layer.active,
+                required=layer.required,
+                detail=layer.detail,
+                remedy=layer.remedy,
+            )
+            for layer in isolation.layers
+        ],
+        summary=isolation.summary(),
+    )
 
 
 def run_problem(
@@ -128,10 +143,6 @@ def student_output(outcomes: Sequence[CallOutcome]) -> str:
     return "".join(outcome.stdout + outcome.stderr for outcome in outcomes)
 
 
-def _distinct_events(outcomes: Sequence[CallOutcome]) -> list[dict[str, str]]:
-    seen: dict[tuple[str, str, str], dict[str, str]] = {}
-    for outcome in outcomes:
-        for event in outcome.compat_events:
-            key = (event.get("kind", ""), event.get("env_id", ""), event.get("detail", ""))
-            seen.setdefault(key, dict(event))
-    return list(seen.values())[:MAX_COMPAT_EVENTS]
+def _distinct_events(outcomes: Sequence[CallOutcome]) -> list[CompatEventRecord]:
+    distinct = dict.fromkeys(event for outcome in outcomes for event in outcome.compat_events)
+    return list(distinct)[:MAX_COMPAT_EVENTS]

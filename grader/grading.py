@@ -254,7 +254,7 @@ def build_report(
         if run.internal_error is not None:
             errors.append(f"{problem}: {run.internal_error}")
         results.append(run.result)
-    isolation = next((run.isolation for run in runs if run.isolation), {})
+    isolation = next((run.isolation for run in runs if run.isolation), None)
     timings = [result.timings for result in results if result.timings is not None]
     check_seconds = sum(timing.wall_seconds for timing in timings)
     student_seconds = sum(timing.student_seconds for timing in timings)

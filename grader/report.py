@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, JsonValue
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, JsonValue, WrapSerializer
 
 from grader.notebook import NotebookSummary
+from grader.sandbox.outcome import CompatEventRecord
 from grader.sandbox.text import clean_plain
 
 Status = Literal["passed", "failed", "error", "timeout", "missing"]
@@ -53,6 +54,42 @@ class GradingTimings(BaseModel):
     )
 
 
+class LayerSummary(BaseModel):
+    """One layer of isolation and whether it protected the grading (`grader.sandbox.LayerReport`)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    name: str = Field(description="The layer: cgroup, bubblewrap, seccomp, privileges, rlimits, landlock.")
+    active: bool = Field(description="Whether it was applied.")
+    required: bool = Field(description="Whether full isolation needs it.")
+    detail: str = Field(description="What it enforced, or why it could not.")
+    remedy: str = Field(description="What would make it available; empty when nothing is needed.")
+
+
+class IsolationSummary(BaseModel):
+    """What the sandbox enforced for a grading (`grader.sandbox.IsolationReport`)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    full: bool = Field(description="Every required layer was active.")
+    layers: list[LayerSummary] = Field(description="Each layer, active or not.")
+    summary: str = Field(
+        description="One line per layer: `[x] name: detail` or `[ ] name: detail -- remedy`."
+    )
+
+
+def _none_when_empty(value: object) -> object:
+    return None if value == {} else value
+
+
+Isolation = Annotated[
+    IsolationSummary | None,
+    BeforeValidator(_none_when_empty),
+    WrapSerializer(lambda value, handler: {} if value is None else handler(value)),
+]
+"""An `IsolationSummary`, or None when no sandbox ran (the file was refused): `{}` in JSON, as always."""
+
+
 class EpisodeReplay(BaseModel):
     """Enough to re-render one episode the student played: the game, its reset seed and the actions."""
 
@@ -81,7 +118,7 @@ class ProblemResult(BaseModel):
         default_factory=dict, description="The numbers behind the verdict (deterministic for bytes + seed)."
     )
     output: str = Field(default="", description="The student's captured stdout/stderr, capped.")
-    compat_events: list[dict[str, str]] = Field(
+    compat_events: list[CompatEventRecord] = Field(
         default_factory=list,
         description="What the lab-compatibility layer had to tolerate (e.g. steps after the episode ended).",
     )
@@ -103,7 +140,7 @@ class ProblemRun(BaseModel):
 
     submission: str = Field(description="The submission path exactly as given to the plugin.")
     result: ProblemResult
-    isolation: dict[str, JsonValue] = Field(default_factory=dict, description="What the sandbox enforced.")
+    isolation: Isolation = Field(default=None, description="What the sandbox enforced.")
     internal_error: str | None = Field(
         default=None, description="'ExceptionType: message' when the grader itself failed on this problem."
     )
@@ -171,9 +208,7 @@ class Report(BaseModel):
     )
     gymnasium_version: str = Field(description="Gymnasium version the episodes were replayed with.")
     grader_version: str = Field(description="gymgrade version.")
-    isolation: dict[str, JsonValue] = Field(
-        default_factory=dict, description="What the sandbox could enforce for this grading."
-    )
+    isolation: Isolation = Field(default=None, description="What the sandbox could enforce for this grading.")
     score: float = Field(description="Points earned over all problems.")
     max_score: float = Field(description="Points available over all graded problems.")
     submission_error: str | None = Field(

@@ -1,45 +1,33 @@
-"""`EpisodeLog`: one episode as the student's code played it, decoded strictly from the result channel.
+"""`EpisodeLog`: one episode as the student's code played it, decoded by a declared model from the child.
 
-The child sends each episode in the layout of `grader.sandbox.child.recorder.EpisodeRecord.to_plain`
-(per-step columns as numpy arrays, or plain lists for short episodes). Nothing in a log is trusted:
-`grader.sandbox.replay` replays it.
+The child sends each episode in the layout `grader.sandbox.child.recorder` declares (`EPISODE_HEADER` and
+`EPISODE_COLUMNS`: per-step columns as numpy arrays, or plain lists for short episodes). `WireEpisode` is
+that layout on the parent's side (pydantic, strict, no other fields; a test holds it to the child's
+declaration). `episodes_from_plain` validates it, checks the call's budget from list lengths and array
+shapes, and only then decodes arrays. Nothing in a log is trusted: `grader.sandbox.replay` replays it.
 """
 
 from __future__ import annotations
 
-import math
+from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from pydantic import AfterValidator, Field, TypeAdapter, ValidationError, with_config
+from typing_extensions import TypedDict
 
+from grader.sandbox.boundary import STRICT, describe, one_of, problem
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
-from grader.sandbox.child.frames import MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
+from grader.sandbox.child.frames import MAX_DEPTH, MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
+from grader.sandbox.child.recorder import EPISODE_COLUMNS
 from grader.sandbox.outcome import CallBudget
 from grader.sandbox.text import clean_plain, clean_text
 
 MAX_ID_LENGTH = 200
 MAX_SEED = 2**64
-_LARGEST_INT = 2**MAX_INT_BITS
-_NUMBER_TYPES = frozenset({int, float})
-_INT_TYPE = frozenset({int})
-_BOOL_TYPE = frozenset({bool})
-_COLUMNS = ("actions", "rewards", "terminated", "truncated")
-_FIELDS = frozenset(
-    {
-        "env_index",
-        "requested_id",
-        "env_id",
-        "env_kwargs",
-        "reset_seed",
-        "student_seed",
-        "reset_options",
-        "actions",
-        "rewards",
-        "terminated",
-        "truncated",
-    }
-)
+ARRAY_BATCH = 256
+"""Array columns decoded by one `decode_value` call."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,6 +99,85 @@ def _same_action(mine: Any, theirs: Any) -> bool:
     return bool(type(mine) is type(theirs) and mine == theirs)
 
 
+@dataclass(frozen=True)
+class PlainList:
+    """A per-step column of plain values that are not all ints (a `Box` env's actions, say): it is decoded
+    as plain data (`decode_value`) only after the budget check."""
+
+    items: list[Any]
+
+
+class ArraySpec(TypedDict):
+    """The payload of a tagged numpy array: its data are decoded (and sized against the shape) later."""
+
+    dtype: str
+    shape: Annotated[list[Annotated[int, Field(ge=0, lt=2**62)]], Field(max_length=MAX_DEPTH)]
+    data: str
+
+
+class TaggedArray(TypedDict):
+    """`{"$ndarray": {...}}`, a column sent as one array (`grader.sandbox.child.frames`)."""
+
+    spec: Annotated[ArraySpec, Field(alias=NDARRAY_TAG)]
+
+
+TaggedFloat = TypedDict("TaggedFloat", {"$float": Literal["nan", "inf", "-inf"]})
+"""A non-finite reward in a list column (JSON has no NaN): `{"$float": "nan"}`."""
+
+Int = Annotated[int, Field(gt=-(2**MAX_INT_BITS), lt=2**MAX_INT_BITS)]
+Seed = Annotated[int, Field(ge=0, lt=MAX_SEED)]
+EnvId = Annotated[
+    str,
+    Field(min_length=1, max_length=MAX_ID_LENGTH),
+    AfterValidator(lambda text: clean_text(text, MAX_ID_LENGTH)),
+]
+Number = Annotated[
+    Annotated[float, Field(allow_inf_nan=False)]
+    | Annotated[TaggedFloat, AfterValidator(lambda tag: float(tag["$float"]))],
+    Field(union_mode="left_to_right"),
+]
+"""A reward in a list column, as a float: an int (converted exactly as `float()` does), a finite float, or
+a tagged non-finite one."""
+Actions = Annotated[
+    list[Int] | TaggedArray | Annotated[list[Any], AfterValidator(PlainList)],
+    Field(union_mode="left_to_right"),
+    one_of("should be a list of actions or an int array"),
+]
+Rewards = Annotated[
+    list[Number] | TaggedArray,
+    Field(union_mode="left_to_right"),
+    one_of("should be a list of numbers or a numeric array"),
+]
+Flags = Annotated[
+    list[bool] | TaggedArray,
+    Field(union_mode="left_to_right"),
+    one_of("should be a list of bools or a bool array"),
+]
+
+
+@with_config(STRICT)
+class WireEpisode(TypedDict):
+    """One episode as the child sends it (`EpisodeRecord.to_plain`), validated but not yet decoded."""
+
+    env_index: Annotated[int, Field(ge=0, lt=2**31)]
+    requested_id: EnvId
+    env_id: EnvId
+    env_kwargs: dict[str, Any]
+    reset_seed: Seed
+    student_seed: Seed | None
+    reset_options: dict[str, Any] | None
+    actions: Actions
+    rewards: Rewards
+    terminated: Flags
+    truncated: Flags
+
+
+WIRE_EPISODES: TypeAdapter[list[WireEpisode]] = TypeAdapter(
+    Annotated[list[WireEpisode], Field(fail_fast=True)]
+)
+"""Validates the `episodes` of a result frame, stopping at the first bad episode."""
+
+
 def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[EpisodeLog]:
     """Decode and validate the `episodes` field of a result frame (JSON data, as parsed).
 
@@ -124,65 +191,86 @@ def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[Epi
     Raises:
         InvalidEpisodeLogError: the data does not have the layout the child sends, or exceeds `budget`.
     """
-    if type(data) is not list:
-        raise InvalidEpisodeLogError(f"episodes must be a list, found {type(data).__name__}")
-    if budget is not None:
-        _check_budget(data, budget)
-    with paused_gc():
-        return [_episode(item, number) for number, item in enumerate(data)]
-
-
-def _check_budget(data: list[Any], budget: CallBudget) -> None:
-    if len(data) > budget.max_episodes:
+    if budget is not None and type(data) is list and len(data) > budget.max_episodes:
         raise InvalidEpisodeLogError(
             f"the log holds {len(data):,} episodes, more than the call's limit of {budget.max_episodes:,}"
         )
+    with paused_gc():
+        try:
+            episodes = WIRE_EPISODES.validate_python(data)
+        except ValidationError as error:
+            raise InvalidEpisodeLogError(_problem(error)) from None
+        if budget is not None:
+            _check_steps(episodes, budget)
+        arrays = _decoded_arrays(episodes)
+        return [_episode(episode, f"episode {number}", arrays) for number, episode in enumerate(episodes)]
+
+
+def _problem(error: ValidationError) -> str:
+    location = error.errors(include_url=False)[0]["loc"]
+    if location and type(location[0]) is int:
+        return problem(error, f"episode {location[0]}", skip=1)
+    return problem(error, "the episode log")
+
+
+def _check_steps(episodes: list[WireEpisode], budget: CallBudget) -> None:
     steps = 0
-    for item in data:
-        if type(item) is dict:
-            steps += max((_column_length(item.get(name)) for name in _COLUMNS), default=0)
+    for episode in episodes:
+        steps += max(_length(episode[name]) for name in EPISODE_COLUMNS)  # type: ignore[literal-required]
         if steps > budget.max_steps:
             raise InvalidEpisodeLogError(
                 f"the log holds more than {budget.max_steps:,} steps, the call's limit"
             )
 
 
-def _column_length(column: Any) -> int:
+def _length(column: list[Any] | PlainList | TaggedArray) -> int:
     """Entries of a per-step column as announced (list length or array shape), without decoding it."""
-    if type(column) is list:
+    if isinstance(column, list):
         return len(column)
-    spec = column.get(NDARRAY_TAG) if type(column) is dict else None
-    shape = spec.get("shape") if type(spec) is dict else None
-    if type(shape) is list and shape and all(type(size) is int and size >= 0 for size in shape):
-        return int(shape[0])
-    return 0  # not a column the decoder accepts: refused there
+    if isinstance(column, PlainList):
+        return len(column.items)
+    shape = column["spec"]["shape"]
+    return shape[0] if shape else 0
 
 
-def _episode(item: Any, number: int) -> EpisodeLog:
-    where = f"episode {number}"
-    if type(item) is not dict or item.keys() != _FIELDS:
-        item = _decoded(item, where)
-        found = sorted(item) if type(item) is dict else type(item).__name__
-        raise InvalidEpisodeLogError(f"{where} must have the fields {sorted(_FIELDS)}, found {found}")
-    student_seed = item["student_seed"]
-    if student_seed is not None:
-        student_seed = _seed(student_seed, f"{where}: student_seed")
-    rewards = _rewards(item["rewards"], f"{where}: rewards")
-    terminated = _flags(item["terminated"], f"{where}: terminated")
-    truncated = _flags(item["truncated"], f"{where}: truncated")
-    actions = _actions(item["actions"], f"{where}: actions")
+def _decoded_arrays(episodes: list[WireEpisode]) -> Iterator[np.ndarray]:
+    """Every array column of the log, episode by episode in `EPISODE_COLUMNS` order (the order `_episode`
+    takes them in), decoded `ARRAY_BATCH` at a time: one decoder per batch, not one per column, and only a
+    batch of arrays alive at once."""
+    columns = [
+        (number, name, column["spec"])
+        for number, episode in enumerate(episodes)
+        for name in EPISODE_COLUMNS
+        if isinstance(column := episode[name], dict)  # type: ignore[literal-required]
+    ]
+    for start in range(0, len(columns), ARRAY_BATCH):
+        batch = columns[start : start + ARRAY_BATCH]
+        try:
+            arrays: list[np.ndarray] = decode_value([{NDARRAY_TAG: spec} for _, _, spec in batch], "the log")
+        except InvalidValueError:
+            for number, name, spec in batch:  # the first bad one again, for a message that names it
+                _decoded({NDARRAY_TAG: spec}, f"episode {number}: {name}")
+            raise
+        yield from arrays
+
+
+def _episode(episode: WireEpisode, where: str, arrays: Iterator[np.ndarray]) -> EpisodeLog:
+    actions = _actions(episode["actions"], arrays, f"{where}: actions")
+    rewards = _rewards(episode["rewards"], arrays, f"{where}: rewards")
+    terminated = _flags(episode["terminated"], arrays, f"{where}: terminated")
+    truncated = _flags(episode["truncated"], arrays, f"{where}: truncated")
     if not len(actions) == len(rewards) == len(terminated) == len(truncated):
         raise InvalidEpisodeLogError(
             f"{where}: actions, rewards, terminated and truncated must have one entry per step, found {len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"  # noqa: E501
         )
-    reset_options = item["reset_options"]
+    reset_options = episode["reset_options"]
     return EpisodeLog(
-        env_index=_bounded_int(item["env_index"], 0, 2**31, f"{where}: env_index"),
-        requested_id=_identifier(item["requested_id"], f"{where}: requested_id"),
-        env_id=_identifier(item["env_id"], f"{where}: env_id"),
-        env_kwargs=_mapping(item["env_kwargs"], f"{where}: env_kwargs"),
-        reset_seed=_seed(item["reset_seed"], f"{where}: reset_seed"),
-        student_seed=student_seed,
+        env_index=episode["env_index"],
+        requested_id=episode["requested_id"],
+        env_id=episode["env_id"],
+        env_kwargs=_mapping(episode["env_kwargs"], f"{where}: env_kwargs"),
+        reset_seed=episode["reset_seed"],
+        student_seed=episode["student_seed"],
         actions=actions,
         rewards=rewards,
         terminated=terminated,
@@ -191,86 +279,48 @@ def _episode(item: Any, number: int) -> EpisodeLog:
     )
 
 
+def _actions(
+    column: list[int] | PlainList | TaggedArray, arrays: Iterator[np.ndarray], where: str
+) -> list[Any]:
+    if isinstance(column, list):
+        return column
+    if isinstance(column, PlainList):
+        return _decoded(column.items, where)  # type: ignore[no-any-return]
+    return _array(next(arrays), "iu", where).tolist()  # type: ignore[no-any-return]
+
+
+def _rewards(column: list[Any] | TaggedArray, arrays: Iterator[np.ndarray], where: str) -> list[float]:
+    if isinstance(column, list):
+        return column
+    return _array(next(arrays), "biuf", where).astype(np.float64).tolist()  # type: ignore[no-any-return]
+
+
+def _flags(column: list[bool] | TaggedArray, arrays: Iterator[np.ndarray], where: str) -> list[bool]:
+    if isinstance(column, list):
+        return column
+    return _array(next(arrays), "b", where).tolist()  # type: ignore[no-any-return]
+
+
+def _array(array: np.ndarray, kinds: str, where: str) -> np.ndarray:
+    if array.ndim != 1 or array.dtype.kind not in kinds:
+        raise InvalidEpisodeLogError(
+            f"{where} should be a 1-D array of kind {kinds!r} or a list, found {describe(array)}"
+        )
+    return array
+
+
+def _mapping(value: dict[str, Any], where: str) -> dict[str, Any]:
+    if not value:  # the common case, without a decoder's set-up
+        return value
+    decoded = clean_plain(_decoded(value, where))
+    if type(decoded) is not dict:
+        raise InvalidEpisodeLogError(f"{where} should be a dict, found {describe(decoded)}")
+    return decoded
+
+
 def _decoded(value: Any, where: str) -> Any:
     """`decode_value` for one field of the log, its errors as `InvalidEpisodeLogError`."""
     try:
         return decode_value(value, f"the episode log ({where})")
     except InvalidValueError as error:
         raise InvalidEpisodeLogError(error.message) from None
-
-
-def _array(value: Any, kinds: str, where: str) -> np.ndarray:
-    array = _decoded(value, where) if type(value) is dict else value
-    if type(array) is not np.ndarray or array.ndim != 1 or array.dtype.kind not in kinds:
-        raise InvalidEpisodeLogError(
-            f"{where} must be a 1-D array of kind {kinds!r} or a list, found {_describe(array)}"
-        )
-    return array
-
-
-def _rewards(value: Any, where: str) -> list[float]:
-    if type(value) is not list:
-        return _array(value, "biuf", where).astype(np.float64).tolist()  # type: ignore[no-any-return]
-    numbers = value if _plain_numbers(value) else _decoded(value, where)
-    if not _plain_numbers(numbers):
-        raise InvalidEpisodeLogError(f"{where} must hold only numbers, found {_describe(value)}")
-    rewards = [float(number) for number in numbers]
-    if not all(map(math.isfinite, rewards)) and numbers is value:
-        _decoded(value, where)  # an untagged non-finite float: the protocol's own error
-    return rewards
-
-
-def _plain_numbers(values: list[Any]) -> bool:
-    """Only floats and ints small enough for a float (what `decode_value` accepts untagged)."""
-    return set(map(type, values)) <= _NUMBER_TYPES and all(
-        type(value) is float or -_LARGEST_INT < value < _LARGEST_INT for value in values
-    )
-
-
-def _flags(value: Any, where: str) -> list[bool]:
-    if type(value) is not list:
-        return _array(value, "b", where).tolist()  # type: ignore[no-any-return]
-    if not set(map(type, value)) <= _BOOL_TYPE:
-        raise InvalidEpisodeLogError(f"{where} must hold only bools, found {_describe(value)}")
-    return list(value)
-
-
-def _actions(value: Any, where: str) -> list[Any]:
-    if type(value) is list:
-        if set(map(type, value)) <= _INT_TYPE and all(
-            -_LARGEST_INT < action < _LARGEST_INT for action in value
-        ):
-            return list(value)
-        return _decoded(value, where)  # type: ignore[no-any-return]
-    if type(value) is dict:
-        return _array(value, "iu", where).tolist()  # type: ignore[no-any-return]
-    raise InvalidEpisodeLogError(f"{where} must be an int array or a list, found {_describe(value)}")
-
-
-def _seed(value: Any, where: str) -> int:
-    return _bounded_int(value, 0, MAX_SEED, where)
-
-
-def _bounded_int(value: Any, low: int, high: int, where: str) -> int:
-    if type(value) is not int or not low <= value < high:
-        raise InvalidEpisodeLogError(f"{where} must be an int in [{low}, {high}), found {_describe(value)}")
-    return value
-
-
-def _identifier(value: Any, where: str) -> str:
-    if type(value) is not str or not 0 < len(value) <= MAX_ID_LENGTH:
-        raise InvalidEpisodeLogError(f"{where} must be a non-empty str of at most {MAX_ID_LENGTH} characters")
-    return clean_text(value, MAX_ID_LENGTH)
-
-
-def _mapping(value: Any, where: str) -> dict[str, Any]:
-    if type(value) is not dict:
-        raise InvalidEpisodeLogError(f"{where} must be a dict, found {_describe(value)}")
-    return clean_plain(_decoded(value, where))  # type: ignore[no-any-return]
-
-
-def _describe(value: Any) -> str:
-    if type(value) is np.ndarray:
-        return f"an array of dtype {value.dtype} and shape {value.shape}"
-    text = repr(value)
-    return f"{type(value).__name__} {text[:60]}"

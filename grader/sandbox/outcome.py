@@ -7,6 +7,8 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import TYPE_CHECKING, Any, TypeAlias
 
+from pydantic import BaseModel, ConfigDict, Field
+
 if TYPE_CHECKING:
     from grader.sandbox.episode_log import EpisodeLog
 
@@ -94,6 +96,21 @@ class FunctionInfo:
     parameters: tuple[ParameterInfo, ...] = ()
 
 
+class CompatEventRecord(BaseModel):
+    """One thing the lab-compatibility layer had to tolerate during a call (`grader.compat.events`).
+
+    The same JSON in a call's outcome and in a problem's result: `{"kind", "env_id", "detail"}`.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    kind: str = Field(
+        description="What was tolerated: step_after_done, renamed_id, seed_replaced, api_detected..."
+    )
+    env_id: str = Field(description="The environment (or, for api_detected, the function) it concerns.")
+    detail: str = Field(description="What happened and how often, in words.")
+
+
 @dataclass(frozen=True)
 class CallOutcome:
     """What one call produced.
@@ -103,7 +120,7 @@ class CallOutcome:
         status: How it ended.
         value: Decoded plain data; None unless status is OK.
         episodes: Episode logs recorded in the child (untrusted until replayed).
-        compat_events: What the compatibility layer had to tolerate ({"kind", "env_id", "detail"}).
+        compat_events: What the compatibility layer had to tolerate, in the order it was drained.
         stdout: The student's own output, capped (a note says how much was dropped).
         stderr: The student's error output, capped likewise.
         message: Student-readable explanation; empty only for OK.
@@ -115,7 +132,7 @@ class CallOutcome:
     status: OutcomeStatus
     value: PlainValue
     episodes: list[EpisodeLog]
-    compat_events: list[dict[str, str]]
+    compat_events: list[CompatEventRecord]
     stdout: str
     stderr: str
     message: str

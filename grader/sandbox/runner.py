@@ -13,7 +13,6 @@ from typing import Any
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError, ProtocolError
 from grader.sandbox.child.frames import decode_value, encode_frame, encode_value, parse_payload
-from grader.sandbox.child.importer import MAX_LISTED_NAMES, MAX_LISTED_PARAMETERS
 from grader.sandbox.child.seeding import derive_call_seed
 from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
 from grader.sandbox.errors import IsolationUnavailable, SandboxClosedError
@@ -21,38 +20,16 @@ from grader.sandbox.isolation import probe_isolation
 from grader.sandbox.isolation.launch import build_launch
 from grader.sandbox.isolation.layer import IsolationReport
 from grader.sandbox.limits import IsolationPolicy, Limits
-from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
+from grader.sandbox.messages import ImportErrorMessage, ResultMessage, first_message, result_message
+from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus
 from grader.sandbox.process import ChildProcess, FrameEnd, FrameWait
 from grader.sandbox.termination import Ending, classify_exit, forged_message
-from grader.sandbox.text import EVENT_CHARS, MESSAGE_CHARS, NAME_CHARS, clean_plain, clean_text
+from grader.sandbox.text import clean_plain
 
 READY_FRAME_LIMITS = FrameLimits(max_bytes=16 << 20, max_nodes=200_000)
 """The `ready` frame lists at most `MAX_LISTED_NAMES` names of `MAX_LISTED_PARAMETERS` parameters each."""
 IMPORT_SEED_INDEX = 2**31
 """`derive_call_seed(seed, IMPORT_SEED_INDEX)` seeds randomness while the submission is imported."""
-
-_CHILD_STATUSES = {
-    "ok": OutcomeStatus.OK,
-    "exception": OutcomeStatus.EXCEPTION,
-    "missing_function": OutcomeStatus.MISSING_FUNCTION,
-    "bad_signature": OutcomeStatus.BAD_SIGNATURE,
-    "invalid_value": OutcomeStatus.INVALID_VALUE,
-    "output_too_large": OutcomeStatus.OUTPUT_TOO_LARGE,
-    "memory_limit": OutcomeStatus.MEMORY_LIMIT,
-    "episode_limit": OutcomeStatus.EPISODE_LIMIT,
-}
-_RESULT_FIELDS = {
-    "type",
-    "id",
-    "nonce",
-    "status",
-    "value",
-    "message",
-    "traceback",
-    "episodes",
-    "compat_events",
-    "wall_time",
-}
 
 
 def _unavailable_message(report: IsolationReport) -> str:
@@ -220,26 +197,16 @@ class Sandbox:
     ) -> CallOutcome:
         elapsed = time.perf_counter() - started
         child = self._child
-        # Sized and counted before any Python object is built: a forged frame costs what an honest may.
-        problem = frame_limit.excess(payload)
-        try:
-            frame = {} if problem else parse_payload(payload)
-            problem = problem or _frame_problem(frame, index, nonce)
-        except ProtocolError as error:
-            problem = str(error)
-        if problem:
-            return self._fatal(call, seed, started, _forged(problem))
-        status = _CHILD_STATUSES[frame["status"]]
-        wall_time = min(float(frame["wall_time"]), elapsed)
-        message = clean_text(frame["message"], MESSAGE_CHARS) if status is not OutcomeStatus.OK else ""
-        if frame["traceback"]:
-            message = f"{message}\n\n{clean_text(frame['traceback'], MESSAGE_CHARS)}"
+        message = _result_message(payload, frame_limit, index, nonce)
+        if isinstance(message, str):
+            return self._fatal(call, seed, started, _forged(message))
+        status = message.outcome_status
         value: Any = None
         episodes: list[EpisodeLog] = []
         if status is OutcomeStatus.OK:
             try:
-                value = clean_plain(decode_value(frame["value"], f"the value returned by {call.function}()"))
-                episodes = episodes_from_plain(frame["episodes"], call.budget)
+                value = clean_plain(decode_value(message.value, f"the value returned by {call.function}()"))
+                episodes = episodes_from_plain(message.episodes, call.budget)
             except (InvalidValueError, InvalidEpisodeLogError) as error:
                 return self._fatal(call, seed, started, _forged(str(error)))
         return CallOutcome(
@@ -247,14 +214,11 @@ class Sandbox:
             status=status,
             value=value,
             episodes=episodes,
-            compat_events=[
-                {name: clean_text(text, EVENT_CHARS) for name, text in event.items()}
-                for event in frame["compat_events"]
-            ],
+            compat_events=message.compat_events,
             stdout=child.stdout.take() if child else "",
             stderr=child.stderr.take() if child else "",
-            message=message,
-            wall_time=wall_time,
+            message=message.explanation(),
+            wall_time=min(message.wall_time, elapsed),
             seed=seed,
         )
 
@@ -329,24 +293,15 @@ class Sandbox:
             child.kill_tree()
             return Ending(OutcomeStatus.INVALID_VALUE, forged_message("the first frame was malformed"))
         try:
-            problem = READY_FRAME_LIMITS.excess(wait.payload)
-            frame = {} if problem else parse_payload(wait.payload)
+            message = READY_FRAME_LIMITS.excess(wait.payload) or first_message(parse_payload(wait.payload))
         except ProtocolError as error:
-            problem = str(error)
-        if problem:
+            message = str(error)
+        if isinstance(message, str):
             child.kill_tree()
-            return Ending(OutcomeStatus.INVALID_VALUE, forged_message(problem))
-        if frame.get("type") == "import_error" and type(frame.get("message")) is str:
-            traceback = frame.get("traceback")
-            detail = (
-                f"\n\n{clean_text(traceback, MESSAGE_CHARS)}" if type(traceback) is str and traceback else ""
-            )
-            return Ending(OutcomeStatus.IMPORT_ERROR, clean_text(frame["message"], MESSAGE_CHARS) + detail)
-        functions = _function_table(frame)
-        if functions is None:
-            child.kill_tree()
-            return Ending(OutcomeStatus.INVALID_VALUE, forged_message("the ready frame was malformed"))
-        self._functions = functions
+            return Ending(OutcomeStatus.INVALID_VALUE, forged_message(message))
+        if isinstance(message, ImportErrorMessage):
+            return Ending(OutcomeStatus.IMPORT_ERROR, message.explanation())
+        self._functions = message.function_table()
         return None
 
     def _stop_child(self) -> None:
@@ -355,68 +310,23 @@ class Sandbox:
             self.leftovers += 1
 
 
-def _frame_problem(frame: dict[str, Any], index: int, nonce: str) -> str:
-    if frame.keys() != _RESULT_FIELDS or frame["type"] != "result":
-        return f"a frame with fields {sorted(frame)[:12]} is not a result"
-    if frame["id"] != index or frame["nonce"] != nonce:
+def _result_message(payload: bytes, frame_limit: FrameLimits, index: int, nonce: str) -> ResultMessage | str:
+    """The result frame answering request `index`, or why it is forged."""
+    # Sized and counted before any Python object is built: a forged frame costs what an honest may.
+    problem = frame_limit.excess(payload)
+    if problem:
+        return problem
+    try:
+        message = result_message(parse_payload(payload))
+    except ProtocolError as error:
+        return str(error)
+    if not isinstance(message, str) and (message.id != index or message.nonce != nonce):
         return "a result frame answered a different request"
-    if frame["status"] not in _CHILD_STATUSES:
-        return f"unknown status {str(frame['status'])[:40]!r}"
-    if type(frame["message"]) is not str or type(frame["traceback"]) is not str:
-        return "message and traceback must be strings"
-    if type(frame["wall_time"]) not in (int, float) or not 0 <= frame["wall_time"] < 1e9:
-        return "wall_time must be a non-negative number"
-    events = frame["compat_events"]
-    if type(events) is not list or not all(
-        type(event) is dict
-        and event.keys() == {"kind", "env_id", "detail"}
-        and all(type(item) is str for item in event.values())
-        for event in events
-    ):
-        return "compat_events must be a list of {kind, env_id, detail} strings"
-    return ""
+    return message
 
 
 def _forged(detail: str) -> Ending:
     return Ending(OutcomeStatus.INVALID_VALUE, forged_message(detail))
-
-
-def _function_table(frame: dict[str, Any]) -> dict[str, FunctionInfo] | None:
-    if (
-        frame.keys() != {"type", "functions"}
-        or frame["type"] != "ready"
-        or type(frame["functions"]) is not dict
-    ):
-        return None
-    table: dict[str, FunctionInfo] = {}
-    if len(frame["functions"]) > MAX_LISTED_NAMES:
-        return None
-    for raw_name, info in frame["functions"].items():
-        name = clean_text(raw_name, NAME_CHARS)
-        if (
-            type(info) is not dict
-            or info.keys() != {"parameters", "is_callable"}
-            or type(info["is_callable"]) is not bool
-        ):
-            return None
-        parameters = info["parameters"]
-        if type(parameters) is not list or len(parameters) > MAX_LISTED_PARAMETERS:
-            return None
-        try:
-            table[name] = FunctionInfo(
-                name,
-                info["is_callable"],
-                tuple(
-                    ParameterInfo(
-                        clean_text(p["name"], NAME_CHARS), clean_text(p["kind"], NAME_CHARS), p["has_default"]
-                    )
-                    for p in parameters
-                    if type(p["name"]) is str and type(p["kind"]) is str and type(p["has_default"]) is bool
-                ),
-            )
-        except (KeyError, TypeError):
-            return None
-    return table
 
 
 def run_calls(

@@ -18,7 +18,7 @@ from grading_support import CLASSIC_COMPLETE, FAST_OVERRIDES, SUBMISSIONS, write
 
 from grader import cli
 from grader.problems import PROBLEMS
-from grader.report import Report
+from grader.report import IsolationSummary, Report
 
 
 @pytest.fixture(scope="module")
@@ -265,7 +265,11 @@ def _layer(name: str, active: bool, required: bool = True, remedy: str = "") -> 
     ("isolation", "expected"),
     [
         (
-            {"full": True, "layers": [_layer("bubblewrap", True), _layer("landlock", False, required=False)]},
+            {
+                "full": True,
+                "layers": [_layer("bubblewrap", True), _layer("landlock", False, required=False)],
+                "summary": "",
+            },
             ["Sandbox: full isolation (bubblewrap)."],
         ),
         (
@@ -276,6 +280,7 @@ def _layer(name: str, active: bool, required: bool = True, remedy: str = "") -> 
                     _layer("rlimits", True),
                     _layer("landlock", False, required=False),
                 ],
+                "summary": "",
             },
             [
                 "Sandbox: weaker isolation on this machine (fine for checking your own code; "
@@ -288,7 +293,7 @@ def _layer(name: str, active: bool, required: bool = True, remedy: str = "") -> 
     ids=["full", "laptop-fallback", "file-never-ran"],
 )
 def test_check_says_how_the_code_was_isolated(isolation: dict[str, Any], expected: list[str]) -> None:
-    assert cli.isolation_lines(isolation) == expected
+    assert cli.isolation_lines(IsolationSummary.model_validate(isolation) if isolation else None) == expected
 
 
 ENDLESS = b"def random_blackjack(n):\n    while True:\n        pass\n"

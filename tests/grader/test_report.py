@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 import pytest
+from pydantic import ValidationError
 
 from grader.report import (
     OUTPUT_CAP_CHARS,
     GradingTimings,
+    IsolationSummary,
     ProblemResult,
     ProblemRun,
     Report,
@@ -17,6 +20,23 @@ from grader.report import (
     cap_output,
     plain_json,
 )
+from grader.sandbox import CompatEventRecord
+
+ISOLATION = {
+    "full": True,
+    "layers": [
+        {"name": "bubblewrap", "active": True, "required": True, "detail": "namespaces", "remedy": ""},
+        {
+            "name": "landlock",
+            "active": False,
+            "required": False,
+            "detail": "kernel 5.10",
+            "remedy": "Linux 5.13+",
+        },
+    ],
+    "summary": "[x] bubblewrap: namespaces\n[ ] landlock: kernel 5.10 -- Linux 5.13+",
+}
+"""`Report.isolation` as stored since before it was a model (the JSON must stay this)."""
 
 
 def _report(wall: float) -> Report:
@@ -39,7 +59,7 @@ def _report(wall: float) -> Report:
         seed=7,
         gymnasium_version="1.4.0",
         grader_version="0.1.0",
-        isolation={"summary": "full", "layers": ["bubblewrap", "cgroup"]},
+        isolation=ISOLATION,
         score=0.0,
         max_score=1.0,
         problems=[problem],
@@ -59,6 +79,50 @@ def test_json_round_trip_is_exact() -> None:
     again = Report.model_validate_json(report.to_json())
     assert again == report
     assert again.to_json() == report.to_json()
+
+
+def test_isolation_and_compat_events_are_models_with_the_json_of_before() -> None:
+    report = _report(1.0)
+    data = json.loads(report.to_json())
+
+    assert isinstance(report.isolation, IsolationSummary)
+    assert isinstance(report.problems[0].compat_events[0], CompatEventRecord)
+    assert data["isolation"] == ISOLATION
+    assert list(data["isolation"]) == ["full", "layers", "summary"]
+    assert data["problems"][0]["compat_events"] == [
+        {"kind": "step_after_done", "env_id": "CartPole-v0", "detail": "1 step"}
+    ]
+
+
+@pytest.mark.parametrize("stored", [{}, None], ids=["empty-dict", "absent"])
+def test_a_report_without_a_sandbox_keeps_an_empty_isolation(stored: object) -> None:
+    fields = {} if stored is None else {"isolation": stored}
+    report = Report(
+        submission="x.py",
+        sha256="0" * 64,
+        seed=1,
+        gymnasium_version="1.4.0",
+        grader_version="0",
+        score=0.0,
+        max_score=0.0,
+        **fields,
+    )
+
+    assert report.isolation is None
+    assert json.loads(report.to_json())["isolation"] == {}
+    assert Report.model_validate_json(report.to_json()) == report
+
+
+@pytest.mark.parametrize(
+    "isolation",
+    [{"full": True}, {**ISOLATION, "extra": 1}, {**ISOLATION, "layers": ["bubblewrap", "cgroup"]}],
+    ids=["missing-fields", "extra-field", "layers-as-names"],
+)
+def test_a_malformed_isolation_summary_is_refused(isolation: dict[str, object]) -> None:
+    with pytest.raises(ValidationError):
+        ProblemRun.model_validate(
+            {"submission": "x.py", "result": _report(1.0).problems[0], "isolation": isolation}
+        )
 
 
 def test_graded_view_ignores_only_the_timings() -> None:

@@ -44,6 +44,21 @@ MAX_KEPT_GENERATORS = 10_000
 _DROPPED_KWARGS = ("render_mode", "disable_env_checker")
 _COMPAT_MAKE_CODE = compat_make.__code__
 _EXACT_INTS = 2**53
+EPISODE_HEADER = (
+    "env_index",
+    "requested_id",
+    "env_id",
+    "env_kwargs",
+    "reset_seed",
+    "student_seed",
+    "reset_options",
+)
+"""The fields of an episode on the wire besides its per-step columns, in the order `to_plain` sends them.
+
+The one declaration of the wire layout: the parent's model (`grader.sandbox.episode_log.WireEpisode`) is
+checked against it and `EPISODE_COLUMNS` by a test (the child cannot import the parent's modules)."""
+EPISODE_COLUMNS = ("actions", "rewards", "terminated", "truncated")
+"""The per-step columns: one entry per step, as a list for short episodes and a numpy array otherwise."""
 
 
 @dataclass
@@ -70,15 +85,7 @@ class EpisodeRecord:
         `SHORT_EPISODE_STEPS` steps (a Blackjack game), where four arrays would cost more to encode and
         decode than the steps themselves (unless `short_as_lists` was turned off, see `finish_call`).
         """
-        plain: dict[str, Any] = {
-            "env_index": self.env_index,
-            "requested_id": self.requested_id,
-            "env_id": self.env_id,
-            "env_kwargs": self.env_kwargs,
-            "reset_seed": self.reset_seed,
-            "student_seed": self.student_seed,
-            "reset_options": self.reset_options,
-        }
+        plain: dict[str, Any] = {name: getattr(self, name) for name in EPISODE_HEADER}
         if self.short_as_lists and len(self.actions) <= SHORT_EPISODE_STEPS:
             plain["actions"] = list(self.actions)
             # Integral rewards travel as ints: JSON parses ints without a Python callback per number.

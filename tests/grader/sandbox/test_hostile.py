@@ -150,12 +150,13 @@ def test_hostile_sample_gets_its_outcome_and_leaves_the_host_unaffected(
         assert type(outcome.value) is type(sample["value"])
     if "value_text" in sample:
         assert sample["value_text"] in json.dumps(outcome.value, ensure_ascii=False)
-    for text in (outcome.message, outcome.stdout, outcome.stderr, json.dumps(outcome.compat_events)):
+    events = [event.model_dump() for event in outcome.compat_events]
+    for text in (outcome.message, outcome.stdout, outcome.stderr, json.dumps(events)):
         assert "\x00" not in text
         text.encode("utf-8")  # no lone surrogate
     json.dumps(outcome.value, ensure_ascii=False).encode("utf-8")
     assert len(outcome.message) < 2 * MESSAGE_CHARS + 200
-    assert all(len(text) < EVENT_CHARS + 100 for event in outcome.compat_events for text in event.values())
+    assert all(len(text) < EVENT_CHARS + 100 for event in events for text in event.values())
     if sample.get("value_below_max_pids"):
         assert 0 < outcome.value < LIMITS.max_pids
     if sample.get("replay_mismatch"):
