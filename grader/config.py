@@ -162,6 +162,17 @@ class FindQvaluesConfig(ProblemConfig):
 
     kind: Literal["find_qvalues"] = "find_qvalues"
     env_id: str = Field(description="The environment id find_qvalues is called with (the lab's Taxi-v3).")
+    run: Literal["when_scored", "always"] = Field(
+        default="when_scored",
+        description="'when_scored' (default) calls find_qvalues only when the problem is worth points (no "
+        "other verdict needs it: taxi(q_table) receives the grader's exact table); 'always' calls it "
+        "for feedback on its table even at 0 points.",
+    )
+
+    @property
+    def called(self) -> bool:
+        """Whether find_qvalues is called: it is worth points, or the configuration asks for it."""
+        return self.points > 0 or self.run == "always"
 
 
 _PROBLEM_CLASSES: dict[ProblemId, type[ProblemConfig]] = {

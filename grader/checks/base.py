@@ -17,7 +17,7 @@ if TYPE_CHECKING:
 
 __all__ = ["PROBLEM_IDS", "CallRecord", "ProblemCheck", "ProblemId", "Status", "Verdict", "outcome_verdict"]
 
-Status = Literal["passed", "failed", "error", "timeout", "missing"]
+Status = Literal["passed", "failed", "error", "timeout", "missing", "skipped"]
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -41,7 +41,8 @@ class Verdict:
     """A problem's result.
 
     Attributes:
-        status: One of ``passed``, ``failed``, ``error``, ``timeout``, ``missing``.
+        status: One of ``passed``, ``failed``, ``error``, ``timeout``, ``missing``, ``skipped`` (not run:
+            no verdict needed the calls).
         fraction: Share of the problem's points earned, 0..1.
         feedback: What was expected, what was measured, the likely cause and what to do.
         measurements: JSON-serialisable numbers behind the verdict; deterministic for a given run.

@@ -16,6 +16,13 @@ from grader.sandbox.outcome import Call, FunctionInfo
 from reference.oracles import greedy_policy_return, optimal_return
 
 TAXI_SHAPE = (500, 6)
+NOT_RUN_FEEDBACK = (
+    "Not run: find_qvalues is worth 0 points and no other check needs its table "
+    "(taxi(q_table) receives the grader's exact optimal table), "
+    "so it was not called and its training cost you no time. "
+    "To have your table checked anyway, grade with an assignment configuration whose "
+    '[problems.find_qvalues] has run = "always" (gymgrade check --config FILE).'
+)
 
 
 def _settings(config: ProblemConfig) -> FindQvaluesConfig:
@@ -32,13 +39,21 @@ class FindQvaluesCheck:
     title: str = "find_qvalues (provided by the lab)"
 
     def plan(self, config: ProblemConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
-        """One unrecorded call (100 000 training episodes are not worth logging)."""
-        return [Call("find_qvalues", (_settings(config).env_id,), record_episodes=False, budget=NO_EPISODES)]
+        """One unrecorded call (100 000 training episodes are not worth logging), or none when not called.
+
+        No verdict needs the table unless the problem is worth points (``taxi(q_table)`` gets the grader's
+        exact table), so by default nothing is called and the student's training costs nothing.
+        """
+        settings = _settings(config)
+        if not settings.called:
+            return []
+        return [Call("find_qvalues", (settings.env_id,), record_episodes=False, budget=NO_EPISODES)]
 
     @paused_gc
     def judge(self, config: ProblemConfig, records: Sequence[CallRecord]) -> Verdict:
         """Validate the table and report the exact expected return of acting greedily on it."""
-        _settings(config)
+        if not _settings(config).called:
+            return Verdict("skipped", 0.0, NOT_RUN_FEEDBACK, {"calls_made": 0})
         early = outcome_verdict(records)
         if early is not None:
             return early
