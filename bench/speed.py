@@ -635,7 +635,26 @@ def section(figures: Figures) -> str:
         row("---", "---"),
     ]
     lines += [row(order, f"`{output}`") for order, output in figures.leaky_orders.items()]
-    lines += ["", "With one child per problem, car's output is the same whatever ran before it.", ""]
+    per_problem_span = longest_first([cost.wall for cost in figures.costs], workers)
+    shared_span = longest_first([cost.wall for cost in shared], workers)
+    saved = sum(cost.wall for cost in figures.costs) - sum(cost.wall for cost in shared)
+    lines += [
+        "",
+        "With one child per problem, car's output is the same whatever ran before it.",
+        "",
+        f"**Decision: one child per problem stays.** A shared child saves {saved:.1f} s of serial time here "
+        f"({saved / sum(cost.wall for cost in figures.costs):.0%}), but on {workers} workers the grading "
+        f"waits for its longest problem, whose own child start remains: the longest-first makespan moves "
+        f"from {per_problem_span:.1f} s to {shared_span:.1f} s at best. Against it: (1) which problems "
+        "share a child would depend on xdist's scheduling, and a child's module-level state (a global env, "
+        "Q-table, cache or list; the call seeds are reset per call, Python objects are not) flows into the "
+        "next problem's calls, so the same bytes and seed could give a different report (the table above); "
+        "(2) the child's life-long CPU limit, its memory growth and its process count would be shared, so "
+        "one problem's consumption could end another's calls with `memory_limit` or `killed`; (3) after a "
+        "timeout or crash the child restarts anyway, mid-submission. Instead, a problem no verdict needs "
+        "starts no child at all (find_qvalues, `skipped`).",
+        "",
+    ]
     return "\n".join(lines)
 
 
