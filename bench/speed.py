@@ -13,8 +13,8 @@
    the same file on `--workers` workers (default: all cores), `--rounds` times each, in one run. Prints
    the ratio gymgrade / plain (goal <= 1.0) and the grader's overhead as a share of the student's CPU
    (goal <= 10%), from the report's `timings` and from the CPU both runs used.
-3. Times the fixed costs: interpreter start, pytest session start, xdist worker start, sandbox child start
-   and student import.
+3. Times the fixed costs: interpreter start, pytest session start, xdist worker start, sandbox child start,
+   isolation set-up and student import.
 4. Prototype (here only, not in the grader): ONE sandbox child serving every problem of the submission
    (seed, call index and per-call limit reset per problem) against one child per problem: the time
    saved, whether every result stays identical, and a two-problem submission with module-level state
@@ -434,17 +434,26 @@ def session_command(submission: Path, workers: int) -> list[str]:
     return [*command, "--submission", str(submission), "-k", "no_such_problem", "-n", str(workers)]
 
 
-def sandbox_start(submission: Path, repeats: int) -> float:
-    """Median seconds from a new `Sandbox` to its `functions` (child started, submission imported)."""
+def sandbox_start(submission: Path, repeats: int, *, isolated: bool = True) -> float:
+    """Median seconds from a new `Sandbox` to its `functions` (child started, submission imported).
+
+    Args:
+        submission: What the child imports.
+        repeats: How many children to start.
+        isolated: False starts the child with every isolation layer off (to time the layers' set-up).
+    """
     from grader.config import load_config
-    from grader.sandbox import IsolationPolicy
+    from grader.sandbox import IsolationPolicy, probe_isolation
+    from grader.sandbox.isolation import LAYER_NAMES
     from grader.sandbox.runner import Sandbox
 
     limits = load_config().sandbox.to_limits(60.0)
+    policy = IsolationPolicy.REQUIRE_FULL if isolated else IsolationPolicy.ALLOW_FALLBACK
+    isolation = probe_isolation(frozenset() if isolated else frozenset(LAYER_NAMES))
     times = []
     for index in range(repeats):
         started = time.perf_counter()
-        with Sandbox(submission, seed=index, limits=limits, policy=IsolationPolicy.REQUIRE_FULL) as sandbox:
+        with Sandbox(submission, seed=index, limits=limits, policy=policy, isolation=isolation) as sandbox:
             if not sandbox.functions and submission.read_text().strip():
                 raise SystemExit(f"{submission} did not import in the sandbox")
             times.append(time.perf_counter() - started)
@@ -468,6 +477,7 @@ class Figures:
     session: float
     session_workers: float
     empty_start: float
+    bare_start: float
     submission_start: float
     shared_costs: list[ProblemCost]
     shared_identical: bool
@@ -583,8 +593,12 @@ def section(figures: Figures) -> str:
             f"{max(figures.session_workers - figures.session, 0):.2f}",
         ),
         row(
-            "sandbox child start (isolation set up, an empty submission imported)",
-            f"{figures.empty_start:.2f}",
+            "sandbox child start, no isolation layer (an empty submission imported)",
+            f"{figures.bare_start:.2f}",
+        ),
+        row(
+            "isolation set-up (cgroup, bubblewrap, seccomp, privileges, rlimits, Landlock)",
+            f"{max(figures.empty_start - figures.bare_start, 0):.2f}",
         ),
         row(
             f"student import (`{name}`: numpy, the gym shim, the module)",
@@ -762,6 +776,7 @@ def main() -> int:
         session = median_wall(session_command(submission, 0), 3, **no_autoload)
         session_workers = median_wall(session_command(submission, args.workers), 3, **no_autoload)
         empty_start = sandbox_start(empty, 5)
+        bare_start = sandbox_start(empty, 5, isolated=False)
         submission_start = sandbox_start(submission, 5)
 
         print("4. module-level state through one shared child ...", flush=True)
@@ -779,6 +794,7 @@ def main() -> int:
         session=session,
         session_workers=session_workers,
         empty_start=empty_start,
+        bare_start=bare_start,
         submission_start=submission_start,
         shared_costs=shared_costs,
         shared_identical=identical,
