@@ -548,7 +548,7 @@ def main() -> int:
         load=load,
         problems=list(plan.problems),
         command=" ".join(["python", "bench/speed.py", *sys.argv[1:]]),
-        busy=max(load_before, os.getloadavg()[0]) > len(os.sched_getaffinity(0)),
+        busy=load_before > len(os.sched_getaffinity(0)),
         skipped=skipped,
     )
     text = section(figures)
