@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 
 from grader.checks.base import CallRecord, Verdict
@@ -20,7 +20,14 @@ from grader.report import (
     cap_output,
     plain_json,
 )
-from grader.sandbox import CallOutcome, CompatEventRecord, IsolationPolicy, IsolationReport, Sandbox
+from grader.sandbox import (
+    CallOutcome,
+    CompatEventRecord,
+    FunctionInfo,
+    IsolationPolicy,
+    IsolationReport,
+    Sandbox,
+)
 from grader.showcase import showcase_episode
 
 MAX_COMPAT_EVENTS = 20
@@ -53,6 +60,26 @@ def isolation_summary(isolation: IsolationReport) -> IsolationSummary:
         ],
         summary=isolation.summary(),
     )
+
+
+class FunctionsOnDemand(Mapping[str, FunctionInfo]):
+    """The submission's functions, read from the sandbox only when a plan looks at them.
+
+    The child starts (and imports the submission) on the first read or the first call, so a problem whose
+    plan calls nothing (find_qvalues when no verdict needs it) costs no child and no import.
+    """
+
+    def __init__(self, sandbox: Sandbox) -> None:
+        self._sandbox = sandbox
+
+    def __getitem__(self, name: str) -> FunctionInfo:
+        return self._sandbox.functions[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._sandbox.functions)
+
+    def __len__(self) -> int:
+        return len(self._sandbox.functions)
 
 
 def run_problem(
@@ -90,7 +117,7 @@ def run_problem(
     records: list[CallRecord] = []
     stopped: str | None = None
     with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:
-        calls = check.plan(settings, sandbox.functions)
+        calls = check.plan(settings, FunctionsOnDemand(sandbox))
         for call in calls:
             records.append(replay_call(sandbox.call(call), games))
             stopped = settled_by(records[-1], games)

@@ -78,7 +78,8 @@ def results(report: Report, *, visibility: Visibility = "visible") -> Gradescope
             number=str(index),
             score=problem.score,
             max_score=problem.max_score,
-            status="passed" if problem.status == "passed" else "failed",
+            # A skipped problem (worth nothing, not run) failed nothing; its output says it was not run.
+            status="passed" if problem.status in ("passed", "skipped") else "failed",
             output=f"{problem.status}: {problem.feedback}"
             + (f"\n\nYour output:\n{problem.output}" if problem.output else ""),
             # A problem the assignment hides (or shows after the due date) stays so on Gradescope.

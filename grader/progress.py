@@ -14,6 +14,7 @@ _STATUS_MARK = {
     "error": "ERROR",
     "timeout": "TIMEOUT",
     "missing": "MISSING",
+    "skipped": "SKIPPED",
 }
 
 

@@ -13,7 +13,7 @@ from grader.notebook import NotebookSummary
 from grader.sandbox.outcome import CompatEventRecord
 from grader.sandbox.text import clean_plain
 
-Status = Literal["passed", "failed", "error", "timeout", "missing"]
+Status = Literal["passed", "failed", "error", "timeout", "missing", "skipped"]
 Visibility = Literal["visible", "after_due_date", "hidden"]
 """Who sees a problem's result and feedback (Gradescope's words): students at once, after the due date, or
 only the instructor. The report always holds everything; the service's student views honour it."""
@@ -110,7 +110,9 @@ class ProblemResult(BaseModel):
 
     id: str = Field(description="Problem id, one of the registry's (grader/problems.py lists the lab's).")
     title: str = Field(description="The problem's title in the lab.")
-    status: Status = Field(description="passed, failed, error, timeout or missing.")
+    status: Status = Field(
+        description="passed, failed, error, timeout, missing, or skipped (not run: no verdict needed it)."
+    )
     score: float = Field(description="Points earned.")
     max_score: float = Field(description="Points available.")
     feedback: str = Field(description="What was expected, what was measured, the likely cause.")
@@ -231,8 +233,11 @@ class Report(BaseModel):
 
     @property
     def full_marks(self) -> bool:
-        """True when every graded problem passed and the file itself was gradable."""
-        return self.submission_error is None and all(problem.status == "passed" for problem in self.problems)
+        """True when every graded problem passed (or was skipped: not run, worth nothing) and the file was
+        gradable."""
+        return self.submission_error is None and all(
+            problem.status in ("passed", "skipped") for problem in self.problems
+        )
 
     def to_json(self) -> str:
         """The report as indented JSON, fields in declaration order (stable for identical reports)."""

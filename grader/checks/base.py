@@ -6,10 +6,11 @@ import functools
 import gc
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal, ParamSpec, Protocol, TypeVar
+from typing import TYPE_CHECKING, ParamSpec, Protocol, TypeVar
 
 from grader.problem_config import ProblemConfig
 from grader.problem_registry import ProblemId
+from grader.report import Status
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, PlainValue
 
 if TYPE_CHECKING:
@@ -17,7 +18,6 @@ if TYPE_CHECKING:
 
 __all__ = ["CallRecord", "ProblemCheck", "ProblemId", "Status", "Verdict", "outcome_verdict"]
 
-Status = Literal["passed", "failed", "error", "timeout", "missing"]
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -42,7 +42,8 @@ class Verdict:
     """A problem's result.
 
     Attributes:
-        status: One of ``passed``, ``failed``, ``error``, ``timeout``, ``missing``.
+        status: One of ``passed``, ``failed``, ``error``, ``timeout``, ``missing``, ``skipped`` (not run:
+            no verdict needed the calls).
         fraction: Share of the problem's points earned, 0..1.
         feedback: What was expected, what was measured, the likely cause and what to do.
         measurements: JSON-serialisable numbers behind the verdict; deterministic for a given run.

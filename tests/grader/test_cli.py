@@ -67,6 +67,43 @@ def test_check_explains_what_is_missing_and_exits_1(
     )
 
 
+QUICK_FIND_QVALUES = (
+    "import numpy as np\n\n\ndef find_qvalues(env):\n    print('training a table')\n"
+    "    return np.zeros((500, 6))\n"
+)
+
+
+def test_check_does_not_call_find_qvalues_when_no_verdict_needs_it(
+    fast_config: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    submission = tmp_path / "opengym.py"
+    submission.write_text(QUICK_FIND_QVALUES, encoding="utf-8")
+    output = tmp_path / "report.json"
+    argv = ["check", str(submission), "--only", "find_qvalues", "--config", str(fast_config)]
+    assert cli.main([*argv, "--output", str(output)]) == cli.EXIT_FULL_MARKS
+    out = capsys.readouterr().out
+    assert "[SKIPPED] find_qvalues (provided by the lab) (0/0)" in out
+    assert "  Not run: find_qvalues is worth 0 points and no other check needs its table" in out
+    (result,) = Report.model_validate_json(output.read_text()).problems
+    assert (result.status, result.output, result.measurements) == ("skipped", "", {"calls_made": 0})
+    assert result.timings is not None and result.timings.student_seconds == 0.0
+
+
+def test_check_calls_find_qvalues_when_the_config_says_always(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = write_config(tmp_path / "assignment.toml", {"find_qvalues": {"run": "always"}})
+    submission = tmp_path / "opengym.py"
+    submission.write_text(QUICK_FIND_QVALUES, encoding="utf-8")
+    output = tmp_path / "report.json"
+    argv = ["check", str(submission), "--only", "find_qvalues", "--config", str(config)]
+    assert cli.main([*argv, "--output", str(output)]) == cli.EXIT_FULL_MARKS
+    assert "[   PASS] find_qvalues (provided by the lab) (0/0)" in capsys.readouterr().out
+    (result,) = Report.model_validate_json(output.read_text()).problems
+    assert (result.status, result.output) == ("passed", "training a table\n")
+    assert "greedy_mean_return" in result.measurements
+
+
 @pytest.fixture
 def without_bubblewrap(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A machine like a student's laptop: `bwrap` (and `setpriv`) cannot be found on PATH."""

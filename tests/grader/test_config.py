@@ -205,6 +205,11 @@ def test_sandbox_settings_become_limits() -> None:
             "uncounted_steps_deduction = 1.5\n\n[problems.taxi]",
             "problems.car.uncounted_steps_deduction: Input should be less than or equal to 1 (found 1.5)",
         ),
+        (
+            'run = "when_scored"',
+            'run = "sometimes"',
+            "problems.find_qvalues.run: Input should be 'when_scored' or 'always' (found 'sometimes')",
+        ),
     ],
     ids=[
         "negative-points",
@@ -218,6 +223,7 @@ def test_sandbox_settings_become_limits() -> None:
         "gradescope-only-visibility",
         "unknown-game",
         "deduction-above-one",
+        "unknown-find-qvalues-run",
     ],
 )
 def test_invalid_fields_are_named_with_what_was_found(

@@ -1,11 +1,17 @@
-"""Tests of grader/execution.py that need no sandbox: the per-problem seeds."""
+"""Tests of grader/execution.py that need no sandbox: the per-problem seeds, plans without calls."""
 
 from __future__ import annotations
 
+from pathlib import Path
+from types import TracebackType
+
 import pytest
 
-from grader.execution import problem_seed
+import grader.execution
+from grader.config import load_config
+from grader.execution import problem_seed, run_problem
 from grader.problems import PROBLEM_IDS
+from grader.sandbox import Call, CallOutcome, FunctionInfo, IsolationPolicy, IsolationReport
 
 
 @pytest.mark.parametrize(
@@ -26,3 +32,42 @@ def test_problem_seeds_are_distinct_63_bit_numbers() -> None:
     seeds = {problem_seed(grading_seed, problem) for grading_seed in range(50) for problem in PROBLEM_IDS}
     assert len(seeds) == 50 * len(PROBLEM_IDS)
     assert all(0 <= seed < 2**63 for seed in seeds)
+
+
+class ChildlessSandbox:
+    """Stands in for `Sandbox`: fails the test if the child would start (functions read or a call made)."""
+
+    opened = 0
+
+    def __init__(self, submission: Path, **settings: object) -> None:
+        ChildlessSandbox.opened += 1
+        self.isolation = IsolationReport(layers=())
+
+    def __enter__(self) -> ChildlessSandbox:
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, error: BaseException | None, traceback: TracebackType | None
+    ) -> None:
+        """Nothing to close."""
+
+    @property
+    def functions(self) -> dict[str, FunctionInfo]:
+        raise AssertionError("the plan read the functions: the child would have started")
+
+    def call(self, call: Call) -> CallOutcome:
+        raise AssertionError(f"{call.function} was called")
+
+
+def test_a_plan_without_calls_starts_no_child(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    monkeypatch.setattr(grader.execution, "Sandbox", ChildlessSandbox)
+    run = run_problem(
+        tmp_path / "opengym.py",
+        "find_qvalues",
+        config=load_config(),
+        grading_seed=0,
+        policy=IsolationPolicy.ALLOW_FALLBACK,
+    )
+    assert ChildlessSandbox.opened == 1
+    assert (run.result.status, run.result.score, run.result.max_score) == ("skipped", 0.0, 0.0)
+    assert run.result.feedback.startswith("Not run: find_qvalues is worth 0 points")

@@ -49,6 +49,25 @@ def test_a_report_becomes_one_gradescope_test_per_problem() -> None:
     GradescopeResults.model_validate(data)
 
 
+def test_a_skipped_problem_failed_nothing_and_says_it_was_not_run() -> None:
+    skipped = ProblemResult(
+        id="find_qvalues",
+        title="find_qvalues",
+        status="skipped",
+        score=0,
+        max_score=0,
+        feedback="Not run: ...",
+    )
+    graded = results(_report(problems=[skipped], score=0.0, max_score=0.0))
+    (test,) = graded.tests
+    assert (test.status, test.score, test.max_score, test.output) == (
+        "passed",
+        0.0,
+        0.0,
+        "skipped: Not run: ...",
+    )
+
+
 def test_a_file_that_cannot_be_graded_says_why_in_the_output() -> None:
     graded = results(_report(submission_error="opengym.py is empty: nothing to grade."))
     assert "opengym.py is empty: nothing to grade." in graded.output

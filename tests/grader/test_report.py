@@ -139,9 +139,10 @@ def test_graded_view_ignores_only_the_timings() -> None:
         (["passed", "passed"], None, True),
         (["passed", "failed"], None, False),
         (["passed", "timeout"], None, False),
+        (["passed", "skipped"], None, True),
         ([], "opengym.py is empty", False),
     ],
-    ids=["all-passed", "one-failed", "one-timeout", "unreadable-file"],
+    ids=["all-passed", "one-failed", "one-timeout", "one-skipped", "unreadable-file"],
 )
 def test_full_marks(statuses: list[str], submission_error: str | None, full: bool) -> None:
     problems = [
