@@ -32,8 +32,8 @@ class FindQvaluesConfig(ProblemConfig):
     env_id: str = Field(description="The environment id find_qvalues is called with (the lab's Taxi-v3).")
     run: Literal["when_scored", "always"] = Field(
         default="when_scored",
-        description="'when_scored' (default) calls find_qvalues only when the problem is worth points "
-        "(no other verdict needs it: taxi(q_table) receives the grader's exact table); "
+        description="'when_scored' (default) calls find_qvalues only when the problem is worth points (no other verdict needs it: "  # noqa: E501
+        "taxi(q_table) receives the grader's exact table); "
         "'always' calls it for feedback on its table even at 0 points.",
     )
 
