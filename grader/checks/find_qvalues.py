@@ -18,11 +18,8 @@ from reference.oracles import greedy_policy_return, optimal_return
 
 TAXI_SHAPE = (500, 6)
 NOT_RUN_FEEDBACK = (
-    "Not run: find_qvalues is worth 0 points and no other check needs its table "
-    "(taxi(q_table) receives the grader's exact optimal table), "
-    "so it was not called and its training cost you no time. "
-    "To have your table checked anyway, grade with an assignment configuration whose "
-    '[problems.find_qvalues] has run = "always" (gymgrade check --config FILE).'
+    "Not run: find_qvalues is worth 0 points and no other check needs its table (taxi(q_table) receives the grader's exact optimal table), so it was not called and its training cost you no time. "  # noqa: E501
+    'To have your table checked anyway, grade with an assignment configuration whose [problems.find_qvalues] has run = "always" (gymgrade check --config FILE).'  # noqa: E501
 )
 
 
