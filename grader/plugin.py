@@ -12,6 +12,8 @@ report (``user_properties`` travel from the worker to the controller): a student
 
 from __future__ import annotations
 
+import json
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -75,7 +77,14 @@ class SessionPlan(BaseModel):
 
     def option(self) -> str:
         """This plan as the ``--gymgrade-plan`` argument of the session and its workers."""
-        return f"{PLAN_OPTION}={self.model_dump_json()}"
+        # json.dumps escapes the lone surrogates a file name that is not UTF-8 decodes to; pydantic's own
+        # JSON refuses them.
+        return f"{PLAN_OPTION}={json.dumps(self.model_dump(mode='json'))}"
+
+    @classmethod
+    def from_option(cls, text: str) -> SessionPlan:
+        """The plan a ``--gymgrade-plan`` value holds."""
+        return cls.model_validate(json.loads(text))
 
 
 class GraderFailure(BaseModel):
@@ -144,7 +153,7 @@ class GradingSession:
         from grader.execution import run_problem
 
         try:
-            return run_problem(
+            run = run_problem(
                 case.submission,
                 case.problem,
                 config=self.assignment,
@@ -153,6 +162,8 @@ class GradingSession:
             )
         except Exception as error:
             return GraderFailure.of(error)
+        printable = os.fsencode(case.submission).decode("utf-8", "replace")  # the file's name is not data
+        return run.model_copy(update={"submission": printable})
 
 
 _SESSION_KEY = pytest.StashKey[GradingSession]()
@@ -167,7 +178,7 @@ def grading_session(config: pytest.Config) -> GradingSession:
                 f"grader.plugin needs {PLAN_OPTION}; found none. Grade through grader.grading "
                 "(gymgrade check/grade), which passes it."
             )
-        config.stash[_SESSION_KEY] = GradingSession(SessionPlan.model_validate_json(text))
+        config.stash[_SESSION_KEY] = GradingSession(SessionPlan.from_option(text))
     return config.stash[_SESSION_KEY]
 
 

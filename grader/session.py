@@ -48,8 +48,9 @@ class SessionEnd:
 def acceptance_args(plan: SessionPlan, workers: int) -> list[str]:
     """The pytest arguments of a session (the workers rebuild their configuration from them).
 
-    ``-c`` and ``--rootdir`` keep the caller's own pytest settings out; faulthandler is off because it
-    would redirect the calling process's own fault handler.
+    ``-c`` and ``--rootdir`` keep the caller's own pytest settings out. The faulthandler,
+    unraisableexception and threadexception plugins are off: they replace process-wide hooks of the
+    calling process, and the second forces garbage collections that cost about a second per session.
     """
     args = [str(ACCEPTANCE_DIR), "-c", str(ACCEPTANCE_DIR / "pytest.ini"), "--rootdir", str(ACCEPTANCE_DIR)]
     return [*args, *_BASE_ARGS.split(), "-n", str(max(workers, 1)), plan.option()]
@@ -67,7 +68,8 @@ def run_session(
 
     ``on_outcome`` is called in the calling thread with each case's outcome as soon as it arrives, at
     most once per case; cases without one when the session ends (it stopped early) are the caller's to
-    fill in. Sessions in one process run one at a time: pytest's state is the process's.
+    fill in. Sessions in one process run one at a time, as pytest's state is the process's (so
+    ``on_outcome`` must not start another).
 
     Args:
         plan: The cases to grade.

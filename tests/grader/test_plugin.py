@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import os
 from pathlib import Path
 from typing import Any
 
@@ -83,6 +84,14 @@ def test_collection_runs_the_longest_expected_checks_first_under_the_planned_ids
     assert collected.node_ids == [
         ProblemCase(index, CLASSIC_COMPLETE, problem).node_id for problem in expected for index in range(2)
     ]
+
+
+def test_the_plan_reaches_the_workers_whatever_the_files_are_called() -> None:
+    names = (Path(os.fsdecode(b"/srv/caf\xe9.py")), Path("/home/zoë/[final] = opengym.py"))
+    plan = SessionPlan(submissions=names, problems=("car",), seed=7, policy=IsolationPolicy.REQUIRE_FULL)
+    name, value = plan.option().split("=", 1)
+    assert name == "--gymgrade-plan"
+    assert SessionPlan.from_option(value) == plan
 
 
 def test_a_case_is_known_by_an_ascii_id_whatever_the_file_is_called() -> None:
