@@ -1,13 +1,9 @@
-"""Grade submissions: validate the file, run the acceptance tests under pytest-xdist, build the report."""
+"""Grade submissions: validate the file, run the acceptance session (pytest-xdist), build the report."""
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import os
-import signal
-import subprocess
-import sys
 import tempfile
 import time
 from collections.abc import Callable, Sequence
@@ -19,18 +15,15 @@ import grader
 from grader.config import load_config
 from grader.execution import problem_seed
 from grader.notebook import NotebookModule, build_module, is_notebook
+from grader.plugin import CaseOutcome, GraderFailure, ProblemCase, SessionPlan
 from grader.problems import PROBLEM_IDS, ProblemId
-from grader.progress import ResultsFollower
 from grader.report import GradingTimings, ProblemResult, ProblemRun, Report, Visibility
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import IsolationUnavailable
 from grader.sandbox.isolation.scope import sandbox_scope
+from grader.sandbox.runner import require_isolation
+from grader.session import run_session
 from grader.validation import FileVerdict, check_source
-
-ACCEPTANCE_DIR = Path(__file__).with_name("acceptance")
-_POLL_SECONDS = 0.1
-_PYTEST_ARGS = "-p grader.plugin -p xdist.plugin -p no:cacheprovider -q"
-_ISOLATION_ERROR = IsolationUnavailable.__name__ + ": "
 
 
 @dataclass(frozen=True)
@@ -356,148 +349,48 @@ def run_acceptance(
     on_result: Callable[[Path, ProblemResult], None] | None,
     on_runs: Callable[[Path, Sequence[ProblemRun]], None] | None = None,
 ) -> dict[str, list[ProblemRun]]:
-    """Run the acceptance tests of valid files in one pytest run; the runs per file path, as given.
+    """Run the acceptance tests of valid files in one session in this process; the runs per file path.
 
-    Problems the run ended without a result for (pytest or a worker died) get an internal-error run.
-    ``on_runs`` is called with a file and all its runs so far each time one of them arrives.
+    ``on_result`` and ``on_runs`` (a file and all its runs so far) are called in the calling thread as
+    each run arrives. Problems the session ended without a result for (a worker died, pytest stopped) get
+    an internal-error run.
 
     Raises:
-        grader.sandbox.errors.IsolationUnavailable: ``REQUIRE_FULL`` and this machine cannot isolate.
+        grader.sandbox.errors.IsolationUnavailable: ``REQUIRE_FULL`` and this machine cannot isolate
+            (checked before anything starts, and raised after the session if a worker found it so).
     """
+    if policy is IsolationPolicy.REQUIRE_FULL:
+        require_isolation(policy)
+    session_plan = SessionPlan(
+        submissions=tuple(path.resolve() for path in paths),
+        problems=plan.problems,
+        seed=seed,
+        policy=policy,
+        config=plan.config.resolve() if plan.config is not None else None,
+    )
     runs: dict[str, list[ProblemRun]] = {str(path): [] for path in paths}
-    resolved = {str(path.resolve()): path for path in paths}
-    # The scope outlives the pytest run: its harness trees, scratch dirs and cgroups go when it closes.
-    with sandbox_scope() as scope, tempfile.TemporaryDirectory(prefix="gymgrade-") as scratch:
-        results_file = Path(scratch) / "results.jsonl"
-        log_file = Path(scratch) / "pytest.log"
-        command = acceptance_command(
-            paths, plan, seed=seed, workers=workers, policy=policy, results=results_file
-        )
-        follower = ResultsFollower(results_file)
-        with log_file.open("wb") as log:
-            # Its own process group, so that abandoning the run also ends the xdist workers.
-            process = subprocess.Popen(
-                command,
-                stdout=log,
-                stderr=subprocess.STDOUT,
-                cwd=scratch,
-                env=acceptance_environment() | scope,
-                start_new_session=True,
-            )
-            try:
-                complete = _follow(
-                    process, follower, resolved, runs, on_result, on_runs, len(paths) * len(plan.problems)
-                )
-            finally:
-                _stop(process)
-        if not complete and process.returncode not in (0, 1):
-            log_text = log_file.read_text(errors="replace")
-            _fill_missing(runs, paths, plan, seed, log_text, process.returncode, on_result, on_runs)
+    unavailable: list[str] = []
+
+    def deliver(case: ProblemCase, outcome: CaseOutcome) -> None:
+        path = paths[case.index]
+        if isinstance(outcome, GraderFailure):
+            if outcome.kind == "isolation_unavailable":
+                unavailable.append(outcome.detail)
+                return
+            outcome = _internal_error_run(path, case.problem, plan, seed, outcome.detail)
+        runs[str(path)].append(outcome)
+        if on_result is not None:
+            on_result(path, outcome.result)
+        if on_runs is not None:
+            on_runs(path, runs[str(path)])
+
+    # The scope outlives the session: its harness trees, scratch dirs and cgroups go when it closes.
+    with sandbox_scope() as scope:
+        end = run_session(session_plan, workers=workers, on_outcome=deliver, environment=scope)
+    if unavailable:
+        raise IsolationUnavailable(unavailable[0])
+    detail = f"the grading run stopped (pytest exit code {end.exit_code}): {end.log_tail}"
+    for case in session_plan.cases():
+        if case.problem not in {run.result.id for run in runs[str(paths[case.index])]}:
+            deliver(case, GraderFailure(kind="grader_error", detail=detail))
     return runs
-
-
-def _follow(
-    process: subprocess.Popen[bytes],
-    follower: ResultsFollower,
-    resolved: dict[str, Path],
-    runs: dict[str, list[ProblemRun]],
-    on_result: Callable[[Path, ProblemResult], None] | None,
-    on_runs: Callable[[Path, Sequence[ProblemRun]], None] | None,
-    expected: int,
-) -> bool:
-    """Hand every result over as soon as the controller writes it, until the run ends.
-
-    Returns True as soon as all ``expected`` results are in: the run's remaining work is only pytest and
-    its workers shutting down (about two seconds), which the caller need not wait for.
-    """
-    received = 0
-    while True:
-        finished = process.poll() is not None
-        for run in follower.poll():
-            received += 1
-            path = resolved.get(run.submission, Path(run.submission))
-            runs.setdefault(str(path), []).append(run)
-            if run.internal_error is not None and run.internal_error.startswith(_ISOLATION_ERROR):
-                raise IsolationUnavailable(run.internal_error.removeprefix(_ISOLATION_ERROR))
-            if on_result is not None:
-                on_result(path, run.result)
-            if on_runs is not None:
-                on_runs(path, runs[str(path)])
-        if received >= expected or finished:
-            return received >= expected
-        time.sleep(_POLL_SECONDS)
-
-
-def acceptance_command(
-    paths: Sequence[Path],
-    plan: GradingPlan,
-    *,
-    seed: int,
-    workers: int,
-    policy: IsolationPolicy,
-    results: Path,
-) -> list[str]:
-    """The pytest command line that runs the acceptance tests of ``paths`` (writing to ``results``)."""
-    command = [sys.executable, "-m", "pytest", *_PYTEST_ARGS.split(), str(ACCEPTANCE_DIR)]
-    command += ["-c", str(ACCEPTANCE_DIR / "pytest.ini"), "--rootdir", str(ACCEPTANCE_DIR)]
-    command += [
-        "--grading-seed",
-        str(seed),
-        "--results-file",
-        str(results),
-        "--isolation-policy",
-        policy.value,
-    ]
-    command += ["--only", ",".join(plan.problems), "-n", str(workers if workers > 1 else 0)]
-    for path in paths:
-        command += ["--submission", str(path.resolve())]
-    if plan.config is not None:
-        command += ["--assignment-config", str(plan.config.resolve())]
-    return command
-
-
-def _stop(process: subprocess.Popen[bytes]) -> None:
-    """End what is left of a run: nothing once it exited by itself; otherwise its whole process group.
-
-    A run is cut short when its results are all in (only pytest's shutdown remains) or when we abandon
-    it (an error or Ctrl-C on our side); the workers' sandboxes die with them (bubblewrap's
-    --die-with-parent, cgroup clean-up).
-    """
-    if process.poll() is None:
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(process.pid, signal.SIGKILL)
-    process.wait()
-
-
-def _fill_missing(
-    runs: dict[str, list[ProblemRun]],
-    paths: Sequence[Path],
-    plan: GradingPlan,
-    seed: int,
-    log_text: str,
-    returncode: int,
-    on_result: Callable[[Path, ProblemResult], None] | None,
-    on_runs: Callable[[Path, Sequence[ProblemRun]], None] | None,
-) -> None:
-    tail = " | ".join(line for line in log_text.strip().splitlines()[-5:] if line.strip())
-    detail = f"the grading run stopped (pytest exit code {returncode}): {tail}"
-    for path in paths:
-        done = {run.result.id for run in runs[str(path)]}
-        for problem in plan.problems:
-            if problem not in done:
-                run = _internal_error_run(path, problem, plan, seed, detail)
-                runs[str(path)].append(run)
-                if on_result is not None:
-                    on_result(path, run.result)
-                if on_runs is not None:
-                    on_runs(path, runs[str(path)])
-
-
-def acceptance_environment() -> dict[str, str]:
-    """The environment of the pytest run: no plugin autoloading (only ours and xdist), this grader first."""
-    environment = dict(os.environ)
-    environment["PYTEST_DISABLE_PLUGIN_AUTOLOAD"] = "1"
-    environment["PYTHONDONTWRITEBYTECODE"] = "1"
-    source_root = str(Path(grader.__file__).resolve().parents[1])
-    environment["PYTHONPATH"] = os.pathsep.join(filter(None, [source_root, environment.get("PYTHONPATH")]))
-    return environment

@@ -1,40 +1,46 @@
-"""The gymgrade pytest plugin: one acceptance test per (submission, problem), results to a JSON-lines file.
+"""The gymgrade pytest plugin: one acceptance test per (submission, problem) case, its outcome typed.
 
-Load it with ``-p grader.plugin`` and point pytest at ``grader/acceptance``. Each acceptance test grades one
-problem of one submission and attaches the structured result to its report (``user_properties`` travel from
-xdist workers to the controller); the controller appends one line per result to ``--results-file`` as soon
-as it arrives, which is what live progress reads. A student's failure is data in that line: the test itself
-errors only when the grader fails, and then the line says so.
+`grader.session` loads it (``-p grader.plugin``) in the calling process, which is pytest-xdist's controller,
+and every xdist worker loads it again from the same arguments. The plan of the session travels as one
+option, ``--gymgrade-plan``: a `SessionPlan` validated once by the caller, serialised as JSON, so the workers
+grade exactly the cases the controller expects and validate nothing twice. Each case's node id is declared
+here (`ProblemCase.node_id`) and checked when the workers collect, so the controller knows every report by
+an id it generated itself. An acceptance test grades its case and attaches the typed `CaseOutcome` to its
+report (``user_properties`` travel from the worker to the controller): a student's failure is a
+`ProblemRun` like any other verdict; a failure of the grader itself is a `GraderFailure`.
 """
 
 from __future__ import annotations
 
-import re
+import json
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO
+from typing import Literal
 
 import pytest
+from pydantic import BaseModel, ConfigDict, TypeAdapter, ValidationError
 from xdist.workermanage import parse_tx_spec_config
 
 from grader.config import AssignmentConfig, load_config
-from grader.execution import problem_seed
-from grader.problems import PROBLEM_IDS, ProblemId
+from grader.problem_registry import ProblemId
+from grader.problems import PROBLEM_IDS, PROBLEMS
 from grader.report import ProblemResult, ProblemRun
 from grader.sandbox import IsolationPolicy
-from grader.scheduling import LongestFirstScheduling, is_slot, with_slots
+from grader.sandbox.errors import IsolationUnavailable
+from grader.scheduling import LongestFirstScheduling, with_slots
 
-RESULT_PROPERTY = "gymgrade_result"
-ERROR_PROPERTY = "gymgrade_internal_error"
+PLAN_OPTION = "--gymgrade-plan"
+OUTCOME_PROPERTY = "gymgrade_outcome"
+"""The ``user_properties`` key under which an acceptance test's report carries its case's outcome (JSON)."""
 GradeCase = Callable[["ProblemCase"], ProblemResult]
-"""The acceptance tests' ``grade`` fixture: grade one case, attach the result to the report, return it."""
-_CASE_ID = re.compile(r"::test_(?P<problem>\w+)\[(?P<index>\d+):")
+"""The ``grade`` fixture of the acceptance tests: grade a case, attach its outcome, return its result."""
 
 
 @dataclass(frozen=True)
 class ProblemCase:
-    """One acceptance test's subject: a problem of a submission."""
+    """One acceptance test's subject: a problem of a submission (its index in the plan)."""
 
     index: int
     submission: Path
@@ -42,127 +48,140 @@ class ProblemCase:
 
     @property
     def test_id(self) -> str:
-        """The parametrize id, also parsed back by the controller for crashed workers."""
-        return f"{self.index}:{self.submission.name}"
+        """The parametrize id: ASCII whatever the file is called, so pytest keeps it as it is."""
+        return f"submission{self.index}"
+
+    @property
+    def node_id(self) -> str:
+        """The pytest node id of this case's acceptance test (rootdir ``grader/acceptance``)."""
+        module = PROBLEMS.problem(self.problem).acceptance_module
+        return f"{module}.py::{module}[{self.test_id}]"
 
 
-@dataclass(frozen=True)
-class GradingOptions:
-    """The plugin's command-line options."""
+class SessionPlan(BaseModel):
+    """What one acceptance session grades; the caller validates it, every process of the session reads it."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
 
     submissions: tuple[Path, ...]
+    problems: tuple[ProblemId, ...]
     seed: int
-    config_path: Path | None
-    only: tuple[ProblemId, ...] | None
-    results_file: Path | None
     policy: IsolationPolicy
+    config: Path | None = None
+
+    def cases(self) -> list[ProblemCase]:
+        """Every (submission, problem) case of the session, problems in the plan's order."""
+        return [
+            ProblemCase(index, submission, problem)
+            for problem in self.problems
+            for index, submission in enumerate(self.submissions)
+        ]
+
+    def option(self) -> str:
+        """This plan as the ``--gymgrade-plan`` argument of the session and its workers."""
+        # json.dumps escapes the lone surrogates a file name that is not UTF-8 decodes to; pydantic's own
+        # JSON refuses them.
+        return f"{PLAN_OPTION}={json.dumps(self.model_dump(mode='json'))}"
 
     @classmethod
-    def from_config(cls, config: pytest.Config) -> GradingOptions:
-        """Read and validate the options; raise ``pytest.UsageError`` naming a bad value."""
-        only_text: str | None = config.getoption("only")
-        only: tuple[ProblemId, ...] | None = None
-        if only_text:
-            names = [name.strip() for name in only_text.split(",") if name.strip()]
-            unknown = [name for name in names if name not in PROBLEM_IDS]
-            if unknown:
-                raise pytest.UsageError(
-                    f"--only: unknown problem {', '.join(unknown)}; "
-                    f"expected ids among {', '.join(PROBLEM_IDS)}"
-                )
-            only = tuple(problem for problem in PROBLEM_IDS if problem in names)
-        config_path = config.getoption("assignment_config")
-        results_file = config.getoption("results_file")
-        return cls(
-            submissions=tuple(Path(path) for path in config.getoption("submission")),
-            seed=config.getoption("grading_seed"),
-            config_path=Path(config_path) if config_path else None,
-            only=only,
-            results_file=Path(results_file) if results_file else None,
-            policy=IsolationPolicy(config.getoption("isolation_policy")),
-        )
+    def from_option(cls, text: str) -> SessionPlan:
+        """The plan a ``--gymgrade-plan`` value holds."""
+        return cls.model_validate(json.loads(text))
+
+
+class GraderFailure(BaseModel):
+    """A case the grader itself failed on: not the student's doing."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    kind: Literal["isolation_unavailable", "grader_error"]
+    detail: str
+
+    @classmethod
+    def of(cls, error: Exception) -> GraderFailure:
+        """The failure an exception raised while grading a case stands for."""
+        if isinstance(error, IsolationUnavailable):
+            return cls(kind="isolation_unavailable", detail=str(error))
+        return cls(kind="grader_error", detail=f"{type(error).__name__}: {error}")
+
+
+CaseOutcome = ProblemRun | GraderFailure
+"""What the controller receives for each case."""
+CASE_OUTCOME: TypeAdapter[CaseOutcome] = TypeAdapter(CaseOutcome)
+
+
+def outcome_json(outcome: CaseOutcome) -> str:
+    """An outcome as the JSON its report carries; never raises on text the student's code produced."""
+    if isinstance(outcome, ProblemRun):
+        return outcome.to_json()
+    detail = outcome.detail.encode("utf-8", "replace").decode("utf-8")
+    return outcome.model_copy(update={"detail": detail}).model_dump_json()
+
+
+def read_outcome(carried: object) -> CaseOutcome:
+    """The outcome a report carries; a value that is not one becomes the grader's own failure."""
+    try:
+        return CASE_OUTCOME.validate_json(carried if isinstance(carried, str | bytes) else "")
+    except ValidationError as error:
+        count = error.error_count()
+        detail = f"the result of this check could not be read back ({count} validation errors)"
+        return GraderFailure(kind="grader_error", detail=detail)
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
     group = parser.getgroup("gymgrade", "gymgrade acceptance tests")
     group.addoption(
-        "--submission",
-        action="append",
-        default=[],
-        metavar="PATH",
-        help="Student file to grade (repeatable).",
-    )
-    group.addoption(
-        "--grading-seed",
-        type=int,
-        default=0,
-        metavar="N",
-        help="Grading seed; each problem's sandbox seed derives from it.",
-    )
-    group.addoption(
-        "--assignment-config",
+        PLAN_OPTION,
+        dest="gymgrade_plan",
         default=None,
-        metavar="PATH",
-        help="Assignment configuration TOML (default: the bundled grader/assignment.toml).",
-    )
-    group.addoption("--only", default=None, metavar="IDS", help="Comma-separated problem ids to grade.")
-    group.addoption(
-        "--results-file",
-        default=None,
-        metavar="PATH",
-        help="JSON-lines file the controller appends one result per line to.",
-    )
-    group.addoption(
-        "--isolation-policy",
-        default=IsolationPolicy.REQUIRE_FULL.value,
-        choices=[policy.value for policy in IsolationPolicy],
-        help="Refuse weaker isolation (require_full) or run with what is available.",
+        metavar="JSON",
+        help="The session's plan (a grader.plugin.SessionPlan as JSON); grader.session passes it.",
     )
 
 
 class GradingSession:
-    """Per-process state: the options and the assignment configuration they select."""
+    """Per-process state: the plan and the assignment configuration it names."""
 
-    def __init__(self, options: GradingOptions) -> None:
-        self.options = options
-        self.assignment: AssignmentConfig = load_config(options.config_path)
-
-    def selected(self, problem: ProblemId) -> bool:
-        """Whether a problem is enabled and chosen by --only."""
-        enabled = self.assignment.problem(problem).enabled
-        return enabled and (self.options.only is None or problem in self.options.only)
+    def __init__(self, plan: SessionPlan) -> None:
+        self.plan = plan
+        self.assignment: AssignmentConfig = load_config(plan.config)
 
     def cases(self, problem: ProblemId) -> list[ProblemCase]:
-        """The acceptance cases of one problem, one per submission."""
-        return [ProblemCase(index, path, problem) for index, path in enumerate(self.options.submissions)]
+        """The acceptance cases of one problem, one per submission (deselected unless planned)."""
+        return [ProblemCase(index, path, problem) for index, path in enumerate(self.plan.submissions)]
 
-    def run(self, case: ProblemCase) -> ProblemRun:
-        """Grade one case (imported lazily so collection stays fast)."""
+    def grade(self, case: ProblemCase) -> CaseOutcome:
+        """Grade one case (imported lazily so collection stays fast); a grader failure is an outcome too."""
         from grader.execution import run_problem
 
-        return run_problem(
-            case.submission,
-            case.problem,
-            config=self.assignment,
-            grading_seed=self.options.seed,
-            policy=self.options.policy,
-        )
+        try:
+            run = run_problem(
+                case.submission,
+                case.problem,
+                config=self.assignment,
+                grading_seed=self.plan.seed,
+                policy=self.plan.policy,
+            )
+        except Exception as error:
+            return GraderFailure.of(error)
+        printable = os.fsencode(case.submission).decode("utf-8", "replace")  # the file's name is not data
+        return run.model_copy(update={"submission": printable})
 
 
 _SESSION_KEY = pytest.StashKey[GradingSession]()
 
 
 def grading_session(config: pytest.Config) -> GradingSession:
-    """The plugin's state for this pytest process."""
+    """The plugin's state for this pytest process (its configuration loaded on first use)."""
+    if _SESSION_KEY not in config.stash:
+        text = config.getoption("gymgrade_plan")
+        if not text:
+            raise pytest.UsageError(
+                f"grader.plugin needs {PLAN_OPTION}; found none. Grade through grader.grading "
+                "(gymgrade check/grade), which passes it."
+            )
+        config.stash[_SESSION_KEY] = GradingSession(SessionPlan.from_option(text))
     return config.stash[_SESSION_KEY]
-
-
-def pytest_configure(config: pytest.Config) -> None:
-    options = GradingOptions.from_config(config)
-    config.stash[_SESSION_KEY] = GradingSession(options)
-    if options.results_file is not None and not hasattr(config, "workerinput"):
-        writer = ResultsWriter(grading_session(config), options.results_file)
-        config.pluginmanager.register(writer, "gymgrade-results")
 
 
 def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
@@ -179,7 +198,11 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     deselected: list[pytest.Item] = []
     for item in items:
         case = _case_of(item)
-        (chosen if case is None or session.selected(case.problem) else deselected).append(item)
+        if case is not None and case.problem in session.plan.problems:
+            _check_node_id(item, case)
+            chosen.append(item)
+        else:
+            deselected.append(item)
     if deselected:
         config.hook.pytest_deselected(items=deselected)
 
@@ -195,9 +218,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 
 @pytest.hookimpl(tryfirst=True, optionalhook=True)
-def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> LongestFirstScheduling | None:
-    if not grading_session(config).options.submissions:
-        return None
+def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> LongestFirstScheduling:
     return LongestFirstScheduling(len(parse_tx_spec_config(config)), log)  # type: ignore[arg-type]
 
 
@@ -209,48 +230,11 @@ def _case_of(item: pytest.Item) -> ProblemCase | None:
     return case if isinstance(case, ProblemCase) else None
 
 
-class ResultsWriter:
-    """Controller side: appends every acceptance result to the results file as it arrives."""
-
-    def __init__(self, session: GradingSession, results_file: Path) -> None:
-        self.session = session
-        self.options = session.options
-        self.stream: IO[str] = results_file.open("a", encoding="utf-8")
-        self.written: set[str] = set()
-
-    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
-        if is_slot(report.nodeid) or report.nodeid in self.written:
-            return
-        properties = dict(report.user_properties)
-        if RESULT_PROPERTY in properties and report.when == "call":
-            self._write(report.nodeid, str(properties[RESULT_PROPERTY]))
-        elif report.failed:
-            self._write_internal_error(report, properties.get(ERROR_PROPERTY))
-
-    def pytest_unconfigure(self) -> None:
-        self.stream.close()
-
-    def _write_internal_error(self, report: pytest.TestReport, error: object) -> None:
-        match = _CASE_ID.search(report.nodeid)
-        if match is None or match["problem"] not in PROBLEM_IDS:
-            return
-        index = int(match["index"])
-        problem: ProblemId = match["problem"]  # type: ignore[assignment]
-        submission = self.options.submissions[index]
-        detail = str(error) if error is not None else (report.longreprtext.strip().splitlines() or ["?"])[-1]
-        settings = self.session.assignment.problem(problem)
-        run = ProblemRun.grader_failure(
-            str(submission),
-            problem,
-            title=settings.title,
-            points=settings.points,
-            seed=problem_seed(self.options.seed, problem),
-            detail=detail,
-            visibility=settings.visibility,
+def _check_node_id(item: pytest.Item, case: ProblemCase) -> None:
+    if item.nodeid != case.node_id:
+        module = PROBLEMS.problem(case.problem).acceptance_module
+        raise pytest.UsageError(
+            f"acceptance test {item.nodeid!r} grades {case.problem} but the controller expects its results "
+            f"under {case.node_id!r}: "
+            f"name the module {module}.py and its test {module}(problem_case, grade)."
         )
-        self._write(report.nodeid, run.to_json())
-
-    def _write(self, nodeid: str, line: str) -> None:
-        self.written.add(nodeid)
-        self.stream.write(line + "\n")
-        self.stream.flush()

@@ -1,12 +1,11 @@
-"""Live progress: follow the results file as checks finish, and show it on a terminal."""
+"""Live progress on a terminal: a line per finished check, or a one-line bar."""
 
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 from typing import TextIO
 
-from grader.report import ProblemResult, ProblemRun
+from grader.report import ProblemResult
 
 _STATUS_MARK = {
     "passed": "PASS",
@@ -16,28 +15,6 @@ _STATUS_MARK = {
     "missing": "MISSING",
     "skipped": "SKIPPED",
 }
-
-
-class ResultsFollower:
-    """Reads the complete lines appended to a JSON-lines results file since the last poll."""
-
-    def __init__(self, path: Path) -> None:
-        self.path = path
-        self._offset = 0
-        self._partial = b""
-
-    def poll(self) -> list[ProblemRun]:
-        """The results written since the previous call (an unfinished last line waits for the next)."""
-        try:
-            with self.path.open("rb") as stream:
-                stream.seek(self._offset)
-                chunk = stream.read()
-        except FileNotFoundError:
-            return []
-        self._offset += len(chunk)
-        lines = (self._partial + chunk).split(b"\n")
-        self._partial = lines.pop()
-        return [ProblemRun.model_validate_json(line) for line in lines if line.strip()]
 
 
 def result_line(result: ProblemResult) -> str:

@@ -1,32 +1,38 @@
-"""Fixtures of the acceptance tests: grade a case and hand the result to the plugin's controller."""
+"""Fixtures of the acceptance tests: grade a case and hand its typed outcome to the controller."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import pytest
 
-from grader.plugin import ERROR_PROPERTY, RESULT_PROPERTY, GradeCase, ProblemCase, grading_session
+from grader.plugin import (
+    OUTCOME_PROPERTY,
+    GradeCase,
+    GraderFailure,
+    ProblemCase,
+    grading_session,
+    outcome_json,
+)
 from grader.report import ProblemResult
 
 
+class GraderFailed(Exception):
+    """Raised when the grader itself failed on a case, to error its test (the outcome is already attached)."""
+
+
 @pytest.fixture
-def grade(request: pytest.FixtureRequest, record_property: Callable[[str, object], None]) -> GradeCase:
-    """Grade a case and attach the result (or the grader's own failure) to the test's report.
+def grade(request: pytest.FixtureRequest) -> GradeCase:
+    """Grade a case and attach its outcome (a result, or the grader's own failure) to the test's report.
 
     The returned result is the grade, whatever the student's code did; only a failure of the grader
-    itself propagates and errors the test.
+    itself errors the test, so the session's log shows it.
     """
     session = grading_session(request.config)
 
     def grade_case(case: ProblemCase) -> ProblemResult:
-        try:
-            run = session.run(case)
-            line = run.to_json()
-        except Exception as error:
-            record_property(ERROR_PROPERTY, f"{type(error).__name__}: {error}")
-            raise
-        record_property(RESULT_PROPERTY, line)
-        return run.result
+        outcome = session.grade(case)
+        request.node.user_properties.append((OUTCOME_PROPERTY, outcome_json(outcome)))
+        if isinstance(outcome, GraderFailure):
+            raise GraderFailed(f"{outcome.kind}: {outcome.detail}")
+        return outcome.result
 
     return grade_case

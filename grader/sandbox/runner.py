@@ -42,6 +42,18 @@ def _unavailable_message(report: IsolationReport) -> str:
     )
 
 
+def require_isolation(policy: IsolationPolicy, isolation: IsolationReport | None = None) -> IsolationReport:
+    """The isolation to apply: `isolation`, else every layer this machine offers (probed once per process).
+
+    Raises:
+        IsolationUnavailable: `policy` is REQUIRE_FULL and a required layer is missing.
+    """
+    report = isolation if isolation is not None else probe_isolation()
+    if policy is IsolationPolicy.REQUIRE_FULL and not report.full:
+        raise IsolationUnavailable(_unavailable_message(report))
+    return report
+
+
 def _file_name(submission: Path) -> str:
     name = re.sub(r"[^A-Za-z0-9_.-]", "_", submission.name) or "submission.py"
     return name if name.endswith(".py") else f"{name}.py"
@@ -81,9 +93,7 @@ class Sandbox:
             IsolationUnavailable: `policy` is REQUIRE_FULL and a required layer is missing.
             OSError: the submission cannot be read.
         """
-        self.isolation = isolation if isolation is not None else probe_isolation()
-        if policy is IsolationPolicy.REQUIRE_FULL and not self.isolation.full:
-            raise IsolationUnavailable(_unavailable_message(self.isolation))
+        self.isolation = require_isolation(policy, isolation)
         self.seed = seed
         self.limits = limits or Limits()
         self._source = submission.read_bytes()

@@ -334,18 +334,32 @@ def test_check_says_how_the_code_was_isolated(isolation: dict[str, Any], expecte
 
 
 ENDLESS = b"def random_blackjack(n):\n    while True:\n        pass\n"
-RESUME_SEED = 736251  # marks this test's pytest command lines
 
 
-def _processes_mentioning(text: str) -> list[int]:
-    found = []
+def _children_of(parent: int) -> set[int]:
+    """Live processes whose parent is ``parent`` (a grading's xdist workers are the batch's children)."""
+    found = set()
     for entry in Path("/proc").iterdir():
         try:
-            if text.encode() in (entry / "cmdline").read_bytes().split(b"\0"):
-                found.append(int(entry.name))
-        except OSError:
+            state, ppid = (entry / "stat").read_text().rsplit(")", 1)[1].split()[0:2]
+        except (OSError, ValueError):
             continue
+        if state != "Z" and int(ppid) == parent:
+            found.add(int(entry.name))
     return found
+
+
+def _alive(pids: set[int]) -> set[int]:
+    """The processes among ``pids`` that still run (neither gone nor zombies)."""
+    alive = set()
+    for pid in pids:
+        try:
+            state = (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()[0]
+        except (OSError, IndexError):
+            continue
+        if state != "Z":
+            alive.add(pid)
+    return alive
 
 
 @pytest.mark.slow
@@ -355,15 +369,16 @@ def test_ctrl_c_keeps_finished_reports_and_a_rerun_resumes(tmp_path: Path, fast_
     (inputs / "empty.py").write_bytes(b"")
     (inputs / "endless.py").write_bytes(ENDLESS)
     argv = [sys.executable, "-m", "grader.cli", "grade", str(inputs), "--out", str(out)]
-    argv += ["--only", "random_blackjack", "--config", str(fast_config), "--seed", str(RESUME_SEED)]
+    argv += ["--only", "random_blackjack", "--config", str(fast_config), "--seed", "736251"]
     argv += ["--allow-weak-isolation"]
     batch = subprocess.Popen(argv, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60
-    # Interrupt while the endless file is being graded: the empty file's report is kept, pytest is running.
-    while not ((out / "empty.json").exists() and len(_processes_mentioning(str(RESUME_SEED))) >= 2):
+    # Interrupt while the endless file is being graded: the empty file's report is kept, a worker is running.
+    while not ((out / "empty.json").exists() and _children_of(batch.pid)):
         assert time.monotonic() < deadline, "the batch did not start grading within 60 s"
         time.sleep(0.1)
     time.sleep(1.0)
+    workers = _children_of(batch.pid)
     batch.send_signal(signal.SIGINT)
     _, err = batch.communicate(timeout=30)
     assert batch.returncode == cli.EXIT_INTERRUPTED, err
@@ -375,7 +390,7 @@ def test_ctrl_c_keeps_finished_reports_and_a_rerun_resumes(tmp_path: Path, fast_
     assert sorted(path.name for path in out.iterdir()) == ["empty.json", "grades.csv"]
     assert [row["submission"] for row in csv.DictReader((out / "grades.csv").open())] == ["empty"]
     time.sleep(0.5)
-    assert _processes_mentioning(str(RESUME_SEED)) == [], "the interrupted grading left processes behind"
+    assert workers and _alive(workers) == set(), "the interrupted grading left processes behind"
 
     (inputs / "endless.py").write_bytes(b"x = 1\n")
     rerun = subprocess.run(argv, capture_output=True, text=True, timeout=120)

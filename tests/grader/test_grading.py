@@ -4,16 +4,25 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import time
 from pathlib import Path
+from typing import NoReturn
 
 import pytest
 from grading_support import CLASSIC_COMPLETE, FAST_OVERRIDES, SUBMISSIONS, write_config
 
+import grader.grading
+import grader.sandbox.runner
 from grader.batch import grade_many
+from grader.errors import BatchInterrupted
 from grader.grading import GradingPlan, grade_files, grade_submission
+from grader.plugin import GraderFailure, SessionPlan
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
+from grader.sandbox.errors import IsolationUnavailable
+from grader.sandbox.isolation.layer import IsolationReport, LayerReport
+from grader.session import OutcomeCallback, SessionEnd
 
 BAD_FILES = [
     ("empty.py", b"", "missing", "empty.py is empty: nothing to grade."),
@@ -118,46 +127,112 @@ def test_batch_writes_a_report_per_submission_and_grades_csv(batch: tuple[Path, 
     assert [(row["total"], row["max_score"]) for row in rows] == [("0", "2"), ("2", "2"), ("0", "2")]
 
 
-def _processes(argument: str | None = None, group: int | None = None) -> list[int]:
-    """Live processes whose command line holds ``argument`` or whose process group is ``group``."""
-    found = []
+def _children() -> set[int]:
+    """Live processes whose parent is this one (the session's xdist workers, while it runs)."""
+    found = set()
     for entry in Path("/proc").iterdir():
         try:
-            command = (entry / "cmdline").read_bytes().split(b"\0")
-            state, pgrp = (entry / "stat").read_text().rsplit(")", 1)[1].split()[0:4:3]
+            state, parent = (entry / "stat").read_text().rsplit(")", 1)[1].split()[0:2]
         except (OSError, ValueError):
             continue
-        if state != "Z" and (
-            (argument is not None and argument.encode() in command)
-            or (group is not None and int(pgrp) == group)
-        ):
-            found.append(int(entry.name))
+        if state != "Z" and int(parent) == os.getpid():
+            found.add(int(entry.name))
     return found
 
 
 def test_an_abandoned_run_leaves_no_process_behind(fast_config: Path) -> None:
-    seed = 918273645  # marks this run's pytest command line
     plan = GradingPlan.load(fast_config, ["car", "cartpole", "random_blackjack"])
-    controllers: list[int] = []
+    workers: set[int] = set()
 
     def give_up(path: Path, result: object) -> None:
-        controllers.extend(_processes(argument=str(seed)))
+        workers.update(_children())
         raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
         grade_files(
             [CLASSIC_COMPLETE],
             plan,
-            seed=seed,
+            seed=918273645,
             workers=2,
             policy=IsolationPolicy.ALLOW_FALLBACK,
             on_result=give_up,
         )
-    [controller] = controllers
+    assert workers, "the session's workers are children of the calling process"
     deadline = time.monotonic() + 10  # SIGKILLed workers take a moment to exit
-    while _processes(group=controller) and time.monotonic() < deadline:
+    while workers & _children() and time.monotonic() < deadline:
         time.sleep(0.1)
-    assert _processes(group=controller) == [], "the pytest run and its xdist workers must be gone"
+    assert not workers & _children(), "the session's xdist workers must be gone"
+
+
+def test_a_batch_interrupted_in_a_callback_says_how_much_is_kept(tmp_path: Path, fast_config: Path) -> None:
+    def interrupt(path: Path, result: object) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(BatchInterrupted) as interrupted:
+        grade_many(
+            [CLASSIC_COMPLETE],
+            tmp_path / "out",
+            seed=3,
+            workers=1,
+            only=["car"],
+            policy=IsolationPolicy.ALLOW_FALLBACK,
+            config=fast_config,
+            on_result=interrupt,
+        )
+    assert (interrupted.value.finished, interrupted.value.total) == (0, 1)
+
+
+def test_full_isolation_is_refused_before_anything_starts(monkeypatch: pytest.MonkeyPatch) -> None:
+    weak = IsolationReport(
+        (LayerReport("bubblewrap", False, "bwrap is missing", "apt-get install bubblewrap"),)
+    )
+    monkeypatch.setattr(grader.sandbox.runner, "probe_isolation", lambda: weak)
+    monkeypatch.setattr(grader.grading, "run_session", _never_called)
+    with pytest.raises(IsolationUnavailable, match="- bubblewrap: bwrap is missing; to fix: apt-get install"):
+        grade_submission(CLASSIC_COMPLETE, only=["car"], policy=IsolationPolicy.REQUIRE_FULL)
+
+
+def _never_called(*args: object, **kwargs: object) -> NoReturn:
+    raise AssertionError("no session may start")
+
+
+def test_isolation_a_worker_finds_unavailable_is_raised_after_the_session(
+    monkeypatch: pytest.MonkeyPatch, fast_config: Path
+) -> None:
+    def refuse(plan: SessionPlan, *, on_outcome: OutcomeCallback, **options: object) -> SessionEnd:
+        failure = GraderFailure(kind="isolation_unavailable", detail="worker: no seccomp")
+        on_outcome(plan.cases()[0], failure)
+        return SessionEnd(exit_code=1, log_tail="")
+
+    monkeypatch.setattr(grader.grading, "run_session", refuse)
+    seen: list[str] = []
+    with pytest.raises(IsolationUnavailable, match=r"^worker: no seccomp$"):
+        grade_submission(
+            CLASSIC_COMPLETE,
+            only=["car"],
+            policy=IsolationPolicy.ALLOW_FALLBACK,
+            config=fast_config,
+            on_progress=lambda result: seen.append(result.id),
+        )
+    assert seen == [], "a check that could not be isolated is not a result"
+
+
+def test_cases_a_stopped_session_left_without_outcome_are_grader_errors(
+    monkeypatch: pytest.MonkeyPatch, fast_config: Path
+) -> None:
+    monkeypatch.setattr(
+        grader.grading,
+        "run_session",
+        lambda *args, **kwargs: SessionEnd(exit_code=3, log_tail="INTERNALERROR> boom"),
+    )
+    report = grade_submission(
+        CLASSIC_COMPLETE, only=["car", "taxi"], policy=IsolationPolicy.ALLOW_FALLBACK, config=fast_config
+    )
+    assert [problem.status for problem in report.problems] == ["error", "error"]
+    assert report.grader_errors == [
+        f"{problem}: the grading run stopped (pytest exit code 3): INTERNALERROR> boom"
+        for problem in ("car", "taxi")
+    ]
 
 
 def test_each_result_carries_its_problems_visibility(tmp_path: Path) -> None:

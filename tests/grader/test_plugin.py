@@ -1,8 +1,10 @@
-"""Tests of grader/plugin.py through real pytest runs: ordering, -n 2 versus -n 0, reproducibility."""
+"""Tests of grader/plugin.py through real pytest sessions: ordering, node ids, 2 workers versus 1, seeds."""
 
 from __future__ import annotations
 
-import subprocess
+import contextlib
+import io
+import os
 from pathlib import Path
 from typing import Any
 
@@ -10,15 +12,18 @@ import pytest
 from grading_support import CLASSIC_COMPLETE, FAST_OVERRIDES, write_config
 
 from grader.config import load_config
-from grader.grading import (
-    GradingPlan,
-    acceptance_command,
-    acceptance_environment,
-    grade_files,
-    run_acceptance,
+from grader.grading import GradingPlan, grade_files, run_acceptance
+from grader.plugin import (
+    CASE_OUTCOME,
+    GraderFailure,
+    ProblemCase,
+    SessionPlan,
+    outcome_json,
+    read_outcome,
 )
-from grader.report import Report
+from grader.report import ProblemResult, ProblemRun, Report
 from grader.sandbox import IsolationPolicy
+from grader.session import acceptance_args, session_environment
 
 PROBLEMS = ("random_blackjack", "cartpole", "car")
 
@@ -49,25 +54,85 @@ def reports(plan: GradingPlan) -> dict[str, Report]:
     }
 
 
-def test_collection_runs_the_longest_expected_checks_first(fast_config: Path, tmp_path: Path) -> None:
-    plan = GradingPlan.load(fast_config, None)
-    run = acceptance_command(
-        [CLASSIC_COMPLETE, CLASSIC_COMPLETE],
-        plan,
+class Collected:
+    """A plugin object that keeps the node ids of a collection."""
+
+    def __init__(self) -> None:
+        self.node_ids: list[str] = []
+
+    def pytest_collection_finish(self, session: pytest.Session) -> None:
+        self.node_ids = [item.nodeid for item in session.items]
+
+
+def test_collection_runs_the_longest_expected_checks_first_under_the_planned_ids(fast_config: Path) -> None:
+    grading = GradingPlan.load(fast_config, None)
+    plan = SessionPlan(
+        submissions=(CLASSIC_COMPLETE, CLASSIC_COMPLETE),
+        problems=grading.problems,
         seed=0,
-        workers=1,
         policy=IsolationPolicy.ALLOW_FALLBACK,
-        results=tmp_path / "results.jsonl",
+        config=fast_config,
     )
-    environment = acceptance_environment()
-    output = subprocess.run(
-        [*run, "--collect-only"], capture_output=True, text=True, cwd=tmp_path, check=True, env=environment
-    ).stdout
-    collected = [line.split("::")[1].split("[")[0] for line in output.splitlines() if "::" in line]
+    collected = Collected()
+    with session_environment({}), contextlib.redirect_stdout(io.StringIO()):
+        exit_code = pytest.main(
+            [*acceptance_args(plan, workers=1), "-n", "0", "--collect-only"], plugins=[collected]
+        )
+    assert exit_code == pytest.ExitCode.OK
     problems = load_config(fast_config).problems
-    enabled = [problem for problem in problems if problems[problem].enabled]
-    expected = sorted(enabled, key=lambda problem: -problems[problem].expected_seconds)
-    assert collected == [f"test_{problem}" for problem in expected for _ in range(2)]
+    expected = sorted(grading.problems, key=lambda problem: -problems[problem].expected_seconds)
+    assert collected.node_ids == [
+        ProblemCase(index, CLASSIC_COMPLETE, problem).node_id for problem in expected for index in range(2)
+    ]
+
+
+def test_the_plan_reaches_the_workers_whatever_the_files_are_called() -> None:
+    names = (Path(os.fsdecode(b"/srv/caf\xe9.py")), Path("/home/zoë/[final] = opengym.py"))
+    plan = SessionPlan(submissions=names, problems=("car",), seed=7, policy=IsolationPolicy.REQUIRE_FULL)
+    name, value = plan.option().split("=", 1)
+    assert name == "--gymgrade-plan"
+    assert SessionPlan.from_option(value) == plan
+
+
+def test_a_case_is_known_by_an_ascii_id_whatever_the_file_is_called() -> None:
+    case = ProblemCase(3, Path("/home/zoë/[final] opengym.py"), "taxi")
+    assert case.node_id == "test_taxi.py::test_taxi[submission3]"
+
+
+def _result(status: str = "passed") -> ProblemResult:
+    return ProblemResult(id="car", title="Car", status=status, score=1.0, max_score=1.0, feedback="ok")  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("outcome", "expected"),
+    [
+        (
+            ProblemRun(submission="/tmp/a.py", result=_result()),
+            ProblemRun(submission="/tmp/a.py", result=_result()),
+        ),
+        (
+            GraderFailure(kind="isolation_unavailable", detail="no bwrap"),
+            GraderFailure(kind="isolation_unavailable", detail="no bwrap"),
+        ),
+        (
+            GraderFailure(kind="grader_error", detail="OSError: \udcff"),
+            GraderFailure(kind="grader_error", detail="OSError: ?"),
+        ),
+    ],
+    ids=["run", "isolation-unavailable", "unencodable-detail"],
+)
+def test_an_outcome_travels_as_json_and_back(outcome: Any, expected: Any) -> None:
+    assert read_outcome(outcome_json(outcome)) == expected
+
+
+@pytest.mark.parametrize(
+    "carried", ['{"kind": "grader_error"}', "not json", 42], ids=["partial", "text", "int"]
+)
+def test_an_unreadable_outcome_is_the_graders_own_failure(carried: object) -> None:
+    outcome = read_outcome(carried)
+    assert isinstance(outcome, GraderFailure) and outcome.kind == "grader_error"
+    assert outcome.detail.startswith("the result of this check could not be read back (")
+    assert CASE_OUTCOME.validate_json(outcome_json(outcome)) == outcome
 
 
 def test_serial_and_parallel_runs_give_the_same_report(reports: dict[str, Report]) -> None:
