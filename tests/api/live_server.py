@@ -25,7 +25,7 @@ PARTIAL_STATUSES = {
     "cartpole": "passed",
     "car": "passed",
     "taxi": "missing",
-    "find_qvalues": "missing",
+    "find_qvalues": "skipped",  # worth 0 points: not called (issue 11)
 }
 SYNTAX_ERROR = b"def random_blackjack(n):\n    return (\n"
 GRADING_WAIT_SECONDS = 300.0

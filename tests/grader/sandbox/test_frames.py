@@ -154,7 +154,7 @@ def test_refusal_message_names_the_function_and_the_fix() -> None:
         frames.encode_value(RiggedFloat(0.4), "the value returned by blackjack()")
 
     assert caught.value.message == (
-        "the value returned by blackjack() is not plain data: found test_protocol.RiggedFloat, a subclass of "
+        "the value returned by blackjack() is not plain data: found test_frames.RiggedFloat, a subclass of "
         "float; subclasses are refused because they can change comparisons; only plain data can be returned: "
         "None, bool, int, float, str, list, tuple, dict with str keys, numpy numbers and numpy arrays of "
         "bool/int/float; convert it with `float(...)`"
