@@ -185,12 +185,12 @@ def sandbox_start(submission: Path, repeats: int, *, isolated: bool = True) -> f
     """
     from grader.config import load_config
     from grader.sandbox import IsolationPolicy, probe_isolation
-    from grader.sandbox.isolation import LAYER_NAMES
+    from grader.sandbox.isolation.registry import LAYERS
     from grader.sandbox.runner import Sandbox
 
     limits = load_config().sandbox.to_limits(60.0)
     policy = IsolationPolicy.REQUIRE_FULL if isolated else IsolationPolicy.ALLOW_FALLBACK
-    isolation = probe_isolation(frozenset() if isolated else frozenset(LAYER_NAMES))
+    isolation = probe_isolation(frozenset() if isolated else frozenset(layer.name for layer in LAYERS))
     times = []
     for index in range(repeats):
         started = time.perf_counter()
