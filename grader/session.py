@@ -26,10 +26,15 @@ from grader.plugin import OUTCOME_PROPERTY, CaseOutcome, GraderFailure, ProblemC
 
 ACCEPTANCE_DIR = Path(__file__).with_name("acceptance")
 OutcomeCallback = Callable[[ProblemCase, CaseOutcome], None]
-_BASE_ARGS = (
-    "-p grader.plugin -p xdist.plugin -p no:cacheprovider -p no:faulthandler -p no:unraisableexception "
-    "-p no:threadexception -q"
+_PLUGINS = (
+    "grader.plugin",
+    "xdist.plugin",
+    "no:cacheprovider",
+    "no:faulthandler",
+    "no:unraisableexception",
+    "no:threadexception",
 )
+_BASE_ARGS = (*(argument for plugin in _PLUGINS for argument in ("-p", plugin)), "-q")
 _SESSION_ENVIRONMENT = {"PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1", "PYTHONDONTWRITEBYTECODE": "1"}
 _CALLER_SETTINGS = ("PYTEST_ADDOPTS", "PYTEST_PLUGINS")
 """Environment variables through which the caller's own pytest settings would reach the session."""
@@ -53,7 +58,7 @@ def acceptance_args(plan: SessionPlan, workers: int) -> list[str]:
     calling process, and the second forces garbage collections that cost about a second per session.
     """
     args = [str(ACCEPTANCE_DIR), "-c", str(ACCEPTANCE_DIR / "pytest.ini"), "--rootdir", str(ACCEPTANCE_DIR)]
-    return [*args, *_BASE_ARGS.split(), "-n", str(max(workers, 1)), plan.option()]
+    return [*args, *_BASE_ARGS, "-n", str(max(workers, 1)), plan.option()]
 
 
 def run_session(

@@ -127,9 +127,10 @@ def test_isolation_unavailable_on_a_worker_is_a_typed_outcome(
 def test_an_outcome_callback_that_raises_ends_the_session_and_its_workers(tmp_path: Path) -> None:
     plan = _plan(tmp_path, "car", "cartpole", submissions=2)
     workers: set[int] = set()
+    before = _children()  # processes earlier tests of this run left as children (servers, fixtures)
 
     def give_up(case: ProblemCase, outcome: CaseOutcome) -> None:
-        workers.update(_children())
+        workers.update(_children() - before)
         raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
@@ -143,9 +144,10 @@ def test_ctrl_c_during_a_session_reaches_the_caller(tmp_path: Path) -> None:
         pytest.skip("Ctrl-C does not raise KeyboardInterrupt in this process")
     plan = _plan(tmp_path, "car", source=ENDLESS)
     workers: set[int] = set()
+    before = _children()  # processes earlier tests of this run left as children (servers, fixtures)
 
     def press_ctrl_c() -> None:
-        workers.update(_children())
+        workers.update(_children() - before)
         os.kill(os.getpid(), signal.SIGINT)
 
     started = time.monotonic()
