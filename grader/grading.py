@@ -13,10 +13,11 @@ from pathlib import Path
 
 import grader
 from grader.config import load_config
+from grader.errors import UnknownProblem
 from grader.execution import problem_seed
 from grader.notebook import NotebookModule, build_module, is_notebook
 from grader.plugin import CaseOutcome, GraderFailure, ProblemCase, SessionPlan
-from grader.problems import PROBLEM_IDS, ProblemId
+from grader.problems import PROBLEM_IDS, PROBLEMS, ProblemId
 from grader.report import GradingTimings, ProblemResult, ProblemRun, Report, Visibility
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import IsolationUnavailable
@@ -49,9 +50,7 @@ class GradingPlan:
         """
         unknown = sorted(set(only or ()) - set(PROBLEM_IDS))
         if unknown:
-            raise ValueError(
-                f"unknown problem {', '.join(unknown)}; expected ids among {', '.join(PROBLEM_IDS)}"
-            )
+            raise UnknownProblem(PROBLEMS.unknown_message(unknown))
         assignment = load_config(config)
         problems = tuple(
             problem
