@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import signal
+import tempfile
+from datetime import datetime
 import sys
 from collections.abc import Callable, Sequence
 from importlib.metadata import entry_points
@@ -21,6 +23,8 @@ from grader.seeds import PRACTICE_SEED, held_out_seed
 
 if TYPE_CHECKING:
     from grader.batch import BatchExecutor
+    from grader.classroom.model import ClassDownload
+    from grader.classroom.output import ClassGradebook
 
 COMMAND_GROUP = "gymgrade.commands"
 EXECUTOR_GROUP = "gymgrade.executors"
@@ -74,6 +78,50 @@ def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
     )
 
 
+def _add_class_options(grade: argparse.ArgumentParser) -> None:
+    from grader.classroom.gradebooks import GRADEBOOKS
+    from grader.classroom.layouts import LAYOUTS
+
+    grade.add_argument(
+        "--layout",
+        choices=tuple(LAYOUTS),
+        default=None,
+        help="the download's layout (default: recognised from its names; see docs/instructors.md)",
+    )
+    grade.add_argument(
+        "--roster",
+        type=Path,
+        default=None,
+        metavar="CSV",
+        help="class roster (GitHub Classroom roster, Canvas gradebook export, or a CSV with id/name/email)",
+    )
+    grade.add_argument(
+        "--gradebook",
+        action="append",
+        choices=tuple(GRADEBOOKS),
+        default=[],
+        help="also write this LMS's import CSV into --out (repeatable)",
+    )
+    grade.add_argument("--assignment-title", default="OpenGym AI lab", help="the assignment's title in gradebooks")
+    grade.add_argument(
+        "--assignment-id", default="", metavar="ID", help="the LMS's assignment id (needed by --gradebook canvas)"
+    )
+    grade.add_argument(
+        "--due",
+        type=_moment,
+        default=None,
+        metavar="ISO-TIME",
+        help="deadline (e.g. 2026-03-01T23:59-05:00): submissions whose source gives a time but no late mark are late after it",  # noqa: E501
+    )
+
+
+def _moment(text: str) -> datetime:
+    try:
+        return datetime.fromisoformat(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an ISO 8601 time such as 2026-03-01T23:59-05:00") from None
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser, including subcommands registered under the `gymgrade.commands` entry points."""
     parser = argparse.ArgumentParser(prog="gymgrade", description="Grade OpenGym AI lab submissions.")
@@ -122,6 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="grade even where the sandbox cannot enforce every isolation layer",
     )
+    _add_class_options(grade)
     grade.set_defaults(handler=run_grade)
 
     bundle = subparsers.add_parser(
@@ -336,20 +385,68 @@ def run_gradescope_run(args: argparse.Namespace) -> int:
 
 
 def run_grade(args: argparse.Namespace) -> int:
-    """`gymgrade grade`: grade every file not yet graded in --out, keep each report as it is done."""
-    from grader.batch import BatchOutcome, collect_submissions, grade_many
+    """`gymgrade grade`: recognise the class download, grade each student's file not yet graded in --out
+    (reports named by identity), keep each report and the gradebooks as they are done."""
+    from grader.classroom import GradedFileRule, discover_all
+    from grader.classroom.errors import GradebookError
+    from grader.classroom.gradebooks import Assignment
+    from grader.classroom.output import ClassGradebook
+    from grader.classroom.roster import read_roster
+    from grader.grading import GradingPlan
 
-    paths = collect_submissions(args.targets)
-    if not paths:
-        print("gymgrade grade: no .py or .ipynb files found in the given targets", file=sys.stderr)
-        return EXIT_ERROR
+    plan = GradingPlan.load(args.config, args.only)
+    roster = read_roster(args.roster) if args.roster is not None else None
+    assignment = Assignment(title=args.assignment_title, lms_id=args.assignment_id)
+    if "canvas" in args.gradebook and not assignment.lms_id:
+        raise GradebookError(
+            "--gradebook canvas needs --assignment-id ID (the number in the assignment's Canvas URL "
+            ".../assignments/ID), so Canvas puts the scores in that assignment's column"
+        )
+    with tempfile.TemporaryDirectory(prefix="gymgrade-class-") as scratch:
+        download = discover_all(
+            args.targets,
+            layout=args.layout,
+            rule=GradedFileRule(functions=plan.problems),
+            scratch=Path(scratch),
+            due=args.due,
+        )
+        print(class_summary(download), file=sys.stderr, flush=True)
+        graded = [submission for submission in download.submissions if submission.graded_file is not None]
+        if not download.submissions and roster is None:
+            print("gymgrade grade: no submissions found in the given targets", file=sys.stderr)
+            return EXIT_ERROR
+        identities = {submission.graded_file.path: submission.identity for submission in graded if submission.graded_file}  # noqa: E501
+        gradebook = ClassGradebook(download, identities, plan.problems, roster, args.gradebook, assignment)
+        return _grade_class(args, list(identities), identities, gradebook)
+
+
+def class_summary(download: ClassDownload) -> str:
+    """What was found: the layout, which file is graded for whom and why, what was refused or unattributed."""
+    from grader.classroom import LAYOUTS
+
+    title = LAYOUTS[download.layout].title if download.layout in LAYOUTS else download.layout
+    lines = [f"Found {len(download.submissions)} submissions ({title}):"]
+    for submission in download.submissions:
+        graded = submission.graded_file.relative if submission.graded_file else "nothing graded"
+        late = " [late]" if submission.late else ""
+        lines.append(f"  {submission.display_name}{late}: {graded} ({submission.why})")
+    for skipped in download.refused:
+        lines.append(f"  refused {skipped.where}: {skipped.reason}")
+    for skipped in download.unattributed:
+        lines.append(f"  not attributed {skipped.where}: {skipped.reason}")
+    return "\n".join(lines)
+
+
+def _grade_class(
+    args: argparse.Namespace, paths: list[Path], identities: dict[Path, str], gradebook: ClassGradebook
+) -> int:
+    from grader.batch import BatchOutcome, grade_many
+
     policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
     executor = find_executor(policy)
     bar = ProgressBar(total=0)
-    graded: list[Path] = []
 
     def planned(outcome: BatchOutcome) -> None:
-        graded.extend(outcome.graded)
         bar.total = max(len(outcome.graded) * len(problems_of(args)), 1)
         if outcome.reused:
             print(
@@ -361,7 +458,7 @@ def run_grade(args: argparse.Namespace) -> int:
             print(f"Grading on {executor}.", file=sys.stderr)
 
     def advance(path: Path, result: ProblemResult) -> None:
-        bar.advance(f"{path.name}: {result.id} {result.status}")
+        bar.advance(f"{identities[path]}: {result.id} {result.status}")
 
     seed = choose_seed(args.seed, args.out)
     try:
@@ -376,6 +473,8 @@ def run_grade(args: argparse.Namespace) -> int:
             on_result=advance,
             executor=executor,
             on_plan=planned,
+            names=identities,
+            gradebook=gradebook,
         )
     except BatchInterrupted as interruption:
         print(
@@ -387,10 +486,11 @@ def run_grade(args: argparse.Namespace) -> int:
         )
         return EXIT_INTERRUPTED
     errors = sum(1 for report in outcome.reports if report.grader_errors)
+    written = ", ".join(["grades.csv", *(f"{name}.csv" for name in args.gradebook)])
     print(
         f"Graded {len(outcome.graded)} submissions"
         + (f" (reused {len(outcome.reused)} earlier reports)" if outcome.reused else "")
-        + f" into {args.out} (grades.csv) with seed {seed}"
+        + f" into {args.out} ({written}) with seed {seed}"
         + (f"; {errors} with grader errors (run again to retry them)" if errors else ""),
         file=sys.stderr,
     )
