@@ -201,7 +201,7 @@ def _extract_member(  # noqa: PLR0913 - one entry, its zip and the bounds it is 
     if stat.S_ISLNK(mode):
         tree.refused.append(Skipped(where, "a symbolic link stored in the zip: links are never followed"))
         return
-    if mode and not stat.S_ISREG(mode) and not stat.S_ISDIR(mode):
+    if stat.S_IFMT(mode) and not stat.S_ISREG(mode) and not stat.S_ISDIR(mode):
         tree.refused.append(Skipped(where, "not a regular file in the zip (a device, FIFO or socket)"))
         return
     if member.flag_bits & 0x1:
