@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import argparse
 import signal
-import tempfile
-from datetime import datetime
 import sys
+import tempfile
 from collections.abc import Callable, Sequence
+from datetime import datetime
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -102,9 +102,14 @@ def _add_class_options(grade: argparse.ArgumentParser) -> None:
         default=[],
         help="also write this LMS's import CSV into --out (repeatable)",
     )
-    grade.add_argument("--assignment-title", default="OpenGym AI lab", help="the assignment's title in gradebooks")
     grade.add_argument(
-        "--assignment-id", default="", metavar="ID", help="the LMS's assignment id (needed by --gradebook canvas)"
+        "--assignment-title", default="OpenGym AI lab", help="the assignment's title in gradebooks"
+    )
+    grade.add_argument(
+        "--assignment-id",
+        default="",
+        metavar="ID",
+        help="the LMS's assignment id (needed by --gradebook canvas)",
     )
     grade.add_argument(
         "--due",
@@ -119,7 +124,9 @@ def _moment(text: str) -> datetime:
     try:
         return datetime.fromisoformat(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an ISO 8601 time such as 2026-03-01T23:59-05:00") from None
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not an ISO 8601 time such as 2026-03-01T23:59-05:00"
+        ) from None
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -399,8 +406,8 @@ def run_grade(args: argparse.Namespace) -> int:
     assignment = Assignment(title=args.assignment_title, lms_id=args.assignment_id)
     if "canvas" in args.gradebook and not assignment.lms_id:
         raise GradebookError(
-            "--gradebook canvas needs --assignment-id ID (the number in the assignment's Canvas URL "
-            ".../assignments/ID), so Canvas puts the scores in that assignment's column"
+            "--gradebook canvas needs --assignment-id ID (the number in the assignment's Canvas URL .../assignments/ID), "  # noqa: E501
+            "so Canvas puts the scores in that assignment's column"
         )
     with tempfile.TemporaryDirectory(prefix="gymgrade-class-") as scratch:
         download = discover_all(
@@ -415,7 +422,11 @@ def run_grade(args: argparse.Namespace) -> int:
         if not download.submissions and roster is None:
             print("gymgrade grade: no submissions found in the given targets", file=sys.stderr)
             return EXIT_ERROR
-        identities = {submission.graded_file.path: submission.identity for submission in graded if submission.graded_file}  # noqa: E501
+        identities = {
+            submission.graded_file.path: submission.identity
+            for submission in graded
+            if submission.graded_file
+        }
         gradebook = ClassGradebook(download, identities, plan.problems, roster, args.gradebook, assignment)
         return _grade_class(args, list(identities), identities, gradebook)
 

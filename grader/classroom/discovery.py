@@ -12,6 +12,8 @@ from grader.classroom.layouts import LAYOUTS, Group, Layout
 from grader.classroom.model import ClassDownload, Skipped, Submission, SubmittedFile
 from grader.classroom.tree import Limits, Tree, read_tree
 
+DEFAULT_RULE = GradedFileRule()
+DEFAULT_LIMITS = Limits()
 RECOGNISED = 0.5
 """Share of a download's top-level names that must carry an LMS's marks for it to be taken as that LMS's."""
 
@@ -39,9 +41,9 @@ def discover(
     path: Path,
     *,
     layout: str | None = None,
-    rule: GradedFileRule = GradedFileRule(),
+    rule: GradedFileRule = DEFAULT_RULE,
     scratch: Path | None = None,
-    limits: Limits = Limits(),
+    limits: Limits = DEFAULT_LIMITS,
     due: datetime | None = None,
 ) -> ClassDownload:
     """Read a class download: recognise its layout, group files by student, choose each graded file.
@@ -76,7 +78,11 @@ def discover(
         )
     grouping = chosen.group(tree)
     download = ClassDownload(
-        layout=chosen.name, root=path, unattributed=grouping.unattributed, refused=tree.refused, ignored=tree.ignored
+        layout=chosen.name,
+        root=path,
+        unattributed=grouping.unattributed,
+        refused=tree.refused,
+        ignored=tree.ignored,
     )
     for group in _merged(grouping.groups):
         download.submissions.append(_submission(group, rule, chosen.name, due))
@@ -110,7 +116,10 @@ def discover_all(paths: Sequence[Path], **options: object) -> ClassDownload:
 
 def _duplicate(later: Submission, kept: Submission) -> Skipped:
     where = later.graded_file.relative if later.graded_file else later.identity
-    return Skipped(where, f"a second submission for {later.identity} (kept {kept.graded_file.relative if kept.graded_file else 'the first'}); pass each student once")  # noqa: E501
+    return Skipped(
+        where,
+        f"a second submission for {later.identity} (kept {kept.graded_file.relative if kept.graded_file else 'the first'}); pass each student once",  # noqa: E501
+    )
 
 
 def _merged(groups: list[Group]) -> list[Group]:

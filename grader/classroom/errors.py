@@ -12,7 +12,7 @@ class UnknownLayout(ClassroomError):
 
 
 class LayoutMismatch(ClassroomError):
-    """Raised when a download is not of the layout named by ``--layout`` (the message says what is missing)."""
+    """Raised when a download is not of the layout ``--layout`` names (the message says what is missing)."""
 
 
 class RosterError(ClassroomError):
@@ -20,4 +20,4 @@ class RosterError(ClassroomError):
 
 
 class GradebookError(ClassroomError):
-    """Raised when a gradebook format is unknown or lacks what it needs (e.g. Canvas without an assignment)."""
+    """Raised when a gradebook lacks what it needs (e.g. Canvas without an assignment id)."""

@@ -55,7 +55,9 @@ class GradeRow:
         return (self.roster.email if self.roster else "") or self.member.email
 
 
-def class_rows(download: ClassDownload, reports: Mapping[str, Report], roster: Roster | None = None) -> list[GradeRow]:
+def class_rows(
+    download: ClassDownload, reports: Mapping[str, Report], roster: Roster | None = None
+) -> list[GradeRow]:
     """A row per student: each member of each submission, and each roster student who submitted nothing.
 
     Args:
@@ -86,7 +88,9 @@ def class_rows(download: ClassDownload, reports: Mapping[str, Report], roster: R
             rows.append(GradeRow(member, submission, report, entry, "; ".join(notes)))
     for entry in roster.entries if roster else []:
         if id(entry) not in seen:
-            rows.append(GradeRow(Member(entry.identity, entry.name, entry.email), None, None, entry, "no submission"))
+            rows.append(
+                GradeRow(Member(entry.identity, entry.name, entry.email), None, None, entry, "no submission")
+            )
     rows.sort(key=lambda row: row.member.identity)
     return rows
 
@@ -123,7 +127,9 @@ def grades_csv(rows: Sequence[GradeRow], problems: Sequence[str]) -> str:
                 submission.graded_file.relative if submission and submission.graded_file else "",
                 submission.why if submission else "",
                 submission.submitted_at.isoformat() if submission and submission.submitted_at else "",
-                "" if submission is None or submission.late is None else ("late" if submission.late else "on time"),
+                ""
+                if submission is None or submission.late is None
+                else ("late" if submission.late else "on time"),
                 report.sha256 if report else "",
                 report.seed if report else "",
                 *(_number(scores.get(problem, 0.0)) if report else "" for problem in problems),
@@ -201,7 +207,10 @@ def gradescope_csv(rows: Sequence[GradeRow], problems: Sequence[str]) -> str:
 
 
 def github_classroom_csv(rows: Sequence[GradeRow]) -> str:
-    """GitHub Classroom's grades CSV: ``github_username, roster_identifier, points_awarded, points_available``."""
+    """GitHub Classroom's grades CSV.
+
+    Columns: ``github_username, roster_identifier, points_awarded, points_available``.
+    """
     points = _max_points(rows)
     lines = [
         [
@@ -223,6 +232,9 @@ GradebookFormat = Callable[[Sequence[GradeRow], Sequence[str], Assignment], str]
 GRADEBOOKS: dict[str, tuple[str, GradebookFormat]] = {
     "canvas": ("canvas.csv", lambda rows, _problems, assignment: canvas_csv(rows, assignment)),
     "gradescope": ("gradescope.csv", lambda rows, problems, _assignment: gradescope_csv(rows, problems)),
-    "github-classroom": ("github-classroom.csv", lambda rows, _problems, _assignment: github_classroom_csv(rows)),
+    "github-classroom": (
+        "github-classroom.csv",
+        lambda rows, _problems, _assignment: github_classroom_csv(rows),
+    ),
 }
 """Every ``--gradebook`` format: its file name in the output directory and how it is written."""

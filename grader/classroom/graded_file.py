@@ -61,7 +61,9 @@ def defined_functions(data: bytes, *, notebook: bool) -> set[str]:
         try:
             cells = json.loads(text).get("cells", [])
             text = "\n".join(
-                "".join(cell.get("source", "")) if isinstance(cell.get("source"), list) else str(cell.get("source", ""))  # noqa: E501
+                "".join(cell.get("source", ""))
+                if isinstance(cell.get("source"), list)
+                else str(cell.get("source", ""))
                 for cell in cells
                 if isinstance(cell, dict) and cell.get("cell_type") == "code"
             )
@@ -94,16 +96,28 @@ def choose(files: Sequence[SubmittedFile], rule: GradedFileRule) -> tuple[Submit
     if len(candidates) == 1:
         return candidates[0], f"the only .py/.ipynb file ({_others(files, candidates[0])})"
     defined = {
-        file: len(defined_functions(_read(file), notebook=file.original_name.lower().endswith(".ipynb")) & set(rule.functions))  # noqa: E501
+        file: len(
+            defined_functions(_read(file), notebook=file.original_name.lower().endswith(".ipynb"))
+            & set(rule.functions)
+        )
         for file in candidates
     }
     best = max(defined.values())
     leaders = [file for file in candidates if defined[file] == best]
     if best == 0:
-        return None, f"none of {_listing(candidates)} defines the lab's functions ({', '.join(rule.functions)}) or is named {' / '.join(rule.names)}"  # noqa: E501
+        return (
+            None,
+            f"none of {_listing(candidates)} defines the lab's functions ({', '.join(rule.functions)}) or is named {' / '.join(rule.names)}",  # noqa: E501
+        )
     if len(leaders) > 1:
-        return None, f"{_listing(leaders)} each define {best} of the lab's functions: rename the one to grade {rule.names[0]}"  # noqa: E501
-    return leaders[0], f"defines {best} of the lab's {len(rule.functions)} functions, more than {_listing([f for f in candidates if f is not leaders[0]])}"  # noqa: E501
+        return (
+            None,
+            f"{_listing(leaders)} each define {best} of the lab's functions: rename the one to grade {rule.names[0]}",  # noqa: E501
+        )
+    return (
+        leaders[0],
+        f"defines {best} of the lab's {len(rule.functions)} functions, more than {_listing([f for f in candidates if f is not leaders[0]])}",  # noqa: E501
+    )
 
 
 def _leaf(name: str) -> str:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from grader.batch import GRADES_FILE, write_atomically
@@ -31,7 +31,7 @@ class ClassGradebook:
     problems: Sequence[str]
     roster: Roster | None = None
     formats: Sequence[str] = ()
-    assignment: Assignment = Assignment()
+    assignment: Assignment = field(default_factory=Assignment)
     rows: list[GradeRow] | None = None
 
     def __call__(self, out_dir: Path, reports: Mapping[Path, Report]) -> None:

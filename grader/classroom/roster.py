@@ -86,8 +86,10 @@ def parse_roster(text: str, *, source: str = "roster") -> Roster:
         identity = next((fields[column] for column in ID_COLUMNS if fields.get(column)), "")
         if not identity:
             continue
-        name = fields.get("name") or fields.get("student") or " ".join(
-            part for part in (fields.get("first name", ""), fields.get("last name", "")) if part
+        name = (
+            fields.get("name")
+            or fields.get("student")
+            or " ".join(part for part in (fields.get("first name", ""), fields.get("last name", "")) if part)
         )
         email = fields.get("email") or fields.get("email address") or ""
         entries.append(RosterEntry(identity, name, email, fields))
@@ -105,7 +107,9 @@ def read_roster(path: Path) -> Roster:
     except OSError as error:
         raise RosterError(f"cannot read the roster {path} ({error.strerror}): pass a CSV file") from error
     if len(data) > MAX_ROSTER_BYTES:
-        raise RosterError(f"the roster {path} is {len(data):,} bytes, over {MAX_ROSTER_BYTES:,}: is it a roster?")
+        raise RosterError(
+            f"the roster {path} is {len(data):,} bytes, over {MAX_ROSTER_BYTES:,}: is it a roster?"
+        )
     try:
         return parse_roster(data.decode("utf-8"), source=str(path))
     except UnicodeDecodeError as error:

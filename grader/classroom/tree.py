@@ -73,7 +73,7 @@ def ignorable(name: str) -> bool:
     return name.startswith(".") or name == "__MACOSX" or name == "__pycache__"
 
 
-def read_tree(root: Path, scratch: Path | None, limits: Limits = Limits()) -> Tree:
+def read_tree(root: Path, scratch: Path | None, limits: Limits | None = None) -> Tree:
     """Every regular file under ``root`` (a folder or a zip), zips opened into ``scratch``.
 
     Args:
@@ -84,6 +84,7 @@ def read_tree(root: Path, scratch: Path | None, limits: Limits = Limits()) -> Tr
     Returns:
         The files, sorted by path, and the refusals.
     """
+    limits = limits or Limits()
     tree = Tree(root=root)
     if root.is_symlink():
         tree.refused.append(Skipped(root.name, "a symbolic link: pass the folder or file itself"))
@@ -123,21 +124,35 @@ def _walk(tree: Tree, folder: Path, prefix: str, scratch: Path | None, limits: L
             tree.refused.append(Skipped(relative, f"cannot be read ({error.strerror})"))
             continue
         if stat.S_ISLNK(info.st_mode):
-            tree.refused.append(Skipped(relative, f"a symbolic link (to {_link_target(item.path)}): links are never followed"))  # noqa: E501
+            tree.refused.append(
+                Skipped(relative, f"a symbolic link (to {_link_target(item.path)}): links are never followed")
+            )
         elif stat.S_ISDIR(info.st_mode):
             _walk(tree, Path(item.path), f"{relative}/", scratch, limits, depth + 1)
         elif not stat.S_ISREG(info.st_mode):
             tree.refused.append(Skipped(relative, "not a regular file (a device, FIFO or socket)"))
         elif info.st_nlink > 1:
             tree.refused.append(
-                Skipped(relative, f"a hard link ({info.st_nlink} names for one file, possibly outside the class folder)")  # noqa: E501
+                Skipped(
+                    relative,
+                    f"a hard link ({info.st_nlink} names for one file, possibly outside the class folder)",
+                )
             )
         elif info.st_size > limits.max_file_bytes:
-            tree.refused.append(Skipped(relative, f"{info.st_size:,} bytes, over the {limits.max_file_bytes:,} limit"))  # noqa: E501
+            tree.refused.append(
+                Skipped(relative, f"{info.st_size:,} bytes, over the {limits.max_file_bytes:,} limit")
+            )
         elif len(tree.entries) >= limits.max_files:
             tree.refused.append(Skipped(relative, f"over the {limits.max_files:,}-file limit of a download"))
         elif item.name.lower().endswith(".zip") and scratch is not None:
-            _expand_zip(tree, Path(item.path), f"{relative}/", scratch / f"z{len(tree.entries)}-{len(tree.refused)}", limits, depth=1)  # noqa: E501
+            _expand_zip(
+                tree,
+                Path(item.path),
+                f"{relative}/",
+                scratch / f"z{len(tree.entries)}-{len(tree.refused)}",
+                limits,
+                depth=1,
+            )
         else:
             tree.entries.append(Entry(relative, Path(item.path)))
 
@@ -177,7 +192,7 @@ def _safe_name(name: str) -> tuple[str, ...] | str:
     return parts
 
 
-def _extract_member(  # noqa: PLR0913 - one entry, its zip and the bounds it is checked against
+def _extract_member(
     tree: Tree,
     bundle: zipfile.ZipFile,
     member: zipfile.ZipInfo,
@@ -208,15 +223,22 @@ def _extract_member(  # noqa: PLR0913 - one entry, its zip and the bounds it is 
         tree.refused.append(Skipped(where, "encrypted: it cannot be read without the password"))
         return
     if member.file_size > limits.max_file_bytes:
-        tree.refused.append(Skipped(where, f"{member.file_size:,} bytes, over the {limits.max_file_bytes:,} limit"))  # noqa: E501
+        tree.refused.append(
+            Skipped(where, f"{member.file_size:,} bytes, over the {limits.max_file_bytes:,} limit")
+        )
         return
     if member.file_size > limits.max_ratio * max(member.compress_size, 1) and member.file_size > 2**20:
         tree.refused.append(
-            Skipped(where, f"compressed {member.file_size / max(member.compress_size, 1):,.0f} to 1, over the {limits.max_ratio:g}:1 limit (a zip bomb?)")  # noqa: E501
+            Skipped(
+                where,
+                f"compressed {member.file_size / max(member.compress_size, 1):,.0f} to 1, over the {limits.max_ratio:g}:1 limit (a zip bomb?)",  # noqa: E501
+            )
         )
         return
     if tree.extracted_bytes + member.file_size > limits.max_total_bytes:
-        tree.refused.append(Skipped(where, f"the download's zips expand past {limits.max_total_bytes:,} bytes"))  # noqa: E501
+        tree.refused.append(
+            Skipped(where, f"the download's zips expand past {limits.max_total_bytes:,} bytes")
+        )
         return
     if len(tree.entries) >= limits.max_files:
         tree.refused.append(Skipped(where, f"over the {limits.max_files:,}-file limit of a download"))

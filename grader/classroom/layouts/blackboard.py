@@ -15,7 +15,9 @@ from grader.classroom.layouts.protocol import Group, Grouping, fraction, top_nam
 from grader.classroom.model import Member, Skipped
 from grader.classroom.tree import Entry, Tree
 
-ATTEMPT = re.compile(r"^(?P<head>.+)_attempt_(?P<ts>\d{4}-\d{2}-\d{2}-\d{2}-\d{2}-\d{2})(?:_(?P<original>.+)|\.txt)$")
+ATTEMPT = re.compile(
+    r"^(?P<head>.+)_attempt_(?P<ts>\d{4}-\d{2}-\d{2}-\d{2}-\d{2}-\d{2})(?:_(?P<original>.+)|\.txt)$"
+)
 NAME_LINE = re.compile(r"^Name:\s*(?P<name>.*?)\s*\((?P<user>[^()]*)\)\s*$", re.MULTILINE)
 
 
@@ -25,7 +27,7 @@ def assignment_prefix(heads: set[str]) -> str:
     if len(heads) == 1:
         head = next(iter(heads))
         return head[: head.rfind("_") + 1]
-    common = os.path.commonprefix(sorted(heads))
+    common = os.path.commonprefix(sorted(heads))  # noqa: RUF071 - names, compared character by character
     return common[: common.rfind("_") + 1]
 
 
@@ -49,7 +51,9 @@ class BlackboardLayout:
         names: dict[str, str] = {}
         for entry, match in matched:
             if match is None or not match["head"].startswith(prefix) or len(match["head"]) == len(prefix):
-                grouping.unattributed.append(Skipped(entry.relative, "not named {assignment}_{username}_attempt_{date}_{file}"))  # noqa: E501
+                grouping.unattributed.append(
+                    Skipped(entry.relative, "not named {assignment}_{username}_attempt_{date}_{file}")
+                )
                 continue
             username = match["head"][len(prefix) :]
             if match["original"] is None:

@@ -50,7 +50,12 @@ class CanvasLayout:
         for entry in tree.entries:
             match = parse(entry.parts[0])
             if match is None:
-                grouping.unattributed.append(Skipped(entry.relative, "not named {name}_{user id}_{attachment id}_{file} as Canvas names its files"))  # noqa: E501
+                grouping.unattributed.append(
+                    Skipped(
+                        entry.relative,
+                        "not named {name}_{user id}_{attachment id}_{file} as Canvas names its files",
+                    )
+                )
                 continue
             identity = match["anon"] or match["user"]
             names.setdefault(identity, match["name"] or "")
@@ -67,9 +72,14 @@ class CanvasLayout:
             grouping.groups.append(
                 Group(
                     (Member(identity, names[identity]),),
-                    [(entry, original) for _, entry, original in sorted(latest.values(), key=lambda item: item[2])],
+                    [
+                        (entry, original)
+                        for _, entry, original in sorted(latest.values(), key=lambda item: item[2])
+                    ],
                     late=late[identity],
-                    note=f"{dropped} earlier upload{'s' if dropped != 1 else ''} of the same name left out" if dropped else "",  # noqa: E501
+                    note=f"{dropped} earlier upload{'s' if dropped != 1 else ''} of the same name left out"
+                    if dropped
+                    else "",
                 )
             )
         return grouping

@@ -36,7 +36,7 @@ def repository_prefix(repositories: set[str], slug: str) -> str:
         return f"{slug}-"
     if len(repositories) < 2:
         return ""
-    common = os.path.commonprefix(sorted(repositories))
+    common = os.path.commonprefix(sorted(repositories))  # noqa: RUF071 - names, compared character by character
     return common[: common.rfind("-") + 1] if "-" in common else ""
 
 
@@ -65,7 +65,11 @@ class GitHubClassroomLayout:
         files: dict[str, list[tuple[Entry, str]]] = defaultdict(list)
         for entry in tree.entries:
             if len(entry.parts) <= skip + 1 or not entry.parts[skip].startswith(prefix):
-                grouping.unattributed.append(Skipped(entry.relative, f"not inside a {prefix or '{prefix}-'}{{username}} repository folder"))  # noqa: E501
+                grouping.unattributed.append(
+                    Skipped(
+                        entry.relative, f"not inside a {prefix or '{prefix}-'}{{username}} repository folder"
+                    )
+                )
                 continue
             username = entry.parts[skip][len(prefix) :]
             files[username].append((entry, "/".join(entry.parts[skip + 1 :])))

@@ -66,7 +66,7 @@ class GradescopeLayout:
         if entry is None:
             raise LayoutMismatch(
                 f"no {METADATA} at the top of the download or one folder down: a Gradescope export has "
-                "assignment_{id}_export/submission_metadata.yml; pass the export's zip or folder as downloaded"
+                "assignment_{id}_export/submission_metadata.yml; pass the export's zip or folder as downloaded"  # noqa: E501
             )
         metadata = self._load(entry)
         base = len(entry.parts) - 1
@@ -84,7 +84,10 @@ class GradescopeLayout:
             members = tuple(self._member(submitter) for submitter in (_field(record, "submitters") or []))
             members = tuple(member for member in members if member.identity)
             if not members:
-                grouping.unattributed += [Skipped(item.relative, f"{folder} names no submitter in {METADATA}") for item in folders.pop(folder, [])]  # noqa: E501
+                grouping.unattributed += [
+                    Skipped(item.relative, f"{folder} names no submitter in {METADATA}")
+                    for item in folders.pop(folder, [])
+                ]
                 continue
             history = _field(record, "history") or []
             files = folders.pop(folder, [])
@@ -97,20 +100,28 @@ class GradescopeLayout:
                 )
             )
         for folder, files in sorted(folders.items()):
-            grouping.unattributed += [Skipped(item.relative, f"the folder {folder} is not in {METADATA}") for item in files]  # noqa: E501
+            grouping.unattributed += [
+                Skipped(item.relative, f"the folder {folder} is not in {METADATA}") for item in files
+            ]
         return grouping
 
     @staticmethod
     def _load(entry: Entry) -> dict[Any, Any]:
         data = entry.path.read_bytes()[: MAX_METADATA_BYTES + 1]
         if len(data) > MAX_METADATA_BYTES:
-            raise LayoutMismatch(f"{entry.relative} is over {MAX_METADATA_BYTES:,} bytes: not a Gradescope export's metadata")  # noqa: E501
+            raise LayoutMismatch(
+                f"{entry.relative} is over {MAX_METADATA_BYTES:,} bytes: not a Gradescope export's metadata"
+            )
         try:
             loaded = yaml.safe_load(data)
         except yaml.YAMLError as error:
-            raise LayoutMismatch(f"{entry.relative} is not valid YAML ({error}): re-download the export") from error
+            raise LayoutMismatch(
+                f"{entry.relative} is not valid YAML ({error}): re-download the export"
+            ) from error
         if not isinstance(loaded, dict):
-            raise LayoutMismatch(f"{entry.relative} holds {type(loaded).__name__}, expected a mapping of submission_{{id}} folders")  # noqa: E501
+            raise LayoutMismatch(
+                f"{entry.relative} holds {type(loaded).__name__}, expected a mapping of submission_{{id}} folders"  # noqa: E501
+            )
         return loaded
 
     @staticmethod

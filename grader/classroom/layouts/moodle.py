@@ -1,4 +1,5 @@
-"""Moodle "Download all submissions": ``{Full Name}_{participant id}_assignsubmission_file_/`` folders, or flat
+"""Moodle "Download all submissions": ``{Full Name}_{participant id}_assignsubmission_file_/`` folders,
+or flat
 files with that prefix (``..._assignsubmission_file_{original}``); online text comes as ``_onlinetext_``.
 
 The student is the participant id (names repeat; the id does not).
@@ -35,7 +36,9 @@ class MoodleLayout:
         for entry in tree.entries:
             match = MOODLE_NAME.match(entry.parts[0])
             if match is None:
-                grouping.unattributed.append(Skipped(entry.relative, "not under a {Full Name}_{participant id}_assignsubmission_ name"))  # noqa: E501
+                grouping.unattributed.append(
+                    Skipped(entry.relative, "not under a {Full Name}_{participant id}_assignsubmission_ name")
+                )
                 continue
             names.setdefault(match["id"], match["name"])
             original = "/".join(part for part in (match["rest"], *entry.parts[1:]) if part)

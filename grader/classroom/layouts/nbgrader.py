@@ -17,7 +17,7 @@ TIMESTAMP = "timestamp.txt"
 
 
 def _skip(tree: Tree) -> int | None:
-    """Components before the student id: 1 under a ``submitted/`` folder, 0 when given ``submitted/`` itself."""
+    """Components before the student id: 1 under ``submitted/``, 0 when given ``submitted/`` itself."""
     if any(entry.parts[0] == SUBMITTED and len(entry.parts) >= 4 for entry in tree.entries):
         return 1
     if tree.root.name == SUBMITTED:

@@ -43,14 +43,18 @@ def _split(entries: list[Entry], depth: int, grouping: Grouping, *, top: bool) -
                 stem = entry.name.rsplit(".", 1)[0]
                 grouping.groups.append(Group((Member(stem),), [(entry, entry.name)]))
             else:
-                grouping.unattributed.append(Skipped(entry.relative, "a file outside every student's folder that is not code"))  # noqa: E501
+                grouping.unattributed.append(
+                    Skipped(entry.relative, "a file outside every student's folder that is not code")
+                )
         for name, inside in sorted(folders.items()):
             _student_or_container(name, inside, depth + 1, grouping)
 
 
 def _student_or_container(name: str, entries: list[Entry], depth: int, grouping: Grouping) -> None:
     own = [entry for entry in entries if len(entry.parts) == depth + 1]
-    with_code = {entry.parts[depth] for entry in entries if len(entry.parts) > depth + 1 and is_candidate(entry.name)}
+    with_code = {
+        entry.parts[depth] for entry in entries if len(entry.parts) > depth + 1 and is_candidate(entry.name)
+    }
     if not own and len(with_code) > 1:
         subfolders: dict[str, list[Entry]] = defaultdict(list)
         for entry in entries:

@@ -27,7 +27,9 @@ class CanvasImportError(ValueError):
     """Raised where Canvas's importer would refuse the file or a row of it."""
 
 
-def canvas_import(text: str, students: set[str], assignments: dict[str, float]) -> dict[tuple[str, str], float | str]:
+def canvas_import(
+    text: str, students: set[str], assignments: dict[str, float]
+) -> dict[tuple[str, str], float | str]:
     """Apply a gradebook CSV as Canvas would: the scores it sets, by (user id, assignment id)."""
     rows = list(csv.reader(io.StringIO(text.lstrip("\ufeff"), newline="")))
     if not rows:
@@ -42,7 +44,9 @@ def canvas_import(text: str, students: set[str], assignments: dict[str, float]) 
             continue
         match = ASSIGNMENT.match(name)
         if match is None:
-            raise CanvasImportError(f"column {name!r} names no assignment id: Canvas would create an assignment")
+            raise CanvasImportError(
+                f"column {name!r} names no assignment id: Canvas would create an assignment"
+            )
         if match["id"] not in assignments:
             raise CanvasImportError(f"assignment {match['id']} is not in the course")
         columns[index] = match["id"]

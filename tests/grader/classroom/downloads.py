@@ -19,7 +19,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[3]
 SOLUTION = (ROOT / "submissions" / "gymnasium_complete.py").read_bytes()
 HELPER = b"def clamp(x, low, high):\n    return max(low, min(high, x))\n"
-TEST_FILE = b"from opengym import random_blackjack\n\ndef test_rate():\n    assert random_blackjack(10) >= 0\n"
+TEST_FILE = (
+    b"from opengym import random_blackjack\n\ndef test_rate():\n    assert random_blackjack(10) >= 0\n"
+)
 DUE = datetime(2026, 3, 1, 23, 59, tzinfo=UTC)
 ON_TIME = DUE - timedelta(days=1)
 LATE = DUE + timedelta(hours=5)
@@ -155,7 +157,8 @@ def _yaml_time(moment: datetime) -> str:
 
 
 def gradescope(root: Path, students: int = 4) -> Expected:
-    """``assignment_{id}_export/``: metadata with Ruby-symbol keys, a pair's submission, history, a late one, a
+    """``assignment_{id}_export/``: metadata with Ruby-symbol keys, a pair's submission, history, a late
+    one, a
     folder not in the metadata, a symlinked file."""
     base = root / "assignment_4242_export"
     expected = Expected(root, "gradescope")
@@ -170,7 +173,10 @@ def gradescope(root: Path, students: int = 4) -> Expected:
         if history:
             lines.append("  :history:")
             for attempt in range(history):
-                lines += [f"  - :id: {700 + attempt}", f"    :created_at: {_yaml_time(when - timedelta(days=attempt + 1))}"]  # noqa: E501
+                lines += [
+                    f"  - :id: {700 + attempt}",
+                    f"    :created_at: {_yaml_time(when - timedelta(days=attempt + 1))}",
+                ]
         else:
             lines.append("  :history: []")
         records.append("\n".join(lines))
@@ -182,7 +188,12 @@ def gradescope(root: Path, students: int = 4) -> Expected:
         record(folder, [(f"Student {number}", sid, f"s{number}@uni.edu")], ON_TIME)
         expected.graded[sid] = f"assignment_4242_export/{folder}/opengym.py"
     _write(base / "submission_9101" / "opengym.py", SOLUTION)
-    record("submission_9101", [("Ada Lovelace", "000101", "ada@uni.edu"), ("Bob Brown", "000102", "bob@uni.edu")], ON_TIME, history=2)  # noqa: E501
+    record(
+        "submission_9101",
+        [("Ada Lovelace", "000101", "ada@uni.edu"), ("Bob Brown", "000102", "bob@uni.edu")],
+        ON_TIME,
+        history=2,
+    )
     expected.graded["000101+000102"] = "assignment_4242_export/submission_9101/opengym.py"
     expected.groups["000101+000102"] = ("000101", "000102")
     _write(base / "submission_9102" / "opengym.py", SOLUTION)
@@ -275,19 +286,27 @@ def nbgrader(root: Path, students: int = 4) -> Expected:
     for number in range(students):
         sid = f"{number:05d}"
         _write(submitted / sid / "ps1" / "opengym.ipynb", _notebook(SOLUTION))
-        _write(submitted / sid / "ps1" / "timestamp.txt", ON_TIME.strftime("%Y-%m-%d %H:%M:%S.%f UTC").encode())
+        _write(
+            submitted / sid / "ps1" / "timestamp.txt", ON_TIME.strftime("%Y-%m-%d %H:%M:%S.%f UTC").encode()
+        )
         expected.graded[sid] = f"submitted/{sid}/ps1/opengym.ipynb"
     _write(submitted / "late01" / "ps1" / "gymnasium.ipynb", _notebook(SOLUTION))
     _write(submitted / "late01" / "ps1" / "timestamp.txt", LATE.strftime("%Y-%m-%d %H:%M:%S.%f UTC").encode())
     expected.graded["late01"] = "submitted/late01/ps1/gymnasium.ipynb"
     expected.late.add("late01")
     _write(submitted / "extra01" / "ps1" / "opengym.ipynb", _notebook(SOLUTION))
-    _write(submitted / "extra01" / "ps1" / ".ipynb_checkpoints" / "opengym-checkpoint.ipynb", _notebook(SOLUTION))
+    _write(
+        submitted / "extra01" / "ps1" / ".ipynb_checkpoints" / "opengym-checkpoint.ipynb", _notebook(SOLUTION)
+    )
     _write(submitted / "extra01" / "ps1" / "helpers.py", HELPER)
-    _write(submitted / "extra01" / "ps1" / "timestamp.txt", ON_TIME.strftime("%Y-%m-%d %H:%M:%S.%f UTC").encode())
+    _write(
+        submitted / "extra01" / "ps1" / "timestamp.txt", ON_TIME.strftime("%Y-%m-%d %H:%M:%S.%f UTC").encode()
+    )
     expected.graded["extra01"] = "submitted/extra01/ps1/opengym.ipynb"
     _symlink(submitted / "mallory" / "ps1" / "opengym.ipynb", "/etc/passwd")
-    _write(submitted / "mallory" / "ps1" / "timestamp.txt", ON_TIME.strftime("%Y-%m-%d %H:%M:%S.%f UTC").encode())
+    _write(
+        submitted / "mallory" / "ps1" / "timestamp.txt", ON_TIME.strftime("%Y-%m-%d %H:%M:%S.%f UTC").encode()
+    )
     expected.graded["mallory"] = None
     expected.refused.append("submitted/mallory/ps1/opengym.ipynb")
     _write(submitted / "README.txt", b"nbgrader collect\n")
@@ -303,7 +322,10 @@ def blackboard(root: Path, students: int = 4) -> Expected:
 
     def attempt(user: str, name: str, when: datetime, files: dict[str, bytes]) -> str:
         stamp = when.strftime("%Y-%m-%d-%H-%M-%S")
-        _write(folder / f"Lab 1_{user}_attempt_{stamp}.txt", f"Name: {name} ({user})\nAssignment: Lab 1\n".encode())
+        _write(
+            folder / f"Lab 1_{user}_attempt_{stamp}.txt",
+            f"Name: {name} ({user})\nAssignment: Lab 1\n".encode(),
+        )
         for original, data in files.items():
             _write(folder / f"Lab 1_{user}_attempt_{stamp}_{original}", data)
         return stamp
@@ -319,7 +341,12 @@ def blackboard(root: Path, students: int = 4) -> Expected:
     stamp = attempt("bbrown", "Bob Brown", LATE, {"opengym.py": SOLUTION})
     expected.graded["bbrown"] = f"Lab 1_bbrown_attempt_{stamp}_opengym.py"
     expected.late.add("bbrown")
-    stamp = attempt("cdubois", "Chloé Dubois", ON_TIME, {"main.py": SOLUTION, "helpers.py": HELPER, "test_main.py": TEST_FILE})  # noqa: E501
+    stamp = attempt(
+        "cdubois",
+        "Chloé Dubois",
+        ON_TIME,
+        {"main.py": SOLUTION, "helpers.py": HELPER, "test_main.py": TEST_FILE},
+    )
     expected.graded["cdubois"] = f"Lab 1_cdubois_attempt_{stamp}_main.py"
     stamp = ON_TIME.strftime("%Y-%m-%d-%H-%M-%S")
     _symlink(folder / f"Lab 1_emallory_attempt_{stamp}_opengym.py", "/etc/passwd")

@@ -16,7 +16,6 @@ import grader
 from grader import cli
 from grader.batch import grade_many, identity_stem
 from grader.classroom import GradedFileRule, discover
-from grader.classroom.gradebooks import Assignment
 from grader.classroom.output import ClassGradebook
 from grader.grading import GradingPlan
 from grader.report import ProblemResult, Report
@@ -48,7 +47,14 @@ class FakeExecutor:
             data = path.read_bytes()
             score = 1.0 if data == SOLUTION else 0.0
             results = [
-                ProblemResult(id=p, title=p, status="passed" if score else "failed", score=score, max_score=1.0, feedback="")  # noqa: E501
+                ProblemResult(
+                    id=p,
+                    title=p,
+                    status="passed" if score else "failed",
+                    score=score,
+                    max_score=1.0,
+                    feedback="",
+                )
                 for p in plan.problems
             ]
             on_report(
@@ -72,7 +78,9 @@ def _batch(path: Path, out: Path, executor: FakeExecutor, **options: object) -> 
     identities = {s.graded_file.path: s.identity for s in download.submissions if s.graded_file}
     plan = GradingPlan.load(None, ONLY)
     gradebook = ClassGradebook(download, identities, plan.problems, **options)  # type: ignore[arg-type]
-    grade_many(list(identities), out, seed=5, only=ONLY, executor=executor, names=identities, gradebook=gradebook)
+    grade_many(
+        list(identities), out, seed=5, only=ONLY, executor=executor, names=identities, gradebook=gradebook
+    )
     return list(csv.DictReader((out / "grades.csv").open(encoding="utf-8", newline="")))
 
 
@@ -125,10 +133,15 @@ def test_gymgrade_grade_a_canvas_zip_into_every_gradebook(
     assert cli.main(argv) == 0
     err = capsys.readouterr().err
     assert "Found 6 submissions (Canvas Download Submissions):" in err
-    assert "  lovelaceada (2001): lovelaceada_2001_6007_opengym-1.py (named opengym.py, the lab's file name; 1 earlier upload of the same name left out)" in err  # noqa: E501
+    assert (
+        "  lovelaceada (2001): lovelaceada_2001_6007_opengym-1.py (named opengym.py, the lab's file name; 1 earlier upload of the same name left out)"  # noqa: E501
+        in err
+    )
     assert "  obrienbob (2002) [late]: obrienbob_LATE_2002_6002_opengym.py" in err
     assert "  refused malloryeve_2006_6009_opengym.py: a symbolic link stored in the zip" in err
-    assert "  not attributed grades_from_last_year.csv: not named {name}_{user id}_{attachment id}_{file}" in err
+    assert (
+        "  not attributed grades_from_last_year.csv: not named {name}_{user id}_{attachment id}_{file}" in err
+    )
     assert "2001: random_blackjack passed" in err
     rows = list(csv.DictReader((out / "grades.csv").open(encoding="utf-8")))
     totals = {row["student"]: row["total"] for row in rows}
@@ -136,5 +149,11 @@ def test_gymgrade_grade_a_canvas_zip_into_every_gradebook(
     changes = canvas_import((out / "canvas.csv").read_text(encoding="utf-8"), set(totals), {"777": 1.0})
     assert changes == {(user, "777"): 1.0 for user in totals}
     assert sorted(path.name for path in out.iterdir()) == sorted(
-        ["grades.csv", "canvas.csv", "gradescope.csv", "github-classroom.csv", *(f"{user}.json" for user in totals)]
+        [
+            "grades.csv",
+            "canvas.csv",
+            "gradescope.csv",
+            "github-classroom.csv",
+            *(f"{user}.json" for user in totals),
+        ]
     )

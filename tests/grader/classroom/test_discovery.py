@@ -101,7 +101,9 @@ def test_a_zip_needs_a_scratch_folder(tmp_path: Path) -> None:
 def test_an_unknown_layout_is_named_with_the_known_ones(tmp_path: Path) -> None:
     from grader.classroom.errors import UnknownLayout
 
-    with pytest.raises(UnknownLayout, match=r"unknown layout 'brightspace': use one of plain, canvas, gradescope"):
+    with pytest.raises(
+        UnknownLayout, match=r"unknown layout 'brightspace': use one of plain, canvas, gradescope"
+    ):
         discover(tmp_path, layout="brightspace")
 
 

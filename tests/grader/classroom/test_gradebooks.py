@@ -40,7 +40,9 @@ def _report(identity: str, score: float) -> Report:
         score=score,
         max_score=2.0,
         problems=[
-            ProblemResult(id=problem, title=problem, status="passed", score=score / 2, max_score=1.0, feedback="")
+            ProblemResult(
+                id=problem, title=problem, status="passed", score=score / 2, max_score=1.0, feedback=""
+            )
             for problem in PROBLEMS
         ],
     )
@@ -83,7 +85,18 @@ def test_grades_csv_has_a_row_per_student_under_their_identity(layout: str, tmp_
         assert row["seed"] == ("42" if graded else "")
     late = {row["student"] for row in rows if row["late"] == "late"}
     assert late == {m for identity in expected.late for m in identity.split("+")}
-    assert list(rows[0])[:10] == ["student", "name", "email", "group", "graded_file", "why", "submitted_at", "late", "sha256", "seed"]  # noqa: E501
+    assert list(rows[0])[:10] == [
+        "student",
+        "name",
+        "email",
+        "group",
+        "graded_file",
+        "why",
+        "submitted_at",
+        "late",
+        "sha256",
+        "seed",
+    ]
 
 
 def test_a_file_named_like_a_formula_is_text_in_grades_csv(tmp_path: Path) -> None:
@@ -137,8 +150,8 @@ def test_canvas_csv_from_another_layout_uses_the_roster_ids(tmp_path: Path) -> N
     _, download, reports = _graded("blackboard", tmp_path)
     roster = parse_roster(
         "Student,ID,SIS User ID,SIS Login ID,Section\r\n    Points Possible,,,,\r\n"
-        "\"Lovelace, Ada\",501,S1,a_lovelace,Sec 1\r\n\"Brown, Bob\",502,S2,bbrown,Sec 2\r\n"
-        "\"Absent, Al\",503,S3,aabsent,Sec 1\r\n"
+        '"Lovelace, Ada",501,S1,a_lovelace,Sec 1\r\n"Brown, Bob",502,S2,bbrown,Sec 2\r\n'
+        '"Absent, Al",503,S3,aabsent,Sec 1\r\n'
     )
     rows = class_rows(download, reports, roster)
     text = canvas_csv(rows, Assignment("Lab 1", "88"))
@@ -157,7 +170,12 @@ def test_a_roster_names_missing_students_and_strangers(tmp_path: Path) -> None:
     assert notes["team-rocket"] == "not on the roster"
     assert notes["octo-cat0"] == ""
     github = _csv(github_classroom_csv(rows))
-    assert github[0] == {"github_username": "dancer", "roster_identifier": "", "points_awarded": "2", "points_available": "2"}  # noqa: E501
+    assert github[0] == {
+        "github_username": "dancer",
+        "roster_identifier": "",
+        "points_awarded": "2",
+        "points_available": "2",
+    }
     by_user = {row["github_username"]: row for row in github}
     assert by_user["octo-cat1"]["roster_identifier"] == "s0001@uni.edu"
     assert by_user["never-submitted"]["points_awarded"] == ""
@@ -169,7 +187,10 @@ def test_a_roster_names_missing_students_and_strangers(tmp_path: Path) -> None:
     ("text", "message"),
     [
         ("", "is empty: expected a CSV with a header row"),
-        ("colour,size\r\nred,2\r\n", "has columns colour, size; expected one naming students: id, github_username"),
+        (
+            "colour,size\r\nred,2\r\n",
+            "has columns colour, size; expected one naming students: id, github_username",
+        ),
     ],
     ids=["empty", "no-id-column"],
 )

@@ -87,7 +87,9 @@ def test_nested_zips_are_read_to_a_depth_and_macos_forks_ignored(tmp_path: Path)
     assert [entry.relative for entry in tree.entries] == ["alice/sub.zip/inner.zip/opengym.py"]
     assert tree.ignored == 1
     shallow = read_tree(archive, tmp_path / "scratch2", Limits(max_zip_depth=2))
-    assert [(s.where, s.reason) for s in shallow.refused] == [("alice/sub.zip/inner.zip", "a zip nested deeper than 2 zips")]  # noqa: E501
+    assert [(s.where, s.reason) for s in shallow.refused] == [
+        ("alice/sub.zip/inner.zip", "a zip nested deeper than 2 zips")
+    ]
 
 
 def test_a_corrupt_zip_is_refused_not_raised(tmp_path: Path) -> None:
