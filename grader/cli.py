@@ -406,8 +406,7 @@ def run_grade(args: argparse.Namespace) -> int:
     assignment = Assignment(title=args.assignment_title, lms_id=args.assignment_id)
     if "canvas" in args.gradebook and not assignment.lms_id:
         raise GradebookError(
-            "--gradebook canvas needs --assignment-id ID (the number in the assignment's Canvas URL .../assignments/ID), "  # noqa: E501
-            "so Canvas puts the scores in that assignment's column"
+            "--gradebook canvas needs --assignment-id ID (the number in the assignment's Canvas URL .../assignments/ID), so Canvas puts the scores in that assignment's column"  # noqa: E501
         )
     with tempfile.TemporaryDirectory(prefix="gymgrade-class-") as scratch:
         download = discover_all(
