@@ -113,7 +113,7 @@ def test_the_export_offers_the_formats_of_gymgrade_grade(
         assert rows[1:] == [
             ["1234", "1234", "", "1", "1", "Graded", "1"],
             ["octocat", "octocat", "", "", "", "Missing", ""],
-        ]  # noqa: E501
+        ]
     else:
         assert rows[1:] == [["1234", "", "1", "1"], ["octocat", "", "", "1"]]
 
