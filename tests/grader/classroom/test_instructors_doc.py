@@ -1,4 +1,4 @@
-"""Every command docs/instructors.md shows is one `gymgrade` accepts, and its layout table is the registry's."""
+"""Every command docs/instructors.md shows is one `gymgrade` accepts; its layout names are the registry's."""
 
 from __future__ import annotations
 
