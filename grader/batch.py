@@ -14,6 +14,7 @@ import hashlib
 import io
 import os
 import tempfile
+import time
 import urllib.parse
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -34,6 +35,9 @@ CHUNK_SUBMISSIONS = 24
 takes few results with it (its unfinished problems are reported as grader errors, the batch goes on)."""
 
 GRADES_FILE = "grades.csv"
+GRADEBOOK_INTERVAL = 1.0
+"""Seconds between two rewrites of a class's gradebooks (a rewrite costs O(class size), so rewriting after
+every report costs O(n^2)); the gradebooks are always rewritten when the batch ends or is interrupted."""
 SUBMISSION_SUFFIXES = (".py", NOTEBOOK_SUFFIX)
 
 ReportCallback = Callable[[Path, Report], None]
@@ -215,6 +219,8 @@ class OutputDirectory:
         self.names = dict(names) if names is not None else report_names(paths)
         self.gradebook = gradebook
         self.reports: dict[Path, Report] = {}
+        self.pending = False
+        self.written_at = -GRADEBOOK_INTERVAL
 
     def report_path(self, path: Path) -> Path:
         """Where the report of ``path`` is kept."""
@@ -232,15 +238,26 @@ class OutputDirectory:
         self.reports[path] = report
 
     def keep(self, path: Path, report: Report) -> None:
-        """Write a finished file's report and rewrite ``grades.csv`` with every file finished so far."""
+        """Write a finished file's report and rewrite ``grades.csv`` with every file finished so far (a
+        class's gradebooks at most every ``GRADEBOOK_INTERVAL`` seconds, the rest at :meth:`flush`)."""
         self.reports[path] = report
         write_atomically(self.report_path(path), report.to_json() + "\n")
+        if self.gradebook is not None and time.monotonic() - self.written_at < GRADEBOOK_INTERVAL:
+            self.pending = True
+            return
         self.write_gradebook()
+
+    def flush(self) -> None:
+        """Rewrite the gradebook if reports arrived since it was last written."""
+        if self.pending:
+            self.write_gradebook()
 
     def write_gradebook(self) -> None:
         """Rewrite ``grades.csv``: a row per finished file, in the batch's order."""
+        self.pending = False
         if self.gradebook is not None:
             self.gradebook(self.out_dir, dict(self.reports))
+            self.written_at = time.monotonic()
             return
         finished = [path for path in self.paths if path in self.reports]
         names = [self.names[path] for path in finished]
@@ -313,6 +330,8 @@ def grade_many(
             )
         except KeyboardInterrupt as interruption:
             raise BatchInterrupted(len(output.reports), len(paths)) from interruption
+        finally:
+            output.flush()
     outcome.reports = [output.reports[path] for path in paths]
     return outcome
 

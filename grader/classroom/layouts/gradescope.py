@@ -113,7 +113,8 @@ class GradescopeLayout:
                 f"{entry.relative} is over {MAX_METADATA_BYTES:,} bytes: not a Gradescope export's metadata"
             )
         try:
-            loaded = yaml.safe_load(data)
+            # The C safe loader where PyYAML has it (10x faster on a large class), the Python one otherwise.
+            loaded = yaml.load(data, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
         except yaml.YAMLError as error:
             raise LayoutMismatch(
                 f"{entry.relative} is not valid YAML ({error}): re-download the export"

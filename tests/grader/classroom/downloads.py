@@ -183,7 +183,7 @@ def gradescope(root: Path, students: int = 4) -> Expected:
 
     for number in range(students):
         sid = f"00{3100 + number}"
-        folder = f"submission_{9000 + number}"
+        folder = f"submission_{20000 + number}"
         _write(base / folder / "opengym.py", SOLUTION)
         record(folder, [(f"Student {number}", sid, f"s{number}@uni.edu")], ON_TIME)
         expected.graded[sid] = f"assignment_4242_export/{folder}/opengym.py"
@@ -205,7 +205,7 @@ def gradescope(root: Path, students: int = 4) -> Expected:
     _write(base / "submission_9103" / "tests" / "agent_test.py", TEST_FILE)
     record("submission_9103", [("Dan Ng", "000104", "dan@uni.edu")], ON_TIME)
     expected.graded["000104"] = "assignment_4242_export/submission_9103/src/agent.py"
-    _symlink(base / "submission_9104" / "opengym.py", "../submission_9000/opengym.py")
+    _symlink(base / "submission_9104" / "opengym.py", "../submission_20000/opengym.py")
     record("submission_9104", [("Eve Mallory", "000105", "eve@uni.edu")], ON_TIME)
     expected.graded["000105"] = None
     expected.refused.append("assignment_4242_export/submission_9104/opengym.py")
