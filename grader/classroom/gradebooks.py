@@ -70,9 +70,12 @@ def class_rows(
     """
     rows: list[GradeRow] = []
     seen: set[int] = set()
+    counted = _counted_submissions(download)
     for submission in download.submissions:
         report = reports.get(submission.identity)
         for member in submission.members:
+            if counted[member.identity] is not submission:
+                continue
             entry = roster.find(member.identity) if roster else None
             if entry is not None:
                 seen.add(id(entry))
@@ -85,6 +88,13 @@ def class_rows(
                 notes.append(report.submission_error or "; ".join(report.grader_errors))
             if roster is not None and entry is None:
                 notes.append("not on the roster")
+            others = [
+                other.identity
+                for other in download.submissions
+                if other is not submission and member in other.members
+            ]
+            if others:
+                notes.append(f"also in {', '.join(others)}: the latest submission counts")
             rows.append(GradeRow(member, submission, report, entry, "; ".join(notes)))
     for entry in roster.entries if roster else []:
         if id(entry) not in seen:
@@ -93,6 +103,27 @@ def class_rows(
             )
     rows.sort(key=lambda row: row.member.identity)
     return rows
+
+
+def _counted_submissions(download: ClassDownload) -> dict[str, Submission]:
+    """The submission that counts for each student: their only one, or of several (a student in two groups
+    of a Gradescope export), the latest by submission time, else the last by identity."""
+    counted: dict[str, Submission] = {}
+    for submission in download.submissions:
+        for member in submission.members:
+            current = counted.get(member.identity)
+            if current is None or _later(submission, current):
+                counted[member.identity] = submission
+    return counted
+
+
+def _later(candidate: Submission, current: Submission) -> bool:
+    if candidate.submitted_at is not None and current.submitted_at is not None:
+        try:
+            return candidate.submitted_at >= current.submitted_at
+        except TypeError:  # one time has a zone, the other not
+            return True
+    return True
 
 
 def _number(value: float | None) -> str:

@@ -17,16 +17,20 @@ from grader.classroom.model import Member, Skipped
 from grader.classroom.tree import Entry, Tree
 
 CANVAS_NAME = re.compile(
-    r"^(?:(?P<anon>anon_[A-Za-z0-9]+)|(?P<name>[a-z0-9]*))(?P<late>_LATE)?"
+    r"^(?:(?P<anon>anon_[A-Za-z0-9]+)|(?P<name>[^_]*))(?P<late>_LATE)?"
     r"(?:_(?P<user>\d+))?_(?P<attachment>\d+)_(?P<original>.+)$"
 )
+CANVAS_TEXT_ENTRY = re.compile(
+    r"^(?P<name>[^_]*)(?P<late>_LATE)?_(?P<user>\d+)_(?P<original>(?:text|url|link)\.\w+)$"
+)
+"""A submission typed into Canvas (text entry, website URL) has no attachment id."""
 
 
 def parse(name: str) -> re.Match[str] | None:
     """The parts of a Canvas download name, None when it is not one."""
     match = CANVAS_NAME.match(name)
     if match is None or not (match["anon"] or match["user"]):
-        return None
+        match = CANVAS_TEXT_ENTRY.match(name)
     return match
 
 
@@ -57,11 +61,12 @@ class CanvasLayout:
                     )
                 )
                 continue
-            identity = match["anon"] or match["user"]
+            groups = match.groupdict()
+            identity = groups.get("anon") or match["user"]
             names.setdefault(identity, match["name"] or "")
             late[identity] |= bool(match["late"])
             original = "/".join((match["original"], *entry.parts[1:]))
-            by_user[identity].append((int(match["attachment"]), entry, original))
+            by_user[identity].append((int(groups.get("attachment") or 0), entry, original))
         for identity, uploads in sorted(by_user.items()):
             latest: dict[str, tuple[int, Entry, str]] = {}
             for attachment, entry, original in uploads:

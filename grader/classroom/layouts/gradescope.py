@@ -21,6 +21,25 @@ from grader.classroom.model import Member, Skipped
 from grader.classroom.tree import Entry, Tree
 
 METADATA = "submission_metadata.yml"
+_SafeLoader: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+class MetadataLoader(_SafeLoader):  # type: ignore[misc,valid-type]
+    """PyYAML's safe loader (the C one where PyYAML has it), reading a tagged node (``!ruby/object:...``, as
+    Rails writes a time or a record) as the plain mapping, list or text under the tag: no tag builds an
+    object."""
+
+
+def _untagged(loader: yaml.SafeLoader, _suffix: str, node: yaml.Node) -> object:
+    if isinstance(node, yaml.MappingNode):
+        return loader.construct_mapping(node, deep=True)
+    if isinstance(node, yaml.SequenceNode):
+        return loader.construct_sequence(node, deep=True)
+    return loader.construct_scalar(node)  # type: ignore[arg-type]
+
+
+MetadataLoader.add_multi_constructor("!", _untagged)
+MetadataLoader.add_multi_constructor("tag:yaml.org,2002:", _untagged)
 MAX_METADATA_BYTES = 32 * 2**20
 
 
@@ -42,6 +61,8 @@ def _text(value: object) -> str:
 
 
 def _time(value: object) -> datetime | None:
+    if isinstance(value, dict):  # a tagged Rails time, read as its fields
+        value = value.get("utc", value.get("time"))
     if isinstance(value, datetime):
         return value
     try:
@@ -113,8 +134,7 @@ class GradescopeLayout:
                 f"{entry.relative} is over {MAX_METADATA_BYTES:,} bytes: not a Gradescope export's metadata"
             )
         try:
-            # The C safe loader where PyYAML has it (10x faster on a large class), the Python one otherwise.
-            loaded = yaml.load(data, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+            loaded = yaml.load(data, Loader=MetadataLoader)  # a safe loader: see MetadataLoader
         except yaml.YAMLError as error:
             raise LayoutMismatch(
                 f"{entry.relative} is not valid YAML ({error}): re-download the export"

@@ -204,3 +204,39 @@ def test_a_roster_matches_ids_case_insensitively_and_keeps_leading_zeros() -> No
     entry = roster.find("00123")
     assert entry is not None and entry.identity == "00123" and roster.find("ada@uni.edu") is entry
     assert roster.find("123") is None
+
+
+def test_a_student_in_two_submissions_gets_one_row_from_the_latest(tmp_path: Path) -> None:
+    export = tmp_path / "assignment_1_export"
+    for folder in ("submission_1", "submission_2"):
+        (export / folder).mkdir(parents=True)
+        (export / folder / "opengym.py").write_text("def random_blackjack(n):\n    return 0\n")
+    (export / "submission_metadata.yml").write_text(
+        "submission_1:\n  :submitters:\n  - :name: Ada\n    :sid: '01'\n  - :name: Bob\n    :sid: '02'\n"
+        "  :created_at: 2026-03-01 10:00:00.000000000 +00:00\n"
+        "submission_2:\n  :submitters:\n  - :name: Ada\n    :sid: '01'\n"
+        "  :created_at: !ruby/object:ActiveSupport::TimeWithZone\n    utc: 2026-03-02 10:00:00 Z\n"
+        "  :history: !!python/object/apply:os.system ['echo owned']\n"
+    )
+    download = discover(tmp_path, rule=RULE)
+    assert [s.identity for s in download.submissions] == ["01", "01+02"]
+    rows = class_rows(download, {s.identity: _report(s.identity, 1.0) for s in download.submissions})
+    assert [(row.member.identity, row.submission.identity if row.submission else None) for row in rows] == [
+        ("01", "01"),
+        ("02", "01+02"),
+    ]
+    assert rows[0].note == "also in 01+02: the latest submission counts"
+
+
+def test_canvas_text_entries_and_accented_names_are_attributed(tmp_path: Path) -> None:
+    (tmp_path / "dl").mkdir()
+    for name in [
+        "duboischloé_2004_6006_opengym.py",
+        "smithjohn_12345_text.html",
+        "smithjohn_12345_7_opengym.py",
+    ]:
+        (tmp_path / "dl" / name).write_text("x = 1\n")
+    download = discover(tmp_path / "dl", rule=RULE)
+    assert download.layout == "canvas" and download.unattributed == []
+    files = {s.identity: sorted(f.original_name for f in s.files) for s in download.submissions}
+    assert files == {"12345": ["opengym.py", "text.html"], "2004": ["opengym.py"]}
