@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from datetime import UTC, datetime
 from pathlib import Path
@@ -9,8 +10,8 @@ from pathlib import Path
 from grader.classroom.errors import LayoutMismatch, UnknownLayout
 from grader.classroom.graded_file import GradedFileRule, choose
 from grader.classroom.layouts import LAYOUTS, Group, Layout
-from grader.classroom.model import ClassDownload, Skipped, Submission, SubmittedFile
-from grader.classroom.tree import Limits, Tree, read_tree
+from grader.classroom.model import ClassDownload, Member, Skipped, Submission, SubmittedFile
+from grader.classroom.tree import Entry, Limits, Tree, read_tree
 
 DEFAULT_RULE = GradedFileRule()
 DEFAULT_LIMITS = Limits()
@@ -84,8 +85,22 @@ def discover(
         refused=tree.refused,
         ignored=tree.ignored,
     )
+    refused_by = _refused_by_student(chosen, tree)
     for group in _merged(grouping.groups):
-        download.submissions.append(_submission(group, rule, chosen.name, due))
+        refused = refused_by.pop(group.identity, (group.members, []))[1]
+        download.submissions.append(_submission(group, rule, chosen.name, due, refused))
+    for identity, (members, refused) in refused_by.items():
+        download.submissions.append(
+            Submission(
+                identity=identity,
+                display_name=_display(members, identity),
+                members=members,
+                files=(),
+                graded_file=None,
+                why=f"nothing to grade: every file was refused ({_refusals(refused)})",
+                source=chosen.name,
+            )
+        )
     download.submissions.sort(key=lambda submission: submission.identity)
     return download
 
@@ -122,6 +137,41 @@ def _duplicate(later: Submission, kept: Submission) -> Skipped:
     )
 
 
+def _regroup(layout: Layout, tree: Tree) -> list[Group]:
+    """The groups of the download with its refused files put back as stand-ins (``os.devnull``: nothing of
+    theirs is read), so that each refused file can be said to be some student's."""
+    stand_ins = [Entry(skipped.where, Path(os.devnull)) for skipped in tree.refused]
+    return layout.group(
+        Tree(root=tree.root, entries=sorted([*tree.entries, *stand_ins], key=lambda e: e.relative))
+    ).groups
+
+
+def _refused_by_student(layout: Layout, tree: Tree) -> dict[str, tuple[tuple[Member, ...], list[Skipped]]]:
+    """The refused files of each student a layout can name for them, with the student's members."""
+    if not tree.refused:
+        return {}
+    reasons = {skipped.where: skipped for skipped in tree.refused}
+    found: dict[str, tuple[tuple[Member, ...], list[Skipped]]] = {}
+    for group in _merged(_regroup(layout, tree)):
+        mine = [
+            reasons[entry.relative]
+            for entry, _ in group.files
+            if entry.relative in reasons and entry.path == Path(os.devnull)
+        ]
+        if mine:
+            found[group.identity] = (group.members, mine)
+    return found
+
+
+def _refusals(refused: list[Skipped]) -> str:
+    return "; ".join(f"{skipped.where}: {skipped.reason}" for skipped in refused)
+
+
+def _display(members: tuple[Member, ...], identity: str) -> str:
+    names = ", ".join(member.name for member in members if member.name)
+    return f"{names} ({identity})" if names else identity
+
+
 def _merged(groups: list[Group]) -> list[Group]:
     """Groups of one identity (a student's folder and a file of their name) made one."""
     by_identity: dict[str, Group] = {}
@@ -133,16 +183,19 @@ def _merged(groups: list[Group]) -> list[Group]:
     return list(by_identity.values())
 
 
-def _submission(group: Group, rule: GradedFileRule, source: str, due: datetime | None) -> Submission:
+def _submission(
+    group: Group, rule: GradedFileRule, source: str, due: datetime | None, refused: list[Skipped]
+) -> Submission:
     files = tuple(SubmittedFile(entry.path, entry.relative, original) for entry, original in group.files)
     graded, why = choose(files, rule)
-    names = ", ".join(member.name for member in group.members if member.name)
+    if refused:
+        why = f"{why}; refused {_refusals(refused)}"
     late = group.late
     if late is None and due is not None and group.submitted_at is not None:
         late = _aware(group.submitted_at) > _aware(due)
     return Submission(
         identity=group.identity,
-        display_name=f"{names} ({group.identity})" if names else group.identity,
+        display_name=_display(group.members, group.identity),
         members=group.members,
         files=files,
         graded_file=graded,

@@ -139,6 +139,7 @@ def canvas(root: Path, students: int = 4) -> Expected:
         bundle.writestr(link, "/etc/passwd")
         bundle.writestr("../../escaped_2007_6010_opengym.py", SOLUTION)
     expected.refused += ["malloryeve_2006_6009_opengym.py", "../../escaped_2007_6010_opengym.py"]
+    expected.graded["2006"] = None  # a student whose only file is refused still gets a row saying so
     return expected
 
 
@@ -351,6 +352,7 @@ def blackboard(root: Path, students: int = 4) -> Expected:
     stamp = ON_TIME.strftime("%Y-%m-%d-%H-%M-%S")
     _symlink(folder / f"Lab 1_emallory_attempt_{stamp}_opengym.py", "/etc/passwd")
     expected.refused.append(f"Lab 1_emallory_attempt_{stamp}_opengym.py")
+    expected.graded["emallory"] = None
     _write(folder / "Lab 1_instructions.pdf", b"%PDF-1.4\n")
     expected.unattributed.append("Lab 1_instructions.pdf")
     return expected

@@ -58,7 +58,10 @@ def test_graded_file_choices_say_why(tmp_path: Path) -> None:
     assert why["bob"] == "named opengym.py, the lab's file name"
     assert why["carol"] == "the only .py/.ipynb file (nothing else)"
     assert why["dan"] == "defines 6 of the lab's 6 functions, more than helpers.py"
-    assert why["eve"] == "no .py or .ipynb file to grade (test files and checkpoints are never graded)"
+    assert why["eve"] == (
+        "no .py or .ipynb file to grade (test files and checkpoints are never graded); "
+        "refused eve/opengym.py: a symbolic link (to /etc/passwd): links are never followed"
+    )
 
 
 def test_a_symlink_is_refused_with_its_target_and_never_read(tmp_path: Path) -> None:
@@ -113,3 +116,18 @@ def test_a_named_layout_that_does_not_fit_says_so(tmp_path: Path) -> None:
     expected = BUILDERS["plain"](tmp_path / "download", 2)
     with pytest.raises(LayoutMismatch, match="does not look like a Moodle Download all submissions download"):
         discover(expected.path, layout="moodle")
+
+
+def test_a_student_whose_every_file_is_refused_gets_a_submission_saying_so(tmp_path: Path) -> None:
+    folder = tmp_path / "moodle"
+    (folder / "Ann Lee_501_assignsubmission_file_").mkdir(parents=True)
+    (folder / "Ann Lee_501_assignsubmission_file_" / "opengym.py").write_text("x = 1\n")
+    (folder / "Eve Ray_502_assignsubmission_file_").mkdir()
+    (folder / "Eve Ray_502_assignsubmission_file_" / "opengym.py").symlink_to(folder.parent)
+    download = discover(folder, rule=RULE)
+    eve = download.submissions[1]
+    assert (eve.identity, eve.display_name, eve.graded_file, eve.files) == ("502", "Eve Ray (502)", None, ())
+    assert eve.why == (
+        "nothing to grade: every file was refused (Eve Ray_502_assignsubmission_file_/opengym.py: "
+        f"a symbolic link (to {folder.parent}): links are never followed)"
+    )
