@@ -158,3 +158,31 @@ def test_gymgrade_grade_a_canvas_zip_into_every_gradebook(
             *(f"{user}.json" for user in graded),
         ]
     )
+
+
+@dataclass
+class InterruptingExecutor(FakeExecutor):
+    """Stops (as Ctrl-C would) after grading ``after`` files."""
+
+    after: int = 2
+
+    def grade(self, paths: Sequence[Path], plan: GradingPlan, **options: object) -> None:  # type: ignore[override]
+        super().grade(paths[: self.after], plan, **options)  # type: ignore[arg-type]
+        raise KeyboardInterrupt
+
+
+def test_an_interrupted_batch_leaves_gradebooks_with_every_finished_report(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from grader import batch
+    from grader.errors import BatchInterrupted
+
+    monkeypatch.setattr(batch, "GRADEBOOK_INTERVAL", 3600.0)  # only the first report rewrites at once
+    expected = BUILDERS["plain"](tmp_path / "download", 3)
+    with pytest.raises(BatchInterrupted):
+        _batch(expected.path, tmp_path / "out", InterruptingExecutor(after=3))
+    rows = list(csv.DictReader((tmp_path / "out" / "grades.csv").open(encoding="utf-8")))
+    assert sum(1 for row in rows if row["total"]) == 3
+    assert (
+        sum(1 for row in rows if row["note"] == "not graded yet") == len(rows) - 3 - 1
+    )  # eve: nothing graded
