@@ -21,7 +21,7 @@ from grader.grading import GradingPlan
 from grader.report import ProblemResult, Report
 
 from .canvas_import import canvas_import
-from .downloads import BUILDERS, DUE, SOLUTION
+from .downloads import BUILDERS, DUE
 
 RULE = GradedFileRule(functions=("random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues"))
 ONLY = ("random_blackjack",)
@@ -29,7 +29,7 @@ ONLY = ("random_blackjack",)
 
 @dataclass
 class FakeExecutor:
-    """Grades each file into a report of its bytes (a score of 1 for the lab's solution, else 0)."""
+    """Grades each file into a report of its bytes (1 for the lab's solution, as a file or notebook, else 0)."""
 
     asked: list[list[Path]] = field(default_factory=list)
 
@@ -45,7 +45,7 @@ class FakeExecutor:
         self.asked.append(list(paths))
         for path in paths:
             data = path.read_bytes()
-            score = 1.0 if data == SOLUTION else 0.0
+            score = 1.0 if b"def find_qvalues(env, alpha=.1" in data else 0.0
             results = [
                 ProblemResult(
                     id=p,
@@ -186,3 +186,38 @@ def test_an_interrupted_batch_leaves_gradebooks_with_every_finished_report(
     assert (
         sum(1 for row in rows if row["note"] == "not graded yet") == len(rows) - 3 - 1
     )  # eve: nothing graded
+
+
+@pytest.mark.parametrize("layout", list(BUILDERS), ids=list(BUILDERS))
+def test_gymgrade_grade_each_layout_into_every_gradebook(
+    layout: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The command's whole path but grading (an instant executor stands in for the sandbox)."""
+    monkeypatch.setattr(cli, "find_executor", lambda policy: FakeExecutor())
+    expected = BUILDERS[layout](tmp_path / "download", 3)
+    out = tmp_path / "out"
+    argv = ["grade", str(expected.path), "--out", str(out), "--only", "random_blackjack", "--seed", "3"]
+    argv += ["--due", DUE.isoformat(), "--assignment-id", "9"]
+    argv += ["--gradebook", "canvas", "--gradebook", "gradescope", "--gradebook", "github-classroom"]
+    roster = expected.path.parent / "roster.csv"
+    if roster.exists():
+        argv += ["--roster", str(roster)]
+    assert cli.main(argv) == 0
+    assert f"Grading on {FakeExecutor()}." in capsys.readouterr().err
+    rows = list(csv.DictReader((out / "grades.csv").open(encoding="utf-8")))
+    members = {identity: expected.groups.get(identity, (identity,)) for identity in expected.graded}
+    students = sorted(member for group in members.values() for member in group)
+    on_roster_only = ["never-submitted"] if roster.exists() else []
+    assert [row["student"].removeprefix("'") for row in rows] == sorted(students + on_roster_only)
+    graded = {m for identity, file in expected.graded.items() if file for m in members[identity]}
+    assert {row["student"].removeprefix("'") for row in rows if row["total"] == "1"} == graded
+    assert {row["student"] for row in rows if row["late"] == "late"} == {
+        m for identity in expected.late for m in members[identity]
+    }
+    for name in ("gradescope.csv", "github-classroom.csv"):
+        other = list(csv.reader((out / name).open(encoding="utf-8")))
+        assert len(other) == len(rows) + 1, f"{name}: a row per student"
+    canvas = list(csv.reader((out / "canvas.csv").open(encoding="utf-8")))
+    assert canvas[1][0] == "    Points Possible"
+    if layout == "canvas":
+        assert {row[1] for row in canvas[2:]} == set(students)
