@@ -29,7 +29,7 @@ ONLY = ("random_blackjack",)
 
 @dataclass
 class FakeExecutor:
-    """Grades each file into a report of its bytes (1 for the lab's solution, as a file or notebook, else 0)."""
+    """Grades each file into a report of its bytes (1 for the lab's solution, file or notebook, else 0)."""
 
     asked: list[list[Path]] = field(default_factory=list)
 
