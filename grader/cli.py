@@ -412,7 +412,8 @@ def run_grade(args: argparse.Namespace) -> int:
         download = discover_all(
             args.targets,
             layout=args.layout,
-            rule=GradedFileRule(functions=plan.problems),
+            # Every enabled problem, not just --only's: the graded file must not change with --only.
+            rule=GradedFileRule(functions=GradingPlan.load(args.config, None).problems),
             scratch=Path(scratch),
             due=args.due,
         )
