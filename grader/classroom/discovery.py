@@ -105,12 +105,14 @@ def discover(
     return download
 
 
-def discover_all(paths: Sequence[Path], **options: object) -> ClassDownload:
-    """:func:`discover` each path and put the submissions together (``layout`` "mixed" when they differ).
-
-    A student found under two paths gets the files of both in one submission.
-    """
-    found = [discover(path, **options) for path in paths]  # type: ignore[arg-type]
+def discover_all(paths: Sequence[Path], *, scratch: Path | None = None, **options: object) -> ClassDownload:
+    """:func:`discover` each path (zips into a scratch subfolder of their own) and put the submissions
+    together (``layout`` "mixed" when they differ). A student found under two paths keeps the first
+    submission; the second is refused with a reason."""
+    found = [
+        discover(path, scratch=scratch / str(index) if scratch else None, **options)  # type: ignore[arg-type]
+        for index, path in enumerate(paths)
+    ]
     if len(found) == 1:
         return found[0]
     layouts = {download.layout for download in found}

@@ -131,3 +131,17 @@ def test_a_student_whose_every_file_is_refused_gets_a_submission_saying_so(tmp_p
         "nothing to grade: every file was refused (Eve Ray_502_assignsubmission_file_/opengym.py: "
         f"a symbolic link (to {folder.parent}): links are never followed)"
     )
+
+
+def test_several_downloads_are_read_apart_and_a_student_twice_is_refused(tmp_path: Path) -> None:
+    from grader.classroom import discover_all
+
+    first = BUILDERS["canvas"](tmp_path / "one", 2)
+    second = BUILDERS["canvas"](tmp_path / "two", 3)
+    download = discover_all([first.path, second.path], rule=RULE, scratch=tmp_path / "scratch", due=DUE)
+    assert download.layout == "canvas"
+    assert {s.identity for s in download.submissions} == set(first.graded) | set(second.graded)
+    twice = [s.where for s in download.refused if s.reason.startswith("a second submission for 1000 ")]
+    assert twice == ["student0_1000_5001_opengym.py"]
+    paths = [file.path for submission in download.submissions for file in submission.files]
+    assert len(set(paths)) == len(paths), "each zip keeps its own scratch files"
