@@ -174,6 +174,15 @@ def _expand_zip(tree: Tree, archive: Path, prefix: str, dest: Path, limits: Limi
             members = bundle.infolist()
             dest.mkdir(parents=True, exist_ok=True)
             for number, member in enumerate(members):
+                if len(tree.entries) >= limits.max_files and not member.is_dir():
+                    left = sum(1 for rest in members[number:] if not rest.is_dir())
+                    tree.refused.append(
+                        Skipped(
+                            label,
+                            f"{left:,} entries not read: over the {limits.max_files:,}-file limit of a download",
+                        )
+                    )
+                    break
                 _extract_member(tree, bundle, member, prefix, dest, number, limits, depth)
     except (zipfile.BadZipFile, OSError, EOFError, NotImplementedError, RuntimeError) as error:
         tree.refused.append(Skipped(label, f"not a readable zip ({type(error).__name__}: {error})"))
@@ -239,9 +248,6 @@ def _extract_member(
         tree.refused.append(
             Skipped(where, f"the download's zips expand past {limits.max_total_bytes:,} bytes")
         )
-        return
-    if len(tree.entries) >= limits.max_files:
-        tree.refused.append(Skipped(where, f"over the {limits.max_files:,}-file limit of a download"))
         return
     # Written under a numbered name: the entry's own name never reaches the file system.
     target = dest / f"{number}{Path(parts[-1]).suffix[:16]}"

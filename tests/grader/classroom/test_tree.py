@@ -74,7 +74,9 @@ def test_sizes_and_counts_are_bounded(tmp_path: Path) -> None:
     archive = _zip(tmp_path / "class.zip", [(f"s{n}/opengym.py", b"x = 1\n" * 10) for n in range(5)])
     tree = read_tree(archive, tmp_path / "scratch", Limits(max_files=3, max_file_bytes=1000))
     assert len(tree.entries) == 3
-    assert [s.reason for s in tree.refused] == ["over the 3-file limit of a download"] * 2
+    assert [(s.where, s.reason) for s in tree.refused] == [
+        ("class.zip", "2 entries not read: over the 3-file limit of a download")
+    ]
     small = read_tree(archive, tmp_path / "scratch2", Limits(max_file_bytes=20))
     assert small.entries == [] and all("over the 20 limit" in s.reason for s in small.refused)
 
