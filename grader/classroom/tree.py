@@ -179,7 +179,7 @@ def _expand_zip(tree: Tree, archive: Path, prefix: str, dest: Path, limits: Limi
                     tree.refused.append(
                         Skipped(
                             label,
-                            f"{left:,} entries not read: over the {limits.max_files:,}-file limit of a download",
+                            f"{left:,} entries not read: over the {limits.max_files:,}-file limit of a download",  # noqa: E501
                         )
                     )
                     break
