@@ -498,6 +498,16 @@ def _grade_class(
         return EXIT_INTERRUPTED
     errors = sum(1 for report in outcome.reports if report.grader_errors)
     written = ", ".join(["grades.csv", *(f"{name}.csv" for name in args.gradebook)])
+    if "canvas" in args.gradebook and gradebook.rows is not None:
+        from grader.classroom.gradebooks import canvas_user_id
+
+        unmatched = [row.member.identity for row in gradebook.rows if not canvas_user_id(row)]
+        if unmatched:
+            print(
+                f"canvas.csv leaves out {len(unmatched)} students without a Canvas user id ({', '.join(unmatched[:5])}{', ...' if len(unmatched) > 5 else ''}): "  # noqa: E501
+                "pass --roster with a Canvas gradebook export (its ID column) to match them.",
+                file=sys.stderr,
+            )
     print(
         f"Graded {len(outcome.graded)} submissions"
         + (f" (reused {len(outcome.reused)} earlier reports)" if outcome.reused else "")

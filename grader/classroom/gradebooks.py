@@ -181,6 +181,15 @@ class Assignment:
     points: float | None = None
 
 
+def canvas_user_id(row: GradeRow) -> str:
+    """The student's Canvas user id ("" when unknown): the roster's ``ID`` column, else the identity of a
+    Canvas download's student. Canvas matches an imported row by it and by nothing else we can give."""
+    canvas_id = row.roster.get("id") if row.roster else ""
+    if not canvas_id and row.submission and row.submission.source == "canvas":
+        canvas_id = row.member.identity
+    return canvas_id if canvas_id.isdigit() else ""
+
+
 def canvas_csv(rows: Sequence[GradeRow], assignment: Assignment) -> str:
     """Canvas's gradebook import CSV: ``Student, ID, SIS User ID, SIS Login ID, Section, {title} ({id})``, a
     ``    Points Possible`` row, then a row per student Canvas can match by ``ID`` (their Canvas user id:
@@ -198,10 +207,8 @@ def canvas_csv(rows: Sequence[GradeRow], assignment: Assignment) -> str:
     points = assignment.points if assignment.points is not None else _max_points(rows)
     lines: list[list[object]] = [["    Points Possible", "", "", "", "", _number(points)]]
     for row in rows:
-        canvas_id = row.roster.get("id") if row.roster else ""
-        if not canvas_id and row.submission and row.submission.source == "canvas":
-            canvas_id = row.member.identity
-        if not canvas_id.isdigit():
+        canvas_id = canvas_user_id(row)
+        if not canvas_id:
             continue
         roster = row.roster
         lines.append(

@@ -203,7 +203,12 @@ def test_gymgrade_grade_each_layout_into_every_gradebook(
     if roster.exists():
         argv += ["--roster", str(roster)]
     assert cli.main(argv) == 0
-    assert f"Grading on {FakeExecutor()}." in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert f"Grading on {FakeExecutor()}." in err
+    if layout == "canvas":
+        assert "canvas.csv leaves out" not in err
+    else:
+        assert "without a Canvas user id" in err and "pass --roster with a Canvas gradebook export" in err
     rows = list(csv.DictReader((out / "grades.csv").open(encoding="utf-8")))
     members = {identity: expected.groups.get(identity, (identity,)) for identity in expected.graded}
     students = sorted(member for group in members.values() for member in group)
