@@ -226,3 +226,18 @@ def test_gymgrade_grade_each_layout_into_every_gradebook(
     assert canvas[1][0] == "    Points Possible"
     if layout == "canvas":
         assert {row[1] for row in canvas[2:]} == set(students)
+
+
+def test_hostile_folder_names_stay_data(tmp_path: Path) -> None:
+    folder = tmp_path / "class"
+    names = ["line\nbreak", '=HYPERLINK("x")', "@SUM(A1)", "-2+3", ".hidden"]
+    for name in names:
+        target = folder / name
+        target.mkdir(parents=True)
+        (target / "opengym.py").write_text("def find_qvalues(env, alpha=.1):\n    return 0\n")
+    rows = _batch(folder, tmp_path / "out", FakeExecutor())
+    students = [row["student"] for row in rows]
+    expected = ["'-2+3", '\'=HYPERLINK("x")', "'@SUM(A1)", "line\nbreak"]  # .hidden is skipped like .git
+    assert students == sorted(expected, key=lambda student: student.lstrip("'"))
+    reports = sorted(path.name for path in (tmp_path / "out").glob("*.json"))
+    assert "line%0Abreak.json" in reports and all("/" not in name for name in reports)
