@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from datetime import UTC, datetime, timedelta
 from typing import Any
 
@@ -113,6 +114,49 @@ def test_after_the_due_date_only_hidden_problems_stay_withheld() -> None:
     view = report_view(_report(), after_due)
     assert [problem["status"] for problem in view["problems"]] == ["passed", "failed", "withheld"]
     assert view["seed"] == GRADING_SEED and view["score"] is None
+
+
+def _varied_report(visibility: Visibility, outcome: int) -> dict[str, Any]:
+    """cartpole shown, taxi ``visibility``: taxi's outcome, the time and the errors follow ``outcome``."""
+    report = _report()
+    problems = [_problem("cartpole", "visible", 1.0), _problem("taxi", visibility, [1.0, 0.0, 0.5][outcome])]
+    problems[1].update(
+        feedback=f"taxi outcome {outcome}",
+        output="x" * outcome,
+        timings={"wall_seconds": 3.0 + outcome, "student_seconds": 1.0 + outcome, "overhead_seconds": 2.0},
+    )
+    elapsed = 10.0 + 7 * outcome
+    report.update(
+        problems=problems,
+        score=1.0 + problems[1]["score"],
+        max_score=2.0,
+        execution_time=elapsed,
+        timings={"elapsed_seconds": elapsed, "workers": 2, "check_seconds": elapsed,
+                 "student_seconds": 1.0 + outcome, "overhead_seconds": 9.0 + 6 * outcome},
+        grader_errors=[f"taxi: failed {outcome}"] if outcome else [],
+    )  # fmt: skip
+    return report
+
+
+@pytest.mark.parametrize("visibility", ["hidden", "after_due_date"])
+def test_nothing_a_student_sees_varies_with_a_withheld_problem(visibility: Visibility) -> None:
+    student = Disclosure(seeds=False, shown=frozenset({"visible"}), due_date=DUE)
+    views = [json.dumps(report_view(_varied_report(visibility, outcome), student)) for outcome in range(3)]
+    assert views[0] == views[1] == views[2]
+    view = report_view(_varied_report(visibility, 1), student)
+    assert (view["score"], view["execution_time"], view["timings"], view["grader_errors"]) == (
+        None,
+        None,
+        None,
+        [],
+    )
+    assert view["problems"][0]["timings"] == _problem("cartpole", "visible", 1.0)["timings"]
+
+
+def test_a_shown_problems_grader_error_is_still_shown() -> None:
+    report = {**_varied_report("hidden", 1), "grader_errors": ["cartpole: broke", "taxi: broke"]}
+    view = report_view(report, Disclosure(seeds=False, shown=frozenset({"visible"})))
+    assert view["grader_errors"] == ["cartpole: broke"]
 
 
 def test_an_unset_due_date_is_named_in_the_note() -> None:
