@@ -220,7 +220,7 @@ def results(
         execution_time=None if withheld else round(report.execution_time),
         output="\n".join(lines),
         # The total (and the results' own output) follows the most withheld problem: a total shown while a
-        # problem is withheld, minus the visible scores, is the withheld score. Visible tests say so each.
+        # problem is withheld, minus the visible scores, is the withheld score.
         visibility=visibility if withheld_visibility is None else withheld_visibility,
         extra_data=_seed_record(upload) if upload is not None else None,
         tests=tests,
