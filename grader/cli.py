@@ -361,7 +361,7 @@ def run_gradescope_run(args: argparse.Namespace) -> int:
     if args.seed is not None:
         upload = UploadSeed(args.seed, "given")
     elif args.secret_file is not None:
-        upload = seed_for_upload(root, secret=args.secret_file.read_text(encoding="ascii"))
+        upload = seed_for_upload(root, secret_file=args.secret_file)
     else:
         print(
             "gymgrade gradescope-run: expected --secret-file (the bundle's seed_secret, as run_autograder "

@@ -403,17 +403,19 @@ def read_metadata(path: Path) -> SubmissionMetadata:
         ) from error
 
 
-def seed_for_upload(root: Path, *, secret: str) -> UploadSeed:
-    """The grading seed of the upload in ``root``: derived from ``secret`` and its metadata.
+def seed_for_upload(root: Path, *, secret_file: Path) -> UploadSeed:
+    """The grading seed of the upload in ``root``: derived from the bundle's secret and its metadata.
 
-    Never raises for the metadata: where it cannot be read, a fresh seed is drawn at random (so the upload
-    still gets starts nobody could know) and the reason recorded for the instructor.
+    Never raises: where the secret or the metadata cannot be read, a fresh seed is drawn at random (so the
+    upload still gets starts nobody could know, and results.json is still written) and the reason is
+    recorded for the instructor.
     """
     try:
+        secret = secret_file.read_text(encoding="ascii")
         identity = read_metadata(root / METADATA_FILE).identity()
-    except GradescopeError as error:
+        return UploadSeed(upload_seed(secret, identity), "derived", identity)
+    except (GradescopeError, OSError, UnicodeDecodeError, ValueError) as error:
         return UploadSeed(held_out_seed(), "fresh", note=str(error))
-    return UploadSeed(upload_seed(secret, identity), "derived", identity)
 
 
 def run_autograder(

@@ -254,52 +254,44 @@ def test_an_uploads_identity_is_read_from_gradescopes_metadata(tmp_path: Path) -
         "4",
         "9",
     )
+    (tmp_path / SECRET_FILE).write_text(SECRET + "\n")
+    upload = seed_for_upload(tmp_path, secret_file=tmp_path / SECRET_FILE)
+    assert (upload.seed, upload.source) == (upload_seed(SECRET, read_metadata(path).identity()), "derived")
 
 
 @pytest.mark.parametrize(
-    ("other", "same"),
+    ("content", "secret", "note"),
     [
-        (("gradescope", "77", "2026-11-25T10:00:00-08:00", "5"), True),
-        (("gradescope", "78", "2026-11-25T10:00:00-08:00", "5"), False),
-        (("gradescope", "77", "2026-11-25T10:00:01-08:00", "5"), False),
-        (("gradescope", "77", "2026-11-25T10:00:00-08:00", "6"), False),
-        (("gradescope", "77", "2026-11-25T10:00:00-08:00", "5", "6"), False),
+        (None, SECRET, "cannot read"),
+        ("{not json", SECRET, "is not Gradescope's submission metadata: the file: Invalid JSON"),
+        (
+            '{"id": 5, "users": []}',
+            SECRET,
+            "is not Gradescope's submission metadata: created_at: Field required",
+        ),
+        (json.dumps(metadata(7, "2026-11-25T10:00:00-08:00", 5)), None, "No such file or directory"),
+        (
+            json.dumps(metadata(7, "2026-11-25T10:00:00-08:00", 5)),
+            "abc",
+            "a seed secret must be at least 64 hex",
+        ),
     ],
-    ids=["same-upload", "other-id", "other-time", "other-student", "with-a-partner"],
+    ids=["no-metadata", "not-json", "no-time", "no-secret", "short-secret"],
 )
-def test_every_upload_gets_its_own_seed(other: tuple[str, ...], same: bool) -> None:
-    upload = ("gradescope", "77", "2026-11-25T10:00:00-08:00", "5")
-    assert (upload_seed(SECRET, upload) == upload_seed(SECRET, other)) is same
-    assert upload_seed(SECRET, upload) != upload_seed("6f" * 32, upload), "the secret decides the seed"
-    assert 1 <= upload_seed(SECRET, other) < 2**63
-
-
-@pytest.mark.parametrize(
-    ("content", "note"),
-    [
-        (None, "cannot read"),
-        ("{not json", "is not Gradescope's submission metadata: the file: Invalid JSON"),
-        ('{"id": 5, "users": []}', "is not Gradescope's submission metadata: created_at: Field required"),
-    ],
-    ids=["missing", "not-json", "no-time"],
-)
-def test_unreadable_metadata_gets_a_fresh_seed_and_says_why(
-    tmp_path: Path, content: str | None, note: str
+def test_an_unreadable_secret_or_metadata_gets_a_fresh_seed_and_says_why(
+    tmp_path: Path, content: str | None, secret: str | None, note: str
 ) -> None:
     if content is not None:
         (tmp_path / METADATA_FILE).write_text(content)
-    seeds = {seed_for_upload(tmp_path, secret=SECRET) for _ in range(3)}
+    if secret is not None:
+        (tmp_path / SECRET_FILE).write_text(secret + "\n")
+    seeds = {seed_for_upload(tmp_path, secret_file=tmp_path / SECRET_FILE) for _ in range(3)}
     assert len({upload.seed for upload in seeds}) == 3, "never a fixed fallback seed"
     for upload in seeds:
         assert upload.source == "fresh" and note in upload.note, upload.note
         assert upload.describe().endswith(
             f"Regrade it identically with: gymgrade check FILE --seed {upload.seed}"
         )
-
-
-def test_a_secret_that_is_not_the_bundles_is_refused() -> None:
-    with pytest.raises(ValueError, match="a seed secret must be at least 64 hex digits; found 6 characters"):
-        upload_seed("abcdef", ("gradescope", "1"))
 
 
 def test_each_bundle_draws_its_own_secret_and_keeps_it_private(tmp_path: Path) -> None:
