@@ -364,8 +364,8 @@ def run_gradescope_run(args: argparse.Namespace) -> int:
         upload = seed_for_upload(root, secret_file=args.secret_file)
     else:
         print(
-            "gymgrade gradescope-run: expected --secret-file (the bundle's seed_secret, as run_autograder "
-            "passes it) or --seed N; found neither",
+            "gymgrade gradescope-run: expected --secret-file (the bundle's seed_secret, as run_autograder passes it) or --seed N; "  # noqa: E501
+            "found neither",
             file=sys.stderr,
         )
         return EXIT_ERROR

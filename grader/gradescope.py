@@ -43,8 +43,8 @@ METADATA_FILE = "submission_metadata.json"
 METADATA_LIMIT_BYTES = 64 * 2**20
 """Read no more of the metadata (it embeds every earlier upload's results.json)."""
 OUTPUT_KEPT_NOTE = (
-    "What your code printed is kept for your instructor, not shown here; run gymgrade check on your own "
-    "machine to see it."
+    "What your code printed is kept for your instructor, not shown here; "
+    "run gymgrade check on your own machine to see it."
 )
 _RESTRICTIVENESS: dict[str, int] = {"visible": 0, "after_published": 1, "after_due_date": 2, "hidden": 3}
 
@@ -398,8 +398,8 @@ def read_metadata(path: Path) -> SubmissionMetadata:
         first = error.errors()[0]
         where = ".".join(str(part) for part in first["loc"]) or "the file"
         raise GradescopeError(
-            f"{path} is not Gradescope's submission metadata: {where}: {first['msg']} "
-            "(expected JSON with the upload's id, created_at and users)"
+            f"{path} is not Gradescope's submission metadata: {where}: {first['msg']}; "
+            "expected JSON with the upload's id, created_at and users"
         ) from error
 
 
