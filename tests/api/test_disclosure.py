@@ -166,13 +166,13 @@ def test_an_unset_due_date_is_named_in_the_note() -> None:
     )
 
 
-def _graded(client: TestClient, token: str) -> int:
+def _graded(client: TestClient, token: str, report: dict[str, Any] | None = None) -> int:
     response = client.post("/submissions", files={"file": ("opengym.py", b"x = 1\n")}, headers=bearer(token))
     submission_id: int = response.json()["id"]
     jobs = client.app.state.context.jobs  # type: ignore[attr-defined]
     job = jobs.claim("test-worker")
     assert job is not None and job.submission_id == submission_id
-    report = _report()
+    report = report if report is not None else _report()
     for problem in report["problems"]:
         assert jobs.add_progress(submission_id, "test-worker", problem)
     assert jobs.complete(submission_id, "test-worker", report)
@@ -230,3 +230,18 @@ def test_the_web_page_shows_students_their_view_and_the_instructor_everything(
     assert "Score: withheld (out of 3)" in student_page and "withheld" in student_home
     assert "feedback of taxi" in instructor_page and "output of taxi" in instructor_page
     assert "Score: 2 / 3" in instructor_page and " · seed " in instructor_page
+
+
+def test_the_students_pages_and_json_do_not_vary_with_a_withheld_problem(
+    make_settings: SettingsFactory,
+) -> None:
+    seen = []
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        for outcome in range(3):
+            token = add_student(client, f"student{outcome}")
+            submission_id = _graded(client, token, _varied_report("hidden", outcome))
+            own = client.get(f"/submissions/{submission_id}", headers=bearer(token)).json()
+            _sign_in(client, token)
+            fragment = client.get(f"/ui/submissions/{submission_id}/live").text
+            seen.append((json.dumps([own["score"], own["report"], own["progress"]]), fragment))
+    assert seen[0] == seen[1] == seen[2]
