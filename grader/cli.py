@@ -259,7 +259,7 @@ def run_check(args: argparse.Namespace) -> int:
     elif output_format == "gradescope":
         from grader.gradescope import results
 
-        sys.stdout.write(results(report).model_dump_json(indent=2) + "\n")
+        sys.stdout.write(results(report).to_json())
     else:
         print(summary(report))
     if report.grader_errors:
