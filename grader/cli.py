@@ -355,7 +355,8 @@ def run_gradescope_bundle(args: argparse.Namespace) -> int:
 
 def run_gradescope_run(args: argparse.Namespace) -> int:
     """`gymgrade gradescope-run`: what the bundle's run_autograder calls; always writes results.json."""
-    from grader.gradescope import UploadSeed, default_root, run_autograder, seed_for_upload
+    from grader.gradescope import default_root, run_autograder
+    from grader.gradescope_upload import UploadSeed, seed_for_upload
 
     root = args.root or default_root()
     if args.seed is not None:

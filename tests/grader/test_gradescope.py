@@ -18,44 +18,16 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from gradescope_support import SECRET, metadata
 from grading_support import ROOT, SUBMISSIONS, write_config
 
 from grader.cli import main
 from grader.errors import GradescopeError
-from grader.gradescope import (
-    METADATA_FILE,
-    SECRET_FILE,
-    GradescopeResults,
-    UploadSeed,
-    bundle,
-    bundle_secret,
-    pick_submission,
-    read_metadata,
-    results,
-    seed_for_upload,
-)
+from grader.gradescope import SECRET_FILE, GradescopeResults, bundle, bundle_secret, pick_submission, results
+from grader.gradescope_upload import METADATA_FILE, UploadSeed, read_metadata
 from grader.problems import PROBLEM_IDS
 from grader.report import GradingTimings, ProblemResult, Report, Timings
 from grader.seeds import upload_seed
-
-SECRET = "5e" * 32
-"""A fixed bundle secret, so that the tests' seeds are reproducible."""
-
-
-def metadata(submission_id: int, created_at: str, *user_ids: int) -> dict[str, object]:
-    """Gradescope's submission_metadata.json as its documentation shows it (fields gymgrade ignores too)."""
-    return {
-        "id": submission_id,
-        "created_at": created_at,
-        "assignment": {"due_date": "2026-12-01T23:00:00.000000-08:00", "id": 25828, "course_id": 1234,
-                       "title": "OpenGym AI", "total_points": "6.0", "group_submission": True},
-        "submission_method": "upload",
-        "users": [{"email": f"s{user}@example.edu", "id": user, "name": f"S {user}"} for user in user_ids],
-        "previous_submissions": [
-            {"submission_time": "2026-11-20T10:00:00.000000-08:00", "score": 1.0,
-             "results": {"score": 1.0, "tests": [], "extra_data": {"gymgrade": {"seed": 12345}}}},
-        ],
-    }  # fmt: skip
 
 
 def student_sees(data: dict[str, Any], shown: frozenset[str] = frozenset({"visible"})) -> dict[str, Any]:
@@ -242,56 +214,6 @@ def test_check_prints_valid_gradescope_results(tmp_path: Path, capsys: pytest.Ca
     GradescopeResults.model_validate(data)
     assert data["score"] == 0 and [test["status"] for test in data["tests"]] == ["failed"]
     assert "opengym.ipynb is not a readable notebook" in data["output"]
-
-
-def test_an_uploads_identity_is_read_from_gradescopes_metadata(tmp_path: Path) -> None:
-    path = tmp_path / METADATA_FILE
-    path.write_text(json.dumps(metadata(123456, "2026-11-25T10:00:00.000000-08:00", 9, 4)))
-    assert read_metadata(path).identity() == (
-        "gradescope",
-        "123456",
-        "2026-11-25T10:00:00.000000-08:00",
-        "4",
-        "9",
-    )
-    (tmp_path / SECRET_FILE).write_text(SECRET + "\n")
-    upload = seed_for_upload(tmp_path, secret_file=tmp_path / SECRET_FILE)
-    assert (upload.seed, upload.source) == (upload_seed(SECRET, read_metadata(path).identity()), "derived")
-
-
-@pytest.mark.parametrize(
-    ("content", "secret", "note"),
-    [
-        (None, SECRET, "cannot read"),
-        ("{not json", SECRET, "is not Gradescope's submission metadata: the file: Invalid JSON"),
-        (
-            '{"id": 5, "users": []}',
-            SECRET,
-            "is not Gradescope's submission metadata: created_at: Field required",
-        ),
-        (json.dumps(metadata(7, "2026-11-25T10:00:00-08:00", 5)), None, "No such file or directory"),
-        (
-            json.dumps(metadata(7, "2026-11-25T10:00:00-08:00", 5)),
-            "abc",
-            "a seed secret must be at least 64 hex",
-        ),
-    ],
-    ids=["no-metadata", "not-json", "no-time", "no-secret", "short-secret"],
-)
-def test_an_unreadable_secret_or_metadata_gets_a_fresh_seed_and_says_why(
-    tmp_path: Path, content: str | None, secret: str | None, note: str
-) -> None:
-    if content is not None:
-        (tmp_path / METADATA_FILE).write_text(content)
-    if secret is not None:
-        (tmp_path / SECRET_FILE).write_text(secret + "\n")
-    seeds = {seed_for_upload(tmp_path, secret_file=tmp_path / SECRET_FILE) for _ in range(3)}
-    assert len({upload.seed for upload in seeds}) == 3, "never a fixed fallback seed"
-    for upload in seeds:
-        assert upload.source == "fresh" and note in upload.note, upload.note
-        assert upload.describe().endswith(
-            f"Regrade it identically with: gymgrade check FILE --seed {upload.seed}"
-        )
 
 
 def test_each_bundle_draws_its_own_secret_and_keeps_it_private(tmp_path: Path) -> None:
