@@ -1,4 +1,4 @@
-"""The class page's figures: the score histogram and each problem's pass rate, drawn like the student report's.
+"""The class page's figures: the score histogram and each problem's pass rate, like the student report's.
 
 PNG plots on matplotlib's Agg canvas (no pyplot, no display), the size and colours of ``grader.figures``,
 embedded as ``data:`` URIs. Labels are the problems' registry ids (never student text).

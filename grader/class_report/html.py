@@ -42,7 +42,9 @@ def content_security_policy(style: str) -> str:
     """The report pages' policy for a page whose only stylesheet is ``style``: nothing loads or runs but
     its ``data:`` images and that stylesheet (the same policy as ``grader.html_report.CSP``)."""
     digest = base64.b64encode(hashlib.sha256(style.encode()).digest()).decode()
-    return f"default-src 'none'; img-src data:; style-src 'sha256-{digest}'; base-uri 'none'; form-action 'none'"
+    return (
+        f"default-src 'none'; img-src data:; style-src 'sha256-{digest}'; base-uri 'none'; form-action 'none'"
+    )
 
 
 CSP = content_security_policy(STYLE)

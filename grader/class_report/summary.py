@@ -44,7 +44,7 @@ DIAGNOSED: frozenset[Status] = frozenset({"failed", "error", "timeout", "missing
 KEY_DIGEST_CHARS = 12
 
 # A number as the checks print it (14, 0.4170, -771.09, 1e-06), not a digit inside a word (CartPole-v0).
-_NUMBER = re.compile(r"(?<![A-Za-z_\d.])[-+]?(?:\d+(?:\.\d+)?|\.\d+)(?:[eE][-+]?\d+)?")
+_NUMBER = re.compile(r"(?<![A-Za-z_\d])(?<!\d\.)[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
 
 
 class ScoreBin(BaseModel):

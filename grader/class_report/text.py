@@ -1,9 +1,10 @@
-"""Hostile text made safe to show: identities, names and feedback bounded, stripped of controls and bidi overrides.
+"""Hostile text made safe to show: identities, names and feedback bounded, controls and bidi overrides inert.
 
 Escaping for HTML is the template's (Jinja autoescape); what is left is what escaping cannot do: a name
 of a million characters, a right-to-left override that turns ``evil.exe\u202egpj.py`` around, a newline
-in an identity. These functions bound and clean a string for display; the summary's JSON keeps each
-identity as given (bounded the same way, so a page or a file never grows with one hostile string).
+in an identity. These functions bound a string and show such characters as U+FFFD; the summary's JSON
+keeps each identity as given (bounded the same way, so no file grows with one hostile string), and its
+encoder escapes every non-ASCII character.
 """
 
 from __future__ import annotations
