@@ -8,13 +8,13 @@ from grader.report import ProblemResult, Report, Status
 TITLES = {"blackjack": "Problem 2", "cartpole": "Problem 3", "taxi": "Problem 5", "find_qvalues": "Q-values"}
 
 STOOD_ON_N = (
-    "blackjack({n}) returned {rate}; a player drawing on sums <= {n} wins 0.4170 of games (4080..4260 of 10000). "
-    "Your games stood on a sum of exactly {n} in {hands} hands, so they follow 'draw while the sum is < {n}': "
-    "check `<` versus `<=`."
+    "blackjack({n}) returned {rate}; a player drawing on sums <= {n} wins 0.4170 of games "
+    "(4080..4260 of 10000). Your games stood on a sum of exactly {n} in {hands} hands, so they follow "
+    "'draw while the sum is < {n}': check `<` versus `<=`."
 )
 OFF_BY_ONE = (
-    "blackjack({n}) returned {rate}; a player drawing on sums <= {n} wins 0.4170 of games (4080..4260 of 10000). "
-    "Your games drew on a sum of {m} in {hands} hands, so they follow 'draw while the sum is <= {m}': "
+    "blackjack({n}) returned {rate}; a player drawing on sums <= {n} wins 0.4170 of games "
+    "(4080..4260 of 10000). Your games drew on a sum of {m} in {hands} hands, so they follow 'draw while the sum is <= {m}': "
     "the threshold is off by one."
 )
 SHORT_POLE = (

@@ -1,4 +1,4 @@
-"""The class summary: score distribution, pass rates, diagnoses grouped by cause, late and missing students."""
+"""The class summary: score distribution, pass rates, diagnoses grouped by cause, late and missing."""
 
 from __future__ import annotations
 
@@ -35,7 +35,8 @@ def test_an_empty_class_has_every_key_and_nothing_in_them() -> None:
     ("statuses", "expected"),
     [
         (["passed", "passed"], (2, 2, 1.0, {"passed": 2})),
-        (["passed", "failed", "error", "timeout"], (4, 1, 0.25, {"error": 1, "failed": 1, "passed": 1, "timeout": 1})),
+        (["passed", "failed", "error", "timeout"],
+         (4, 1, 0.25, {"error": 1, "failed": 1, "passed": 1, "timeout": 1})),
         (["passed", "skipped", "missing"], (2, 1, 0.5, {"missing": 1, "passed": 1, "skipped": 1})),
         (["skipped", "skipped"], (0, 0, None, {"skipped": 2})),
     ],
@@ -134,7 +135,7 @@ def test_a_diagnosis_of_huge_feedback_is_bounded() -> None:
 
 
 def test_the_diagnosis_key_names_problem_and_status_and_is_stable() -> None:
-    digest = hashlib.sha256("check `<` versus `<=`".encode()).hexdigest()[:12]
+    digest = hashlib.sha256(b"check `<` versus `<=`").hexdigest()[:12]
     assert diagnosis_key("blackjack", "failed", "check `<` versus `<=`") == f"blackjack:failed:{digest}"
     assert diagnosis_key("blackjack", "failed", "a") != diagnosis_key("blackjack", "error", "a")
     assert diagnosis_key("blackjack", "failed", "a") != diagnosis_key("taxi", "failed", "a")
@@ -148,8 +149,8 @@ def _class() -> list[ClassEntry]:
     ]  # fmt: skip
     off = [graded("u100", result("blackjack", "failed", OFF_BY_ONE.format(n=14, m=15, rate=0.41, hands=90)),
                   result("cartpole", "failed", SHORT_POLE.format(mean=120.5, episodes=100)))]  # fmt: skip
-    pole = [graded("u200", result("blackjack", "passed"), result("cartpole", "failed", SHORT_POLE.format(mean=80, episodes=100)),
-                   late=True)]  # fmt: skip
+    pole = [graded("u200", result("blackjack", "passed"),
+                   result("cartpole", "failed", SHORT_POLE.format(mean=80, episodes=100)), late=True)]  # fmt: skip
     return [*stood, *off, *pole, all_passed("u300"), ClassEntry("u400", status="missing")]
 
 
@@ -163,7 +164,8 @@ def test_diagnoses_group_students_by_cause_most_common_first() -> None:
     first = diagnoses[0]
     assert first["status"] == "failed" and first["title"] == "Problem 2"
     assert first["text"].endswith(
-        "Your games stood on a sum of exactly # in # hands, so they follow 'draw while the sum is < #': check `<` versus `<=`."
+        "Your games stood on a sum of exactly # in # hands, so they follow 'draw while the sum is < #': "
+        "check `<` versus `<=`."
     )
     assert first["key"] == diagnosis_key("blackjack", "failed", first["text"])
 
@@ -193,8 +195,8 @@ def test_late_and_missing_students_are_listed_by_identity() -> None:
         "u400",
     ]
     assert summary["roster"][-1] == {
-        "identity": "u400", "name": None, "status": "missing", "score": None, "max_score": None, "late": False,
-        "note": "", "report_href": None,
+        "identity": "u400", "name": None, "status": "missing", "score": None, "max_score": None,
+        "late": False, "note": "", "report_href": None,
     }  # fmt: skip
 
 
