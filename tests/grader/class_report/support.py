@@ -14,7 +14,8 @@ STOOD_ON_N = (
 )
 OFF_BY_ONE = (
     "blackjack({n}) returned {rate}; a player drawing on sums <= {n} wins 0.4170 of games "
-    "(4080..4260 of 10000). Your games drew on a sum of {m} in {hands} hands, so they follow 'draw while the sum is <= {m}': "
+    "(4080..4260 of 10000). Your games drew on a sum of {m} in {hands} hands, so they follow "
+    "'draw while the sum is <= {m}': "
     "the threshold is off by one."
 )
 SHORT_POLE = (
