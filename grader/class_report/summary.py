@@ -9,8 +9,9 @@ what was measured, the likely cause). Two students get the same diagnosis when t
 problem have the same status and the same feedback once every number is replaced by ``#`` (see
 ``diagnosis_text``): the checks write one sentence template per cause and fill it with the student's
 measurements (``blackjack(14)``, ``212 hands``), so the template is the cause. A sandbox outcome
-(exception, crash, timeout) reads the same way: its message is the same template for the same exception,
-and a student's own exception message, being different text, stays a group of its own.
+(exception, crash, timeout) reads the same way: its message and traceback are the same template for the
+same exception once the file's own name (which differs between students in flat downloads) is replaced
+too, and a student's own exception message, being different text, stays a group of its own.
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ MAX_DIAGNOSES = 100
 DIAGNOSED: frozenset[Status] = frozenset({"failed", "error", "timeout", "missing"})
 """Problem statuses that carry a diagnosis (passed and skipped ones do not)."""
 KEY_DIGEST_CHARS = 12
+FILE_PLACEHOLDER = "<file>"
 
 # A number as the checks print it (14, 0.4170, -771.09, 1e-06), not a digit inside a word (CartPole-v0).
 _NUMBER = re.compile(r"(?<![A-Za-z_\d])(?<!\d\.)[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
@@ -134,16 +136,21 @@ class ClassSummary(BaseModel):
     roster: list[StudentRow] = Field(description="Every student, by identity.")
 
 
-def diagnosis_text(feedback: str) -> str:
-    """The template of a feedback: one line, controls removed, every number replaced by ``#``, bounded.
+def diagnosis_text(feedback: str, submission: str = "") -> str:
+    """The template of a feedback: one line, controls inert, the file name and numbers replaced, bounded.
 
     Args:
         feedback: A problem result's feedback.
+        submission: The report's file name (tracebacks and messages name it: ``File "/submission/x.py"``);
+            it becomes ``{FILE_PLACEHOLDER}``, so students whose files are named differently still group.
 
     Returns:
         The text two students share when their results have the same cause.
     """
-    return display_text(_NUMBER.sub("#", feedback[: MAX_DIAGNOSIS_CHARS * 4]), MAX_DIAGNOSIS_CHARS)
+    text = feedback[: MAX_DIAGNOSIS_CHARS * 4]
+    if submission:
+        text = text.replace(submission, FILE_PLACEHOLDER)
+    return display_text(_NUMBER.sub("#", text), MAX_DIAGNOSIS_CHARS)
 
 
 def diagnosis_key(problem: str, status: str, text: str) -> str:
@@ -270,7 +277,7 @@ def _diagnoses(graded: Sequence[ClassEntry]) -> list[Diagnosis]:
         for index, result in enumerate(entry.report.problems if entry.report is not None else []):
             if result.status not in DIAGNOSED:
                 continue
-            text = diagnosis_text(result.feedback)
+            text = diagnosis_text(result.feedback, entry.report.submission if entry.report else "")
             key = diagnosis_key(result.id, result.status, text)
             order.setdefault(result.id, index)
             group = groups.setdefault(

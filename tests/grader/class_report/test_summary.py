@@ -129,6 +129,19 @@ def test_a_diagnosis_is_the_feedback_with_its_numbers_replaced(feedback: str, te
     assert diagnosis_text(feedback) == text
 
 
+def test_a_diagnosis_does_not_depend_on_the_students_file_name() -> None:
+    trace = 'car() raised ValueError: x Traceback: File "/submission/{}", line {}, in car'
+    first = diagnosis_text(
+        trace.format("smithjane_1234_5678_opengym.py", 2), "smithjane_1234_5678_opengym.py"
+    )
+    second = diagnosis_text(
+        trace.format("doejohn_LATE_99_100_opengym-1.py", 7), "doejohn_LATE_99_100_opengym-1.py"
+    )
+    assert (
+        first == second == 'car() raised ValueError: x Traceback: File "/submission/<file>", line #, in car'
+    )
+
+
 def test_a_diagnosis_of_huge_feedback_is_bounded() -> None:
     text = diagnosis_text("x" * 10_000_000)
     assert len(text) == MAX_DIAGNOSIS_CHARS and text.endswith("…")
