@@ -8,10 +8,12 @@ Diagnoses have no code in the reports: a check's verdict is its ``feedback`` pro
 what was measured, the likely cause). Two students get the same diagnosis when their results of the same
 problem have the same status and the same feedback once every number is replaced by ``#`` (see
 ``diagnosis_text``): the checks write one sentence template per cause and fill it with the student's
-measurements (``blackjack(14)``, ``212 hands``), so the template is the cause. A sandbox outcome
-(exception, crash, timeout) reads the same way: its message and traceback are the same template for the
-same exception once the file's own name (which differs between students in flat downloads) is replaced
-too, and a student's own exception message, being different text, stays a group of its own.
+measurements (``blackjack(14)``, ``212 hands``, a list ``resets 3, 5, 8, ...``: one ``#``), so the
+template is the cause. A sandbox outcome (exception, crash, timeout) reads the same way: its message and
+traceback are the same template for the same exception once the file's own name (which differs between
+students in flat downloads) is replaced too, and a student's own exception message, being different
+text, stays a group of its own. tests/grader/class_report/test_real_diagnoses.py holds this against the
+checks' own feedback for the simulated mistakes of ``grader.testing.behaviours``.
 """
 
 from __future__ import annotations
@@ -46,6 +48,8 @@ KEY_DIGEST_CHARS = 12
 FILE_PLACEHOLDER = "<file>"
 
 # A number as the checks print it (14, 0.4170, -771.09, 1e-06), not a digit inside a word (CartPole-v0).
+_NUMBER_LIST = re.compile(r"#(?:, #)+(?:, \.\.\.)?")
+"""A list of numbers after substitution ("resets 3, 5, 8, ..."): its length differs between students too."""
 _NUMBER = re.compile(r"(?<![A-Za-z_\d])(?<!\d\.)[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
 
 
@@ -150,7 +154,7 @@ def diagnosis_text(feedback: str, submission: str = "") -> str:
     text = feedback[: MAX_DIAGNOSIS_CHARS * 4]
     if submission:
         text = text.replace(submission, FILE_PLACEHOLDER)
-    return display_text(_NUMBER.sub("#", text), MAX_DIAGNOSIS_CHARS)
+    return display_text(_NUMBER_LIST.sub("#", _NUMBER.sub("#", text)), MAX_DIAGNOSIS_CHARS)
 
 
 def diagnosis_key(problem: str, status: str, text: str) -> str:

@@ -120,10 +120,21 @@ def test_submission_errors_score_zero_in_the_distribution_and_missing_students_n
         ("wins 0.4170 of games (4080..4260 of 10000)", "wins # of games (#..# of #)"),
         ("mean -771.09 within 1e-06", "mean # within #"),
         ("CartPole-v0 and Taxi-v3 on gym 0.26 (v0.26)", "CartPole-v0 and Taxi-v3 on gym # (v0.26)"),
+        ("resets 3, 5, 8, 13, 21, ... took no step", "resets # took no step"),
+        ("resets 3 took no step", "resets # took no step"),
         ("line one\n\n  line two", "line one line two"),
         ("a \u202eright-to-left\u202c override", f"a {HIDDEN}right-to-left{HIDDEN} override"),
     ],
-    ids=["call-and-value", "band", "signs-and-exponents", "names-keep-their-digits", "whitespace", "bidi"],
+    ids=[
+        "call-and-value",
+        "band",
+        "signs-and-exponents",
+        "names-keep-their-digits",
+        "a-list",
+        "a-list-of-one",
+        "whitespace",
+        "bidi",
+    ],
 )
 def test_a_diagnosis_is_the_feedback_with_its_numbers_replaced(feedback: str, text: str) -> None:
     assert diagnosis_text(feedback) == text
