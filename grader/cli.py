@@ -136,8 +136,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=_class_page,
         default=None,
         metavar="PATH",
-        help="also write a self-contained class report (scores, pass rates, common diagnoses, links to each "
-        "report) and its JSON summary beside it (class.html -> class.json)",
+        help="also write a self-contained class report (scores, pass rates, common diagnoses, links to each report); "  # noqa: E501
+        "its JSON summary goes beside it (class.html -> class.json)",
     )
     grade.set_defaults(handler=run_grade)
 
