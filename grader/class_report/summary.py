@@ -271,19 +271,27 @@ def _pass_rates(graded: Sequence[ClassEntry]) -> list[ProblemPassRate]:
     for row in rows.values():
         row.pass_rate = row.passed / row.graded if row.graded else None
         row.statuses = dict(sorted(row.statuses.items()))
-    return list(rows.values())
+    order = _problem_order(graded)
+    return sorted(rows.values(), key=lambda row: order[row.id])
+
+
+def _problem_order(graded: Sequence[ClassEntry]) -> dict[str, tuple[int, str]]:
+    """Each problem's rank: its earliest position in any report (reports list them in the plan's order)."""
+    order: dict[str, tuple[int, str]] = {}
+    for entry in graded:
+        for index, result in enumerate(entry.report.problems if entry.report is not None else []):
+            order[result.id] = min(order.get(result.id, (index, result.id)), (index, result.id))
+    return order
 
 
 def _diagnoses(graded: Sequence[ClassEntry]) -> list[Diagnosis]:
     groups: dict[str, Diagnosis] = {}
-    order: dict[str, int] = {}
     for entry in graded:
-        for index, result in enumerate(entry.report.problems if entry.report is not None else []):
+        for result in entry.report.problems if entry.report is not None else []:
             if result.status not in DIAGNOSED:
                 continue
             text = diagnosis_text(result.feedback, entry.report.submission if entry.report else "")
             key = diagnosis_key(result.id, result.status, text)
-            order.setdefault(result.id, index)
             group = groups.setdefault(
                 key,
                 Diagnosis(key=key, problem=result.id, title=result.title, status=result.status, text=text,
@@ -293,4 +301,5 @@ def _diagnoses(graded: Sequence[ClassEntry]) -> list[Diagnosis]:
             if identity not in group.identities:
                 group.identities.append(identity)
                 group.count += 1
+    order = _problem_order(graded)
     return sorted(groups.values(), key=lambda group: (-group.count, order[group.problem], group.key))

@@ -94,6 +94,19 @@ def test_scores_fall_in_ten_bins_from_zero_to_the_maximum_the_top_one_closed(
     ) == pytest.approx(stats)
 
 
+def test_problems_come_in_the_reports_order_whoever_is_listed_first() -> None:
+    entries = [
+        graded("a", result("cartpole", "passed")),
+        graded(
+            "b",
+            result("blackjack", "failed", "x"),
+            result("cartpole", "failed", "y"),
+            result("taxi", "passed"),
+        ),
+    ]
+    assert [row["id"] for row in class_summary(entries)["problems"]] == ["blackjack", "cartpole", "taxi"]
+
+
 def test_a_class_worth_nothing_puts_every_score_in_one_bin() -> None:
     entries = [graded("a", result("find_qvalues", "passed", points=0.0))]
     assert class_summary(entries)["scores"]["bins"] == [{"low": 0.0, "high": 0.0, "count": 1}]
