@@ -16,6 +16,7 @@ from matplotlib.figure import Figure as PlotFigure
 from grader.class_report.summary import ClassSummary
 from grader.figures import BAR_COLOUR, EXACT_COLOUR, PLOT_DPI, PLOT_SIZE, STUDENT_COLOUR, Figure
 
+TICK_CHARS = 24
 CLASS_FIGURE = "class"
 """The ``problem`` of every class figure (they belong to no single problem)."""
 
@@ -64,7 +65,10 @@ def pass_rate_bars(summary: ClassSummary) -> tuple[str, str, PlotFigure]:
         axes.text(position, (problem.pass_rate or 0.0) + 0.02, f"{problem.passed}/{problem.graded}",
                   ha="center", fontsize=8)  # fmt: skip
     axes.set(xticks=positions, ylim=(0, 1.12), ylabel="pass rate")
-    axes.set_xticklabels([problem.id for problem in rows], rotation=20, fontsize=8)
+    # Ids come from the reports; never let matplotlib read one as mathtext ($...$).
+    axes.set_xticklabels(
+        [problem.id[:TICK_CHARS] for problem in rows], rotation=20, fontsize=8, parse_math=False
+    )
     caption = "Pass rate of each problem: the share of graded submissions that passed it (above each bar: passed / graded; a problem skipped for a submission is not counted)."  # noqa: E501
     return "Pass rate per problem", caption, figure
 

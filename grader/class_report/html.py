@@ -18,7 +18,7 @@ from jinja2 import Environment, FileSystemLoader, select_autoescape
 from grader.class_report.entries import ClassEntry
 from grader.class_report.figures import class_figures
 from grader.class_report.summary import ClassSummary, summarise
-from grader.class_report.text import MAX_NAME_CHARS, MAX_NOTE_CHARS, display_text
+from grader.class_report.text import MAX_NAME_CHARS, MAX_NOTE_CHARS, display_identity, display_text
 from grader.figures import Figure
 
 TEMPLATES = Path(__file__).resolve().parents[1] / "templates"
@@ -52,7 +52,7 @@ CSP = content_security_policy(STYLE)
 _environment = Environment(
     loader=FileSystemLoader(TEMPLATES), autoescape=select_autoescape(["html"]), keep_trailing_newline=True
 )
-_environment.filters["identity"] = lambda text: display_text(text, IDENTITY_SHOWN_CHARS)
+_environment.filters["identity"] = lambda text: display_identity(text, IDENTITY_SHOWN_CHARS)
 _environment.filters["name"] = lambda text: display_text(text, MAX_NAME_CHARS)
 _environment.filters["note"] = lambda text: display_text(text, MAX_NOTE_CHARS)
 

@@ -259,9 +259,16 @@ def _pass_rates(graded: Sequence[ClassEntry]) -> list[ProblemPassRate]:
         for result in entry.report.problems if entry.report is not None else []:
             row = rows.setdefault(
                 result.id,
-                ProblemPassRate(id=result.id, title=result.title, max_score=result.max_score, graded=0,
-                                passed=0, pass_rate=None, statuses={}),
-            )  # fmt: skip
+                ProblemPassRate(
+                    id=result.id,
+                    title=bounded(result.title, MAX_NAME_CHARS),
+                    max_score=result.max_score,
+                    graded=0,
+                    passed=0,
+                    pass_rate=None,
+                    statuses={},
+                ),
+            )
             row.max_score = max(row.max_score, result.max_score)
             row.statuses[result.status] = row.statuses.get(result.status, 0) + 1
             if result.status != "skipped":
@@ -294,9 +301,16 @@ def _diagnoses(graded: Sequence[ClassEntry]) -> list[Diagnosis]:
             key = diagnosis_key(result.id, result.status, text)
             group = groups.setdefault(
                 key,
-                Diagnosis(key=key, problem=result.id, title=result.title, status=result.status, text=text,
-                          count=0, identities=[]),
-            )  # fmt: skip
+                Diagnosis(
+                    key=key,
+                    problem=result.id,
+                    title=bounded(result.title, MAX_NAME_CHARS),
+                    status=result.status,
+                    text=text,
+                    count=0,
+                    identities=[],
+                ),
+            )
             identity = _identity(entry)
             if identity not in group.identities:
                 group.identities.append(identity)

@@ -23,6 +23,9 @@ ELLIPSIS = "…"
 
 HIDDEN = "\ufffd"
 """Shown in place of a control, bidi override or unassigned character: visibly there, doing nothing."""
+HIDDEN_CATEGORIES = frozenset({"Cc", "Cs", "Co", "Cn"})
+"""Controls, surrogates, private-use and unassigned characters: shown as ``HIDDEN`` everywhere."""
+BLANK = "(blank)"
 BIDI_CONTROLS = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
 """Characters that reorder the text around them (Unicode TR9 explicit formatting); never shown."""
 
@@ -53,18 +56,30 @@ def display_text(text: str, limit: int) -> str:
     Returns:
         The cleaned, bounded text (HTML escaping is still the template's job).
     """
+    return _cleaned(text, limit, HIDDEN_CATEGORIES)
+
+
+def display_identity(text: str, limit: int) -> str:
+    """An identity to show: as ``display_text``, and every invisible format character (zero-width space,
+    joiners, soft hyphen, byte order mark) also shown as ``\ufffd``, so two identities that differ only
+    by one never look alike; a blank identity reads ``(blank)``.
+
+    Names keep their joiners (scripts such as Persian and Devanagari need them); ids never do.
+    """
+    return _cleaned(text, limit, HIDDEN_CATEGORIES | {"Cf"}) or BLANK
+
+
+def _cleaned(text: str, limit: int, hidden: frozenset[str]) -> str:
     # Cut first (bounded work on huge input), then clean, then cut again to the exact bound.
     rough = text[: limit * 4]
-    single = " ".join("".join(_shown(character) for character in rough).split())
+    shown = "".join(
+        " " if character.isspace()
+        else HIDDEN if character in BIDI_CONTROLS or unicodedata.category(character) in hidden
+        else character
+        for character in rough
+    )  # fmt: skip
+    single = " ".join(shown.split())
     return bounded(single if len(rough) == len(text) else single + ELLIPSIS, limit)
-
-
-def _shown(character: str) -> str:
-    if character.isspace():
-        return " "
-    if character in BIDI_CONTROLS or unicodedata.category(character) in ("Cc", "Cs", "Co", "Cn"):
-        return HIDDEN
-    return character
 
 
 def safe_href(href: str | None) -> str | None:

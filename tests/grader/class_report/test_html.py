@@ -137,6 +137,12 @@ def test_the_page_shows_the_figures_diagnoses_late_missing_and_links() -> None:
     assert "u200.json" not in hrefs
 
 
+def test_a_problem_id_that_reads_as_mathtext_is_drawn_as_text() -> None:
+    odd = result("taxi", "failed", "x").model_copy(update={"id": "$\\nosuch$"})
+    page = render_class_html([ClassEntry("a", report=report(odd))])
+    assert page.count('src="data:image/png;base64,') == 2
+
+
 def test_long_lists_are_cut_on_the_page_and_say_where_the_rest_is() -> None:
     many = [
         graded(f"s{index:03d}", result("taxi", "failed", "same cause"))

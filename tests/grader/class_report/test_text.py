@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import pytest
 
-from grader.class_report.text import ELLIPSIS, HIDDEN, bounded, display_text, safe_href
+from grader.class_report.text import (
+    BLANK,
+    ELLIPSIS,
+    HIDDEN,
+    bounded,
+    display_identity,
+    display_text,
+    safe_href,
+)
 
 
 @pytest.mark.parametrize(
@@ -27,6 +35,37 @@ from grader.class_report.text import ELLIPSIS, HIDDEN, bounded, display_text, sa
 )  # fmt: skip
 def test_display_text_is_one_bounded_line_with_every_control_inert(text: str, limit: int, shown: str) -> None:
     assert display_text(text, limit) == shown
+
+
+@pytest.mark.parametrize(
+    ("identity", "shown"),
+    [
+        ("alice\u200b", f"alice{HIDDEN}"),
+        ("\ufeffbob", f"{HIDDEN}bob"),
+        ("car\u00adol", f"car{HIDDEN}ol"),
+        ("da\u200dve", f"da{HIDDEN}ve"),
+        ("", BLANK),
+        (" \n\t ", BLANK),
+        ("0042", "0042"),
+    ],
+    ids=[
+        "zero-width-space",
+        "byte-order-mark",
+        "soft-hyphen",
+        "joiner",
+        "empty",
+        "whitespace",
+        "leading-zeros",
+    ],
+)
+def test_identities_that_differ_invisibly_look_different(identity: str, shown: str) -> None:
+    assert display_identity(identity, 80) == shown
+
+
+def test_names_keep_the_joiners_their_scripts_need() -> None:
+    persian = "\u0645\u06cc\u200c\u062e\u0648\u0627\u0647\u0645"
+    assert display_text(persian, 80) == persian
+    assert display_identity(persian, 80) != persian
 
 
 def test_bounded_keeps_text_as_given_up_to_its_limit() -> None:
