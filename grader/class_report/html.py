@@ -81,7 +81,7 @@ def render_class_html(
         summary=summarised,
         figures=drawn,
         diagnoses=summarised.diagnoses[:DIAGNOSES_SHOWN],
-        rows={row.identity: row for row in summarised.roster},
+        rows={row.identity: row for row in summarised.entries},
         identities_shown=IDENTITIES_SHOWN,
         csp=CSP,
         style=STYLE,

@@ -137,7 +137,7 @@ class ClassSummary(BaseModel):
     problems: list[ProblemPassRate]
     diagnoses: list[Diagnosis] = Field(description=f"Most common first; at most {MAX_DIAGNOSES}.")
     diagnoses_left_off: int = Field(description="Less common diagnosis groups not listed.")
-    roster: list[StudentRow] = Field(description="Every student, by identity.")
+    entries: list[StudentRow] = Field(description="Every student, by identity.")
 
 
 def diagnosis_text(feedback: str, submission: str = "") -> str:
@@ -186,7 +186,7 @@ def summarise(entries: Sequence[ClassEntry], *, title: str = "") -> ClassSummary
         problems=_pass_rates(graded),
         diagnoses=(diagnoses := _diagnoses(graded))[:MAX_DIAGNOSES],
         diagnoses_left_off=max(len(diagnoses) - MAX_DIAGNOSES, 0),
-        roster=[_row(entry) for entry in ordered],
+        entries=[_row(entry) for entry in ordered],
     )
 
 
@@ -200,7 +200,7 @@ def class_summary(entries: Sequence[ClassEntry], *, title: str = "") -> dict[str
     Returns:
         ``format``, ``title``, ``students``, ``graded``, ``missing``, ``late``, ``submission_errors``,
         ``scores`` (distribution and histogram bins), ``problems`` (pass rates), ``diagnoses`` (most
-        common first, with the identities concerned), ``diagnoses_left_off`` and ``roster``.
+        common first, with the identities concerned), ``diagnoses_left_off`` and ``entries``.
     """
     return summarise(entries, title=title).model_dump(mode="json")
 

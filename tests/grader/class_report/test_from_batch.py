@@ -78,10 +78,10 @@ def test_grade_with_html_writes_the_class_page_and_its_summary(
         'raised ValueError: no car yet Traceback (most recent call last): File "/submission/<file>", line #'
         in (summary["diagnoses"][0]["text"])
     ), "the traceback names each student's file; the diagnosis does not"
-    assert [row["report_href"] for row in summary["roster"]] == [
+    assert [row["report_href"] for row in summary["entries"]] == [
         f"out/{name}.json" for name in ("alice", "bob", "carol", "dave")
     ]
-    assert all((tmp_path / row["report_href"]).is_file() for row in summary["roster"])
+    assert all((tmp_path / row["report_href"]).is_file() for row in summary["entries"])
     html = page.read_text(encoding="utf-8")
     assert html.count('href="out/carol.json"') == 2  # under its diagnosis and in the table
 

@@ -105,11 +105,13 @@ def test_a_huge_identity_is_cut_on_the_page_and_in_the_summary(tmp_path: Path) -
     assert "x" * MAX_DIAGNOSIS_CHARS not in page and len(page) < 100_000
     written = write_class_report(tmp_path / "class.html", _hostile_class())
     summary = json.loads(written.read_text(encoding="utf-8"))
-    assert max(len(row["identity"]) for row in summary["roster"]) == 256
+    assert max(len(row["identity"]) for row in summary["entries"]) == 256
     assert all(ord(character) < 128 for character in written.read_text(encoding="utf-8"))
-    identities = [row["identity"] for row in summary["roster"]]
+    identities = [row["identity"] for row in summary["entries"]]
     assert "evil\u202egpj.py" in identities, "the JSON keeps identities as given"
-    assert [row["report_href"] for row in summary["roster"] if row["identity"] == "javascript-link"] == [None]
+    assert [row["report_href"] for row in summary["entries"] if row["identity"] == "javascript-link"] == [
+        None
+    ]
 
 
 def test_the_page_shows_the_figures_diagnoses_late_missing_and_links() -> None:

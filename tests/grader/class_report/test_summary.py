@@ -16,7 +16,7 @@ from .support import OFF_BY_ONE, SHORT_POLE, STOOD_ON_N, all_passed, graded, rep
 
 SUMMARY_KEYS = [
     "format", "title", "students", "graded", "missing", "late", "submission_errors", "scores", "problems",
-    "diagnoses", "diagnoses_left_off", "roster",
+    "diagnoses", "diagnoses_left_off", "entries",
 ]  # fmt: skip
 
 
@@ -27,7 +27,7 @@ def test_an_empty_class_has_every_key_and_nothing_in_them() -> None:
         "count": 0, "max_score": 0.0, "mean": None, "median": None, "min": None, "max": None,
         "full_marks": 0, "bins": [],
     }  # fmt: skip
-    assert (summary["problems"], summary["diagnoses"], summary["roster"]) == ([], [], [])
+    assert (summary["problems"], summary["diagnoses"], summary["entries"]) == ([], [], [])
     json.dumps(summary, allow_nan=False)
 
 
@@ -222,7 +222,7 @@ def test_passed_and_skipped_results_are_no_diagnosis_and_each_student_counts_onc
 def test_late_and_missing_students_are_listed_by_identity() -> None:
     summary = class_summary(_class())
     assert (summary["late"], summary["missing"]) == (["u200"], ["u400"])
-    assert [row["identity"] for row in summary["roster"]] == [
+    assert [row["identity"] for row in summary["entries"]] == [
         "u000",
         "u001",
         "u002",
@@ -231,7 +231,7 @@ def test_late_and_missing_students_are_listed_by_identity() -> None:
         "u300",
         "u400",
     ]
-    assert summary["roster"][-1] == {
+    assert summary["entries"][-1] == {
         "identity": "u400", "name": None, "status": "missing", "score": None, "max_score": None,
         "late": False, "note": "", "report_href": None,
     }  # fmt: skip
@@ -251,5 +251,5 @@ def test_identities_keep_leading_zeros_and_rare_diagnoses_beyond_the_limit_are_c
         for index in range(MAX_DIAGNOSES + 3)
     ]
     summary = class_summary(entries)
-    assert summary["roster"][0]["identity"] == "00000"
+    assert summary["entries"][0]["identity"] == "00000"
     assert (len(summary["diagnoses"]), summary["diagnoses_left_off"]) == (MAX_DIAGNOSES, 3)
