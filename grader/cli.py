@@ -360,6 +360,9 @@ def run_grade(args: argparse.Namespace) -> int:
     if not paths:
         print("gymgrade grade: no .py or .ipynb files found in the given targets", file=sys.stderr)
         return EXIT_ERROR
+    if args.html is not None and (clash := class_page_clash(args.html, paths, args.out)) is not None:
+        print(f"gymgrade grade: {clash}", file=sys.stderr)
+        return EXIT_ERROR
     policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
     executor = find_executor(policy)
     bar = ProgressBar(total=0)
@@ -414,6 +417,13 @@ def run_grade(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     return EXIT_ERROR if errors else 0
+
+
+def class_page_clash(page: Path, paths: Sequence[Path], out_dir: Path) -> str | None:
+    """Why `gymgrade grade --html` would overwrite one of the batch's files, or None."""
+    from grader.class_report.from_batch import page_clash
+
+    return page_clash(page, paths, out_dir)
 
 
 def write_class_page(page: Path, paths: Sequence[Path], reports: Sequence[Report], out_dir: Path) -> None:

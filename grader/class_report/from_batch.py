@@ -10,7 +10,8 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from grader.batch import report_names
+from grader.batch import GRADES_FILE, report_names
+from grader.class_report import summary_path
 from grader.class_report.entries import ClassEntry
 from grader.report import Report
 
@@ -45,3 +46,28 @@ def entries_from_batch(
             )
         )
     return entries
+
+
+def page_clash(page: Path, paths: Sequence[Path], out_dir: Path) -> str | None:
+    """Why the class page or its summary would overwrite a file of the batch, or None when neither does.
+
+    A student whose file is ``class.py`` has the report ``class.json``: ``--html gradebook/class.html``
+    would replace it with the summary. Checked before grading, so the batch never starts.
+
+    Args:
+        page: Where the class page goes; its summary goes beside it (``summary_path``).
+        paths: The batch's submission files.
+        out_dir: The batch's output directory.
+
+    Returns:
+        The message to show, or None.
+    """
+    names = report_names(paths)
+    outputs = {(out_dir / f"{name}.json").resolve(): path for path, name in names.items()}
+    for written in (page, summary_path(page)):
+        if written.resolve() == (out_dir / GRADES_FILE).resolve():
+            return f"--html {page} would write {written} over the batch's {GRADES_FILE}; name the page e.g. class.html or put it outside {out_dir}"  # noqa: E501
+        clashing = outputs.get(written.resolve())
+        if clashing is not None:
+            return f"--html {page} would write {written} over the report of {clashing}; put the page outside {out_dir} (e.g. {out_dir.parent / 'class.html'}) or give it another name"  # noqa: E501
+    return None

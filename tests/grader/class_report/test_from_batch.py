@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from grader import cli
-from grader.class_report.from_batch import entries_from_batch
+from grader.class_report.from_batch import entries_from_batch, page_clash
 
 from .support import report, result
 
@@ -103,3 +103,39 @@ def test_grade_refuses_a_json_name_for_the_page_before_grading(
         )
     assert "expected an .html file name (the JSON summary is written beside it)" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("page", "clash"),
+    [
+        ("class.html", None),
+        ("out/class.html", "would write {out}/class.json over the report of {inputs}/class.py"),
+        ("out/alice.html", "would write {out}/alice.json over the report of {inputs}/alice.py"),
+        ("out/grades.csv", "would write {out}/grades.csv over the batch's grades.csv"),
+        ("out/summary.html", None),
+    ],
+    ids=["outside", "a-student-named-class", "a-students-name", "the-gradebook", "inside-no-clash"],
+)
+def test_the_class_page_never_overwrites_a_file_of_the_batch(
+    tmp_path: Path, page: str, clash: str | None
+) -> None:
+    inputs, out = tmp_path / "in", tmp_path / "out"
+    found = page_clash(tmp_path / page, [inputs / "alice.py", inputs / "class.py"], out)
+    if clash is None:
+        assert found is None
+    else:
+        assert found is not None and clash.format(out=out, inputs=inputs) in found
+
+
+def test_grade_refuses_a_page_that_would_overwrite_a_report_before_grading(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "class.py").write_bytes(b"")
+    out = tmp_path / "out"
+    arguments = ["grade", str(tmp_path / "class.py"), "--out", str(out), "--html", str(out / "class.html")]
+    assert cli.main(arguments) == cli.EXIT_ERROR
+    assert (
+        f"would write {out / 'class.json'} over the report of {tmp_path / 'class.py'}; put the page outside"
+        in (capsys.readouterr().err)
+    )
+    assert not out.exists()
