@@ -153,7 +153,9 @@ def diagnosis_text(feedback: str, submission: str = "") -> str:
     """
     text = feedback[: MAX_DIAGNOSIS_CHARS * 4]
     if submission:
-        text = text.replace(submission, FILE_PLACEHOLDER)
+        # The name as a whole word only: the file "a.py" must not turn "data.py" into "dat<file>".
+        own_name = re.compile(rf"(?<![\w.-]){re.escape(submission)}(?![\w-])")
+        text = own_name.sub(FILE_PLACEHOLDER, text)
     return display_text(_NUMBER_LIST.sub("#", _NUMBER.sub("#", text)), MAX_DIAGNOSIS_CHARS)
 
 

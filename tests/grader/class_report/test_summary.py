@@ -166,6 +166,24 @@ def test_a_diagnosis_does_not_depend_on_the_students_file_name() -> None:
     )
 
 
+@pytest.mark.parametrize(
+    ("feedback", "submission", "text"),
+    [
+        (
+            'File "/submission/a.py", line 3: import data.py',
+            "a.py",
+            'File "/submission/<file>", line #: import data.py',
+        ),
+        ("a.py defines no car(); a.pyc", "a.py", "<file> defines no car(); a.pyc"),
+        ("x (1).py is empty", "x (1).py", "<file> is empty"),
+        ("opengym.py is empty", "", "opengym.py is empty"),
+    ],
+    ids=["a-path-not-another-name", "at-the-start-not-a-longer-name", "odd-characters", "no-name"],
+)
+def test_only_the_files_own_name_is_replaced(feedback: str, submission: str, text: str) -> None:
+    assert diagnosis_text(feedback, submission) == text
+
+
 def test_a_diagnosis_of_huge_feedback_is_bounded() -> None:
     text = diagnosis_text("x" * 10_000_000)
     assert len(text) == MAX_DIAGNOSIS_CHARS and text.endswith("…")
