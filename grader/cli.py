@@ -53,6 +53,15 @@ def _seed(text: str) -> int:
     return value
 
 
+def _class_page(text: str) -> Path:
+    page = Path(text)
+    if page.suffix.lower() == ".json":
+        raise argparse.ArgumentTypeError(
+            f"expected an .html file name (the JSON summary is written beside it), found {text}; name the page e.g. class.html"  # noqa: E501
+        )
+    return page
+
+
 def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
     parser.add_argument("--seed", type=_seed, default=None, help=seed_help)
     parser.add_argument(
@@ -121,6 +130,14 @@ def build_parser() -> argparse.ArgumentParser:
         "--allow-weak-isolation",
         action="store_true",
         help="grade even where the sandbox cannot enforce every isolation layer",
+    )
+    grade.add_argument(
+        "--html",
+        type=_class_page,
+        default=None,
+        metavar="PATH",
+        help="also write a self-contained class report (scores, pass rates, common diagnoses, links to each report); "  # noqa: E501
+        "its JSON summary goes beside it (class.html -> class.json)",
     )
     grade.set_defaults(handler=run_grade)
 
@@ -396,6 +413,9 @@ def run_grade(args: argparse.Namespace) -> int:
     if not paths:
         print("gymgrade grade: no .py or .ipynb files found in the given targets", file=sys.stderr)
         return EXIT_ERROR
+    if args.html is not None and (clash := class_page_clash(args.html, paths, args.out)) is not None:
+        print(f"gymgrade grade: {clash}", file=sys.stderr)
+        return EXIT_ERROR
     policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
     executor = find_executor(policy)
     bar = ProgressBar(total=0)
@@ -439,6 +459,8 @@ def run_grade(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED
+    if args.html is not None:
+        write_class_page(args.html, paths, outcome.reports, args.out)
     errors = sum(1 for report in outcome.reports if report.grader_errors)
     print(
         f"Graded {len(outcome.graded)} submissions"
@@ -448,6 +470,22 @@ def run_grade(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     return EXIT_ERROR if errors else 0
+
+
+def class_page_clash(page: Path, paths: Sequence[Path], out_dir: Path) -> str | None:
+    """Why `gymgrade grade --html` would overwrite one of the batch's files, or None."""
+    from grader.class_report.from_batch import page_clash
+
+    return page_clash(page, paths, out_dir)
+
+
+def write_class_page(page: Path, paths: Sequence[Path], reports: Sequence[Report], out_dir: Path) -> None:
+    """`gymgrade grade --html`: the class report of the batch, and its JSON summary beside it."""
+    from grader.class_report import write_class_report
+    from grader.class_report.from_batch import entries_from_batch
+
+    summary = write_class_report(page, entries_from_batch(paths, reports, out_dir, page))
+    print(f"Wrote the class report {page} and its summary {summary}.", file=sys.stderr)
 
 
 def problems_of(args: argparse.Namespace) -> tuple[str, ...]:
