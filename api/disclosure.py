@@ -4,8 +4,10 @@ Students never see a grading seed (the submission's, the report's or a problem's
 releases them (GYMGRADE_RELEASE_SEEDS), because every start of every call follows from it through public
 functions. A problem marked ``hidden`` in the assignment config, or ``after_due_date`` before
 GYMGRADE_DUE_DATE, is withheld: its status, score, feedback, measurements, output, events and timings are
-replaced by a note, and so is the total score, which would give the withheld scores away. The stored
-report always keeps everything; these pure functions only shape the views.
+replaced by a note. So is everything summed over the problems, which would give the withheld ones away
+(a total minus the shown parts is the withheld part): the total score, the grading's time and its timings,
+and the grader's errors about a withheld problem. The stored report always keeps everything; these pure
+functions only shape the views.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from typing import Any
 
 from api.auth import Principal
 from api.settings import Settings
+from grader.report import errors_shown, withheld_ids
 
 JsonObject = dict[str, Any]
 
@@ -85,13 +88,21 @@ def problem_view(problem: JsonObject, disclosure: Disclosure) -> JsonObject:
 
 
 def report_view(report: JsonObject, disclosure: Disclosure) -> JsonObject:
-    """A report as ``disclosure`` allows: seeds and withheld problems (and then the total) replaced."""
+    """A report as ``disclosure`` allows: seeds and withheld problems replaced, and with them every total.
+
+    While a problem is withheld, the total score, the grading's time (``execution_time``, ``timings``) and
+    the grader's errors about the withheld problem are left out: what remains is the same whatever the
+    withheld problem's outcome.
+    """
     view = dict(report)
-    view["problems"] = [problem_view(problem, disclosure) for problem in report.get("problems", [])]
+    problems = report.get("problems", [])
+    view["problems"] = [problem_view(problem, disclosure) for problem in problems]
     if not disclosure.seeds:
         view["seed"] = None
-    if withholds_any(report, disclosure):
-        view["score"] = None
+    withheld = withheld_ids(problems, disclosure.shown)
+    if withheld:
+        view.update(score=None, execution_time=None, timings=None)
+        view["grader_errors"] = errors_shown(report.get("grader_errors", []), withheld)
     return view
 
 

@@ -1,13 +1,14 @@
 """The grader's own cost for each hostile sample next to the honest one, and the endless function's time.
 
-    python bench/hostile.py [--write]
+    python bench/hostile.py [--write] [--heading "## Fourth round"]
 
 Each row grades one problem of one sample in a fresh process with the bundled assignment configuration
 (`grader.execution.run_problem`, the code an acceptance test runs) and reads that process's own CPU time
 and peak resident memory (`getrusage(RUSAGE_SELF)`: the sandbox child, which runs the student's code, is
 not counted). So the figures are what the student's code can make the *grader* spend: parsing frames,
 replaying episodes, judging. `--write` replaces the `## Integrity and bounded cost` section of
-bench/RESULTS.md.
+bench/RESULTS.md (or the section `--heading` names). The machine's load average before and after the run
+is recorded with the figures: on a shared machine the wall times grow with it, the grader's CPU much less.
 """
 
 from __future__ import annotations
@@ -37,8 +38,11 @@ CASES: list[tuple[str, str]] = [
     ("hostile/scouting_many_envs.py", "car"),
     ("hostile/zero_step_resets.py", "cartpole"),
     ("hostile/acrobot_in_cartpole.py", "cartpole"),
+    ("hostile/patched_dynamics.py", "cartpole"),
     ("hostile/frozenlake_desc.py", "car"),
     ("hostile/endless_car.py", "car"),
+    ("hostile/start_printer.py", "cartpole"),
+    ("hostile/start_keyed_tapes.py", "cartpole"),
 ]
 
 _PROBE = """
@@ -75,16 +79,31 @@ def measure(sample: str, problem: str) -> dict[str, object]:
     return figures
 
 
-def table(rows: list[tuple[str, str, dict[str, object]]], call_seconds: float) -> str:
+def table(
+    rows: list[tuple[str, str, dict[str, object]]],
+    call_seconds: float,
+    heading: str = HEADING,
+    loads: tuple[tuple[float, ...], tuple[float, ...]] | None = None,
+) -> str:
     """The section's Markdown."""
     honest = {problem: figures for sample, problem, figures in rows if sample == HONEST}
+    command = "python bench/hostile.py --write" + (f' --heading "{heading}"' if heading != HEADING else "")
+    load = (
+        " Load average (1, 5, 15 min) before the run "
+        + ", ".join(f"{value:.2f}" for value in loads[0])
+        + ", after it "
+        + ", ".join(f"{value:.2f}" for value in loads[1])
+        + "."
+        if loads is not None
+        else ""
+    )
     lines = [
-        HEADING,
+        heading,
         "",
-        f"`python bench/hostile.py --write`, {date.today()}, {platform.machine()}, {os.cpu_count()} cores. "
+        f"`{command}`, {date.today()}, {platform.machine()}, {os.cpu_count()} cores.{load} "
         "One problem per fresh process with the bundled configuration; the grader process's own CPU and "
         "peak RSS (the sandboxed student code is not counted); ratios against the honest lab solution's "
-        "same problem.",
+        "same problem, measured in the same run.",
         "",
         "| sample | problem | verdict | calls made | wall s | grader CPU s | x honest CPU "
         "| grader peak MiB |",
@@ -112,22 +131,24 @@ def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    parser.add_argument("--write", action="store_true", help=f"replace the {HEADING!r} section of RESULTS.md")
+    parser.add_argument("--write", action="store_true", help="replace the section --heading of RESULTS.md")
+    parser.add_argument("--heading", default=HEADING, help=f"the section's heading (default {HEADING!r})")
     arguments = parser.parse_args()
     sys.path.insert(0, str(ROOT))
     from grader.config import load_config
 
     call_seconds = load_config().problem("car").call_seconds
     rows = []
+    before = os.getloadavg()
     for sample, problem in CASES:
         figures = measure(sample, problem)
         print(sample, problem, json.dumps(figures), flush=True)
         rows.append((sample, problem, figures))
-    text = table(rows, call_seconds)
+    text = table(rows, call_seconds, arguments.heading, (before, os.getloadavg()))
     print(text)
     if arguments.write:
         current = RESULTS.read_text(encoding="utf-8")
-        pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.S | re.M)
+        pattern = re.compile(rf"^{re.escape(arguments.heading)}\n.*?(?=^## |\Z)", re.S | re.M)
         updated = pattern.sub(text + "\n", current) if pattern.search(current) else current + "\n" + text
         RESULTS.write_text(updated, encoding="utf-8")
 

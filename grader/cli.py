@@ -57,6 +57,15 @@ def _seed(text: str) -> int:
     return value
 
 
+def _class_page(text: str) -> Path:
+    page = Path(text)
+    if page.suffix.lower() == ".json":
+        raise argparse.ArgumentTypeError(
+            f"expected an .html file name (the JSON summary is written beside it), found {text}; name the page e.g. class.html"  # noqa: E501
+        )
+    return page
+
+
 def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
     parser.add_argument("--seed", type=_seed, default=None, help=seed_help)
     parser.add_argument(
@@ -178,18 +187,20 @@ def build_parser() -> argparse.ArgumentParser:
         help="grade even where the sandbox cannot enforce every isolation layer",
     )
     _add_class_options(grade)
+    grade.add_argument(
+        "--html",
+        type=_class_page,
+        default=None,
+        metavar="PATH",
+        help="also write a self-contained class report (scores, pass rates, common diagnoses, links to each report); "  # noqa: E501
+        "its JSON summary goes beside it (class.html -> class.json)",
+    )
     grade.set_defaults(handler=run_grade)
 
     bundle = subparsers.add_parser(
         "gradescope-bundle", help="build the Gradescope autograder zip (setup.sh, run_autograder, config)"
     )
     bundle.add_argument("--out", type=Path, default=Path("autograder.zip"), metavar="ZIP")
-    bundle.add_argument(
-        "--seed",
-        type=_seed,
-        default=None,
-        help="grading seed of every submission (default: a held-out seed drawn at random and printed)",
-    )
     bundle.add_argument("--config", type=Path, default=None, metavar="PATH", help="assignment configuration")
     bundle.set_defaults(handler=run_gradescope_bundle)
 
@@ -197,10 +208,43 @@ def build_parser() -> argparse.ArgumentParser:
         "gradescope-run", help="grade ROOT/submission into ROOT/results/results.json (run_autograder)"
     )
     gradescope_run.add_argument("--root", type=Path, default=None, metavar="DIR")
-    gradescope_run.add_argument("--seed", type=int, default=0)
+    gradescope_run.add_argument(
+        "--secret-file",
+        type=Path,
+        default=None,
+        metavar="PATH",
+        help="the bundle's seed secret (the upload's seed derives from it and ROOT/submission_metadata.json)",
+    )
+    gradescope_run.add_argument(
+        "--seed", type=_seed, default=None, help="grade on this seed instead (an instructor's regrade)"
+    )
     gradescope_run.add_argument("--config", type=Path, default=None, metavar="PATH")
     gradescope_run.add_argument("--workers", type=_positive, default=None)
     gradescope_run.set_defaults(handler=run_gradescope_run)
+
+    gradescope_seed = subparsers.add_parser(
+        "gradescope-seed",
+        help="an upload's grading seed from the autograder zip and its submission_metadata.json; "
+        "with --submission, regrade it identically",
+    )
+    gradescope_seed.add_argument(
+        "--bundle", type=Path, required=True, metavar="ZIP", help="the autograder zip"
+    )
+    gradescope_seed.add_argument(
+        "--metadata", type=Path, required=True, metavar="JSON", help="the upload's submission_metadata.json"
+    )
+    gradescope_seed.add_argument(
+        "--submission", type=Path, default=None, metavar="FILE|DIR", help="the upload's file(s): regrade them"
+    )
+    gradescope_seed.add_argument(
+        "--out",
+        type=Path,
+        default=Path("results.json"),
+        metavar="PATH",
+        help="where the regrade's results go",
+    )
+    gradescope_seed.add_argument("--workers", type=_positive, default=None)
+    gradescope_seed.set_defaults(handler=run_gradescope_seed)
 
     for entry_point in entry_points(group=COMMAND_GROUP):
         try:
@@ -288,7 +332,7 @@ def run_check(args: argparse.Namespace) -> int:
     elif output_format == "gradescope":
         from grader.gradescope import results
 
-        sys.stdout.write(results(report).model_dump_json(indent=2) + "\n")
+        sys.stdout.write(results(report).to_json())
     else:
         print(summary(report))
     if report.grader_errors:
@@ -373,21 +417,47 @@ def run_gradescope_bundle(args: argparse.Namespace) -> int:
     from grader.gradescope import bundle
 
     load_config(args.config)  # an invalid configuration fails here, not on Gradescope
-    seed = held_out_seed() if args.seed is None else args.seed
-    print(f"Grading seed {seed} (kept in the bundle, never shown to students; rebuild with --seed {seed})")
-    path = bundle(args.out, config=args.config, seed=seed)
+    path = bundle(args.out, config=args.config)
     print(f"Wrote {path} ({path.stat().st_size:,} bytes): upload it as the assignment's autograder.")
+    print(
+        "Each upload is graded on its own seed, derived from a secret drawn now and kept in the zip (never shown to students). "  # noqa: E501
+        "Keep the zip: `gymgrade gradescope-seed --bundle ZIP --metadata submission_metadata.json` recomputes an upload's seed and regrades it identically."  # noqa: E501
+    )
     return 0
 
 
 def run_gradescope_run(args: argparse.Namespace) -> int:
     """`gymgrade gradescope-run`: what the bundle's run_autograder calls; always writes results.json."""
     from grader.gradescope import default_root, run_autograder
+    from grader.gradescope_upload import UploadSeed, seed_for_upload
 
-    graded = run_autograder(
-        args.root or default_root(), seed=args.seed, config=args.config, workers=args.workers
-    )
+    root = args.root or default_root()
+    if args.seed is not None:
+        upload = UploadSeed(args.seed, "given")
+    elif args.secret_file is not None:
+        upload = seed_for_upload(root, secret_file=args.secret_file)
+    else:
+        print(
+            "gymgrade gradescope-run: expected --secret-file (the bundle's seed_secret, as run_autograder passes it) or --seed N; "  # noqa: E501
+            "found neither",
+            file=sys.stderr,
+        )
+        return EXIT_ERROR
+    graded = run_autograder(root, upload=upload, config=args.config, workers=args.workers)
     print(f"Score: {graded.score:g}")
+    return 0
+
+
+def run_gradescope_seed(args: argparse.Namespace) -> int:
+    """`gymgrade gradescope-seed`: an upload's seed; with ``--submission``, its results regraded."""
+    from grader.gradescope import regrade_upload, upload_seed_of
+
+    upload = upload_seed_of(args.bundle, args.metadata)
+    print(f"Grading seed {upload.seed} (upload {', '.join(upload.identity)})")
+    if args.submission is None:
+        return 0
+    graded = regrade_upload(args.bundle, args.metadata, args.submission, args.out, workers=args.workers)
+    print(f"Regraded {args.submission} on seed {upload.seed} into {args.out}: score {graded.score:g}")
     return 0
 
 
@@ -427,6 +497,11 @@ def run_grade(args: argparse.Namespace) -> int:
             for submission in graded
             if submission.graded_file
         }
+        if args.html is not None:
+            clash = class_page_clash(args.html, list(identities.values()), args.out)
+            if clash is not None:
+                print(f"gymgrade grade: {clash}", file=sys.stderr)
+                return EXIT_ERROR
         gradebook = ClassGradebook(download, identities, plan.problems, roster, args.gradebook, assignment)
         return _grade_class(args, list(identities), identities, gradebook)
 
@@ -496,6 +571,8 @@ def _grade_class(
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED
+    if args.html is not None and gradebook.rows is not None:
+        write_class_page(args.html, gradebook, args.out)
     errors = sum(1 for report in outcome.reports if report.grader_errors)
     written = ", ".join(["grades.csv", *(f"{name}.csv" for name in args.gradebook)])
     if "canvas" in args.gradebook and gradebook.rows is not None:
@@ -516,6 +593,24 @@ def _grade_class(
         file=sys.stderr,
     )
     return EXIT_ERROR if errors else 0
+
+
+def class_page_clash(page: Path, identities: Sequence[str], out_dir: Path) -> str | None:
+    """Why `gymgrade grade --html` would overwrite one of the batch's files (a student's report), or None."""
+    from grader.batch import identity_stem
+    from grader.class_report.from_batch import page_clash_of_reports
+
+    reports = {out_dir / f"{identity_stem(identity)}.json": f"student {identity}" for identity in identities}
+    return page_clash_of_reports(page, reports, out_dir)
+
+
+def write_class_page(page: Path, gradebook: ClassGradebook, out_dir: Path) -> None:
+    """`gymgrade grade --html`: the class report of the batch, and its JSON summary beside it."""
+    from grader.class_report import write_class_report
+    from grader.class_report.from_batch import entries_from_rows
+
+    summary = write_class_report(page, entries_from_rows(gradebook.rows or [], out_dir, page))
+    print(f"Wrote the class report {page} and its summary {summary}.", file=sys.stderr)
 
 
 def problems_of(args: argparse.Namespace) -> tuple[str, ...]:

@@ -33,3 +33,7 @@ class BatchInterrupted(KeyboardInterrupt):
         super().__init__(f"{finished} of {total} submissions graded")
         self.finished = finished
         self.total = total
+
+
+class GradescopeError(GraderError, ValueError):
+    """Raised when a Gradescope file (an autograder zip, an upload's submission metadata) cannot be used."""

@@ -9,7 +9,9 @@ from __future__ import annotations
 import io
 import json
 import os
+import shutil
 import stat
+import tempfile
 import tomllib
 import zipfile
 from importlib.metadata import requires, version
@@ -21,7 +23,10 @@ from pydantic import BaseModel, ConfigDict, Field
 import grader
 from grader.batch import SUBMISSION_SUFFIXES
 from grader.cli import isolation_lines, notebook_lines
-from grader.report import Report
+from grader.errors import GradescopeError
+from grader.gradescope_upload import METADATA_FILE, UploadSeed, read_metadata
+from grader.report import SHOWN_AT_ONCE, Report, errors_shown, withheld_ids
+from grader.seeds import new_secret, upload_seed
 
 Visibility = Literal["hidden", "after_due_date", "after_published", "visible"]
 DEFAULT_ROOT = Path("/autograder")
@@ -31,10 +36,17 @@ PROJECT_PACKAGES = ("grader", "reference")
 """What the bundle installs on Gradescope: the grader and its oracles (the service is not needed)."""
 BUNDLE_PYTHON = "python3.11"
 BUNDLE_VENV = "/opt/gymgrade"
+SECRET_FILE = "seed_secret"
+"""The bundle's seed secret (hex), drawn when the bundle is built; only the grader (root) reads it."""
+OUTPUT_KEPT_NOTE = (
+    "What your code printed is kept for your instructor, not shown here; "
+    "run gymgrade check on your own machine to see it."
+)
+_RESTRICTIVENESS: dict[str, int] = {"visible": 0, "after_published": 1, "after_due_date": 2, "hidden": 3}
 
 
 class GradescopeTest(BaseModel):
-    """One entry of ``tests``: a problem of the lab."""
+    """One entry of ``tests``: a problem of the lab (or an instructor-only note)."""
 
     model_config = ConfigDict(extra="forbid")
 
@@ -53,55 +65,124 @@ class GradescopeResults(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     score: float
-    execution_time: int = Field(description="Seconds, as Gradescope's schema gives it (an integer).")
+    execution_time: int | None = Field(
+        default=None,
+        description="Seconds, as Gradescope's schema gives it (an integer); left out while a problem is withheld.",  # noqa: E501
+    )
     output: str
     output_format: Literal["text", "md", "html", "simple_format", "ansi"] = "text"
     visibility: Visibility = "visible"
     stdout_visibility: Visibility = "hidden"
+    extra_data: dict[str, object] | None = Field(
+        default=None, description="Stored by Gradescope, never shown to students: the grading seed."
+    )
     tests: list[GradescopeTest]
 
+    def to_json(self) -> str:
+        """results.json as written (unset optional fields left out)."""
+        return self.model_dump_json(indent=2, exclude_none=True) + "\n"
 
-def results(report: Report, *, visibility: Visibility = "visible") -> GradescopeResults:
+
+def results(
+    report: Report, *, visibility: Visibility = "visible", upload: UploadSeed | None = None
+) -> GradescopeResults:
     """Gradescope's results for one report: a test per problem, the summary and the isolation as output.
+
+    Nothing a student sees identifies a start or depends on a withheld problem: what the student's code
+    printed goes to an instructor-only test per problem (a file could print its starts), the grading seed
+    only to an instructor-only test and ``extra_data``; while a problem is withheld (``hidden`` or
+    ``after_due_date`` in the assignment), the total score is withheld with it (the results' top-level
+    visibility), the grading time is left out and its grader errors are not in the visible output.
 
     Args:
         report: The grading report.
-        visibility: When students see the results.
+        visibility: When students see the results of the visible problems.
+        upload: The upload's grading seed and its origin, recorded for the instructor (None: not recorded).
 
     Returns:
         The results; ``score`` is the report's, so partial credit and zero-point problems add up as in
         the gradebook.
     """
-    tests = [
-        GradescopeTest(
-            name=problem.title,
-            number=str(index),
-            score=problem.score,
-            max_score=problem.max_score,
-            # A skipped problem (worth nothing, not run) failed nothing; its output says it was not run.
-            status="passed" if problem.status in ("passed", "skipped") else "failed",
-            output=f"{problem.status}: {problem.feedback}"
-            + (f"\n\nYour output:\n{problem.output}" if problem.output else ""),
-            # A problem the assignment hides (or shows after the due date) stays so on Gradescope.
-            visibility=visibility if problem.visibility == "visible" else problem.visibility,
+    withheld = withheld_ids([problem.model_dump() for problem in report.problems], SHOWN_AT_ONCE)
+    tests: list[GradescopeTest] = []
+    for index, problem in enumerate(report.problems, start=1):
+        # A problem the assignment hides (or shows after the due date) stays so on Gradescope.
+        shown_when = visibility if problem.visibility == "visible" else problem.visibility
+        tests.append(
+            GradescopeTest(
+                name=problem.title,
+                number=str(index),
+                score=problem.score,
+                max_score=problem.max_score,
+                # A skipped problem (worth nothing, not run) failed nothing; its output says it was not run.
+                status="passed" if problem.status in ("passed", "skipped") else "failed",
+                output=f"{problem.status}: {problem.feedback}"
+                + (f"\n\n{OUTPUT_KEPT_NOTE}" if problem.output else ""),
+                visibility=shown_when,
+            )
         )
-        for index, problem in enumerate(report.problems, start=1)
-    ]
-    # The grading seed stays the instructor's: every resubmission is graded on the same held-out starts.
+        if problem.output:
+            tests.append(
+                _instructor_note(f"{problem.title}: what the code printed", f"{index}.1", problem.output)
+            )
     lines = [f"gymgrade {report.grader_version}, gymnasium {report.gymnasium_version}."]
     if report.notebook is not None:
         lines += notebook_lines(report.notebook)
     if report.submission_error is not None:
         lines.append(report.submission_error)
     lines += isolation_lines(report.isolation)
-    lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
+    lines += [
+        f"Grader error (not your fault): {error}" for error in errors_shown(report.grader_errors, withheld)
+    ]
+    withheld_visibility = max(
+        (problem.visibility for problem in report.problems if problem.id in withheld),
+        key=_RESTRICTIVENESS.__getitem__,
+        default=None,
+    )
+    if withheld_visibility is not None:
+        # The results' own output is withheld with the total; what it says is the students' all the same.
+        notes = [*lines, "The total score is shown when every problem's result is."]
+        tests.append(
+            GradescopeTest(
+                name="About this grading",
+                number=str(len(report.problems) + 1),
+                score=0.0,
+                max_score=0.0,
+                status="passed",
+                output="\n".join(notes),
+                visibility=visibility,
+            )
+        )
+    if upload is not None:
+        tests.append(_instructor_note("Grading seed", str(len(report.problems) + 2), upload.describe()))
     return GradescopeResults(
         score=report.score,
-        execution_time=round(report.execution_time),
+        execution_time=None if withheld else round(report.execution_time),
         output="\n".join(lines),
-        visibility=visibility,
+        # The total (and the results' own output) follows the most withheld problem: a total shown while a
+        # problem is withheld, minus the visible scores, is the withheld score.
+        visibility=visibility if withheld_visibility is None else withheld_visibility,
+        extra_data=_seed_record(upload) if upload is not None else None,
         tests=tests,
     )
+
+
+def _instructor_note(name: str, number: str, output: str) -> GradescopeTest:
+    return GradescopeTest(
+        name=f"{name} (instructor only)",
+        number=number,
+        score=0.0,
+        max_score=0.0,
+        status="passed",
+        output=output,
+        visibility="hidden",
+    )
+
+
+def _seed_record(upload: UploadSeed) -> dict[str, object]:
+    return {
+        "gymgrade": {"seed": upload.seed, "seed_source": upload.source, "identity": list(upload.identity)}
+    }
 
 
 def failed_run(message: str) -> GradescopeResults:
@@ -134,18 +215,22 @@ def pick_submission(directory: Path) -> Path | str:
     )
 
 
-def bundle(out: Path, *, config: Path | None, seed: int) -> Path:
+def bundle(out: Path, *, config: Path | None, secret: str | None = None) -> Path:
     """Write the Gradescope autograder zip.
 
     It holds ``setup.sh`` (Debian/Ubuntu packages, Python 3.11 and a virtualenv with this gymgrade),
-    ``run_autograder``, the assignment configuration, and the source of this gymgrade's ``grader`` and
-    ``reference`` packages with a minimal ``pyproject.toml`` (so the autograder grades exactly as this
-    installation does, without reaching any package index for gymgrade itself).
+    ``run_autograder``, the assignment configuration, the seed secret, and the source of this gymgrade's
+    ``grader`` and ``reference`` packages with a minimal ``pyproject.toml`` (so the autograder grades
+    exactly as this installation does, without reaching any package index for gymgrade itself).
+
+    Each upload is graded on its own seed, derived from the secret and the upload's identity
+    (`grader.seeds.upload_seed`); keep the zip: with it and an upload's ``submission_metadata.json``,
+    ``gymgrade gradescope-seed`` gives that upload's seed and regrades it identically.
 
     Args:
         out: The zip to write.
         config: Assignment configuration; the bundled one when None.
-        seed: The grading seed every submission is graded with.
+        secret: The seed secret (hex); a fresh one when None (the usual case: tests pass one).
 
     Returns:
         ``out``.
@@ -155,8 +240,9 @@ def bundle(out: Path, *, config: Path | None, seed: int) -> Path:
     buffer = io.BytesIO()
     with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
         _add(archive, "setup.sh", SETUP_SH, executable=True)
-        _add(archive, "run_autograder", RUN_AUTOGRADER.format(seed=seed), executable=True)
+        _add(archive, "run_autograder", RUN_AUTOGRADER, executable=True)
         _add(archive, "assignment.toml", config_text)
+        _add(archive, SECRET_FILE, (secret or new_secret()) + "\n", private=True)
         _add(archive, "gymgrade/pyproject.toml", _pyproject(_dependencies(source_root)))
         for package in PROJECT_PACKAGES:
             for path in sorted((source_root / package).rglob("*")):
@@ -167,9 +253,39 @@ def bundle(out: Path, *, config: Path | None, seed: int) -> Path:
     return out
 
 
-def _add(archive: zipfile.ZipFile, name: str, content: str | bytes, *, executable: bool = False) -> None:
+def bundle_secret(archive_path: Path) -> str:
+    """The seed secret kept in an autograder zip (what ``gymgrade gradescope-seed`` reads).
+
+    Raises:
+        GradescopeError: The file is not a zip, or a zip without a seed secret (an older bundle graded
+            every upload on one seed: its ``run_autograder`` names it).
+    """
+    try:
+        with zipfile.ZipFile(archive_path) as archive:
+            return archive.read(SECRET_FILE).decode("ascii").strip()
+    except (OSError, zipfile.BadZipFile, KeyError, UnicodeDecodeError) as error:
+        raise GradescopeError(
+            f"expected an autograder zip built by gymgrade gradescope-bundle with a {SECRET_FILE} file; "
+            f"{archive_path} gave {type(error).__name__}: {error}. Pass the zip you uploaded to Gradescope."
+        ) from error
+
+
+def bundle_config(archive_path: Path) -> str:
+    """The assignment configuration (TOML text) kept in an autograder zip."""
+    with zipfile.ZipFile(archive_path) as archive:
+        return archive.read("assignment.toml").decode("utf-8")
+
+
+def _add(
+    archive: zipfile.ZipFile,
+    name: str,
+    content: str | bytes,
+    *,
+    executable: bool = False,
+    private: bool = False,
+) -> None:
     info = zipfile.ZipInfo(name, date_time=(2026, 1, 1, 0, 0, 0))
-    mode = 0o755 if executable else 0o644
+    mode = 0o755 if executable else 0o600 if private else 0o644
     info.external_attr = (stat.S_IFREG | mode) << 16
     info.compress_type = zipfile.ZIP_DEFLATED
     archive.writestr(info, content)
@@ -201,12 +317,20 @@ def default_root() -> Path:
     return Path(os.environ.get("GYMGRADE_AUTOGRADER_ROOT", str(DEFAULT_ROOT)))
 
 
-def run_autograder(root: Path, *, seed: int, config: Path | None, workers: int | None) -> GradescopeResults:
+def run_autograder(
+    root: Path, *, upload: UploadSeed, config: Path | None, workers: int | None
+) -> GradescopeResults:
     """Grade ``<root>/submission`` into ``<root>/results/results.json`` (what ``run_autograder`` runs).
 
     Never raises for a student's file: no file, a bad file, a crash are all results. The policy is
     ``ALLOW_FALLBACK``: Gradescope's containers do not allow every isolation layer (see the README), and
     the results' output names the missing ones.
+
+    Args:
+        root: The autograder's root (``/autograder``).
+        upload: The upload's grading seed (`seed_for_upload`), recorded for the instructor.
+        config: Assignment configuration; the bundled one when None.
+        workers: Parallel workers; the machine's cores when None.
     """
     from grader.grading import grade_submission
     from grader.sandbox import IsolationPolicy
@@ -217,7 +341,11 @@ def run_autograder(root: Path, *, seed: int, config: Path | None, workers: int |
     else:
         try:
             report = grade_submission(
-                picked, seed=seed, workers=workers, policy=IsolationPolicy.ALLOW_FALLBACK, config=config
+                picked,
+                seed=upload.seed,
+                workers=workers,
+                policy=IsolationPolicy.ALLOW_FALLBACK,
+                config=config,
             )
         except Exception as error:  # results.json must exist whatever happens, or Gradescope shows nothing
             graded = failed_run(
@@ -225,10 +353,53 @@ def run_autograder(root: Path, *, seed: int, config: Path | None, workers: int |
                 f"{type(error).__name__}: {error}"
             )
         else:
-            graded = results(report)
+            graded = results(report, upload=upload)
+    if graded.extra_data is None:
+        graded = graded.model_copy(update={"extra_data": _seed_record(upload)})
     target = root / "results" / "results.json"
     target.parent.mkdir(parents=True, exist_ok=True)
-    target.write_text(graded.model_dump_json(indent=2) + "\n", encoding="utf-8")
+    target.write_text(graded.to_json(), encoding="utf-8")
+    return graded
+
+
+def upload_seed_of(archive_path: Path, metadata_path: Path) -> UploadSeed:
+    """The seed the bundle gave the upload that ``metadata_path`` describes (the instructor's side).
+
+    Raises:
+        GradescopeError: The zip has no secret, or the metadata cannot be read.
+    """
+    identity = read_metadata(metadata_path).identity()
+    return UploadSeed(upload_seed(bundle_secret(archive_path), identity), "derived", identity)
+
+
+def regrade_upload(
+    archive_path: Path, metadata_path: Path, submission: Path, out: Path, *, workers: int | None = None
+) -> GradescopeResults:
+    """Grade a recorded upload again exactly as the bundle did: same secret, metadata and configuration.
+
+    Args:
+        archive_path: The autograder zip the upload was graded with.
+        metadata_path: The upload's ``submission_metadata.json``.
+        submission: The upload's file, or the directory of its files.
+        out: Where to write its ``results.json``.
+        workers: Parallel workers; the machine's cores when None.
+
+    Raises:
+        GradescopeError: The zip has no secret, or the metadata cannot be read.
+    """
+    upload = upload_seed_of(archive_path, metadata_path)
+    with tempfile.TemporaryDirectory(prefix="gymgrade-regrade-") as temporary:
+        root = Path(temporary)
+        (root / "source").mkdir()
+        config = root / "source" / "assignment.toml"
+        config.write_text(bundle_config(archive_path), encoding="utf-8")
+        if submission.is_dir():
+            shutil.copytree(submission, root / "submission")
+        else:
+            (root / "submission").mkdir()
+            shutil.copy2(submission, root / "submission" / submission.name)
+        graded = run_autograder(root, upload=upload, config=config, workers=workers)
+        shutil.copy2(root / "results" / "results.json", out)
     return graded
 
 
@@ -246,14 +417,21 @@ apt-get install -y -qq --no-install-recommends bubblewrap libseccomp2 {BUNDLE_PY
 {BUNDLE_VENV}/bin/python -m pip install --quiet --disable-pip-version-check --upgrade pip
 {BUNDLE_VENV}/bin/python -m pip install --quiet --disable-pip-version-check ./gymgrade
 {BUNDLE_VENV}/bin/gymgrade --help >/dev/null
+# The seed secret is the grader's alone: student code runs as an unprivileged uid.
+chmod 600 {SECRET_FILE}
 """
 
-RUN_AUTOGRADER = """#!/usr/bin/env bash
+RUN_AUTOGRADER = f"""#!/usr/bin/env bash
 # Gradescope runs this for every submission: grade /autograder/submission/* into
-# /autograder/results/results.json. GYMGRADE_AUTOGRADER_ROOT and GYMGRADE_COMMAND move it (tests).
+# /autograder/results/results.json, on a seed derived from the bundle's secret and this upload's
+# submission_metadata.json (never passed on a command line, where other processes could read it).
+# GYMGRADE_AUTOGRADER_ROOT and GYMGRADE_COMMAND move it (tests).
 set -uo pipefail
 root="${{GYMGRADE_AUTOGRADER_ROOT:-/autograder}}"
-command="${{GYMGRADE_COMMAND:-/opt/gymgrade/bin/gymgrade}}"
+command="${{GYMGRADE_COMMAND:-{BUNDLE_VENV}/bin/gymgrade}}"
+# Only the grader (root) reads the secret and the metadata (which embeds earlier uploads' results).
+chmod 600 "$root/source/{SECRET_FILE}" "$root/{METADATA_FILE}" 2>/dev/null
 # $command is split on spaces on purpose: tests pass "python3 -m grader.cli".
-$command gradescope-run --root "$root" --seed {seed} --config "$root/source/assignment.toml"
+$command gradescope-run --root "$root" --secret-file "$root/source/{SECRET_FILE}" \\
+  --config "$root/source/assignment.toml"
 """

@@ -251,6 +251,29 @@ class Report(BaseModel):
         return data
 
 
+SHOWN_AT_ONCE: frozenset[str] = frozenset({"visible"})
+"""The visibilities a student sees before the due date."""
+
+
+def withheld_ids(problems: Sequence[Mapping[str, Any]], shown: frozenset[str]) -> frozenset[str]:
+    """The ids of the problems a viewer who sees ``shown`` visibilities does not see (results as JSON data).
+
+    Everything a student sees that sums or counts over problems (the total score, the grading's time, the
+    grader's errors) must leave these out, or withhold itself with them: a total minus the shown parts is
+    the withheld part.
+    """
+    return frozenset(
+        str(problem.get("id"))
+        for problem in problems
+        if str(problem.get("visibility", "visible")) not in shown
+    )
+
+
+def errors_shown(grader_errors: Sequence[str], withheld: frozenset[str]) -> list[str]:
+    """The grader's errors a viewer may read: those not about a withheld problem (``problem: ...``)."""
+    return [error for error in grader_errors if error.split(":", 1)[0] not in withheld]
+
+
 def plain_json(value: object) -> JsonValue:
     """Convert a measurement into JSON-safe data: numpy to Python, non-finite floats to strings.
 

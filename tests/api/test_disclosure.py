@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from datetime import UTC, datetime, timedelta
 from typing import Any
 
@@ -115,6 +116,49 @@ def test_after_the_due_date_only_hidden_problems_stay_withheld() -> None:
     assert view["seed"] == GRADING_SEED and view["score"] is None
 
 
+def _varied_report(visibility: Visibility, outcome: int) -> dict[str, Any]:
+    """cartpole shown, taxi ``visibility``: taxi's outcome, the time and the errors follow ``outcome``."""
+    report = _report()
+    problems = [_problem("cartpole", "visible", 1.0), _problem("taxi", visibility, [1.0, 0.0, 0.5][outcome])]
+    problems[1].update(
+        feedback=f"taxi outcome {outcome}",
+        output="x" * outcome,
+        timings={"wall_seconds": 3.0 + outcome, "student_seconds": 1.0 + outcome, "overhead_seconds": 2.0},
+    )
+    elapsed = 10.0 + 7 * outcome
+    report.update(
+        problems=problems,
+        score=1.0 + problems[1]["score"],
+        max_score=2.0,
+        execution_time=elapsed,
+        timings={"elapsed_seconds": elapsed, "workers": 2, "check_seconds": elapsed,
+                 "student_seconds": 1.0 + outcome, "overhead_seconds": 9.0 + 6 * outcome},
+        grader_errors=[f"taxi: failed {outcome}"] if outcome else [],
+    )  # fmt: skip
+    return report
+
+
+@pytest.mark.parametrize("visibility", ["hidden", "after_due_date"])
+def test_nothing_a_student_sees_varies_with_a_withheld_problem(visibility: Visibility) -> None:
+    student = Disclosure(seeds=False, shown=frozenset({"visible"}), due_date=DUE)
+    views = [json.dumps(report_view(_varied_report(visibility, outcome), student)) for outcome in range(3)]
+    assert views[0] == views[1] == views[2]
+    view = report_view(_varied_report(visibility, 1), student)
+    assert (view["score"], view["execution_time"], view["timings"], view["grader_errors"]) == (
+        None,
+        None,
+        None,
+        [],
+    )
+    assert view["problems"][0]["timings"] == _problem("cartpole", "visible", 1.0)["timings"]
+
+
+def test_a_shown_problems_grader_error_is_still_shown() -> None:
+    report = {**_varied_report("hidden", 1), "grader_errors": ["cartpole: broke", "taxi: broke"]}
+    view = report_view(report, Disclosure(seeds=False, shown=frozenset({"visible"})))
+    assert view["grader_errors"] == ["cartpole: broke"]
+
+
 def test_an_unset_due_date_is_named_in_the_note() -> None:
     view = problem_view(_problem("car", "after_due_date", 1.0), Disclosure(False, frozenset({"visible"})))
     assert view["feedback"].startswith(
@@ -122,13 +166,13 @@ def test_an_unset_due_date_is_named_in_the_note() -> None:
     )
 
 
-def _graded(client: TestClient, token: str) -> int:
+def _graded(client: TestClient, token: str, report: dict[str, Any] | None = None) -> int:
     response = client.post("/submissions", files={"file": ("opengym.py", b"x = 1\n")}, headers=bearer(token))
     submission_id: int = response.json()["id"]
     jobs = client.app.state.context.jobs  # type: ignore[attr-defined]
     job = jobs.claim("test-worker")
     assert job is not None and job.submission_id == submission_id
-    report = _report()
+    report = report if report is not None else _report()
     for problem in report["problems"]:
         assert jobs.add_progress(submission_id, "test-worker", problem)
     assert jobs.complete(submission_id, "test-worker", report)
@@ -186,3 +230,18 @@ def test_the_web_page_shows_students_their_view_and_the_instructor_everything(
     assert "Score: withheld (out of 3)" in student_page and "withheld" in student_home
     assert "feedback of taxi" in instructor_page and "output of taxi" in instructor_page
     assert "Score: 2 / 3" in instructor_page and " · seed " in instructor_page
+
+
+def test_the_students_pages_and_json_do_not_vary_with_a_withheld_problem(
+    make_settings: SettingsFactory,
+) -> None:
+    seen = []
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        for outcome in range(3):
+            token = add_student(client, f"student{outcome}")
+            submission_id = _graded(client, token, _varied_report("hidden", outcome))
+            own = client.get(f"/submissions/{submission_id}", headers=bearer(token)).json()
+            _sign_in(client, token)
+            fragment = client.get(f"/ui/submissions/{submission_id}/live").text
+            seen.append((json.dumps([own["score"], own["report"], own["progress"]]), fragment))
+    assert seen[0] == seen[1] == seen[2]

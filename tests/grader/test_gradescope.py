@@ -1,22 +1,44 @@
-"""Gradescope: results.json per its schema, the choice of file, and the autograder zip run for real."""
+"""Gradescope: results.json per its schema, the choice of file, and the autograder zip run for real.
+
+What students see of results.json is modelled by `student_sees`, after Gradescope's specification
+(https://gradescope-autograders.readthedocs.io/en/latest/specs/): the tests whose visibility they may see, the
+top-level score, output and time only when the results' own visibility allows, never ``extra_data`` (stored
+only) nor stdout (``stdout_visibility`` hidden).
+"""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import subprocess
 import sys
-import tomllib
 import zipfile
 from pathlib import Path
+from typing import Any
 
 import pytest
-from grading_support import CLASSIC_COMPLETE, ROOT, write_config
+from gradescope_support import SECRET, metadata
+from grading_support import ROOT, SUBMISSIONS, write_config
 
 from grader.cli import main
-from grader.gradescope import GradescopeResults, bundle, pick_submission, results
+from grader.errors import GradescopeError
+from grader.gradescope import SECRET_FILE, GradescopeResults, bundle, bundle_secret, pick_submission, results
+from grader.gradescope_upload import METADATA_FILE, UploadSeed, read_metadata
 from grader.problems import PROBLEM_IDS
-from grader.report import ProblemResult, Report
+from grader.report import GradingTimings, ProblemResult, Report, Timings
+from grader.seeds import upload_seed
+
+
+def student_sees(data: dict[str, Any], shown: frozenset[str] = frozenset({"visible"})) -> dict[str, Any]:
+    """What Gradescope shows a student of results.json (see the module's docstring)."""
+    whole = data.get("visibility", "visible") in shown
+    return {
+        "score": data["score"] if whole else None,
+        "execution_time": data.get("execution_time") if whole else None,
+        "output": data["output"] if whole else None,
+        "tests": [test for test in data["tests"] if test.get("visibility", "visible") in shown],
+    }
 
 
 def _report(**fields: object) -> Report:
@@ -37,16 +59,106 @@ def _report(**fields: object) -> Report:
 
 def test_a_report_becomes_one_gradescope_test_per_problem() -> None:
     graded = results(_report())
-    data = json.loads(graded.model_dump_json())
+    data = json.loads(graded.to_json())
     assert (data["score"], data["execution_time"], data["visibility"]) == (1.0, 62, "visible")
-    assert [(t["name"], t["number"], t["score"], t["max_score"], t["status"]) for t in data["tests"]] == [
-        ("Problem 1", "1", 1.0, 1.0, "passed"),
-        ("Problem 3", "2", 0.0, 1.0, "failed"),
-    ]
-    assert data["tests"][1]["output"] == "timeout: too slow\n\nYour output:\nhello"
+    fields = ("name", "number", "score", "max_score", "status", "visibility")
+    assert [tuple(test[field] for field in fields) for test in data["tests"]] == [
+        ("Problem 1", "1", 1.0, 1.0, "passed", "visible"),
+        ("Problem 3", "2", 0.0, 1.0, "failed", "visible"),
+        ("Problem 3: what the code printed (instructor only)", "2.1", 0.0, 0.0, "passed", "hidden"),
+    ]  # fmt: skip
+    assert data["tests"][1]["output"] == (
+        "timeout: too slow\n\nWhat your code printed is kept for your instructor, not shown here; "
+        "run gymgrade check on your own machine to see it."
+    )
+    assert data["tests"][2]["output"] == "hello"
     assert data["output"].startswith("gymgrade 0.1.0, gymnasium 1.4.0.")
-    assert "seed" not in data["output"], "the grading seed stays held out: resubmissions see the same starts"
+    assert "extra_data" not in data, "no seed recorded unless the upload's seed is given"
+    assert "hello" not in json.dumps(student_sees(data)), "a file could print its starts"
     GradescopeResults.model_validate(data)
+
+
+def test_the_upload_seed_is_recorded_for_the_instructor_only() -> None:
+    upload = UploadSeed(8_913_374_620, "derived", ("gradescope", "77", "2026-11-25T10:00:00-08:00", "5"))
+    data = json.loads(results(_report(), upload=upload).to_json())
+    assert data["extra_data"] == {
+        "gymgrade": {"seed": 8_913_374_620, "seed_source": "derived", "identity": list(upload.identity)}
+    }
+    (note,) = [test for test in data["tests"] if test["name"] == "Grading seed (instructor only)"]
+    assert note["visibility"] == "hidden" and note["output"] == (
+        "Grading seed 8913374620, derived from the bundle's secret and this upload "
+        "(gradescope, 77, 2026-11-25T10:00:00-08:00, 5). Regrade it identically with: "
+        "gymgrade gradescope-seed --bundle autograder.zip --metadata submission_metadata.json "
+        "--submission FILE"
+    )
+    assert "8913374620" not in json.dumps(student_sees(data))
+
+
+def _problem(problem_id: str, visibility: str, outcome: int) -> ProblemResult:
+    """A problem whose every outcome-dependent field follows ``outcome``."""
+    return ProblemResult.model_validate(
+        {"id": problem_id, "title": f"Problem {problem_id}", "status": ["passed", "failed", "error"][outcome],
+         "score": [1.0, 0.25, 0.0][outcome], "max_score": 1.0, "feedback": f"{problem_id} outcome {outcome}",
+         "output": f"printed {outcome}" * outcome, "seed": 11, "visibility": visibility,
+         "timings": Timings(wall_seconds=3.0 + outcome, student_seconds=1.0 + outcome, overhead_seconds=2.0)}
+    )  # fmt: skip
+
+
+def _withholding_report(visibility: str, outcome: int) -> Report:
+    """Two visible problems and taxi, ``visibility``, whose outcome (and so its time, errors) varies."""
+    problems = [
+        _problem("cartpole", "visible", 0),
+        _problem("car", "visible", 1),
+        _problem("taxi", visibility, outcome),
+    ]
+    elapsed = 10.0 + 7 * outcome
+    return _report(
+        problems=problems,
+        score=sum(problem.score for problem in problems),
+        max_score=3.0,
+        grader_errors=["taxi: the grader failed"] if outcome == 2 else [],
+        execution_time=elapsed,
+        timings=GradingTimings(elapsed_seconds=elapsed, workers=2, check_seconds=elapsed,
+                               student_seconds=outcome, overhead_seconds=elapsed - outcome),
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("visibility", "shown", "withheld"),
+    [
+        ("hidden", frozenset({"visible"}), True),
+        ("hidden", frozenset({"visible", "after_due_date"}), True),
+        ("after_due_date", frozenset({"visible"}), True),
+        ("after_due_date", frozenset({"visible", "after_due_date"}), False),
+    ],
+    ids=["hidden", "hidden-after-due-date", "after-due-date-before-it", "after-due-date-past-it"],
+)
+def test_nothing_a_student_sees_varies_with_a_withheld_problem(
+    visibility: str, shown: frozenset[str], withheld: bool
+) -> None:
+    seen = [
+        json.dumps(
+            student_sees(json.loads(results(_withholding_report(visibility, outcome)).to_json()), shown)
+        )
+        for outcome in range(3)
+    ]
+    if withheld:
+        assert seen[0] == seen[1] == seen[2], "a withheld problem's outcome shows through"
+        data = json.loads(results(_withholding_report(visibility, 1)).to_json())
+        assert (data["visibility"], data["score"], "execution_time" in data) == (visibility, 1.5, False)
+        (about,) = [test for test in data["tests"] if test["name"] == "About this grading"]
+        assert about["visibility"] == "visible"
+        assert about["output"].endswith("The total score is shown when every problem's result is.")
+    else:
+        assert len(set(seen)) == 3, "once shown, the problem and the total are the student's"
+
+
+def test_a_shown_problems_grader_error_stays_in_the_output() -> None:
+    report = _withholding_report("hidden", 0).model_copy(
+        update={"grader_errors": ["car: broke", "taxi: broke"]}
+    )
+    output = results(report).output
+    assert "Grader error (not your fault): car: broke" in output and "taxi: broke" not in output
 
 
 def test_a_skipped_problem_failed_nothing_and_says_it_was_not_run() -> None:
@@ -104,40 +216,119 @@ def test_check_prints_valid_gradescope_results(tmp_path: Path, capsys: pytest.Ca
     assert "opengym.ipynb is not a readable notebook" in data["output"]
 
 
-@pytest.mark.slow
-def test_the_bundle_grades_a_submission_in_a_gradescope_layout(tmp_path: Path) -> None:
-    overrides = {problem: {"enabled": False} for problem in PROBLEM_IDS if problem != "random_blackjack"}
-    overrides["random_blackjack"] = {"games": 2000}
-    config = write_config(tmp_path / "assignment.toml", overrides)
-    archive = bundle(tmp_path / "autograder.zip", config=config, seed=7)
+def test_each_bundle_draws_its_own_secret_and_keeps_it_private(tmp_path: Path) -> None:
+    first, second = bundle(tmp_path / "a.zip", config=None), bundle(tmp_path / "b.zip", config=None)
+    assert bundle_secret(first) != bundle_secret(second) and len(bundle_secret(first)) == 64
+    with zipfile.ZipFile(first) as opened:
+        assert opened.getinfo(SECRET_FILE).external_attr >> 16 & 0o077 == 0
+        scripts = opened.read("run_autograder").decode() + opened.read("setup.sh").decode()
+    assert bundle_secret(first) not in scripts and "--seed" not in scripts, "no seed on a command line"
+    with pytest.raises(
+        GradescopeError, match="expected an autograder zip built by gymgrade gradescope-bundle"
+    ):
+        bundle_secret(tmp_path / "nothing.zip")
 
+
+@pytest.fixture(scope="module")
+def gradescope(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """An autograder zip of the cartpole problem alone (5 calls), with the tests' fixed secret."""
+    directory = tmp_path_factory.mktemp("bundle")
+    overrides: dict[str, dict[str, Any]] = {problem: {"enabled": False} for problem in PROBLEM_IDS}
+    overrides["cartpole"] = {"enabled": True, "calls": 5}
+    config = write_config(directory / "assignment.toml", overrides)
+    return bundle(directory / "autograder.zip", config=config, secret=SECRET)
+
+
+def _upload(archive: Path, root: Path, submission: Path, meta: dict[str, object]) -> dict[str, Any]:
+    """Run the bundle's run_autograder as Gradescope does: a fresh root, the upload, its metadata."""
     with zipfile.ZipFile(archive) as opened:
-        names = set(opened.namelist())
-        modes = {info.filename: info.external_attr >> 16 for info in opened.infolist()}
-        pyproject = tomllib.loads(opened.read("gymgrade/pyproject.toml").decode())
-        opened.extractall(tmp_path / "root" / "source")
-    assert {"setup.sh", "run_autograder", "assignment.toml", "gymgrade/grader/acceptance/pytest.ini"} <= names
-    assert modes["run_autograder"] & 0o111 and modes["setup.sh"] & 0o111
-    assert any(requirement.startswith("gymnasium") for requirement in pyproject["project"]["dependencies"])
-    source = tmp_path / "root" / "source"
-    subprocess.run(["bash", "-n", str(source / "setup.sh")], check=True)
-
-    submission = tmp_path / "root" / "submission"
-    submission.mkdir()
-    (submission / "opengym.py").write_bytes(CLASSIC_COMPLETE.read_bytes())
-    os.chmod(source / "run_autograder", 0o755)
+        opened.extractall(root / "source")
+    (root / "submission").mkdir()
+    (root / "submission" / "opengym.py").write_bytes(submission.read_bytes())
+    (root / METADATA_FILE).write_text(json.dumps(meta))
+    os.chmod(root / "source" / "run_autograder", 0o755)
     environment = {
         **os.environ,
-        "GYMGRADE_AUTOGRADER_ROOT": str(tmp_path / "root"),
+        "GYMGRADE_AUTOGRADER_ROOT": str(root),
         "GYMGRADE_COMMAND": f"{sys.executable} -m grader.cli",
         "PYTHONPATH": str(ROOT),
     }
-    subprocess.run([str(source / "run_autograder")], env=environment, check=True, timeout=600)
-
-    data = json.loads((tmp_path / "root" / "results" / "results.json").read_text())
+    subprocess.run([str(root / "source" / "run_autograder")], env=environment, check=True, timeout=600)
+    assert (root / "source" / SECRET_FILE).stat().st_mode & 0o077 == 0, "student code runs as another uid"
+    assert (root / METADATA_FILE).stat().st_mode & 0o077 == 0, "it embeds earlier uploads' results"
+    data: dict[str, Any] = json.loads((root / "results" / "results.json").read_text())
     GradescopeResults.model_validate(data)
-    assert data["score"] == 1.0
-    assert [(test["name"], test["status"]) for test in data["tests"]] == [
-        ("Problem 1: random Blackjack", "passed")
+    return data
+
+
+def _printed(data: dict[str, Any]) -> str:
+    (printed,) = [
+        test["output"] for test in data["tests"] if test["name"].endswith("printed (instructor only)")
     ]
-    assert "seed 7" not in data["output"]
+    return printed
+
+
+def _cartpole(data: dict[str, Any]) -> dict[str, Any]:
+    return next(test for test in data["tests"] if test["name"] == "Problem 3: CartPole")
+
+
+def _tapes_module() -> Any:
+    spec = importlib.util.spec_from_file_location("memorised_tapes", ROOT / "scripts" / "memorised_tapes.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:.*CartPole-v0 is out of date:DeprecationWarning")
+def test_two_uploads_get_different_starts_and_a_recorded_one_regrades_identically(
+    gradescope: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    printer = SUBMISSIONS / "hostile" / "start_printer.py"
+    first_meta = metadata(1001, "2026-11-25T10:00:00.000000-08:00", 5)
+    first = _upload(gradescope, tmp_path / "first", printer, first_meta)
+    second = _upload(
+        gradescope, tmp_path / "second", printer, metadata(1002, "2026-11-25T10:05:00.000000-08:00", 5)
+    )
+
+    tapes = _tapes_module()
+    first_starts, second_starts = (
+        tapes.printed_starts(_printed(first)),
+        tapes.printed_starts(_printed(second)),
+    )
+    assert len(first_starts) == len(second_starts) == 5
+    assert not set(map(tuple, first_starts)) & set(map(tuple, second_starts)), "a start came back"
+    assert _cartpole(first)["status"] == _cartpole(second)["status"] == "passed"
+    for data in (first, second):
+        seen = json.dumps(student_sees(data))
+        assert "start [" not in seen and str(data["extra_data"]["gymgrade"]["seed"]) not in seen
+        assert SECRET not in json.dumps(data), "the secret is in no results, not even the instructor's"
+
+    metadata_path = tmp_path / "first.json"
+    metadata_path.write_text(json.dumps(first_meta))
+    identity = read_metadata(metadata_path).identity()
+    expected_seed = upload_seed(SECRET, identity)
+    assert first["extra_data"]["gymgrade"] == {
+        "seed": expected_seed, "seed_source": "derived", "identity": list(identity)
+    }  # fmt: skip
+
+    # The instructor reproduces the recorded upload from the zip and its metadata alone.
+    regraded = tmp_path / "regraded.json"
+    arguments = ["gradescope-seed", "--bundle", str(gradescope), "--metadata", str(metadata_path)]
+    assert main([*arguments, "--submission", str(printer), "--out", str(regraded)]) == 0
+    assert f"Grading seed {expected_seed} (upload gradescope, 1001," in capsys.readouterr().out
+    again = json.loads(regraded.read_text())
+    first.pop("execution_time"), again.pop("execution_time")
+    assert again == first
+
+    # The attack of issue 22: tapes for the starts the first upload printed, uploaded again.
+    attack = tmp_path / "start_keyed_tapes.py"
+    attack.write_text(tapes.keyed_source(first_starts))
+    replayed = _upload(
+        gradescope, tmp_path / "third", attack, metadata(1003, "2026-11-25T10:10:00.000000-08:00", 5)
+    )
+    assert _cartpole(replayed)["status"] == "failed", _cartpole(replayed)["output"]
+    # Where the seed repeats (one seed per bundle, as before), the same tapes get full marks.
+    assert main([*arguments, "--submission", str(attack), "--out", str(tmp_path / "same-seed.json")]) == 0
+    assert _cartpole(json.loads((tmp_path / "same-seed.json").read_text()))["status"] == "passed"

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import hashlib
+import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -199,6 +200,7 @@ def test_gymgrade_grade_each_layout_into_every_gradebook(
     argv = ["grade", str(expected.path), "--out", str(out), "--only", "random_blackjack", "--seed", "3"]
     argv += ["--due", DUE.isoformat(), "--assignment-id", "9"]
     argv += ["--gradebook", "canvas", "--gradebook", "gradescope", "--gradebook", "github-classroom"]
+    argv += ["--html", str(tmp_path / "class.html")]
     roster = expected.path.parent / "roster.csv"
     if roster.exists():
         argv += ["--roster", str(roster)]
@@ -222,6 +224,14 @@ def test_gymgrade_grade_each_layout_into_every_gradebook(
     for name in ("gradescope.csv", "github-classroom.csv"):
         other = list(csv.reader((out / name).open(encoding="utf-8")))
         assert len(other) == len(rows) + 1, f"{name}: a row per student"
+    summary = json.loads((tmp_path / "class.json").read_text(encoding="utf-8"))
+    assert sorted(entry["identity"] for entry in summary["entries"]) == sorted(students + on_roster_only)
+    assert summary["missing"] == on_roster_only
+    assert sorted(summary["late"]) == sorted(m for identity in expected.late for m in members[identity])
+    for entry in summary["entries"]:
+        if entry["identity"] in graded:
+            assert entry["status"] == "graded" and entry["score"] == 1.0
+            assert (tmp_path / entry["report_href"]).resolve().parent == out.resolve()
     canvas = list(csv.reader((out / "canvas.csv").open(encoding="utf-8")))
     assert canvas[1][0] == "    Points Possible"
     if layout == "canvas":

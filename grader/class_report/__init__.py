@@ -1,0 +1,61 @@
+"""The class report: one page and one JSON summary of a whole class's grades (`gymgrade grade --html`).
+
+``ClassEntry`` is its input (one per student, from any layout or roster); ``class_summary`` and
+``render_class_html`` are pure functions of the entries; ``write_class_report`` is the thin shell that
+writes both files.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+from grader.class_report.entries import ClassEntry, EntryStatus
+from grader.class_report.html import CSP, render_class_html
+from grader.class_report.summary import ClassSummary, class_summary, diagnosis_key, diagnosis_text, summarise
+
+__all__ = [
+    "CSP",
+    "ClassEntry",
+    "ClassSummary",
+    "EntryStatus",
+    "class_summary",
+    "diagnosis_key",
+    "diagnosis_text",
+    "render_class_html",
+    "summarise",
+    "summary_path",
+    "write_class_report",
+]
+
+
+def summary_path(page: Path) -> Path:
+    """Where the JSON summary of the class page ``page`` goes: beside it, ``.json`` for ``.html``."""
+    return page.with_suffix(".json")
+
+
+def write_class_report(page: Path, entries: Sequence[ClassEntry], *, title: str = "") -> Path:
+    """Write the class page to ``page`` and its summary beside it (``summary_path``).
+
+    Args:
+        page: The HTML file to write (its folder is created).
+        entries: One entry per student.
+        title: What the class or assignment is called.
+
+    Returns:
+        The summary's path.
+
+    Raises:
+        ValueError: ``page`` ends in ``.json``, so the summary would overwrite it.
+    """
+    target = summary_path(page)
+    if target == page:
+        raise ValueError(
+            f"--html {page}: expected an .html file name (the JSON summary is written beside it as {target.name}); name the page e.g. class.html"  # noqa: E501
+        )
+    summary = summarise(entries, title=title)
+    page.parent.mkdir(parents=True, exist_ok=True)
+    page.write_text(render_class_html(entries, summary=summary), encoding="utf-8")
+    target.write_text(json.dumps(summary.model_dump(mode="json"), indent=2) + "\n", encoding="utf-8")
+    return target

@@ -1,0 +1,104 @@
+"""Hostile text made safe to show: identities, names and feedback bounded, controls and bidi overrides inert.
+
+Escaping for HTML is the template's (Jinja autoescape); what is left is what escaping cannot do: a name
+of a million characters, a right-to-left override that turns ``evil.exe\u202egpj.py`` around, a newline
+in an identity. These functions bound a string and show such characters as U+FFFD; the summary's JSON
+keeps each identity as given (bounded the same way, so no file grows with one hostile string), and its
+encoder escapes every non-ASCII character.
+"""
+
+from __future__ import annotations
+
+import unicodedata
+from urllib.parse import quote, urlsplit
+
+MAX_IDENTITY_CHARS = 256
+"""Longest identity kept (JSON and page); real systems' ids and user names are far shorter."""
+MAX_NAME_CHARS = 120
+MAX_DIAGNOSIS_CHARS = 400
+"""Characters of a diagnosis' normalised feedback kept (its key) and shown."""
+MAX_NOTE_CHARS = 300
+MAX_HREF_CHARS = 2_000
+ELLIPSIS = "…"
+
+HIDDEN = "\ufffd"
+"""Shown in place of a control, bidi override or unassigned character: visibly there, doing nothing."""
+HIDDEN_CATEGORIES = frozenset({"Cc", "Cs", "Co", "Cn"})
+"""Controls, surrogates, private-use and unassigned characters: shown as ``HIDDEN`` everywhere."""
+BLANK = "(blank)"
+BIDI_CONTROLS = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+"""Characters that reorder the text around them (Unicode TR9 explicit formatting); never shown."""
+
+
+def bounded(text: str, limit: int) -> str:
+    """``text`` cut to at most ``limit`` characters, the cut marked with an ellipsis.
+
+    Args:
+        text: Any string.
+        limit: The most characters returned (at least 1).
+
+    Returns:
+        ``text`` when short enough, else its first ``limit - 1`` characters and ``…``.
+    """
+    if len(text) <= limit:
+        return text
+    return text[: limit - 1] + ELLIPSIS
+
+
+def display_text(text: str, limit: int) -> str:
+    """``text`` as one line to show: controls and bidi overrides shown as ``\ufffd``, whitespace collapsed,
+    bounded.
+
+    Args:
+        text: A student identity, name, note or feedback: any string.
+        limit: The most characters returned.
+
+    Returns:
+        The cleaned, bounded text (HTML escaping is still the template's job).
+    """
+    return _cleaned(text, limit, HIDDEN_CATEGORIES)
+
+
+def display_identity(text: str, limit: int) -> str:
+    """An identity to show: as ``display_text``, and every invisible format character (zero-width space,
+    joiners, soft hyphen, byte order mark) also shown as ``\ufffd``, so two identities that differ only
+    by one never look alike; a blank identity reads ``(blank)``.
+
+    Names keep their joiners (scripts such as Persian and Devanagari need them); ids never do.
+    """
+    return _cleaned(text, limit, HIDDEN_CATEGORIES | {"Cf"}) or BLANK
+
+
+def _cleaned(text: str, limit: int, hidden: frozenset[str]) -> str:
+    # Cut first (bounded work on huge input), then clean, then cut again to the exact bound.
+    rough = text[: limit * 4]
+    shown = "".join(
+        " " if character.isspace()
+        else HIDDEN if character in BIDI_CONTROLS or unicodedata.category(character) in hidden
+        else character
+        for character in rough
+    )  # fmt: skip
+    single = " ".join(shown.split())
+    return bounded(single if len(rough) == len(text) else single + ELLIPSIS, limit)
+
+
+def safe_href(href: str | None) -> str | None:
+    """A relative link to a student's report, percent-encoded, or None when it is not a plain relative path.
+
+    Refused: schemes (``javascript:``, ``data:``, ``http:``), absolute and protocol-relative paths,
+    backslashes, query strings and controls; a refused link is shown as plain text, never followed.
+
+    Args:
+        href: The link as given (a path relative to the page, ``/``-separated), or None.
+
+    Returns:
+        The encoded link, or None.
+    """
+    if not href or len(href) > MAX_HREF_CHARS or "\\" in href or href.startswith("/"):
+        return None
+    if any(unicodedata.category(character) in ("Cc", "Cf", "Cs", "Co", "Zl", "Zp") for character in href):
+        return None
+    parts = urlsplit(href)
+    if parts.scheme or parts.netloc or parts.query or parts.fragment or ":" in href.split("/")[0]:
+        return None
+    return quote(href, safe="/")
