@@ -8,7 +8,7 @@ from itertools import combinations
 from grader.similarity.behaviour import WrongResults, rare_wrong_results, shared_wrong_results
 from grader.similarity.clusters import clusters
 from grader.similarity.document import Document
-from grader.similarity.evidence import shared_constants, shared_remarks
+from grader.similarity.evidence import shared_constants, shared_remarks, shared_typos
 from grader.similarity.frequency import Frequencies, frequencies
 from grader.similarity.report import Pair, SimilarityReport, UnreadableFile
 from grader.similarity.score import MIN_SHARED, SCORE_BAR, candidate_pairs, fragments, pair_score, size
@@ -41,7 +41,7 @@ def score_pairs(
         a, b = documents[first], documents[second]
         if a.is_reference:
             a, b = b, a
-        evidence = shared_remarks(a, b, counts) + shared_constants(a, b, counts)
+        evidence = shared_remarks(a, b, counts) + shared_typos(a, b, counts) + shared_constants(a, b, counts)
         evidence += shared_wrong_results(behaviour.get(a.identity, {}), behaviour.get(b.identity, {}), rare_behaviour)
         found = fragments(a, b, counts.common)
         score = pair_score(count, sizes[first], sizes[second])
@@ -96,6 +96,7 @@ def _evidence_pairs(
     for number, document in enumerate(documents):
         keys = [f"r:{key}" for key in document.remarks.keys() & counts.rare_remarks]
         keys += [f"c:{value}" for value in document.constants.keys() & counts.rare_constants]
+        keys += [f"t:{word}" for word in document.typos.keys() & counts.rare_typos]
         keys += [f"b:{key}" for key in behaviour.get(document.identity, {}).keys() & rare_behaviour]
         for key in keys:
             holders.setdefault(key, []).append(number)

@@ -14,6 +14,7 @@ from pydantic import BaseModel
 from grader.similarity.normalise import normalise
 from grader.similarity.sources import SourceText, Unreadable, read_source
 from grader.similarity.template import Template
+from grader.similarity.typos import misspellings
 from grader.similarity.winnow import fingerprints
 
 FILE_HEADER = "# ==== {name} ===="
@@ -78,6 +79,7 @@ class Document:
         fingerprints: Hash -> ``(unit, first line, last line)`` spans, in the joined text's lines.
         remarks: Remark key -> ``(text, line)``, first occurrence.
         constants: Numeric literal -> first line.
+        typos: Known misspelling in a comment or string -> first line.
         notes: What the reader should know (a file cut or left out, template functions removed).
     """
 
@@ -87,6 +89,7 @@ class Document:
     fingerprints: dict[int, list[tuple[int, int, int]]] = field(default_factory=dict)
     remarks: dict[str, tuple[str, int]] = field(default_factory=dict)
     constants: dict[str, int] = field(default_factory=dict)
+    typos: dict[str, int] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
 
 
@@ -140,6 +143,8 @@ def build_document(
         for key, text, line in file.remarks:
             if key not in template.remarks:
                 document.remarks.setdefault(key, (text, line + offset))
+                for word in misspellings(key):
+                    document.typos.setdefault(word, line + offset)
         for value, line in file.constants:
             document.constants.setdefault(value, line + offset)
         unit_offset += len(file.shapes)

@@ -34,11 +34,12 @@ def is_unusual(value: str) -> bool:
 def shared_remarks(a: Document, b: Document, frequencies: Frequencies) -> list[str]:
     """The identical rare comments and strings of two documents, as the reader sees them."""
     keys = sorted(a.remarks.keys() & b.remarks.keys() & frequencies.rare_remarks, key=lambda key: a.remarks[key][1])
-    return [
+    items = [
         f'identical comment or text "{_shown(a.remarks[key][0])}" ({a.identity} line {a.remarks[key][1]}, '
         f"{b.identity} line {b.remarks[key][1]})"
         for key in keys
     ]
+    return _capped(items, "identical comments or texts")
 
 
 def shared_constants(a: Document, b: Document, frequencies: Frequencies) -> list[str]:
@@ -46,11 +47,29 @@ def shared_constants(a: Document, b: Document, frequencies: Frequencies) -> list
     values = sorted(
         value for value in a.constants.keys() & b.constants.keys() & frequencies.rare_constants if is_unusual(value)
     )
-    return [
+    items = [
         f"identical unusual constant {value} ({a.identity} line {a.constants[value]}, "
         f"{b.identity} line {b.constants[value]})"
         for value in values
     ]
+    return _capped(items, "identical unusual constants")
+
+
+def shared_typos(a: Document, b: Document, frequencies: Frequencies) -> list[str]:
+    """The identical rare misspellings in two documents' comments and strings."""
+    words = sorted(a.typos.keys() & b.typos.keys() & frequencies.rare_typos)
+    items = [
+        f'the same misspelling "{word}" ({a.identity} line {a.typos[word]}, {b.identity} line {b.typos[word]})'
+        for word in words
+    ]
+    return _capped(items, "identical misspellings")
+
+
+def _capped(items: list[str], kind: str) -> list[str]:
+    """The first ``MAX_ITEMS`` items, and one more line counting the rest (each counts as evidence)."""
+    if len(items) <= MAX_ITEMS + 1:
+        return items
+    return [*items[:MAX_ITEMS], f"... and {len(items) - MAX_ITEMS} more {kind}"]
 
 
 def _shown(text: str) -> str:

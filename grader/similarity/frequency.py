@@ -33,11 +33,13 @@ class Frequencies:
         common: Fingerprint hashes too frequent to count.
         rare_remarks: Remark keys held by few enough documents to be evidence.
         rare_constants: Constants held by few enough documents to be evidence.
+        rare_typos: Misspellings held by few enough documents to be evidence.
     """
 
     common: frozenset[int]
     rare_remarks: frozenset[str]
     rare_constants: frozenset[str]
+    rare_typos: frozenset[str]
 
 
 def frequencies(documents: Iterable[Document]) -> Frequencies:
@@ -46,6 +48,7 @@ def frequencies(documents: Iterable[Document]) -> Frequencies:
     reference_hashes: Counter[int] = Counter()
     remarks: Counter[str] = Counter()
     constants: Counter[str] = Counter()
+    typos: Counter[str] = Counter()
     students = references = 0
     for document in documents:
         if document.is_reference:
@@ -56,6 +59,7 @@ def frequencies(documents: Iterable[Document]) -> Frequencies:
             student_hashes.update(document.fingerprints.keys())
         remarks.update(document.remarks.keys())
         constants.update(document.constants.keys())
+        typos.update(document.typos.keys())
     student_limit, reference_limit = common_limit(students), common_limit(references)
     common = {hash_ for hash_, count in student_hashes.items() if count > student_limit}
     common.update(hash_ for hash_, count in reference_hashes.items() if count > reference_limit)
@@ -63,4 +67,5 @@ def frequencies(documents: Iterable[Document]) -> Frequencies:
         common=frozenset(common),
         rare_remarks=frozenset(key for key, count in remarks.items() if count <= RARE_MAXIMUM),
         rare_constants=frozenset(value for value, count in constants.items() if count <= RARE_MAXIMUM),
+        rare_typos=frozenset(word for word, count in typos.items() if count <= RARE_MAXIMUM),
     )
