@@ -175,10 +175,16 @@ _CANONICAL_MODULES = {"numpy": "np", "gymnasium": "gym", "matplotlib.pyplot": "p
 
 
 def _stored_attributes(tree: ast.Module) -> frozenset[str]:
-    """Attributes the file assigns (``self.table = ...``): its own names, renameable like variables."""
-    return frozenset(
-        node.attr for node in ast.walk(tree) if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store)
+    """Attributes the file assigns (``self.table = ...``) and its classes' methods: renameable like variables."""
+    names = {node.attr for node in ast.walk(tree) if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store)}
+    names.update(
+        item.name
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ClassDef)
+        for item in node.body
+        if isinstance(item, (ast.FunctionDef, ast.AsyncFunctionDef))
     )
+    return frozenset(names)
 
 
 def _clean_block(statements: list[ast.stmt], read: frozenset[str]) -> list[ast.stmt]:
