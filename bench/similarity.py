@@ -262,9 +262,11 @@ def synthetic(rng: random.Random) -> str:
             if roll < 0.15 and depth < 3:
                 lines.append("    " * depth + f"for {c} in range({rng.randrange(2, 100)}):")
                 depth += 1
+                lines.append("    " * depth + f"{a} = {b} - {rng.randrange(9)}")
             elif roll < 0.25 and depth < 3:
                 lines.append("    " * depth + f"if {a} > {b}:")
                 depth += 1
+                lines.append("    " * depth + f"{b} = {a} * {rng.randrange(9)}")
             elif roll < 0.4 and depth > 1:
                 depth -= 1
         lines.append(f"    return {names[2]}")

@@ -34,17 +34,33 @@ def score_pairs(
     rare_behaviour = rare_wrong_results(behaviour)
     sizes = [size(document, counts.common) for document in documents]
     shared = candidate_pairs(documents, counts.common)
-    for pair in _evidence_pairs(documents, counts, behaviour):
+    with_evidence = _evidence_pairs(documents, counts, behaviour)
+    for pair in with_evidence:
         shared.setdefault(pair, 0)
     pairs: list[Pair] = []
     for (first, second), count in shared.items():
         a, b = documents[first], documents[second]
         if a.is_reference:
             a, b = b, a
+        score = pair_score(count, sizes[first], sizes[second])
+        if count < MIN_SHARED and (first, second) not in with_evidence:
+            # cannot be flagged: ranked by its score alone, without the cost of fragments and evidence
+            pairs.append(
+                Pair(
+                    a=a.identity,
+                    b=b.identity,
+                    b_is_reference=b.is_reference,
+                    score=score,
+                    flagged=False,
+                    shared_fingerprints=count,
+                    shared_fragments=0,
+                    longest_fragment_lines=0,
+                )
+            )
+            continue
         evidence = shared_remarks(a, b, counts) + shared_typos(a, b, counts) + shared_constants(a, b, counts)
         evidence += shared_wrong_results(behaviour.get(a.identity, {}), behaviour.get(b.identity, {}), rare_behaviour)
         found = fragments(a, b, counts.common)
-        score = pair_score(count, sizes[first], sizes[second])
         pairs.append(
             Pair(
                 a=a.identity,

@@ -26,6 +26,8 @@ OUTPUT_CALLS = frozenset({"print", "clear_output", "display", "pprint"})
 OUTPUT_MODULES = frozenset({"plt", "pyplot", "display", "IPython"})
 KEPT_LITERALS = frozenset({0, 1, -1, True, False, None})
 MODULE_UNIT = "<module>"
+MIN_REMARK_CHARS = 12
+"""Shorter comments and strings (``# reset``, ``"Taxi-v3"``) are what everyone writes: not evidence."""
 
 
 @dataclass(frozen=True)
@@ -88,16 +90,16 @@ def normalise(source: str) -> NormalisedSource:
         tree = ast.parse(source)
     except (ValueError, RecursionError, MemoryError) as error:
         raise SyntaxError(f"the parser gave up ({type(error).__name__})") from None
-    bound = _bound_names(tree)
-    aliases = _import_aliases(tree)
-    attributes = _stored_attributes(tree)
-    result = NormalisedSource(remarks=_remarks(source, tree), constants=_constants(tree))
+    facts = _facts(tree)
+    read = frozenset(facts.read)  # a store nothing in the file reads is dead, whatever function it is in
+    result = NormalisedSource(remarks=_remarks(source, facts.strings), constants=facts.constants)
     budget = MAX_TOKENS_PER_FILE
+    renameable, attributes = frozenset(facts.bound - facts.aliases.keys()), frozenset(facts.attributes)
     for name, statements in _units(tree):
-        cleaned = _clean_block(statements, _names_read(statements))
+        cleaned = _clean_block(statements, read)
         if not cleaned:
             continue
-        writer = _TokenWriter(bound - aliases.keys(), aliases, attributes)
+        writer = _TokenWriter(renameable, facts.aliases, attributes)
         for statement in cleaned:
             writer.write(statement)
         tokens, lines = writer.tokens[:budget], writer.lines[:budget]
@@ -131,60 +133,62 @@ def _units(tree: ast.Module) -> list[tuple[str, list[ast.stmt]]]:
     return units
 
 
-def _bound_names(tree: ast.Module) -> frozenset[str]:
-    """Every name the file itself binds: those are the ones a disguise can rename."""
-    names: set[str] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Name) and isinstance(node.ctx, (ast.Store, ast.Del)):
-            names.add(node.id)
-        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
-            names.add(node.name)
-        elif isinstance(node, ast.arg):
-            names.add(node.arg)
-        elif isinstance(node, ast.ExceptHandler) and node.name:
-            names.add(node.name)
-        elif isinstance(node, (ast.Global, ast.Nonlocal)):
-            names.update(node.names)
-    return frozenset(names)
+@dataclass
+class _Facts:
+    """What one walk of the whole tree finds (one walk: the tree is walked once, not once per question)."""
 
-
-def _names_read(statements: list[ast.stmt]) -> frozenset[str]:
-    read: set[str] = set()
-    for statement in statements:
-        for node in ast.walk(statement):
-            if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load):
-                read.add(node.id)
-            elif isinstance(node, (ast.Global, ast.Nonlocal)):
-                read.update(node.names)
-    return frozenset(read)
-
-
-def _import_aliases(tree: ast.Module) -> dict[str, str]:
-    """``import numpy as npy`` reads as ``numpy``; ``from numpy import argmax as best`` as ``argmax``."""
-    aliases: dict[str, str] = {}
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.Import, ast.ImportFrom)):
-            for alias in node.names:
-                if alias.asname:
-                    aliases[alias.asname] = alias.name.split(".")[-1] if isinstance(node, ast.ImportFrom) else alias.name
-    aliases.update({"numpy": "np", "gymnasium": "gym"})
-    return {name: _CANONICAL_MODULES.get(module, module) for name, module in aliases.items()}
+    bound: set[str] = field(default_factory=set)
+    read: set[str] = field(default_factory=set)
+    aliases: dict[str, str] = field(default_factory=dict)
+    attributes: set[str] = field(default_factory=set)
+    strings: list[tuple[str, int]] = field(default_factory=list)
+    constants: list[tuple[str, int]] = field(default_factory=list)
 
 
 _CANONICAL_MODULES = {"numpy": "np", "gymnasium": "gym", "matplotlib.pyplot": "plt", "pyplot": "plt"}
 
 
-def _stored_attributes(tree: ast.Module) -> frozenset[str]:
-    """Attributes the file assigns (``self.table = ...``) and its classes' methods: renameable like variables."""
-    names = {node.attr for node in ast.walk(tree) if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store)}
-    names.update(
-        item.name
-        for node in ast.walk(tree)
-        if isinstance(node, ast.ClassDef)
-        for item in node.body
-        if isinstance(item, (ast.FunctionDef, ast.AsyncFunctionDef))
-    )
-    return frozenset(names)
+def _facts(tree: ast.Module) -> _Facts:
+    """Names the file binds (a disguise can rename them), import aliases (``import numpy as npy`` reads as
+    ``np``), attributes it assigns or defines as methods (renameable too), its strings and numbers."""
+    facts = _Facts(aliases={"numpy": "np", "gymnasium": "gym"})
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name):
+            if isinstance(node.ctx, ast.Load):
+                facts.read.add(node.id)
+            else:
+                facts.bound.add(node.id)
+        elif isinstance(node, ast.Constant):
+            value = node.value
+            if isinstance(value, str):
+                if len(value.strip()) >= MIN_REMARK_CHARS:
+                    facts.strings.append((value, node.lineno))
+            elif isinstance(value, (int, float)) and not isinstance(value, bool):
+                facts.constants.append((repr(value), node.lineno))
+        elif isinstance(node, ast.Attribute):
+            if isinstance(node.ctx, ast.Store):
+                facts.attributes.add(node.attr)
+        elif isinstance(node, ast.arg):
+            facts.bound.add(node.arg)
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            facts.bound.add(node.name)
+        elif isinstance(node, ast.ClassDef):
+            facts.bound.add(node.name)
+            facts.attributes.update(
+                item.name for item in node.body if isinstance(item, (ast.FunctionDef, ast.AsyncFunctionDef))
+            )
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            for alias in node.names:
+                if alias.asname:
+                    module = alias.name.split(".")[-1] if isinstance(node, ast.ImportFrom) else alias.name
+                    facts.aliases[alias.asname] = module
+        elif isinstance(node, ast.ExceptHandler) and node.name:
+            facts.bound.add(node.name)
+        elif isinstance(node, (ast.Global, ast.Nonlocal)):
+            facts.bound.update(node.names)
+            facts.read.update(node.names)
+    facts.aliases = {name: _CANONICAL_MODULES.get(module, module) for name, module in facts.aliases.items()}
+    return facts
 
 
 def _clean_block(statements: list[ast.stmt], read: frozenset[str]) -> list[ast.stmt]:
@@ -323,36 +327,25 @@ def _literal(value: object) -> str:
 
 
 _SPACE = re.compile(r"\s+")
-MIN_REMARK_CHARS = 12
 
 
 def _key(text: str) -> str:
     return _SPACE.sub(" ", text.strip().lower())
 
 
-def _remarks(source: str, tree: ast.Module) -> list[Remark]:
+def _remarks(source: str, strings: list[tuple[str, int]]) -> list[Remark]:
     remarks: list[Remark] = []
     try:
-        for token in tokenize.generate_tokens(io.StringIO(source).readline):
+        tokens = tokenize.generate_tokens(io.StringIO(source).readline) if "#" in source else iter(())
+        for token in tokens:
             if token.type == tokenize.COMMENT:
                 text = token.string.lstrip("#").strip()
                 if len(text) >= MIN_REMARK_CHARS:
                     remarks.append(Remark(_key(text), text, token.start[0]))
     except (tokenize.TokenError, SyntaxError):
         pass  # the tree parsed, so only exotic tokenizer disagreements land here: comments are optional evidence
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Constant) and isinstance(node.value, str) and len(node.value.strip()) >= MIN_REMARK_CHARS:
-            for offset, line in enumerate(node.value.splitlines()):
-                if len(line.strip()) >= MIN_REMARK_CHARS:
-                    remarks.append(Remark(_key(line), line.strip()[:200], node.lineno + offset))
+    for value, line_number in strings:
+        for offset, line in enumerate(value.splitlines()):
+            if len(line.strip()) >= MIN_REMARK_CHARS:
+                remarks.append(Remark(_key(line), line.strip()[:200], line_number + offset))
     return remarks
-
-
-def _constants(tree: ast.Module) -> list[tuple[str, int]]:
-    return [
-        (repr(node.value), node.lineno)
-        for node in ast.walk(tree)
-        if isinstance(node, ast.Constant)
-        and isinstance(node.value, (int, float))
-        and not isinstance(node.value, bool)
-    ]

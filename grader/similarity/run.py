@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -11,7 +13,13 @@ from grader.similarity.cache import IndexCache
 from grader.similarity.compare import build_report
 from grader.similarity.document import Document, IndexedFile, build_document, document_lines, index_text, read_files
 from grader.similarity.report import SimilarityReport, UnreadableFile
-from grader.similarity.sources import MAX_FILES_PER_SUBMISSION, Unreadable, references_from, submissions_from
+from grader.similarity.sources import (
+    MAX_FILES_PER_SUBMISSION,
+    SourceText,
+    Unreadable,
+    references_from,
+    submissions_from,
+)
 from grader.similarity.template import Template, load_template
 
 Discovery = Callable[[Path], list[tuple[str, Path]]]
@@ -44,6 +52,7 @@ def run_similarity(
     behaviour: dict[str, WrongResults] | None = None,
     discover: Discovery = submissions_from,
     notes: Sequence[str] = (),
+    workers: int | None = None,
 ) -> Outcome:
     """Compare a class with itself and with reference folders.
 
@@ -55,6 +64,7 @@ def run_similarity(
         behaviour: Wrong results by student identity, from grading reports.
         discover: The class layout reader.
         notes: Extra notes for the report.
+        workers: Processes that index files (default: one per core; 1 indexes in this process).
 
     Raises:
         ClassDirectoryError: When a folder does not exist.
@@ -63,55 +73,80 @@ def run_similarity(
     grouped: dict[str, list[Path]] = {}
     for identity, path in discover(class_dir):
         grouped.setdefault(identity, []).append(path)
-    reference_files = [entry for folder in references for entry in references_from(folder)]
-    documents: list[Document] = []
     unreadable: list[UnreadableFile] = []
-    files: dict[str, list[Path]] = {}
+    jobs: list[tuple[str, bool, list[Path]]] = []
     for identity, paths in grouped.items():
-        for extra in paths[MAX_FILES_PER_SUBMISSION:]:
-            unreadable.append(
-                UnreadableFile(
-                    identity=identity,
-                    file=extra.name,
-                    reason=f"{identity} has more than {MAX_FILES_PER_SUBMISSION} Python files: {extra.name} was not read.",
-                )
+        unreadable.extend(
+            UnreadableFile(
+                identity=identity,
+                file=extra.name,
+                reason=f"{identity} has more than {MAX_FILES_PER_SUBMISSION} Python files: {extra.name} was not read.",
             )
-        document = _document(identity, False, paths[:MAX_FILES_PER_SUBMISSION], template, None, unreadable)
-        if document is not None:
-            documents.append(document)
-            files[identity] = paths[:MAX_FILES_PER_SUBMISSION]
-    for identity, path in reference_files:
-        document = _document(identity, True, [path], template, cache, unreadable)
-        if document is not None:
-            documents.append(document)
-            files[identity] = [path]
+            for extra in paths[MAX_FILES_PER_SUBMISSION:]
+        )
+        jobs.append((identity, False, paths[:MAX_FILES_PER_SUBMISSION]))
+    jobs.extend((identity, True, [path]) for folder in references for identity, path in references_from(folder))
+    workers = workers or os.cpu_count() or 1
+    documents: list[Document] = []
+    files: dict[str, list[Path]] = {}
+    pool = ProcessPoolExecutor(workers) if workers > 1 and len(jobs) > BATCH else None
+    try:
+        for start in range(0, len(jobs), BATCH):
+            for (identity, is_reference, paths), document in zip(
+                jobs[start : start + BATCH], _documents(jobs[start : start + BATCH], template, cache, unreadable, pool)
+            ):
+                if document is not None:
+                    documents.append(document)
+                    files[identity] = paths
+    finally:
+        if pool is not None:
+            pool.shutdown()
     report = build_report(documents, unreadable, behaviour, template.names, notes)
     return Outcome(report, files)
 
 
-def _document(
-    identity: str,
-    is_reference: bool,
-    paths: list[Path],
+BATCH = 64
+"""Documents read and indexed together: only one batch's texts are in memory at a time."""
+
+
+def _documents(
+    jobs: list[tuple[str, bool, list[Path]]],
     template: Template,
     cache: IndexCache | None,
     unreadable: list[UnreadableFile],
-) -> Document | None:
-    texts, failures = read_files(paths)
-    unreadable.extend(_listed(identity, failure) for failure in failures)
-    indexed: list[tuple[Path, IndexedFile]] = []
-    for source in texts:
-        entry = cache.get(source.text) if cache is not None else None
-        if entry is None:
-            entry = index_text(source.text, source.path.name)
-            if cache is not None:
-                cache.put(source.text, entry)
-        if entry.reason is not None:
-            unreadable.append(UnreadableFile(identity=identity, file=source.path.name, reason=entry.reason))
-        indexed.append((source.path, entry))
-    if all(entry.reason is not None for _, entry in indexed):
-        return None
-    return build_document(identity, is_reference, indexed, template)
+    pool: ProcessPoolExecutor | None,
+) -> list[Document | None]:
+    """Read a batch of documents, index the files not cached (in the pool, if any), and build them."""
+    texts: list[list[SourceText]] = []
+    indexed: dict[tuple[int, int], IndexedFile] = {}
+    missing: list[tuple[int, int, SourceText]] = []
+    for number, (identity, is_reference, paths) in enumerate(jobs):
+        readable, failures = read_files(paths)
+        unreadable.extend(_listed(identity, failure) for failure in failures)
+        texts.append(readable)
+        for position, source in enumerate(readable):
+            entry = cache.get(source.text) if cache is not None and is_reference else None
+            if entry is None:
+                missing.append((number, position, source))
+            else:
+                indexed[(number, position)] = entry
+    arguments = ([source.text for _, _, source in missing], [source.path.name for _, _, source in missing])
+    results = pool.map(index_text, *arguments, chunksize=4) if pool is not None else map(index_text, *arguments)
+    for (number, position, source), entry in zip(missing, results, strict=True):
+        indexed[(number, position)] = entry
+        if cache is not None and jobs[number][1]:
+            cache.put(source.text, entry)
+    documents: list[Document | None] = []
+    for number, (identity, is_reference, _) in enumerate(jobs):
+        entries = [(source.path, indexed[(number, position)]) for position, source in enumerate(texts[number])]
+        for path, entry in entries:
+            if entry.reason is not None:
+                unreadable.append(UnreadableFile(identity=identity, file=path.name, reason=entry.reason))
+        if all(entry.reason is not None for _, entry in entries):
+            documents.append(None)
+        else:
+            documents.append(build_document(identity, is_reference, entries, template))
+    return documents
 
 
 def _listed(identity: str, failure: Unreadable) -> UnreadableFile:
