@@ -1,6 +1,6 @@
 """Similarity check (issue 21): detection per disguise, false positives, copydetect beside it, and scale.
 
-Part 1 (detection). The ten honest solutions of tests/grader/similarity/corpus/class (h01..h10, written
+Part 1 (detection). The ten honest solutions of submissions/similarity/class (h01..h10, written
 independently, each given the template's untouched find_qvalues as students hand it in) are disguised
 by one transformation at a time, applied by this script: renamed identifiers, comments and docstrings
 changed, functions reordered, dead code padded, a notebook instead of a .py, and all five at once. Each
@@ -39,25 +39,80 @@ from grader.similarity.cache import IndexCache  # noqa: E402
 from grader.similarity.run import run_similarity  # noqa: E402
 from grader.similarity.template import BUNDLED  # noqa: E402
 
-CORPUS = ROOT / "tests" / "grader" / "similarity" / "corpus" / "class"
+CORPUS = ROOT / "submissions" / "similarity" / "class"
 BASES = sorted(CORPUS.glob("h[0-9][0-9]_*.py"))
 TEMPLATE = (ROOT / "submissions" / "template.py").read_text(encoding="utf-8")
 FIND_QVALUES = TEMPLATE[TEMPLATE.index("def find_qvalues") : TEMPLATE.index("# Problem 1")]
-WORDS = "alpha beta gamma delta kappa omega river stone cloud ember frost maple cedar pixel orbit comet lumen".split()
-BUILTINS = set(dir(__builtins__)) | {"np", "gym", "random", "plt", "Counter", "partial", "count", "clear_output", "self"}
+WORDS = [
+    "alpha",
+    "beta",
+    "gamma",
+    "delta",
+    "kappa",
+    "omega",
+    "river",
+    "stone",
+    "cloud",
+    "ember",
+    "frost",
+    "maple",
+    "cedar",
+    "pixel",
+    "orbit",
+    "comet",
+    "lumen",
+]
+BUILTINS = set(dir(__builtins__)) | {
+    "np",
+    "gym",
+    "random",
+    "plt",
+    "Counter",
+    "partial",
+    "count",
+    "clear_output",
+    "self",
+}
 
 
 def renamed(source: str, rng: random.Random) -> str:
     tree = ast.parse(source)
-    bound = {node.id for node in ast.walk(tree) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store)}
+    bound = {
+        node.id for node in ast.walk(tree) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store)
+    }
     bound |= {node.arg for node in ast.walk(tree) if isinstance(node, ast.arg)}
     bound |= {node.name for node in ast.walk(tree) if isinstance(node, (ast.FunctionDef, ast.ClassDef))}
-    lab = {"random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues", "epsilon_decay", "sarsa0",
-           "q_table", "q_table_decay", "n", "N", "env", "alpha", "gamma", "epsilon", "render", "decay",
-           "episode", "epsilon_start", "epsilon_end"}
-    mapping = {name: f"{rng.choice(WORDS)}_{index}" for index, name in enumerate(sorted(bound - lab - BUILTINS))}
+    lab = {
+        "random_blackjack",
+        "blackjack",
+        "cartpole",
+        "car",
+        "taxi",
+        "find_qvalues",
+        "epsilon_decay",
+        "sarsa0",
+        "q_table",
+        "q_table_decay",
+        "n",
+        "N",
+        "env",
+        "alpha",
+        "gamma",
+        "epsilon",
+        "render",
+        "decay",
+        "episode",
+        "epsilon_start",
+        "epsilon_end",
+    }
+    mapping = {
+        name: f"{rng.choice(WORDS)}_{index}" for index, name in enumerate(sorted(bound - lab - BUILTINS))
+    }
     methods = {
-        item.name for node in ast.walk(tree) if isinstance(node, ast.ClassDef) for item in node.body
+        item.name
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ClassDef)
+        for item in node.body
         if isinstance(item, ast.FunctionDef)
     }
     tokens = []
@@ -77,7 +132,9 @@ def comments_changed(source: str, rng: random.Random) -> str:
         (node.body[0].lineno, node.body[0].col_offset)
         for node in ast.walk(tree)
         if isinstance(node, (ast.FunctionDef, ast.Module, ast.ClassDef))
-        and node.body and isinstance(node.body[0], ast.Expr) and isinstance(node.body[0].value, ast.Constant)
+        and node.body
+        and isinstance(node.body[0], ast.Expr)
+        and isinstance(node.body[0].value, ast.Constant)
     }
     out = []
     for token in tokenize.generate_tokens(io.StringIO(source).readline):
@@ -93,7 +150,14 @@ def _blocks(source: str) -> tuple[list[str], list[str]]:
     lines = source.splitlines()
     tree = ast.parse(source)
     starts = [node.lineno - len(getattr(node, "decorator_list", [])) for node in tree.body]
-    head_end = next((start for start, node in zip(starts, tree.body) if isinstance(node, (ast.FunctionDef, ast.ClassDef))), len(lines) + 1)
+    head_end = next(
+        (
+            start
+            for start, node in zip(starts, tree.body, strict=True)
+            if isinstance(node, (ast.FunctionDef, ast.ClassDef))
+        ),
+        len(lines) + 1,
+    )
     head = lines[: head_end - 1]
     blocks = []
     for index, start in enumerate(starts):
@@ -119,17 +183,21 @@ def padded(source: str, rng: random.Random) -> str:
     for node in ast.walk(tree):
         if isinstance(node, ast.FunctionDef) and node.body and node.body[0].lineno != node.lineno:
             starts = [
-                statement for statement in node.body
-                if len(lines[statement.lineno - 1]) - len(lines[statement.lineno - 1].lstrip()) == statement.col_offset
+                statement
+                for statement in node.body
+                if len(lines[statement.lineno - 1]) - len(lines[statement.lineno - 1].lstrip())
+                == statement.col_offset
             ]
             for statement in rng.sample(starts, min(2, len(starts))):
                 indent = " " * statement.col_offset
-                pad = rng.choice([
-                    [f"{indent}unused_{rng.randrange(99)} = {rng.randrange(1000)}"],
-                    [f"{indent}if False:", f"{indent}    print('debug {rng.choice(WORDS)}')"],
-                    [f"{indent}scratch = [{rng.randrange(9)}] * {rng.randrange(2, 9)}"],
-                    [f"{indent}print('checkpoint')"],
-                ])
+                pad = rng.choice(
+                    [
+                        [f"{indent}unused_{rng.randrange(99)} = {rng.randrange(1000)}"],
+                        [f"{indent}if False:", f"{indent}    print('debug {rng.choice(WORDS)}')"],
+                        [f"{indent}scratch = [{rng.randrange(9)}] * {rng.randrange(2, 9)}"],
+                        [f"{indent}print('checkpoint')"],
+                    ]
+                )
                 inserts.setdefault(statement.lineno, []).extend(pad)
     out = []
     for number, line in enumerate(lines, start=1):
@@ -142,9 +210,23 @@ def notebook(source: str, rng: random.Random) -> str:
     head, blocks = _blocks(source)
     cells = [{"cell_type": "markdown", "metadata": {}, "source": "# Lab"}]
     for chunk in ["\n".join(head), *blocks, "%matplotlib inline\nprint(blackjack())"]:
-        cells.append({"cell_type": "code", "execution_count": None, "metadata": {}, "outputs": [],
-                      "source": chunk.strip("\n").splitlines(keepends=True)})
-    return json.dumps({"cells": cells, "metadata": {"language_info": {"name": "python"}}, "nbformat": 4, "nbformat_minor": 4})
+        cells.append(
+            {
+                "cell_type": "code",
+                "execution_count": None,
+                "metadata": {},
+                "outputs": [],
+                "source": chunk.strip("\n").splitlines(keepends=True),
+            }
+        )
+    return json.dumps(
+        {
+            "cells": cells,
+            "metadata": {"language_info": {"name": "python"}},
+            "nbformat": 4,
+            "nbformat_minor": 4,
+        }
+    )
 
 
 def combined(source: str, rng: random.Random) -> str:
@@ -152,8 +234,12 @@ def combined(source: str, rng: random.Random) -> str:
 
 
 DISGUISES = {
-    "renamed": renamed, "comments changed": comments_changed, "reordered": reordered,
-    "dead code padded": padded, "notebook": notebook, "all five at once": combined,
+    "renamed": renamed,
+    "comments changed": comments_changed,
+    "reordered": reordered,
+    "dead code padded": padded,
+    "notebook": notebook,
+    "all five at once": combined,
 }
 
 
@@ -185,7 +271,12 @@ def detection(run_copydetect: bool) -> list[tuple[str, dict[str, tuple[int, int,
     return rows
 
 
-def _summary(scores: dict[frozenset[str], float], flagged: set[frozenset[str]], copied: set[frozenset[str]], identities: list[str]):
+def _summary(
+    scores: dict[frozenset[str], float],
+    flagged: set[frozenset[str]],
+    copied: set[frozenset[str]],
+    identities: list[str],
+):
     pairs = [frozenset(pair) for pair in combinations(identities, 2)]
     independent = [pair for pair in pairs if pair not in copied]
     found = sum(pair in flagged for pair in copied)
@@ -196,12 +287,15 @@ def _summary(scores: dict[frozenset[str], float], flagged: set[frozenset[str]], 
 
 
 def _gymgrade(klass: Path, copied, identities):
-    from grader.similarity.compare import score_pairs
     import grader.similarity.run as run_module
+    from grader.similarity.compare import score_pairs
 
     captured = []
     build = run_module.build_report
-    run_module.build_report = lambda documents, *a, **k: (captured.extend(documents), build(documents, *a, **k))[1]
+    run_module.build_report = lambda documents, *a, **k: (
+        captured.extend(documents),
+        build(documents, *a, **k),
+    )[1]
     try:
         report = run_similarity(klass).report
     finally:
@@ -220,11 +314,18 @@ def _copydetect(klass: Path, folder: Path, copied, identities):
     boilerplate = folder / "boilerplate"
     boilerplate.mkdir()
     for path in BUNDLED:
-        (boilerplate / path.name.removesuffix(".txt")).write_text(path.read_text(encoding="utf-8"), encoding="utf-8")
+        (boilerplate / path.name.removesuffix(".txt")).write_text(
+            path.read_text(encoding="utf-8"), encoding="utf-8"
+        )
     with open(os.devnull, "w") as null, contextlib.redirect_stdout(null), contextlib.redirect_stderr(null):
         detector = CopyDetector(
-            test_dirs=[str(klass)], ref_dirs=[str(klass)], boilerplate_dirs=[str(boilerplate)],
-            extensions=["py", "ipynb"], autoopen=False, silent=True, out_file=str(folder / "report.html"),
+            test_dirs=[str(klass)],
+            ref_dirs=[str(klass)],
+            boilerplate_dirs=[str(boilerplate)],
+            extensions=["py", "ipynb"],
+            autoopen=False,
+            silent=True,
+            out_file=str(folder / "report.html"),
         )
         detector.run()
     scores: dict[frozenset[str], float] = {}
@@ -239,10 +340,19 @@ def _copydetect(klass: Path, folder: Path, copied, identities):
 
 
 STATEMENTS = [
-    "{a} = {b} + {n}", "{a} = env.step({b})[0]", "{a} = np.argmax(q_table[{b}])", "{a} += {b} * {f}",
-    "{a} = [{b} for {c} in range({n})]", "{a}, {b} = env.reset(), {n}", "{a} = max({a}, {b} - {f})",
-    "{a} = random.uniform(0, {n}) < {f}", "{a} = {b}[{n}] if {c} > {f} else {b}[0]", "{a}.append({b} ** 2)",
-    "{a} = sum({b}) / max(len({b}), 1)", "{a} = env.action_space.sample()", "{a} = np.zeros(({n}, {n}))",
+    "{a} = {b} + {n}",
+    "{a} = env.step({b})[0]",
+    "{a} = np.argmax(q_table[{b}])",
+    "{a} += {b} * {f}",
+    "{a} = [{b} for {c} in range({n})]",
+    "{a}, {b} = env.reset(), {n}",
+    "{a} = max({a}, {b} - {f})",
+    "{a} = random.uniform(0, {n}) < {f}",
+    "{a} = {b}[{n}] if {c} > {f} else {b}[0]",
+    "{a}.append({b} ** 2)",
+    "{a} = sum({b}) / max(len({b}), 1)",
+    "{a} = env.action_space.sample()",
+    "{a} = np.zeros(({n}, {n}))",
 ]
 
 
@@ -293,11 +403,16 @@ def scale(students: int, references: int) -> dict[str, float]:
         warm = run_similarity(klass, [known], cache=IndexCache(cache_dir)).report
         warm_seconds = time.perf_counter() - started
         found = sum(
-            1 for pair in warm.pairs if pair.b_is_reference and pair.a.startswith("student_00") and pair.b.endswith(pair.a[-1] + ".py")
+            1
+            for pair in warm.pairs
+            if pair.b_is_reference and pair.a.startswith("student_00") and pair.b.endswith(pair.a[-1] + ".py")
         )
         return {
-            "cold_seconds": cold_seconds, "warm_seconds": warm_seconds, "flagged": len(warm.pairs),
-            "planted_found": found, "same": cold == warm,
+            "cold_seconds": cold_seconds,
+            "warm_seconds": warm_seconds,
+            "flagged": len(warm.pairs),
+            "planted_found": found,
+            "same": cold == warm,
             "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         }
 
@@ -309,7 +424,10 @@ def main() -> None:
     parser.add_argument("--skip-copydetect", action="store_true")
     parser.add_argument("--skip-scale", action="store_true")
     args = parser.parse_args()
-    print("| disguise | tool | copied pairs flagged | independent pairs flagged | lowest copied score | highest independent score |")
+    print(
+        "| disguise | tool | copied pairs flagged | independent pairs flagged | lowest copied score "
+        "| highest independent score |"
+    )
     print("|---|---|---|---|---|---|")
     totals: dict[str, list[int]] = {}
     for name, results in detection(not args.skip_copydetect):

@@ -53,7 +53,9 @@ def load_wrong_results(reports_dir: Path, identities: list[str]) -> tuple[dict[s
         try:
             found[identity] = wrong_results(Report.model_validate_json(path.read_bytes()))
         except (OSError, ValidationError, ValueError) as error:
-            notes.append(f"{path.name}: not a gymgrade report ({type(error).__name__}); its behaviour is not compared.")
+            notes.append(
+                f"{path.name}: not a gymgrade report ({type(error).__name__}); its behaviour is not compared."
+            )
     return found, notes
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from grader.similarity.document import IndexedFile
-from grader.similarity.winnow import K, WINDOW
+from grader.similarity.winnow import WINDOW, K
 
 INDEX_VERSION = f"1-k{K}-w{WINDOW}"
 

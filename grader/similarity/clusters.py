@@ -21,4 +21,6 @@ def clusters(pairs: Iterable[tuple[str, str]]) -> list[list[str]]:
     groups: dict[str, list[str]] = {}
     for node in list(parent):
         groups.setdefault(root(node), []).append(node)
-    return sorted((sorted(group) for group in groups.values() if len(group) > 1), key=lambda group: (-len(group), group))
+    return sorted(
+        (sorted(group) for group in groups.values() if len(group) > 1), key=lambda group: (-len(group), group)
+    )

@@ -1,4 +1,4 @@
-"""`gymgrade similarity CLASS_DIR [--reference DIR ...] --out OUT`: parse, compare, write the CSV and the page."""
+"""`gymgrade similarity CLASS_DIR [--reference DIR ...] --out OUT`: parse, compare, write the outputs."""
 
 from __future__ import annotations
 
@@ -16,9 +16,11 @@ def add_similarity_command(subparsers: Any) -> None:
     """Register the subcommand on `gymgrade`'s subparsers."""
     parser = subparsers.add_parser(
         "similarity",
-        help="rank pairs of submissions whose code is alike, beyond the template (instructors; changes no grade)",
+        help="rank pairs of submissions whose code is alike beyond the template (changes no grade)",
     )
-    parser.add_argument("class_dir", type=Path, metavar="CLASS_DIR", help="one folder or one file per student")
+    parser.add_argument(
+        "class_dir", type=Path, metavar="CLASS_DIR", help="one folder or one file per student"
+    )
     parser.add_argument(
         "--reference",
         type=Path,
@@ -27,14 +29,16 @@ def add_similarity_command(subparsers: Any) -> None:
         metavar="DIR",
         help="a folder of known solutions (earlier years, public repositories); may be repeated",
     )
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="where similarity.csv/.html go")
+    parser.add_argument(
+        "--out", type=Path, required=True, metavar="DIR", help="where similarity.csv/.html go"
+    )
     parser.add_argument(
         "--template",
         type=Path,
         action="append",
         default=None,
         metavar="FILE",
-        help="the file handed out to students (default: the lab's templates of every edition); may be repeated",
+        help="the file handed out to students (default: every edition's template); may be repeated",
     )
     parser.add_argument(
         "--reports",
@@ -56,7 +60,7 @@ def add_similarity_command(subparsers: Any) -> None:
 
 def run_similarity_command(args: argparse.Namespace) -> int:
     """Run the comparison and write ``similarity.csv``, ``similarity.html`` and ``similarity.json``."""
-    from grader.similarity.behaviour import load_wrong_results
+    from grader.similarity.behaviour import WrongResults, load_wrong_results
     from grader.similarity.cache import IndexCache, default_cache_dir
     from grader.similarity.csv_output import render_csv
     from grader.similarity.html_output import render_html
@@ -66,7 +70,8 @@ def run_similarity_command(args: argparse.Namespace) -> int:
 
     template = load_template(tuple(args.template) if args.template else BUNDLED)
     cache = None if args.no_cache else IndexCache(args.cache or default_cache_dir())
-    behaviour, notes = None, []
+    behaviour: dict[str, WrongResults] | None = None
+    notes: list[str] = []
     if args.reports is not None:
         identities = sorted({identity for identity, _ in submissions_from(args.class_dir)})
         behaviour, notes = load_wrong_results(args.reports, identities)
@@ -81,7 +86,11 @@ def run_similarity_command(args: argparse.Namespace) -> int:
     (args.out / JSON_FILE).write_text(report.model_dump_json(indent=2) + "\n", encoding="utf-8")
     print(
         f"Compared {len(report.students)} students"
-        + (f" with each other and with {report.references} reference files" if report.references else " with each other")
+        + (
+            f" with each other and with {report.references} reference files"
+            if report.references
+            else " with each other"
+        )
         + f": {len(report.pairs)} pairs flagged for reading, in {len(report.clusters)} groups"
         + (f"; {len(report.unreadable)} files left out (listed in {HTML_FILE})" if report.unreadable else "")
         + ".",

@@ -23,7 +23,7 @@ def score_pairs(
     documents: Sequence[Document],
     behaviour: Mapping[str, WrongResults] | None = None,
 ) -> list[Pair]:
-    """Every pair that shares a rare fingerprint or a piece of evidence, scored, highest first (flagged or not).
+    """Every pair sharing a rare fingerprint or a piece of evidence, scored, highest first, flagged or not.
 
     Args:
         documents: Students and references, template already removed.
@@ -59,7 +59,9 @@ def score_pairs(
             )
             continue
         evidence = shared_remarks(a, b, counts) + shared_typos(a, b, counts) + shared_constants(a, b, counts)
-        evidence += shared_wrong_results(behaviour.get(a.identity, {}), behaviour.get(b.identity, {}), rare_behaviour)
+        evidence += shared_wrong_results(
+            behaviour.get(a.identity, {}), behaviour.get(b.identity, {}), rare_behaviour
+        )
         found = fragments(a, b, counts.common)
         pairs.append(
             Pair(
@@ -91,7 +93,12 @@ def build_report(
     all_notes = list(notes)
     if not students:
         all_notes.append("no readable submission was found in the class folder: nothing was compared.")
-    all_notes.extend(f"{document.identity}: {note}" for document in documents for note in document.notes if "template" not in note)
+    all_notes.extend(
+        f"{document.identity}: {note}"
+        for document in documents
+        for note in document.notes
+        if "template" not in note
+    )
     return SimilarityReport(
         students=students,
         references=sum(1 for document in documents if document.is_reference),

@@ -9,11 +9,11 @@ from grader.similarity.report import SimilarityReport
 
 COLUMNS = ("a", "b", "score", "shared_fragments", "longest_fragment_lines", "evidence")
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
-"""A spreadsheet runs a cell starting with one of these as a formula; student names and comments are untrusted."""
+"""A spreadsheet runs a cell starting with one of these as a formula; names and comments are untrusted."""
 
 
 def neutralised(cell: str) -> str:
-    """The cell with a leading apostrophe when a spreadsheet would read it as a formula (OWASP CSV injection)."""
+    """The cell, with a leading apostrophe when a spreadsheet would run it as a formula (CSV injection)."""
     return "'" + cell if cell.startswith(FORMULA_STARTS) else cell
 
 

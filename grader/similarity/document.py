@@ -56,7 +56,9 @@ def index_text(text: str, name: str) -> IndexedFile:
             lines=lines, reason=f"{name} is not valid Python{where}: {error.msg}; left out of the comparison."
         )
     except RecursionError:
-        return IndexedFile(lines=lines, reason=f"{name} nests too deeply to analyse; left out of the comparison.")
+        return IndexedFile(
+            lines=lines, reason=f"{name} nests too deeply to analyse; left out of the comparison."
+        )
     return IndexedFile(
         lines=lines,
         shapes=[unit.shape for unit in normalised.units],
@@ -120,7 +122,7 @@ def build_document(
     indexed: list[tuple[Path, IndexedFile]],
     template: Template,
 ) -> Document:
-    """Join the indexed files of one submission, dropping the template's functions, fingerprints and remarks."""
+    """Join one submission's indexed files, dropping the template's functions, fingerprints and remarks."""
     document = Document(identity, is_reference, [path for path, _ in indexed])
     offset = 1 if len(indexed) > 1 else 0
     unit_offset = 0
@@ -139,7 +141,9 @@ def build_document(
                 kept_units.add(number)
         for hash_, unit, first, last in file.fingerprints:
             if unit in kept_units and hash_ not in template.fingerprints:
-                document.fingerprints.setdefault(hash_, []).append((unit + unit_offset, first + offset, last + offset))
+                document.fingerprints.setdefault(hash_, []).append(
+                    (unit + unit_offset, first + offset, last + offset)
+                )
         for key, text, line in file.remarks:
             if key not in template.remarks:
                 document.remarks.setdefault(key, (text, line + offset))

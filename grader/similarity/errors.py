@@ -1,4 +1,4 @@
-"""Errors of the similarity check's own inputs (a student's unreadable file is a listed reason, never one of these)."""
+"""Errors of the similarity check's own inputs (a student's unreadable file is a listed reason instead)."""
 
 from grader.errors import GraderError
 

@@ -13,7 +13,9 @@ from grader.similarity.frequency import Frequencies
 
 MAX_ITEMS = 3
 """Evidence items of each kind listed per pair; the count says how many there were."""
-LAB_CONSTANTS = frozenset({"0.1", "0.6", "0.9", "0.5", "1e-06", "0.01", "0.001", "0.05", "0.2", "0.99", "0.95"})
+LAB_CONSTANTS = frozenset(
+    {"0.1", "0.6", "0.9", "0.5", "1e-06", "0.01", "0.001", "0.05", "0.2", "0.99", "0.95"}
+)
 
 
 def is_unusual(value: str) -> bool:
@@ -33,10 +35,11 @@ def is_unusual(value: str) -> bool:
 
 def shared_remarks(a: Document, b: Document, frequencies: Frequencies) -> list[str]:
     """The identical rare comments and strings of two documents, as the reader sees them."""
-    keys = sorted(a.remarks.keys() & b.remarks.keys() & frequencies.rare_remarks, key=lambda key: a.remarks[key][1])
+    keys = sorted(
+        a.remarks.keys() & b.remarks.keys() & frequencies.rare_remarks, key=lambda key: a.remarks[key][1]
+    )
     items = [
-        f'identical comment or text "{_shown(a.remarks[key][0])}" ({a.identity} line {a.remarks[key][1]}, '
-        f"{b.identity} line {b.remarks[key][1]})"
+        f'identical comment or text "{_shown(a.remarks[key][0])}" ({a.identity} line {a.remarks[key][1]}, {b.identity} line {b.remarks[key][1]})'  # noqa: E501
         for key in keys
     ]
     return _capped(items, "identical comments or texts")
@@ -45,11 +48,12 @@ def shared_remarks(a: Document, b: Document, frequencies: Frequencies) -> list[s
 def shared_constants(a: Document, b: Document, frequencies: Frequencies) -> list[str]:
     """The identical unusual constants of two documents."""
     values = sorted(
-        value for value in a.constants.keys() & b.constants.keys() & frequencies.rare_constants if is_unusual(value)
+        value
+        for value in a.constants.keys() & b.constants.keys() & frequencies.rare_constants
+        if is_unusual(value)
     )
     items = [
-        f"identical unusual constant {value} ({a.identity} line {a.constants[value]}, "
-        f"{b.identity} line {b.constants[value]})"
+        f"identical unusual constant {value} ({a.identity} line {a.constants[value]}, {b.identity} line {b.constants[value]})"  # noqa: E501
         for value in values
     ]
     return _capped(items, "identical unusual constants")
@@ -59,7 +63,7 @@ def shared_typos(a: Document, b: Document, frequencies: Frequencies) -> list[str
     """The identical rare misspellings in two documents' comments and strings."""
     words = sorted(a.typos.keys() & b.typos.keys() & frequencies.rare_typos)
     items = [
-        f'the same misspelling "{word}" ({a.identity} line {a.typos[word]}, {b.identity} line {b.typos[word]})'
+        f'the same misspelling "{word}" ({a.identity} line {a.typos[word]}, {b.identity} line {b.typos[word]})'  # noqa: E501
         for word in words
     ]
     return _capped(items, "identical misspellings")

@@ -22,7 +22,8 @@ STYLE = (
     "body{font-family:system-ui,sans-serif;max-width:80rem;margin:2rem auto;padding:0 1rem;color:#222}"
     ".meta{color:#555;font-size:.9rem}table{border-collapse:collapse;font-size:.85rem}"
     "td,th{border:1px solid #ddd;padding:.2rem .4rem;text-align:left;vertical-align:top}"
-    ".pair{border-top:2px solid #ccc;margin-top:1.5rem}.sides{display:grid;grid-template-columns:minmax(0,1fr) minmax(0,1fr);gap:.5rem}"
+    ".pair{border-top:2px solid #ccc;margin-top:1.5rem}"
+    ".sides{display:grid;grid-template-columns:minmax(0,1fr) minmax(0,1fr);gap:.5rem}"
     "pre{white-space:pre;overflow-x:auto;background:#f6f6f6;padding:.5rem;font-size:.8rem;margin:.2rem 0}"
     ".ln{color:#999;user-select:none}.side h4{margin:.3rem 0;font-size:.85rem}.reason{color:#a00}"
 )
@@ -72,8 +73,13 @@ def render_html(report: SimilarityReport, lines_of: Callable[[str], list[str]]) 
             cache[identity] = lines_of(identity)
         return cache[identity]
 
-    shown = {index: [_shown(pair, fragment, lines) for fragment in pair.fragments] for index, pair in enumerate(report.pairs)}
-    return _environment.get_template("similarity.html").render(report=report, shown=shown, csp=CSP, style=STYLE)
+    shown = {
+        index: [_shown(pair, fragment, lines) for fragment in pair.fragments]
+        for index, pair in enumerate(report.pairs)
+    }
+    return _environment.get_template("similarity.html").render(
+        report=report, shown=shown, csp=CSP, style=STYLE
+    )
 
 
 def _shown(pair: Pair, fragment: Fragment, lines: Callable[[str], list[str]]) -> ShownFragment:

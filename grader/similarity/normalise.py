@@ -24,7 +24,7 @@ MAX_TOKENS_PER_FILE = 200_000
 """A lab solution is a few thousand tokens; beyond this a file is padding and is cut (and says so)."""
 OUTPUT_CALLS = frozenset({"print", "clear_output", "display", "pprint"})
 OUTPUT_MODULES = frozenset({"plt", "pyplot", "display", "IPython"})
-KEPT_LITERALS = frozenset({0, 1, -1, True, False, None})
+KEPT_LITERALS = frozenset({0, 1, -1, None})
 MODULE_UNIT = "<module>"
 MIN_REMARK_CHARS = 12
 """Shorter comments and strings (``# reset``, ``"Taxi-v3"``) are what everyone writes: not evidence."""
@@ -50,7 +50,7 @@ class Unit:
 
 @dataclass(frozen=True)
 class Remark:
-    """A comment or string literal, kept as evidence (identical comments and typos rarely arise independently).
+    """A comment or string literal kept as evidence (identical comments and typos rarely arise independently).
 
     Attributes:
         key: The text lowercased with whitespace collapsed (what two files must share).
@@ -123,7 +123,9 @@ def _units(tree: ast.Module) -> list[tuple[str, list[ast.stmt]]]:
         if isinstance(statement, (ast.FunctionDef, ast.AsyncFunctionDef)):
             units.append((statement.name, [statement]))
         elif isinstance(statement, ast.ClassDef):
-            methods = [node for node in statement.body if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))]
+            methods = [
+                node for node in statement.body if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
+            ]
             units.extend((f"{statement.name}.{method.name}", [method]) for method in methods)
             module_code.extend(node for node in statement.body if node not in methods)
         else:
@@ -248,7 +250,11 @@ def _is_output_call(function: ast.expr) -> bool:
 def _constant_truth(test: ast.expr) -> bool | None:
     if isinstance(test, ast.Constant):
         return bool(test.value)
-    if isinstance(test, ast.UnaryOp) and isinstance(test.op, ast.Not) and isinstance(test.operand, ast.Constant):
+    if (
+        isinstance(test, ast.UnaryOp)
+        and isinstance(test.op, ast.Not)
+        and isinstance(test.operand, ast.Constant)
+    ):
         return not test.operand.value
     return None
 
@@ -343,7 +349,7 @@ def _remarks(source: str, strings: list[tuple[str, int]]) -> list[Remark]:
                 if len(text) >= MIN_REMARK_CHARS:
                     remarks.append(Remark(_key(text), text, token.start[0]))
     except (tokenize.TokenError, SyntaxError):
-        pass  # the tree parsed, so only exotic tokenizer disagreements land here: comments are optional evidence
+        pass  # the tree parsed, so only exotic tokenizer disagreements land here; comments are optional
     for value, line_number in strings:
         for offset, line in enumerate(value.splitlines()):
             if len(line.strip()) >= MIN_REMARK_CHARS:

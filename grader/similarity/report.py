@@ -35,7 +35,9 @@ class Pair(BaseModel):
     shared_fingerprints: int
     shared_fragments: int
     longest_fragment_lines: int
-    evidence: list[str] = Field(default_factory=list, description="Identical comments, constants, wrong results.")
+    evidence: list[str] = Field(
+        default_factory=list, description="Identical comments, constants, wrong results."
+    )
     fragments: list[Fragment] = Field(default_factory=list)
 
 
@@ -56,4 +58,6 @@ class SimilarityReport(BaseModel):
     clusters: list[list[str]] = Field(description="Connected groups of flagged pairs, largest first.")
     unreadable: list[UnreadableFile] = Field(default_factory=list)
     notes: list[str] = Field(default_factory=list, description="What else the reader should know.")
-    template_functions: list[str] = Field(default_factory=list, description="Functions removed as the template's.")
+    template_functions: list[str] = Field(
+        default_factory=list, description="Functions removed as the template's."
+    )

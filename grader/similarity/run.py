@@ -1,4 +1,4 @@
-"""The similarity check's shell: find the files, read and index them (references through the cache), compare."""
+"""The similarity check's shell: find the files, read and index them (references cached), compare."""
 
 from __future__ import annotations
 
@@ -11,7 +11,14 @@ from pathlib import Path
 from grader.similarity.behaviour import WrongResults
 from grader.similarity.cache import IndexCache
 from grader.similarity.compare import build_report
-from grader.similarity.document import Document, IndexedFile, build_document, document_lines, index_text, read_files
+from grader.similarity.document import (
+    Document,
+    IndexedFile,
+    build_document,
+    document_lines,
+    index_text,
+    read_files,
+)
 from grader.similarity.report import SimilarityReport, UnreadableFile
 from grader.similarity.sources import (
     MAX_FILES_PER_SUBMISSION,
@@ -27,7 +34,7 @@ Discovery = Callable[[Path], list[tuple[str, Path]]]
 
 @dataclass(frozen=True)
 class Outcome:
-    """A finished comparison: the report, and where each compared identity's files are (for the side-by-side view).
+    """A finished comparison: the report, and each compared identity's files (for the side-by-side view).
 
     Attributes:
         report: The report.
@@ -80,20 +87,23 @@ def run_similarity(
             UnreadableFile(
                 identity=identity,
                 file=extra.name,
-                reason=f"{identity} has more than {MAX_FILES_PER_SUBMISSION} Python files: {extra.name} was not read.",
+                reason=f"{identity} has more than {MAX_FILES_PER_SUBMISSION} Python files: {extra.name} was not read.",  # noqa: E501
             )
             for extra in paths[MAX_FILES_PER_SUBMISSION:]
         )
         jobs.append((identity, False, paths[:MAX_FILES_PER_SUBMISSION]))
-    jobs.extend((identity, True, [path]) for folder in references for identity, path in references_from(folder))
+    jobs.extend(
+        (identity, True, [path]) for folder in references for identity, path in references_from(folder)
+    )
     workers = workers or os.cpu_count() or 1
     documents: list[Document] = []
     files: dict[str, list[Path]] = {}
     pool = ProcessPoolExecutor(workers) if workers > 1 and len(jobs) > BATCH else None
     try:
         for start in range(0, len(jobs), BATCH):
-            for (identity, is_reference, paths), document in zip(
-                jobs[start : start + BATCH], _documents(jobs[start : start + BATCH], template, cache, unreadable, pool)
+            batch = jobs[start : start + BATCH]
+            for (identity, _, paths), document in zip(
+                batch, _documents(batch, template, cache, unreadable, pool), strict=True
             ):
                 if document is not None:
                     documents.append(document)
@@ -131,14 +141,18 @@ def _documents(
             else:
                 indexed[(number, position)] = entry
     arguments = ([source.text for _, _, source in missing], [source.path.name for _, _, source in missing])
-    results = pool.map(index_text, *arguments, chunksize=4) if pool is not None else map(index_text, *arguments)
+    results = (
+        pool.map(index_text, *arguments, chunksize=4) if pool is not None else map(index_text, *arguments)
+    )
     for (number, position, source), entry in zip(missing, results, strict=True):
         indexed[(number, position)] = entry
         if cache is not None and jobs[number][1]:
             cache.put(source.text, entry)
     documents: list[Document | None] = []
     for number, (identity, is_reference, _) in enumerate(jobs):
-        entries = [(source.path, indexed[(number, position)]) for position, source in enumerate(texts[number])]
+        entries = [
+            (source.path, indexed[(number, position)]) for position, source in enumerate(texts[number])
+        ]
         for path, entry in entries:
             if entry.reason is not None:
                 unreadable.append(UnreadableFile(identity=identity, file=path.name, reason=entry.reason))

@@ -24,7 +24,7 @@ MERGE_GAP = 2
 
 
 def candidate_pairs(documents: Sequence[Document], common: frozenset[int]) -> Counter[tuple[int, int]]:
-    """How many rare fingerprints each pair of documents (not two references) shares, through an inverted index."""
+    """How many rare fingerprints each pair of documents (not two references) shares: an inverted index."""
     postings: dict[int, list[int]] = {}
     for number, document in enumerate(documents):
         for hash_ in document.fingerprints:
@@ -78,5 +78,7 @@ def fragments(a: Document, b: Document, common: frozenset[int]) -> list[Fragment
                     ),
                 )
                 continue
-        found.append((unit_a, unit_b, Fragment(a_first=a_first, a_last=a_last, b_first=b_first, b_last=b_last)))
+        found.append(
+            (unit_a, unit_b, Fragment(a_first=a_first, a_last=a_last, b_first=b_first, b_last=b_last))
+        )
     return [fragment for _, _, fragment in found]

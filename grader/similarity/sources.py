@@ -17,7 +17,7 @@ from grader.validation import MAX_SUBMISSION_BYTES
 
 SOURCE_SUFFIXES = (".py", ".ipynb")
 MAX_FILES_PER_SUBMISSION = 20
-"""A student's folder may hold helpers beside the lab file; beyond this many files the rest are listed, not read."""
+"""A student's folder may hold helpers beside the lab file; files beyond this many are listed, not read."""
 IGNORED_PARTS = ("__pycache__", ".ipynb_checkpoints", "__MACOSX")
 
 
@@ -60,7 +60,7 @@ def submissions_from(path: Path) -> list[tuple[str, Path]]:
     """
     if not path.is_dir():
         raise ClassDirectoryError(
-            f"expected a class folder (one sub-folder or one file per student), found {_what(path)} at {path}; "
+            f"expected a class folder (one sub-folder or one file per student), found {_what(path)} at {path}; "  # noqa: E501
             "pass the folder the submissions were downloaded into"
         )
     found: list[tuple[str, Path]] = []
@@ -78,7 +78,7 @@ def submissions_from(path: Path) -> list[tuple[str, Path]]:
 
 
 def references_from(path: Path) -> list[tuple[str, Path]]:
-    """Every ``.py``/``.ipynb`` file under a --reference folder as its own document, named ``folder/relative/path``.
+    """Every ``.py``/``.ipynb`` file under a --reference folder, each a document named ``folder/path``.
 
     Raises:
         ClassDirectoryError: When ``path`` is not a directory.
@@ -101,7 +101,8 @@ def read_source(path: Path) -> SourceText | Unreadable:
         return Unreadable(path, f"{path.name} holds no .py or .ipynb file: nothing to compare.")
     if not _has_source_suffix(path):
         return Unreadable(
-            path, f"{path.name} is neither a .py nor an .ipynb file: only Python sources and notebooks are compared."
+            path,
+            f"{path.name} is neither a .py nor an .ipynb file: only Python sources and notebooks are compared.",  # noqa: E501
         )
     notebook = path.suffix.lower() == ".ipynb"
     limit = MAX_NOTEBOOK_BYTES if notebook else MAX_SUBMISSION_BYTES
@@ -111,7 +112,9 @@ def read_source(path: Path) -> SourceText | Unreadable:
     except OSError as error:
         return Unreadable(path, f"{path.name} could not be read ({error.strerror or error}).")
     if len(data) > limit:
-        return Unreadable(path, f"{path.name} is larger than {limit:,} bytes: too large to be a lab solution, left out.")
+        return Unreadable(
+            path, f"{path.name} is larger than {limit:,} bytes: too large to be a lab solution, left out."
+        )
     if not data.strip():
         return Unreadable(path, f"{path.name} is empty: nothing to compare.")
     if b"\0" in data:
@@ -131,10 +134,14 @@ def _notebook_code(path: Path, text: str) -> SourceText | Unreadable:
     try:
         notebook = json.loads(text)
     except (json.JSONDecodeError, RecursionError) as error:
-        return Unreadable(path, f"{path.name} is not a readable notebook: not valid JSON ({str(error)[:120]}).")
+        return Unreadable(
+            path, f"{path.name} is not a readable notebook: not valid JSON ({str(error)[:120]})."
+        )
     cells = notebook.get("cells") if isinstance(notebook, dict) else None
     if not isinstance(cells, list):
-        return Unreadable(path, f'{path.name} is JSON but not a Jupyter notebook (no "cells" list): left out.')
+        return Unreadable(
+            path, f'{path.name} is JSON but not a Jupyter notebook (no "cells" list): left out.'
+        )
     chunks: list[str] = []
     for cell in cells:
         if not isinstance(cell, dict) or cell.get("cell_type") != "code":
@@ -147,7 +154,8 @@ def _notebook_code(path: Path, text: str) -> SourceText | Unreadable:
     code = "\n\n".join(chunks)
     if len(code.encode()) > MAX_SUBMISSION_BYTES:
         return Unreadable(
-            path, f"{path.name}'s code cells hold more than {MAX_SUBMISSION_BYTES:,} bytes: too large, left out."
+            path,
+            f"{path.name}'s code cells hold more than {MAX_SUBMISSION_BYTES:,} bytes: too large, left out.",
         )
     if not code.strip():
         return Unreadable(path, f"{path.name} has no code cells: nothing to compare.")

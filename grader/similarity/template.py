@@ -52,7 +52,7 @@ def load_template(paths: tuple[Path, ...] = BUNDLED) -> Template:
             normalised = normalise(path.read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, SyntaxError) as error:
             raise TemplateError(
-                f"expected the template {path} to be a readable Python file, found {type(error).__name__}: {error}; "
+                f"expected the template {path} to be a readable Python file, found {type(error).__name__}: {error}; "  # noqa: E501
                 "pass the .py file handed out to students"
             ) from None
         shapes.update(unit.shape for unit in normalised.units)

@@ -5,7 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 
 from grader.report import ProblemResult, Report
-from grader.similarity.behaviour import load_wrong_results, rare_wrong_results, shared_wrong_results, wrong_results
+from grader.similarity.behaviour import (
+    load_wrong_results,
+    rare_wrong_results,
+    shared_wrong_results,
+    wrong_results,
+)
 from grader.similarity.compare import EVIDENCE_BAR, score_pairs
 from grader.similarity.document import Document
 
@@ -24,8 +29,14 @@ def _report(name: str, *results: tuple[str, str, float], seed: int = 7) -> Repor
         for problem, status, value in results
     ]
     return Report(
-        submission=name, sha256="0" * 64, seed=seed, gymnasium_version="1", grader_version="1",
-        score=0.0, max_score=float(len(problems)), problems=problems,
+        submission=name,
+        sha256="0" * 64,
+        seed=seed,
+        gymnasium_version="1",
+        grader_version="1",
+        score=0.0,
+        max_score=float(len(problems)),
+        problems=problems,
     )
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 from grader.similarity.cache import IndexCache, cache_key
 from grader.similarity.run import run_similarity
 
-CORPUS = Path(__file__).with_name("corpus")
+CORPUS = Path(__file__).resolve().parents[3] / "submissions" / "similarity"
 REFERENCE = CORPUS / "references" / "public_2021"
 
 
@@ -36,4 +36,6 @@ def test_a_damaged_entry_is_indexed_again_and_rewritten(tmp_path: Path) -> None:
     report = run_similarity(CORPUS / "class", [REFERENCE], cache=again).report
     assert (again.hits, again.misses) == (0, 1)
     assert any(pair.b_is_reference for pair in report.pairs)
-    assert IndexCache(tmp_path).get((REFERENCE / "opengym_solution.py").read_text(encoding="utf-8")) is not None
+    assert (
+        IndexCache(tmp_path).get((REFERENCE / "opengym_solution.py").read_text(encoding="utf-8")) is not None
+    )

@@ -11,7 +11,7 @@ import pytest
 from grader.cli import main
 from grader.similarity.html_output import CSP
 
-CORPUS = Path(__file__).with_name("corpus")
+CORPUS = Path(__file__).resolve().parents[3] / "submissions" / "similarity"
 CHROMIUM = "/usr/bin/chromium"
 
 
@@ -63,10 +63,14 @@ def test_the_page_is_self_contained_escapes_student_names_and_never_accuses(out:
 def test_the_command_says_what_it_found(out: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["similarity", str(CORPUS / "class"), "--out", str(out.parent / "again"), "--no-cache"]) == 0
     printed = capsys.readouterr().out
-    assert printed.startswith("Compared 22 students with each other: 8 pairs flagged for reading, in 6 groups.\n")
+    assert printed.startswith(
+        "Compared 22 students with each other: 8 pairs flagged for reading, in 6 groups.\n"
+    )
 
 
-def test_a_missing_class_folder_exits_2_with_what_to_pass(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_missing_class_folder_exits_2_with_what_to_pass(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     assert main(["similarity", str(tmp_path / "nowhere"), "--out", str(tmp_path / "out")]) == 2
     assert "expected a class folder" in capsys.readouterr().err
 
@@ -84,13 +88,17 @@ def test_chromium_renders_the_pairs_side_by_side_under_the_page_policy(out: Path
             page.on("console", lambda message: console.append(message.text))
             page.goto((out / "similarity.html").as_uri())
             columns = page.eval_on_selector(".sides", "node => getComputedStyle(node).gridTemplateColumns")
-            sides = page.eval_on_selector_all(".pair", "nodes => nodes.map(n => n.querySelectorAll('.side pre').length)")
+            sides = page.eval_on_selector_all(
+                ".pair", "nodes => nodes.map(n => n.querySelectorAll('.side pre').length)"
+            )
             rows = page.eval_on_selector_all("#pairs + table tr", "rows => rows.length")
             dialogs: list[str] = []
             page.on("dialog", lambda dialog: dialogs.append(dialog.message))
         finally:
             browser.close()
-    assert len(columns.split()) == 2  # the stylesheet applied (its CSP hash matches): two columns side by side
+    assert (
+        len(columns.split()) == 2
+    )  # the stylesheet applied (its CSP hash matches): two columns side by side
     assert len(sides) == 10 and all(count >= 2 and count % 2 == 0 for count in sides)
     assert rows == 11
     assert console == [] and dialogs == []

@@ -1,7 +1,7 @@
-"""The corpus of corpus/ (written for this test): every copied pair ranks above every independent one.
+"""The corpus of submissions/similarity/ (written for this test): copied pairs rank above independent ones.
 
-corpus/expected.toml lists the copied pairs (one per disguise, a reference copy, a ring of three) and
-the template-only students; every other pair is independent.
+submissions/similarity/expected.toml lists the copied pairs (one per disguise, a reference copy, a ring of
+three) and the template-only students; every other pair is independent.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from grader.similarity.compare import score_pairs
 from grader.similarity.document import Document
 from grader.similarity.run import Outcome, run_similarity
 
-CORPUS = Path(__file__).with_name("corpus")
+CORPUS = Path(__file__).resolve().parents[3] / "submissions" / "similarity"
 EXPECTED = tomllib.loads((CORPUS / "expected.toml").read_text(encoding="utf-8"))
 COPIED = {name: frozenset(pair) for name, pair in EXPECTED["copied"].items()}
 REFERENCES = sorted(path for path in (CORPUS / "references").iterdir() if path.is_dir())
@@ -62,7 +62,10 @@ def test_every_copied_pair_ranks_above_every_independent_pair(documents: list[Do
     assert len(independent) > 200
     lowest_copied = min(copied, key=copied.__getitem__)
     highest_independent = max(independent, key=independent.__getitem__)
-    assert copied[lowest_copied] > independent[highest_independent], (sorted(lowest_copied), sorted(highest_independent))
+    assert copied[lowest_copied] > independent[highest_independent], (
+        sorted(lowest_copied),
+        sorted(highest_independent),
+    )
 
 
 @pytest.mark.parametrize("disguise", list(COPIED), ids=list(COPIED))
@@ -87,7 +90,9 @@ def test_template_only_submissions_keep_nothing_of_the_template(documents: list[
     by_identity = {document.identity: document for document in documents}
     assert by_identity["t_template_only"].fingerprints == {}
     removed = {
-        name: next(note for note in by_identity[name].notes if note.startswith("template functions not compared"))
+        name: next(
+            note for note in by_identity[name].notes if note.startswith("template functions not compared")
+        )
         for name in EXPECTED["groups"]["template_only"]
     }
     assert "qlearn" in removed["t_rl1_stub"] and "epsilon_decay" not in removed["t_rl1_stub"]

@@ -22,13 +22,18 @@ def win_rate(env, n):
 '''
 
 DISGUISES = {
-    "renamed": ORIGINAL.replace("wins", "victories").replace("game", "g").replace("state", "obs").replace("win_rate", "rate"),
-    "comments and docstring changed": ORIGINAL.replace('"""Fraction of games won."""', '"""Returns the share of wins, mine."""')
-    .replace("# hit on 11 or less", "# my own comment"),
+    "renamed": ORIGINAL.replace("wins", "victories")
+    .replace("game", "g")
+    .replace("state", "obs")
+    .replace("win_rate", "rate"),
+    "comments and docstring changed": ORIGINAL.replace(
+        '"""Fraction of games won."""', '"""Returns the share of wins, mine."""'
+    ).replace("# hit on 11 or less", "# my own comment"),
     "docstring removed": ORIGINAL.replace('    """Fraction of games won."""\n', ""),
     "dead code padded": ORIGINAL.replace(
         "    wins = 0\n",
-        "    wins = 0\n    unused = 42\n    if False:\n        print('never')\n    pass\n    print('debug', n)\n",
+        "    wins = 0\n    unused = 42\n    if False:\n        print('never')\n"
+        "    pass\n    print('debug', n)\n",
     ).replace("    return wins / n\n", "    return wins / n\n    print('after return')\n"),
     "import alias": ORIGINAL.replace("import numpy as np", "import numpy as npy"),
     "other literal of the same kind": ORIGINAL.replace("<= 11", "<= 12"),
@@ -54,11 +59,14 @@ def test_every_function_is_a_unit_so_their_order_does_not_matter() -> None:
     first = "def a(x):\n    return x + 1\n\ndef b(y):\n    return y * 2\n"
     second = "def b(y):\n    return y * 2\n\ndef a(x):\n    return x + 1\n"
     assert sorted(_tokens(first)) == sorted(_tokens(second))
-    assert [unit.shape for unit in normalise(first).units] == [unit.shape for unit in normalise(second).units][::-1]
+    assert [unit.shape for unit in normalise(first).units] == [
+        unit.shape for unit in normalise(second).units
+    ][::-1]
 
 
 def test_module_code_and_methods_are_units_of_their_own() -> None:
-    source = "class Agent:\n    def act(self, s):\n        return s\n\nTABLE = {}\nfor key in 'ab':\n    TABLE[key] = 1\n"
+    source = "class Agent:\n    def act(self, s):\n        return s\n\n"
+    source += "TABLE = {}\nfor key in 'ab':\n    TABLE[key] = 1\n"
     assert [unit.name for unit in normalise(source).units] == ["Agent.act", MODULE_UNIT]
 
 
@@ -71,7 +79,10 @@ def test_library_names_are_kept_while_the_files_own_names_become_ids() -> None:
 def test_comments_strings_and_constants_are_kept_as_evidence() -> None:
     source = "x = 0.0173  # we recieve the reward here\ns = 'a message printed by the student'\n"
     normalised = normalise(source)
-    assert [remark.key for remark in normalised.remarks] == ["we recieve the reward here", "a message printed by the student"]
+    assert [remark.key for remark in normalised.remarks] == [
+        "we recieve the reward here",
+        "a message printed by the student",
+    ]
     assert ("0.0173", 1) in normalised.constants
 
 

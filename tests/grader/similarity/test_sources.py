@@ -11,7 +11,7 @@ from grader.similarity.errors import ClassDirectoryError
 from grader.similarity.run import run_similarity
 from grader.similarity.sources import read_source, submissions_from
 
-CORPUS = Path(__file__).with_name("corpus")
+CORPUS = Path(__file__).resolve().parents[3] / "submissions" / "similarity"
 GOOD = (CORPUS / "class" / "h01_loops.py").read_text(encoding="utf-8")
 COPY = (CORPUS / "class" / "c_renamed_from_h01.py").read_text(encoding="utf-8")
 
@@ -63,7 +63,9 @@ def test_an_empty_class_gives_an_empty_report_that_says_so(tmp_path: Path) -> No
 
 
 def test_a_missing_class_folder_is_an_error_that_says_what_to_pass(tmp_path: Path) -> None:
-    with pytest.raises(ClassDirectoryError, match="expected a class folder .* found nothing at .*missing; pass the folder"):
+    with pytest.raises(
+        ClassDirectoryError, match=r"expected a class folder .* found nothing at .*missing; pass the folder"
+    ):
         run_similarity(tmp_path / "missing")
 
 
@@ -74,7 +76,9 @@ def test_a_student_folder_holds_every_source_file_of_the_student(tmp_path: Path)
     (tmp_path / "cara" / ".ipynb_checkpoints").mkdir()
     (tmp_path / "cara" / ".ipynb_checkpoints" / "helpers-checkpoint.ipynb").write_text("{}", encoding="utf-8")
     (tmp_path / "dan.ipynb").write_text("{}", encoding="utf-8")
-    assert [(identity, path.relative_to(tmp_path).as_posix()) for identity, path in submissions_from(tmp_path)] == [
+    assert [
+        (identity, path.relative_to(tmp_path).as_posix()) for identity, path in submissions_from(tmp_path)
+    ] == [
         ("cara", "cara/helpers.ipynb"),
         ("cara", "cara/lab/opengym.py"),
         ("dan", "dan.ipynb"),
@@ -105,5 +109,7 @@ def test_a_multi_file_student_is_one_document_whose_lines_cite_each_file(tmp_pat
     fragment = pair.fragments[0]
     eve_first = fragment.a_first if pair.a == "eve" else fragment.b_first
     fay_first = fragment.b_first if pair.a == "eve" else fragment.a_first
-    assert eve_first == fay_first + 1  # the copy keeps h01's line numbers; eve's text starts with a header line
+    assert (
+        eve_first == fay_first + 1
+    )  # the copy keeps h01's line numbers; eve's text starts with a header line
     assert lines[eve_first - 1] == GOOD.splitlines()[fay_first - 1]

@@ -32,12 +32,16 @@ def test_the_template_as_handed_out_leaves_nothing_to_compare() -> None:
 
 
 def test_a_provided_function_with_its_comments_and_docstring_changed_is_still_the_templates() -> None:
-    edited = TEMPLATE.replace("# Make Q-table", "# the table of q values").replace("Use the Q-learning", "Q-learning")
+    edited = TEMPLATE.replace("# Make Q-table", "# the table of q values").replace(
+        "Use the Q-learning", "Q-learning"
+    )
     assert _document(edited).fingerprints == {}
 
 
 def test_an_edited_provided_function_is_compared_without_its_unchanged_lines() -> None:
-    edited = TEMPLATE.replace("next_max = np.max(q_table[next_state])", "next_max = max(q_table[next_state]) * 0.5")
+    edited = TEMPLATE.replace(
+        "next_max = np.max(q_table[next_state])", "next_max = max(q_table[next_state]) * 0.5"
+    )
     document = _document(edited)
     assert document.fingerprints
     assert all(span[1] >= 40 for spans in document.fingerprints.values() for span in spans)
@@ -46,5 +50,7 @@ def test_an_edited_provided_function_is_compared_without_its_unchanged_lines() -
 def test_an_unreadable_template_says_what_to_pass(tmp_path: Path) -> None:
     bad = tmp_path / "template.py"
     bad.write_text("def f(:\n", encoding="utf-8")
-    with pytest.raises(TemplateError, match="expected the template .* to be a readable Python file, found SyntaxError"):
+    with pytest.raises(
+        TemplateError, match=r"expected the template .* to be a readable Python file, found SyntaxError"
+    ):
         load_template((bad,))

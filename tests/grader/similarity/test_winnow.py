@@ -1,4 +1,4 @@
-"""Winnowing keeps the guarantee of Schleimer, Wilkerson and Aiken: a long enough shared run is always seen."""
+"""Winnowing keeps the guarantee of Schleimer, Wilkerson and Aiken: a long shared run is always seen."""
 
 from __future__ import annotations
 
@@ -6,11 +6,14 @@ import random
 
 import pytest
 
-from grader.similarity.winnow import K, WINDOW, kgram_hashes, winnow
+from grader.similarity.winnow import WINDOW, K, kgram_hashes, winnow
 
 
 def _tokens(rng: random.Random, length: int) -> tuple[str, ...]:
-    return tuple(rng.choice(["Name", "Call", "ID", "Assign", "For", "INT", ".step", "BinOp", "Add"]) for _ in range(length))
+    return tuple(
+        rng.choice(["Name", "Call", "ID", "Assign", "For", "INT", ".step", "BinOp", "Add"])
+        for _ in range(length)
+    )
 
 
 def test_each_window_keeps_its_rightmost_minimum() -> None:
