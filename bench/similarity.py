@@ -288,7 +288,7 @@ def _summary(
 
 def _gymgrade(klass: Path, copied, identities):
     import grader.similarity.run as run_module
-    from grader.similarity.compare import score_pairs
+    from grader.similarity.compare import all_scores
 
     captured = []
     build = run_module.build_report
@@ -300,7 +300,7 @@ def _gymgrade(klass: Path, copied, identities):
         report = run_similarity(klass).report
     finally:
         run_module.build_report = build
-    scores = {frozenset((pair.a, pair.b)): pair.score for pair in score_pairs(captured)}
+    scores = all_scores(captured)
     flagged = {frozenset((pair.a, pair.b)) for pair in report.pairs}
     return _summary(scores, flagged, copied, identities)
 

@@ -23,7 +23,7 @@ def score_pairs(
     documents: Sequence[Document],
     behaviour: Mapping[str, WrongResults] | None = None,
 ) -> list[Pair]:
-    """Every pair sharing a rare fingerprint or a piece of evidence, scored, highest first, flagged or not.
+    """Every pair that could be flagged (enough shared fingerprints, or evidence), scored, highest first.
 
     Args:
         documents: Students and references, template already removed.
@@ -35,29 +35,15 @@ def score_pairs(
     sizes = [size(document, counts.common) for document in documents]
     shared = candidate_pairs(documents, counts.common)
     with_evidence = _evidence_pairs(documents, counts, behaviour)
-    for pair in with_evidence:
-        shared.setdefault(pair, 0)
     pairs: list[Pair] = []
-    for (first, second), count in shared.items():
+    for first, second in sorted(
+        with_evidence | {pair for pair, count in shared.items() if count >= MIN_SHARED}
+    ):
+        count = shared.get((first, second), 0)
         a, b = documents[first], documents[second]
         if a.is_reference:
             a, b = b, a
         score = pair_score(count, sizes[first], sizes[second])
-        if count < MIN_SHARED and (first, second) not in with_evidence:
-            # cannot be flagged: ranked by its score alone, without the cost of fragments and evidence
-            pairs.append(
-                Pair(
-                    a=a.identity,
-                    b=b.identity,
-                    b_is_reference=b.is_reference,
-                    score=score,
-                    flagged=False,
-                    shared_fingerprints=count,
-                    shared_fragments=0,
-                    longest_fragment_lines=0,
-                )
-            )
-            continue
         evidence = shared_remarks(a, b, counts) + shared_typos(a, b, counts) + shared_constants(a, b, counts)
         evidence += shared_wrong_results(
             behaviour.get(a.identity, {}), behaviour.get(b.identity, {}), rare_behaviour
@@ -78,6 +64,18 @@ def score_pairs(
             )
         )
     return sorted(pairs, key=lambda pair: (-pair.score, -len(pair.evidence), pair.a, pair.b))
+
+
+def all_scores(documents: Sequence[Document]) -> dict[frozenset[str], float]:
+    """The score of every pair sharing at least one rare fingerprint (for ranking studies and tests)."""
+    common = frequencies(documents).common
+    sizes = [size(document, common) for document in documents]
+    return {
+        frozenset((documents[first].identity, documents[second].identity)): pair_score(
+            count, sizes[first], sizes[second]
+        )
+        for (first, second), count in candidate_pairs(documents, common).items()
+    }
 
 
 def build_report(

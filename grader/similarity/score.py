@@ -8,9 +8,9 @@ score 1.0 on a few lines.
 
 from __future__ import annotations
 
-from collections import Counter
 from collections.abc import Sequence
-from itertools import combinations
+
+import numpy as np
 
 from grader.similarity.document import Document
 from grader.similarity.report import Fragment
@@ -23,21 +23,60 @@ MERGE_GAP = 2
 """Matched k-grams at most this many lines apart, in both documents, belong to one fragment."""
 
 
-def candidate_pairs(documents: Sequence[Document], common: frozenset[int]) -> Counter[tuple[int, int]]:
-    """How many rare fingerprints each pair of documents (not two references) shares: an inverted index."""
+def candidate_pairs(documents: Sequence[Document], common: frozenset[int]) -> dict[tuple[int, int], int]:
+    """How many rare fingerprints each pair of documents shares (never two references), by an inverted index.
+
+    A pair is keyed by its two indexes in increasing order. Pairs are counted as
+    integer codes in numpy, a batch at a time: a fingerprint held by h documents adds up to h^2/2 pairs,
+    and h may reach the frequency filter's limit (a tenth of the class plus a tenth of the references).
+    """
+    count = len(documents)
     postings: dict[int, list[int]] = {}
     for number, document in enumerate(documents):
         for hash_ in document.fingerprints:
             if hash_ not in common:
                 postings.setdefault(hash_, []).append(number)
-    shared: Counter[tuple[int, int]] = Counter()
+    is_reference = np.array([document.is_reference for document in documents], dtype=bool)
+    codes: list[np.ndarray] = []
+    pending = 0
+    totals = (np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64))
     for holders in postings.values():
         if len(holders) < 2:
             continue
-        for first, second in combinations(holders, 2):
-            if not (documents[first].is_reference and documents[second].is_reference):
-                shared[(first, second)] += 1
-    return shared
+        members = np.array(holders, dtype=np.int64)
+        students = members[~is_reference[members]]
+        if students.size == 0:
+            continue
+        others = members[None, :]
+        keep = (others > students[:, None]) | is_reference[others]
+        pair_codes = (students[:, None] * count + others)[keep]
+        codes.append(pair_codes)
+        pending += pair_codes.size
+        if pending > FLUSH_PAIRS:
+            totals = _merged(totals, codes)
+            codes, pending = [], 0
+    totals = _merged(totals, codes)
+    pairs: dict[tuple[int, int], int] = {}
+    for code, shared in zip(totals[0].tolist(), totals[1].tolist(), strict=True):
+        first, second = divmod(code, count)
+        pairs[(first, second) if first < second else (second, first)] = shared
+    return pairs
+
+
+FLUSH_PAIRS = 4_000_000
+"""Pair codes held before they are merged into the counts: bounds memory by the pairs, not the sum of h^2."""
+
+
+def _merged(totals: tuple[np.ndarray, np.ndarray], codes: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    if not codes:
+        return totals
+    unique, counts = np.unique(np.concatenate(codes), return_counts=True)
+    if totals[0].size == 0:
+        return unique, counts
+    merged_codes = np.concatenate([totals[0], unique])
+    merged_counts = np.concatenate([totals[1], counts])
+    order_codes, inverse = np.unique(merged_codes, return_inverse=True)
+    return order_codes, np.bincount(inverse, weights=merged_counts).astype(np.int64)
 
 
 def size(document: Document, common: frozenset[int]) -> int:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from grader.similarity.compare import score_pairs
+from grader.similarity.compare import all_scores
 from grader.similarity.document import Document
 from grader.similarity.run import Outcome, run_similarity
 
@@ -47,7 +47,7 @@ def outcome() -> Outcome:
 
 
 def _scores(documents: list[Document]) -> dict[frozenset[str], float]:
-    scored = {frozenset((pair.a, pair.b)): pair.score for pair in score_pairs(documents)}
+    scored = all_scores(documents)
     return {
         frozenset((a.identity, b.identity)): scored.get(frozenset((a.identity, b.identity)), 0.0)
         for a, b in combinations(documents, 2)

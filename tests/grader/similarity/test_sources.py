@@ -113,3 +113,14 @@ def test_a_multi_file_student_is_one_document_whose_lines_cite_each_file(tmp_pat
         eve_first == fay_first + 1
     )  # the copy keeps h01's line numbers; eve's text starts with a header line
     assert lines[eve_first - 1] == GOOD.splitlines()[fay_first - 1]
+
+
+def test_indexing_in_a_process_pool_gives_the_report_of_indexing_in_process(tmp_path: Path) -> None:
+    from grader.similarity.run import BATCH
+
+    for number in range(BATCH + 6):
+        body = (
+            GOOD if number % 2 else GOOD.replace("wins", f"wins_{number}").replace("10000", str(number + 11))
+        )
+        (tmp_path / f"s{number:03d}.py").write_text(body, encoding="utf-8")
+    assert run_similarity(tmp_path, workers=2).report == run_similarity(tmp_path, workers=1).report
