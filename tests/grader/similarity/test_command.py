@@ -102,3 +102,44 @@ def test_chromium_renders_the_pairs_side_by_side_under_the_page_policy(out: Path
     assert len(sides) == 10 and all(count >= 2 and count % 2 == 0 for count in sides)
     assert rows == 11
     assert console == [] and dialogs == []
+
+
+def test_grading_reports_add_shared_wrong_results_as_evidence(tmp_path: Path) -> None:
+    from grader.report import ProblemResult, Report
+
+    def report(name: str, status: str) -> str:
+        problems = [
+            ProblemResult(
+                id=problem,
+                title=problem,
+                status=status,  # type: ignore[arg-type]
+                score=0.0,
+                max_score=1.0,
+                feedback="",
+                measurements={"returned": value},
+            )
+            for problem, value in (("blackjack", 0.0913), ("car", 201), ("taxi", -812.25))
+        ]
+        return Report(
+            submission=f"{name}.py",
+            sha256="0" * 64,
+            seed=5,
+            gymnasium_version="1",
+            grader_version="1",
+            score=0.0,
+            max_score=3.0,
+            problems=problems,
+        ).to_json()
+
+    reports = tmp_path / "graded"
+    reports.mkdir()
+    (reports / "h06_functional.json").write_text(report("h06_functional", "failed"), encoding="utf-8")
+    (reports / "h09_counter.json").write_text(report("h09_counter", "failed"), encoding="utf-8")
+    (reports / "h07_terse.json").write_text(report("h07_terse", "passed"), encoding="utf-8")
+    argv = ["similarity", str(CORPUS / "class"), "--reports", str(reports), "--out", str(tmp_path / "out")]
+    assert main([*argv, "--no-cache"]) == 0
+    with (tmp_path / "out" / "similarity.csv").open(encoding="utf-8", newline="") as stream:
+        rows = {frozenset((row["a"], row["b"])): row for row in csv.DictReader(stream)}
+    shared = rows[frozenset(("h06_functional", "h09_counter"))]
+    assert shared["evidence"].count("the same wrong result on") == 3
+    assert not any("h07_terse" in pair for pair in rows)
