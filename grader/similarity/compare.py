@@ -19,11 +19,14 @@ MAX_FRAGMENTS = 12
 """Fragments kept per pair (the longest); the count says how many there were."""
 
 
-def score_pairs(
+def flagged_pairs(
     documents: Sequence[Document],
     behaviour: Mapping[str, WrongResults] | None = None,
 ) -> list[Pair]:
-    """Every pair that could be flagged (enough shared fingerprints, or evidence), scored, highest first.
+    """The pairs worth a person's reading, with their fragments and evidence, highest score first.
+
+    A pair is flagged by its code (score >= ``SCORE_BAR`` on at least ``MIN_SHARED`` fingerprints) or by
+    ``EVIDENCE_BAR`` pieces of evidence. Fragments and evidence are computed for those pairs only.
 
     Args:
         documents: Students and references, template already removed.
@@ -34,28 +37,30 @@ def score_pairs(
     rare_behaviour = rare_wrong_results(behaviour)
     sizes = [size(document, counts.common) for document in documents]
     shared = candidate_pairs(documents, counts.common)
-    with_evidence = _evidence_pairs(documents, counts, behaviour)
+    by_code = {
+        pair
+        for pair, count in shared.items()
+        if count >= MIN_SHARED and pair_score(count, sizes[pair[0]], sizes[pair[1]]) >= SCORE_BAR
+    }
     pairs: list[Pair] = []
-    for first, second in sorted(
-        with_evidence | {pair for pair, count in shared.items() if count >= MIN_SHARED}
-    ):
+    for first, second in sorted(by_code | _evidence_pairs(documents, counts, behaviour)):
         count = shared.get((first, second), 0)
         a, b = documents[first], documents[second]
         if a.is_reference:
             a, b = b, a
-        score = pair_score(count, sizes[first], sizes[second])
         evidence = shared_remarks(a, b, counts) + shared_typos(a, b, counts) + shared_constants(a, b, counts)
         evidence += shared_wrong_results(
             behaviour.get(a.identity, {}), behaviour.get(b.identity, {}), rare_behaviour
         )
+        if (first, second) not in by_code and len(evidence) < EVIDENCE_BAR:
+            continue
         found = fragments(a, b, counts.common)
         pairs.append(
             Pair(
                 a=a.identity,
                 b=b.identity,
                 b_is_reference=b.is_reference,
-                score=score,
-                flagged=(score >= SCORE_BAR and count >= MIN_SHARED) or len(evidence) >= EVIDENCE_BAR,
+                score=pair_score(count, sizes[first], sizes[second]),
                 shared_fingerprints=count,
                 shared_fragments=len(found),
                 longest_fragment_lines=max((fragment.lines for fragment in found), default=0),
@@ -86,7 +91,7 @@ def build_report(
     notes: Sequence[str] = (),
 ) -> SimilarityReport:
     """The report of a class: its flagged pairs ranked, their clusters, and every file left out."""
-    flagged = [pair for pair in score_pairs(documents, behaviour) if pair.flagged]
+    flagged = flagged_pairs(documents, behaviour)
     students = [document.identity for document in documents if not document.is_reference]
     all_notes = list(notes)
     if not students:

@@ -150,11 +150,31 @@ class _Facts:
 _CANONICAL_MODULES = {"numpy": "np", "gymnasium": "gym", "matplotlib.pyplot": "plt", "pyplot": "plt"}
 
 
+_FACT_NODES = frozenset(
+    {
+        ast.Name,
+        ast.Constant,
+        ast.Attribute,
+        ast.arg,
+        ast.FunctionDef,
+        ast.AsyncFunctionDef,
+        ast.ClassDef,
+        ast.Import,
+        ast.ImportFrom,
+        ast.ExceptHandler,
+        ast.Global,
+        ast.Nonlocal,
+    }
+)
+
+
 def _facts(tree: ast.Module) -> _Facts:
     """Names the file binds (a disguise can rename them), import aliases (``import numpy as npy`` reads as
     ``np``), attributes it assigns or defines as methods (renameable too), its strings and numbers."""
     facts = _Facts(aliases={"numpy": "np", "gymnasium": "gym"})
     for node in ast.walk(tree):
+        if type(node) not in _FACT_NODES:
+            continue
         if isinstance(node, ast.Name):
             if isinstance(node.ctx, ast.Load):
                 facts.read.add(node.id)
@@ -275,6 +295,10 @@ def _without_dead_stores(statements: list[ast.stmt], read: frozenset[str]) -> li
     return kept
 
 
+_SKIPPED_FIELDS = frozenset({"ctx", "decorator_list", "type_comment"})
+"""Load/Store contexts say nothing a token does not; decorators are the same on every copy of a function."""
+
+
 class _TokenWriter:
     def __init__(self, bound: frozenset[str], aliases: dict[str, str], attributes: frozenset[str]) -> None:
         self.bound = bound
@@ -292,12 +316,15 @@ class _TokenWriter:
             self._emit(current)
             if isinstance(current, (ast.Constant, ast.JoinedStr)):
                 continue
-            decorators = getattr(current, "decorator_list", ())
-            children = [
-                child
-                for child in ast.iter_child_nodes(current)
-                if not isinstance(child, ast.expr_context) and not any(child is seen for seen in decorators)
-            ]
+            children: list[ast.AST] = []
+            for name in current._fields:
+                if name in _SKIPPED_FIELDS:
+                    continue
+                value = getattr(current, name, None)
+                if isinstance(value, ast.AST):
+                    children.append(value)
+                elif isinstance(value, list):
+                    children.extend(item for item in value if isinstance(item, ast.AST))
             stack.extend(reversed(children))
 
     def _emit(self, node: ast.AST) -> None:

@@ -22,7 +22,7 @@ class Fragment(BaseModel):
 
 
 class Pair(BaseModel):
-    """Two documents and what they share.
+    """Two documents worth a person's reading (score or evidence passed its bar) and what they share.
 
     ``b`` may be a reference file; ``a`` is always a student.
     """
@@ -31,7 +31,6 @@ class Pair(BaseModel):
     b: str = Field(description="Another student, or a reference file's folder/path.")
     b_is_reference: bool = False
     score: float = Field(description="Shared rare fingerprints over the smaller document's, in [0, 1].")
-    flagged: bool = Field(description="Worth a person's reading: the score or the evidence passed its bar.")
     shared_fingerprints: int
     shared_fragments: int
     longest_fragment_lines: int

@@ -11,7 +11,7 @@ from grader.similarity.behaviour import (
     shared_wrong_results,
     wrong_results,
 )
-from grader.similarity.compare import EVIDENCE_BAR, score_pairs
+from grader.similarity.compare import EVIDENCE_BAR, flagged_pairs
 from grader.similarity.document import Document
 
 
@@ -66,6 +66,6 @@ def test_shared_wrong_results_flag_a_pair_whose_code_shares_nothing(tmp_path: Pa
     behaviour, notes = load_wrong_results(tmp_path, ["ana", "ben", "cid", "dee", "eve"])
     assert notes == ["dee.json: not a gymgrade report (ValidationError); its behaviour is not compared."]
     documents = [Document(name, False, []) for name in ("ana", "ben", "cid")]
-    (pair,) = score_pairs(documents, behaviour)
-    assert (pair.a, pair.b, pair.score, pair.flagged) == ("ana", "ben", 0.0, True)
+    (pair,) = flagged_pairs(documents, behaviour)
+    assert (pair.a, pair.b, pair.score) == ("ana", "ben", 0.0)
     assert len(pair.evidence) == EVIDENCE_BAR

@@ -34,7 +34,6 @@ def test_one_row_per_flagged_pair_with_the_promised_columns() -> None:
         a="=cmd|' /C calc'!A0",
         b="zoë",
         score=0.91234,
-        flagged=True,
         shared_fingerprints=40,
         shared_fragments=3,
         longest_fragment_lines=12,
