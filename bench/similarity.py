@@ -384,6 +384,12 @@ def synthetic(rng: random.Random) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _cpu_seconds() -> float:
+    """User + system time of this process and of its finished children (the indexing pool's workers)."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
 def scale(students: int, references: int) -> dict[str, float]:
     rng = random.Random("similarity bench scale")
     with tempfile.TemporaryDirectory() as folder:
@@ -396,12 +402,12 @@ def scale(students: int, references: int) -> dict[str, float]:
         for index in range(students):
             text = renamed(reference_texts[index], rng) if index < 10 else synthetic(rng)
             (klass / f"student_{index:03d}.py").write_text(text, encoding="utf-8")
-        started = time.perf_counter()
+        started, cpu = time.perf_counter(), _cpu_seconds()
         cold = run_similarity(klass, [known], cache=IndexCache(cache_dir)).report
-        cold_seconds = time.perf_counter() - started
-        started = time.perf_counter()
+        cold_seconds, cold_cpu = time.perf_counter() - started, _cpu_seconds() - cpu
+        started, cpu = time.perf_counter(), _cpu_seconds()
         warm = run_similarity(klass, [known], cache=IndexCache(cache_dir)).report
-        warm_seconds = time.perf_counter() - started
+        warm_seconds, warm_cpu = time.perf_counter() - started, _cpu_seconds() - cpu
         found = sum(
             1
             for pair in warm.pairs
@@ -409,6 +415,8 @@ def scale(students: int, references: int) -> dict[str, float]:
         )
         return {
             "cold_seconds": cold_seconds,
+            "cold_cpu_seconds": cold_cpu,
+            "warm_cpu_seconds": warm_cpu,
             "warm_seconds": warm_seconds,
             "flagged": len(warm.pairs),
             "planted_found": found,

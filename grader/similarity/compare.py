@@ -96,12 +96,7 @@ def build_report(
     all_notes = list(notes)
     if not students:
         all_notes.append("no readable submission was found in the class folder: nothing was compared.")
-    all_notes.extend(
-        f"{document.identity}: {note}"
-        for document in documents
-        for note in document.notes
-        if "template" not in note
-    )
+    all_notes.extend(f"{document.identity}: {note}" for document in documents for note in document.notes)
     return SimilarityReport(
         students=students,
         references=sum(1 for document in documents if document.is_reference),

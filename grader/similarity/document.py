@@ -6,6 +6,7 @@ files, numbering lines as in `document_lines`, and drops what the lab's template
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -82,7 +83,8 @@ class Document:
         remarks: Remark key -> ``(text, line)``, first occurrence.
         constants: Numeric literal -> first line.
         typos: Known misspelling in a comment or string -> first line.
-        notes: What the reader should know (a file cut or left out, template functions removed).
+        template_functions: The functions dropped because they are the template's.
+        notes: What the reader should know (a file cut, a notebook cell left out).
     """
 
     identity: str
@@ -92,6 +94,7 @@ class Document:
     remarks: dict[str, tuple[str, int]] = field(default_factory=dict)
     constants: dict[str, int] = field(default_factory=dict)
     typos: dict[str, int] = field(default_factory=dict)
+    template_functions: set[str] = field(default_factory=set)
     notes: list[str] = field(default_factory=list)
 
 
@@ -121,12 +124,13 @@ def build_document(
     is_reference: bool,
     indexed: list[tuple[Path, IndexedFile]],
     template: Template,
+    notes: Sequence[str] = (),
 ) -> Document:
     """Join one submission's indexed files, dropping the template's functions, fingerprints and remarks."""
     document = Document(identity, is_reference, [path for path, _ in indexed])
+    document.notes.extend(notes)
     offset = 1 if len(indexed) > 1 else 0
     unit_offset = 0
-    dropped: list[str] = []
     for path, file in indexed:
         if file.reason is not None:
             offset += file.lines + (1 if len(indexed) > 1 else 0)
@@ -136,7 +140,7 @@ def build_document(
         kept_units = set()
         for number, (shape, name) in enumerate(zip(file.shapes, file.unit_names, strict=True)):
             if shape in template.shapes:
-                dropped.append(name)
+                document.template_functions.add(name)
             else:
                 kept_units.add(number)
         for hash_, unit, first, last in file.fingerprints:
@@ -153,6 +157,4 @@ def build_document(
             document.constants.setdefault(value, line + offset)
         unit_offset += len(file.shapes)
         offset += file.lines + (1 if len(indexed) > 1 else 0)
-    if dropped:
-        document.notes.append(f"template functions not compared: {', '.join(sorted(set(dropped)))}")
     return document

@@ -159,7 +159,8 @@ def _documents(
         if all(entry.reason is not None for _, entry in entries):
             documents.append(None)
         else:
-            documents.append(build_document(identity, is_reference, entries, template))
+            notes = [note for source in texts[number] for note in source.notes]
+            documents.append(build_document(identity, is_reference, entries, template, notes))
     return documents
 
 

@@ -7,6 +7,7 @@ layouts of learning platforms (grader/classroom/) plug in here by replacing this
 
 from __future__ import annotations
 
+import ast
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,10 +29,12 @@ class SourceText:
     Attributes:
         path: The file.
         text: Its Python source; the line numbers of this text are the ones reports cite.
+        notes: What was left out of it (a notebook's cells that are not Python).
     """
 
     path: Path
     text: str
+    notes: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -67,12 +70,12 @@ def submissions_from(path: Path) -> list[tuple[str, Path]]:
     for entry in sorted(path.iterdir()):
         if _ignored(entry.name):
             continue
-        if entry.is_dir():
+        if entry.is_dir() and not entry.is_symlink():
             files = [file for file in sorted(entry.rglob("*")) if _is_source(file, entry)]
             found.extend((entry.name, file) for file in files)
             if not files:
                 found.append((entry.name, entry))
-        elif entry.is_file():
+        elif entry.is_file() or entry.is_symlink():
             found.append((entry.stem if _has_source_suffix(entry) else entry.name, entry))
     return found
 
@@ -97,6 +100,8 @@ def references_from(path: Path) -> list[tuple[str, Path]]:
 
 def read_source(path: Path) -> SourceText | Unreadable:
     """Read one submitted file as Python text, bounded in size, never executing or importing it."""
+    if path.is_symlink():
+        return Unreadable(path, f"{path.name} is a symbolic link: only regular files are read, left out.")
     if path.is_dir():
         return Unreadable(path, f"{path.name} holds no .py or .ipynb file: nothing to compare.")
     if not _has_source_suffix(path):
@@ -143,14 +148,20 @@ def _notebook_code(path: Path, text: str) -> SourceText | Unreadable:
             path, f'{path.name} is JSON but not a Jupyter notebook (no "cells" list): left out.'
         )
     chunks: list[str] = []
-    for cell in cells:
+    notes: list[str] = []
+    for number, cell in enumerate(cells, start=1):
         if not isinstance(cell, dict) or cell.get("cell_type") != "code":
             continue
         source = cell.get("source", "")
         if isinstance(source, list):
             source = "".join(part for part in source if isinstance(part, str))
         if isinstance(source, str) and source.strip():
-            chunks.append("\n".join(_without_magic(line) for line in source.splitlines()))
+            lines = [_without_magic(line) for line in source.splitlines()]
+            if not _parses("\n".join(lines)):
+                # one broken cell (a half-typed line) must not hide the rest of the notebook
+                notes.append(f"{path.name}: cell {number} is not valid Python and was not compared.")
+                lines = [""] * len(lines)
+            chunks.append("\n".join(lines))
     code = "\n\n".join(chunks)
     if len(code.encode()) > MAX_SUBMISSION_BYTES:
         return Unreadable(
@@ -159,7 +170,15 @@ def _notebook_code(path: Path, text: str) -> SourceText | Unreadable:
         )
     if not code.strip():
         return Unreadable(path, f"{path.name} has no code cells: nothing to compare.")
-    return SourceText(path, code + "\n")
+    return SourceText(path, code + "\n", tuple(notes))
+
+
+def _parses(code: str) -> bool:
+    try:
+        ast.parse(code)
+    except (SyntaxError, ValueError, RecursionError, MemoryError):
+        return False
+    return True
 
 
 def _without_magic(line: str) -> str:
@@ -177,7 +196,11 @@ def _has_source_suffix(path: Path) -> bool:
 
 def _is_source(file: Path, root: Path) -> bool:
     parts = file.relative_to(root).parts
-    return file.is_file() and _has_source_suffix(file) and not any(_ignored(part) for part in parts)
+    return (
+        (file.is_file() or file.is_symlink())
+        and _has_source_suffix(file)
+        and not any(_ignored(part) for part in parts)
+    )
 
 
 def _what(path: Path) -> str:

@@ -124,3 +124,23 @@ def test_indexing_in_a_process_pool_gives_the_report_of_indexing_in_process(tmp_
         )
         (tmp_path / f"s{number:03d}.py").write_text(body, encoding="utf-8")
     assert run_similarity(tmp_path, workers=2).report == run_similarity(tmp_path, workers=1).report
+
+
+def test_a_notebook_cell_that_is_not_python_is_left_out_alone(tmp_path: Path) -> None:
+    good_cells = [{"cell_type": "code", "source": chunk} for chunk in GOOD.split("\n\n\n")]
+    broken = {"cell_type": "code", "source": "def taxi(q_table:\n    return"}
+    notebook = {"nbformat": 4, "cells": [*good_cells[:2], broken, *good_cells[2:]]}
+    (tmp_path / "gil.ipynb").write_text(json.dumps(notebook), encoding="utf-8")
+    (tmp_path / "hal.py").write_text(COPY, encoding="utf-8")
+    report = run_similarity(tmp_path).report
+    assert [(pair.a, pair.b) for pair in report.pairs] == [("gil", "hal")]
+    assert report.notes == ["gil: gil.ipynb: cell 3 is not valid Python and was not compared."]
+
+
+def test_a_symbolic_link_is_listed_and_never_followed(tmp_path: Path) -> None:
+    (tmp_path / "ivy.py").symlink_to("/dev/zero")
+    (tmp_path / "jon.py").write_text(GOOD, encoding="utf-8")
+    report = run_similarity(tmp_path).report
+    assert [(entry.file, entry.reason) for entry in report.unreadable] == [
+        ("ivy.py", "ivy.py is a symbolic link: only regular files are read, left out.")
+    ]
