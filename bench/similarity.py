@@ -276,8 +276,9 @@ def _summary(
     flagged: set[frozenset[str]],
     copied: set[frozenset[str]],
     identities: list[str],
+    universe=None,
 ):
-    pairs = [frozenset(pair) for pair in combinations(identities, 2)]
+    pairs = universe if universe is not None else [frozenset(pair) for pair in combinations(identities, 2)]
     independent = [pair for pair in pairs if pair not in copied]
     found = sum(pair in flagged for pair in copied)
     false = sum(pair in flagged for pair in independent)
@@ -286,7 +287,7 @@ def _summary(
     return found, len(copied), false, len(independent), lowest_copied, highest_independent
 
 
-def _gymgrade(klass: Path, copied, identities):
+def _gymgrade(klass: Path, copied, identities, references=(), universe=None):
     import grader.similarity.run as run_module
     from grader.similarity.compare import all_scores
 
@@ -297,15 +298,23 @@ def _gymgrade(klass: Path, copied, identities):
         build(documents, *a, **k),
     )[1]
     try:
-        report = run_similarity(klass).report
+        report = run_similarity(klass, list(references)).report
     finally:
         run_module.build_report = build
     scores = all_scores(captured)
     flagged = {frozenset((pair.a, pair.b)) for pair in report.pairs}
-    return _summary(scores, flagged, copied, identities)
+    return _summary(scores, flagged, copied, identities, universe)
 
 
-def _copydetect(klass: Path, folder: Path, copied, identities):
+def _copydetect(
+    klass: Path,
+    folder: Path,
+    copied,
+    identities,
+    references=(),
+    identity=lambda path: path.stem,
+    universe=None,
+):
     import contextlib
     import os
 
@@ -320,7 +329,7 @@ def _copydetect(klass: Path, folder: Path, copied, identities):
     with open(os.devnull, "w") as null, contextlib.redirect_stdout(null), contextlib.redirect_stderr(null):
         detector = CopyDetector(
             test_dirs=[str(klass)],
-            ref_dirs=[str(klass)],
+            ref_dirs=[str(klass), *map(str, references)],
             boilerplate_dirs=[str(boilerplate)],
             extensions=["py", "ipynb"],
             autoopen=False,
@@ -333,10 +342,12 @@ def _copydetect(klass: Path, folder: Path, copied, identities):
         for j, ref in enumerate(detector.ref_files):
             if test == ref:
                 continue
-            pair = frozenset((Path(test).stem, Path(ref).stem))
+            pair = frozenset((identity(Path(test)), identity(Path(ref))))
+            if len(pair) < 2:
+                continue
             scores[pair] = max(scores.get(pair, 0.0), float(max(detector.similarity_matrix[i, j])))
     flagged = {pair for pair, score in scores.items() if score >= detector.conf.display_t}
-    return _summary(scores, flagged, copied, identities)
+    return _summary(scores, flagged, copied, identities, universe)
 
 
 STATEMENTS = [
@@ -382,6 +393,40 @@ def synthetic(rng: random.Random) -> str:
         lines.append(f"    return {names[2]}")
         lines.append("")
     return "\n".join(lines) + "\n"
+
+
+def hand_written_corpus(run_copydetect: bool) -> dict[str, tuple[int, int, int, int, float, float]]:
+    """Both tools on submissions/similarity as written (class and references, expected.toml's pairs)."""
+    import tomllib
+
+    root = CORPUS.parent
+    expected = tomllib.loads((root / "expected.toml").read_text(encoding="utf-8"))
+    copied = {frozenset(pair) for pair in expected["copied"].values()}
+    references = sorted(path for path in (root / "references").iterdir() if path.is_dir())
+    students = sorted({path.stem for path in CORPUS.iterdir() if not path.name.startswith(".")})
+    reference_names = [
+        f"{folder.name}/{file.relative_to(folder).as_posix()}"
+        for folder in references
+        for file in folder.rglob("*.py")
+    ]
+    identities = students + reference_names
+    pairs = {frozenset(pair) for pair in combinations(identities, 2)}
+    pairs -= {frozenset(pair) for pair in combinations(reference_names, 2)}
+
+    def identity(path: Path) -> str:
+        if path.is_relative_to(CORPUS):
+            parts = path.relative_to(CORPUS).parts
+            return parts[0] if len(parts) > 1 else path.stem
+        folder = next(folder for folder in references if path.is_relative_to(folder))
+        return f"{folder.name}/{path.relative_to(folder).as_posix()}"
+
+    results = {"gymgrade": _gymgrade(CORPUS, copied, identities, references, pairs)}
+    if run_copydetect:
+        with tempfile.TemporaryDirectory() as folder:
+            results["copydetect"] = _copydetect(
+                CORPUS, Path(folder), copied, identities, references, identity, pairs
+            )
+    return results
 
 
 def _cpu_seconds() -> float:
@@ -448,6 +493,11 @@ def main() -> None:
             total[3] += independent
     for tool, (found, copied, false, independent) in totals.items():
         print(f"| all | {tool} | {found}/{copied} | {false}/{independent} | | |")
+    print("\nhand-written corpus (submissions/similarity):")
+    for tool, (found, copied, false, independent, low, high) in hand_written_corpus(
+        not args.skip_copydetect
+    ).items():
+        print(f"| {tool} | {found}/{copied} | {false}/{independent} | {low:.2f} | {high:.2f} |")
     if not args.skip_scale:
         result = scale(args.students, args.references)
         print(f"\nscale: {args.students} students x {args.references} references: {result}")
