@@ -79,7 +79,7 @@ class Document:
         identity: The student (as the class folder names them) or the reference file's path.
         is_reference: True for a --reference file.
         files: The files it was read from.
-        fingerprints: Hash -> ``(unit, first line, last line)`` spans, in the joined text's lines.
+        fingerprints: Hash -> (unit, first line, last line) of its first k-gram (lines of the joined text).
         remarks: Remark key -> ``(text, line)``, first occurrence.
         constants: Numeric literal -> first line.
         typos: Known misspelling in a comment or string -> first line.
@@ -90,7 +90,7 @@ class Document:
     identity: str
     is_reference: bool
     files: list[Path]
-    fingerprints: dict[int, list[tuple[int, int, int]]] = field(default_factory=dict)
+    fingerprints: dict[int, tuple[int, int, int]] = field(default_factory=dict)
     remarks: dict[str, tuple[str, int]] = field(default_factory=dict)
     constants: dict[str, int] = field(default_factory=dict)
     typos: dict[str, int] = field(default_factory=dict)
@@ -145,9 +145,7 @@ def build_document(
                 kept_units.add(number)
         for hash_, unit, first, last in file.fingerprints:
             if unit in kept_units and hash_ not in template.fingerprints:
-                document.fingerprints.setdefault(hash_, []).append(
-                    (unit + unit_offset, first + offset, last + offset)
-                )
+                document.fingerprints.setdefault(hash_, (unit + unit_offset, first + offset, last + offset))
         for key, text, line in file.remarks:
             if key not in template.remarks:
                 document.remarks.setdefault(key, (text, line + offset))

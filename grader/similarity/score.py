@@ -63,7 +63,7 @@ def candidate_pairs(documents: Sequence[Document], common: frozenset[int]) -> di
     return pairs
 
 
-FLUSH_PAIRS = 4_000_000
+FLUSH_PAIRS = 1_000_000
 """Pair codes held before they are merged into the counts: bounds memory by the pairs, not the sum of h^2."""
 
 
@@ -92,7 +92,7 @@ def pair_score(shared: int, size_a: int, size_b: int) -> float:
 def fragments(a: Document, b: Document, common: frozenset[int]) -> list[Fragment]:
     """The stretches of code two documents share, each from runs of matched k-grams in the same functions."""
     matches = sorted(
-        (a.fingerprints[hash_][0], b.fingerprints[hash_][0])
+        (a.fingerprints[hash_], b.fingerprints[hash_])
         for hash_ in a.fingerprints.keys() & b.fingerprints.keys()
         if hash_ not in common
     )
