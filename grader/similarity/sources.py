@@ -14,9 +14,11 @@ from pathlib import Path
 
 from grader.notebook import MAX_NOTEBOOK_BYTES
 from grader.similarity.errors import ClassDirectoryError
-from grader.validation import MAX_SUBMISSION_BYTES
 
 SOURCE_SUFFIXES = (".py", ".ipynb")
+MAX_COMPARED_BYTES = 200_000
+"""A lab solution is under 30 KB; parsing a megabyte of padding costs seconds, so larger Python is left out
+(the grader itself accepts up to ``grader.validation.MAX_SUBMISSION_BYTES``)."""
 MAX_FILES_PER_SUBMISSION = 20
 """A student's folder may hold helpers beside the lab file; files beyond this many are listed, not read."""
 IGNORED_PARTS = ("__pycache__", ".ipynb_checkpoints", "__MACOSX")
@@ -110,7 +112,7 @@ def read_source(path: Path) -> SourceText | Unreadable:
             f"{path.name} is neither a .py nor an .ipynb file: only Python sources and notebooks are compared.",  # noqa: E501
         )
     notebook = path.suffix.lower() == ".ipynb"
-    limit = MAX_NOTEBOOK_BYTES if notebook else MAX_SUBMISSION_BYTES
+    limit = MAX_NOTEBOOK_BYTES if notebook else MAX_COMPARED_BYTES
     try:
         with path.open("rb") as stream:
             data = stream.read(limit + 1)
@@ -163,10 +165,10 @@ def _notebook_code(path: Path, text: str) -> SourceText | Unreadable:
                 lines = [""] * len(lines)
             chunks.append("\n".join(lines))
     code = "\n\n".join(chunks)
-    if len(code.encode()) > MAX_SUBMISSION_BYTES:
+    if len(code.encode()) > MAX_COMPARED_BYTES:
         return Unreadable(
             path,
-            f"{path.name}'s code cells hold more than {MAX_SUBMISSION_BYTES:,} bytes: too large, left out.",
+            f"{path.name}'s code cells hold more than {MAX_COMPARED_BYTES:,} bytes: too large, left out.",
         )
     if not code.strip():
         return Unreadable(path, f"{path.name} has no code cells: nothing to compare.")

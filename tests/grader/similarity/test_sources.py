@@ -17,7 +17,7 @@ COPY = (CORPUS / "class" / "c_renamed_from_h01.py").read_text(encoding="utf-8")
 
 BAD_FILES: dict[str, tuple[bytes, str]] = {
     "unparseable.py": (b"def random_blackjack(n:\n    return 0\n", "is not valid Python (line 1)"),
-    "huge.py": (b"x = 1\n" * 200_000, "is larger than 1,000,000 bytes"),
+    "huge.py": (b"x = 1\n" * 40_000, "is larger than 200,000 bytes"),
     "binary.py": (b"\x7fELF\x02\x01\x01\0\0\0" * 10, "is binary"),
     "latin1.py": ("# café\nx = 1\n".encode("latin-1"), "is not UTF-8 text"),
     "empty.py": (b"  \n\n", "is empty"),
