@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from grader.similarity.document import Document
 from grader.similarity.frequency import Frequencies
+from grader.similarity.typos import misspellings
 
 MAX_ITEMS = 3
 """Evidence items of each kind listed per pair; the count says how many there were."""
@@ -61,7 +62,13 @@ def shared_constants(a: Document, b: Document, frequencies: Frequencies) -> list
 
 def shared_typos(a: Document, b: Document, frequencies: Frequencies) -> list[str]:
     """The identical rare misspellings in two documents' comments and strings."""
-    words = sorted(a.typos.keys() & b.typos.keys() & frequencies.rare_typos)
+    # a misspelling inside a comment both share identically is already that comment's evidence
+    in_shared_remarks = {
+        word
+        for key in a.remarks.keys() & b.remarks.keys() & frequencies.rare_remarks
+        for word in misspellings(key)
+    }
+    words = sorted((a.typos.keys() & b.typos.keys() & frequencies.rare_typos) - in_shared_remarks)
     items = [
         f'the same misspelling "{word}" ({a.identity} line {a.typos[word]}, {b.identity} line {b.typos[word]})'  # noqa: E501
         for word in words

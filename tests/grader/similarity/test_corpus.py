@@ -103,3 +103,10 @@ def test_a_reference_match_names_the_reference_file(outcome: Outcome) -> None:
 def test_the_report_lists_evidence_besides_code(outcome: Outcome) -> None:
     ring = next(pair for pair in outcome.report.pairs if {pair.a, pair.b} == {"ring_a", "ring_b"})
     assert any("recieve" in item for item in ring.evidence)
+
+
+def test_a_shared_misspelling_is_evidence_once(outcome: Outcome) -> None:
+    pair = next(pair for pair in outcome.report.pairs if {pair.a, pair.b} == {"ring_a", "ring_b"})
+    assert [item for item in pair.evidence if "recieve" in item] == [
+        'the same misspelling "recieve" (ring_a line 9, ring_b line 9)'
+    ]
