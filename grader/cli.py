@@ -246,6 +246,10 @@ def build_parser() -> argparse.ArgumentParser:
     gradescope_seed.add_argument("--workers", type=_positive, default=None)
     gradescope_seed.set_defaults(handler=run_gradescope_seed)
 
+    from grader.similarity.command import add_similarity_command
+
+    add_similarity_command(subparsers)
+
     for entry_point in entry_points(group=COMMAND_GROUP):
         try:
             entry_point.load()(subparsers)
