@@ -14,7 +14,9 @@ import hashlib
 import io
 import os
 import tempfile
-from collections.abc import Callable, Sequence
+import time
+import urllib.parse
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
@@ -33,10 +35,16 @@ CHUNK_SUBMISSIONS = 24
 takes few results with it (its unfinished problems are reported as grader errors, the batch goes on)."""
 
 GRADES_FILE = "grades.csv"
+GRADEBOOK_INTERVAL = 1.0
+"""Seconds between two rewrites of a class's gradebooks (a rewrite costs O(class size), so rewriting after
+every report costs O(n^2)); the gradebooks are always rewritten when the batch ends or is interrupted."""
 SUBMISSION_SUFFIXES = (".py", NOTEBOOK_SUFFIX)
 
 ReportCallback = Callable[[Path, Report], None]
 ResultCallback = Callable[[Path, ProblemResult], None]
+GradebookWriter = Callable[[Path, Mapping[Path, Report]], None]
+"""Writes the batch's gradebook(s) into the output directory from the reports finished so far (by file);
+called after every report, so an interrupted batch keeps an up-to-date gradebook."""
 
 
 class BatchExecutor(Protocol):
@@ -134,6 +142,13 @@ def report_names(paths: Sequence[Path]) -> dict[Path, str]:
     return names
 
 
+def identity_stem(identity: str) -> str:
+    """A report file stem for a student's identity: the identity itself, with every character that is not
+    safe in a file name percent-encoded (``ada/../x`` -> ``ada%2F..%2Fx``; a leading dot too)."""
+    stem = urllib.parse.quote(identity, safe=" -_.@+,()")
+    return "%2E" + stem[1:] if stem.startswith(".") else stem
+
+
 def stale_reason(report_text: str | None, data: bytes | None, *, seed: int, plan: GradingPlan) -> str | None:
     """Why an existing report cannot stand for a file's grade now, or None when it can be reused.
 
@@ -185,19 +200,31 @@ class OutputDirectory:
         out_dir: The directory (created).
         paths: Every file of the batch, in gradebook order.
         plan: The problems graded (the gradebook's columns).
+        names: Each file's identity (its report is ``<identity>.json``); file stems when None.
+        gradebook: Writes the gradebook; ``grades.csv`` of :func:`write_grades` when None.
     """
 
-    def __init__(self, out_dir: Path, paths: Sequence[Path], plan: GradingPlan) -> None:
+    def __init__(
+        self,
+        out_dir: Path,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        names: Mapping[Path, str] | None = None,
+        gradebook: GradebookWriter | None = None,
+    ) -> None:
         out_dir.mkdir(parents=True, exist_ok=True)
         self.out_dir = out_dir
         self.paths = list(paths)
         self.plan = plan
-        self.names = report_names(paths)
+        self.names = dict(names) if names is not None else report_names(paths)
+        self.gradebook = gradebook
         self.reports: dict[Path, Report] = {}
+        self.pending = False
+        self.written_at = -GRADEBOOK_INTERVAL
 
     def report_path(self, path: Path) -> Path:
         """Where the report of ``path`` is kept."""
-        return self.out_dir / f"{self.names[path]}.json"
+        return self.out_dir / f"{identity_stem(self.names[path])}.json"
 
     def existing_text(self, path: Path) -> str | None:
         """The text of the report file of ``path``, None when there is none or it cannot be read."""
@@ -211,13 +238,27 @@ class OutputDirectory:
         self.reports[path] = report
 
     def keep(self, path: Path, report: Report) -> None:
-        """Write a finished file's report and rewrite ``grades.csv`` with every file finished so far."""
+        """Write a finished file's report and rewrite ``grades.csv`` with every file finished so far (a
+        class's gradebooks at most every ``GRADEBOOK_INTERVAL`` seconds, the rest at :meth:`flush`)."""
         self.reports[path] = report
-        _write_atomically(self.report_path(path), report.to_json() + "\n")
+        write_atomically(self.report_path(path), report.to_json() + "\n")
+        if self.gradebook is not None and time.monotonic() - self.written_at < GRADEBOOK_INTERVAL:
+            self.pending = True
+            return
         self.write_gradebook()
+
+    def flush(self) -> None:
+        """Rewrite the gradebook if reports arrived since it was last written."""
+        if self.pending:
+            self.write_gradebook()
 
     def write_gradebook(self) -> None:
         """Rewrite ``grades.csv``: a row per finished file, in the batch's order."""
+        self.pending = False
+        if self.gradebook is not None:
+            self.gradebook(self.out_dir, dict(self.reports))
+            self.written_at = time.monotonic()
+            return
         finished = [path for path in self.paths if path in self.reports]
         names = [self.names[path] for path in finished]
         write_grades(self.out_dir / GRADES_FILE, names, [self.reports[path] for path in finished], self.plan)
@@ -235,6 +276,8 @@ def grade_many(
     on_result: ResultCallback | None = None,
     executor: BatchExecutor | None = None,
     on_plan: Callable[[BatchOutcome], None] | None = None,
+    names: Mapping[Path, str] | None = None,
+    gradebook: GradebookWriter | None = None,
 ) -> BatchOutcome:
     """Grade many submissions; keep ``<name>.json`` per submission and ``grades.csv`` in ``out_dir``.
 
@@ -254,6 +297,9 @@ def grade_many(
         on_result: Called with (file, result) as each check finishes.
         executor: Who grades; the local executor (``workers``, ``policy``) when None.
         on_plan: Called once before grading with the outcome so far (reused files, files to grade).
+        names: Each file's student identity: it names the report (``<identity>.json``, the resume key) and
+            the gradebook row; file stems (numbered when they repeat) when None.
+        gradebook: Writes the gradebook(s) after each report; ``grades.csv`` by file when None.
 
     Returns:
         Every report in the order of ``paths``, and which files were reused or graded.
@@ -262,7 +308,7 @@ def grade_many(
         grader.errors.BatchInterrupted: Interrupted; the reports finished so far are in ``out_dir``.
     """
     plan = GradingPlan.load(config, only)
-    output = OutputDirectory(out_dir, paths, plan)
+    output = OutputDirectory(out_dir, paths, plan, names, gradebook)
     outcome = BatchOutcome(reports=[], reused=[], graded=[])
     for path in paths:
         report_text = output.existing_text(path)
@@ -275,7 +321,7 @@ def grade_many(
             outcome.reasons[path] = reason or "not graded yet"
     if on_plan is not None:
         on_plan(outcome)
-    if outcome.reused:
+    if outcome.reused or not outcome.graded:
         output.write_gradebook()
     if outcome.graded:
         try:
@@ -284,6 +330,8 @@ def grade_many(
             )
         except KeyboardInterrupt as interruption:
             raise BatchInterrupted(len(output.reports), len(paths)) from interruption
+        finally:
+            output.flush()
     outcome.reports = [output.reports[path] for path in paths]
     return outcome
 
@@ -293,7 +341,7 @@ def recorded_seed(out_dir: Path) -> int | None:
     seed column, or several seeds)."""
     try:
         with (out_dir / GRADES_FILE).open(newline="", encoding="utf-8") as stream:
-            seeds = {row.get("seed") or "" for row in csv.DictReader(stream)}
+            seeds = {row.get("seed") or "" for row in csv.DictReader(stream)} - {""}
     except (OSError, UnicodeDecodeError, csv.Error):
         return None
     if len(seeds) != 1:
@@ -322,10 +370,10 @@ def write_grades(path: Path, names: Sequence[str], reports: Sequence[Report], pl
                 note,
             ]
         )
-    _write_atomically(path, stream.getvalue())
+    write_atomically(path, stream.getvalue())
 
 
-def _write_atomically(path: Path, text: str) -> None:
+def write_atomically(path: Path, text: str) -> None:
     """Replace ``path`` with ``text`` in one rename, so an interruption never leaves half a file."""
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:

@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 import signal
 import sys
+import tempfile
 from collections.abc import Callable, Sequence
+from datetime import datetime
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -21,6 +23,8 @@ from grader.seeds import PRACTICE_SEED, held_out_seed
 
 if TYPE_CHECKING:
     from grader.batch import BatchExecutor
+    from grader.classroom.model import ClassDownload
+    from grader.classroom.output import ClassGradebook
 
 COMMAND_GROUP = "gymgrade.commands"
 EXECUTOR_GROUP = "gymgrade.executors"
@@ -83,6 +87,57 @@ def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
     )
 
 
+def _add_class_options(grade: argparse.ArgumentParser) -> None:
+    from grader.classroom.gradebooks import GRADEBOOKS
+    from grader.classroom.layouts import LAYOUTS
+
+    grade.add_argument(
+        "--layout",
+        choices=tuple(LAYOUTS),
+        default=None,
+        help="the download's layout (default: recognised from its names; see docs/instructors.md)",
+    )
+    grade.add_argument(
+        "--roster",
+        type=Path,
+        default=None,
+        metavar="CSV",
+        help="class roster (GitHub Classroom roster, Canvas gradebook export, or a CSV with id/name/email)",
+    )
+    grade.add_argument(
+        "--gradebook",
+        action="append",
+        choices=tuple(GRADEBOOKS),
+        default=[],
+        help="also write this LMS's import CSV into --out (repeatable)",
+    )
+    grade.add_argument(
+        "--assignment-title", default="OpenGym AI lab", help="the assignment's title in gradebooks"
+    )
+    grade.add_argument(
+        "--assignment-id",
+        default="",
+        metavar="ID",
+        help="the LMS's assignment id (needed by --gradebook canvas)",
+    )
+    grade.add_argument(
+        "--due",
+        type=_moment,
+        default=None,
+        metavar="ISO-TIME",
+        help="deadline (e.g. 2026-03-01T23:59-05:00): submissions whose source gives a time but no late mark are late after it",  # noqa: E501
+    )
+
+
+def _moment(text: str) -> datetime:
+    try:
+        return datetime.fromisoformat(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not an ISO 8601 time such as 2026-03-01T23:59-05:00"
+        ) from None
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser, including subcommands registered under the `gymgrade.commands` entry points."""
     parser = argparse.ArgumentParser(prog="gymgrade", description="Grade OpenGym AI lab submissions.")
@@ -131,6 +186,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="grade even where the sandbox cannot enforce every isolation layer",
     )
+    _add_class_options(grade)
     grade.add_argument(
         "--html",
         type=_class_page,
@@ -410,23 +466,77 @@ def run_gradescope_seed(args: argparse.Namespace) -> int:
 
 
 def run_grade(args: argparse.Namespace) -> int:
-    """`gymgrade grade`: grade every file not yet graded in --out, keep each report as it is done."""
-    from grader.batch import BatchOutcome, collect_submissions, grade_many
+    """`gymgrade grade`: recognise the class download, grade each student's file not yet graded in --out
+    (reports named by identity), keep each report and the gradebooks as they are done."""
+    from grader.classroom import GradedFileRule, discover_all
+    from grader.classroom.errors import GradebookError
+    from grader.classroom.gradebooks import Assignment
+    from grader.classroom.output import ClassGradebook
+    from grader.classroom.roster import read_roster
+    from grader.grading import GradingPlan
 
-    paths = collect_submissions(args.targets)
-    if not paths:
-        print("gymgrade grade: no .py or .ipynb files found in the given targets", file=sys.stderr)
-        return EXIT_ERROR
-    if args.html is not None and (clash := class_page_clash(args.html, paths, args.out)) is not None:
-        print(f"gymgrade grade: {clash}", file=sys.stderr)
-        return EXIT_ERROR
+    plan = GradingPlan.load(args.config, args.only)
+    roster = read_roster(args.roster) if args.roster is not None else None
+    assignment = Assignment(title=args.assignment_title, lms_id=args.assignment_id)
+    if "canvas" in args.gradebook and not assignment.lms_id:
+        raise GradebookError(
+            "--gradebook canvas needs --assignment-id ID (the number in the assignment's Canvas URL .../assignments/ID), so Canvas puts the scores in that assignment's column"  # noqa: E501
+        )
+    with tempfile.TemporaryDirectory(prefix="gymgrade-class-") as scratch:
+        download = discover_all(
+            args.targets,
+            layout=args.layout,
+            # Every enabled problem, not just --only's: the graded file must not change with --only.
+            rule=GradedFileRule(functions=GradingPlan.load(args.config, None).problems),
+            scratch=Path(scratch),
+            due=args.due,
+        )
+        print(class_summary(download), file=sys.stderr, flush=True)
+        graded = [submission for submission in download.submissions if submission.graded_file is not None]
+        if not download.submissions and roster is None:
+            print("gymgrade grade: no submissions found in the given targets", file=sys.stderr)
+            return EXIT_ERROR
+        identities = {
+            submission.graded_file.path: submission.identity
+            for submission in graded
+            if submission.graded_file
+        }
+        if args.html is not None:
+            clash = class_page_clash(args.html, list(identities.values()), args.out)
+            if clash is not None:
+                print(f"gymgrade grade: {clash}", file=sys.stderr)
+                return EXIT_ERROR
+        gradebook = ClassGradebook(download, identities, plan.problems, roster, args.gradebook, assignment)
+        return _grade_class(args, list(identities), identities, gradebook)
+
+
+def class_summary(download: ClassDownload) -> str:
+    """What was found: the layout, which file is graded for whom and why, what was refused or unattributed."""
+    from grader.classroom import LAYOUTS
+
+    title = LAYOUTS[download.layout].title if download.layout in LAYOUTS else download.layout
+    lines = [f"Found {len(download.submissions)} submissions ({title}):"]
+    for submission in download.submissions:
+        graded = submission.graded_file.relative if submission.graded_file else "nothing graded"
+        late = " [late]" if submission.late else ""
+        lines.append(f"  {submission.display_name}{late}: {graded} ({submission.why})")
+    for skipped in download.refused:
+        lines.append(f"  refused {skipped.where}: {skipped.reason}")
+    for skipped in download.unattributed:
+        lines.append(f"  not attributed {skipped.where}: {skipped.reason}")
+    return "\n".join(lines)
+
+
+def _grade_class(
+    args: argparse.Namespace, paths: list[Path], identities: dict[Path, str], gradebook: ClassGradebook
+) -> int:
+    from grader.batch import BatchOutcome, grade_many
+
     policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
     executor = find_executor(policy)
     bar = ProgressBar(total=0)
-    graded: list[Path] = []
 
     def planned(outcome: BatchOutcome) -> None:
-        graded.extend(outcome.graded)
         bar.total = max(len(outcome.graded) * len(problems_of(args)), 1)
         if outcome.reused:
             print(
@@ -438,7 +548,7 @@ def run_grade(args: argparse.Namespace) -> int:
             print(f"Grading on {executor}.", file=sys.stderr)
 
     def advance(path: Path, result: ProblemResult) -> None:
-        bar.advance(f"{path.name}: {result.id} {result.status}")
+        bar.advance(f"{identities[path]}: {result.id} {result.status}")
 
     seed = choose_seed(args.seed, args.out)
     try:
@@ -453,6 +563,8 @@ def run_grade(args: argparse.Namespace) -> int:
             on_result=advance,
             executor=executor,
             on_plan=planned,
+            names=identities,
+            gradebook=gradebook,
         )
     except BatchInterrupted as interruption:
         print(
@@ -463,32 +575,45 @@ def run_grade(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_INTERRUPTED
-    if args.html is not None:
-        write_class_page(args.html, paths, outcome.reports, args.out)
+    if args.html is not None and gradebook.rows is not None:
+        write_class_page(args.html, gradebook, args.out)
     errors = sum(1 for report in outcome.reports if report.grader_errors)
+    written = ", ".join(["grades.csv", *(f"{name}.csv" for name in args.gradebook)])
+    if "canvas" in args.gradebook and gradebook.rows is not None:
+        from grader.classroom.gradebooks import canvas_user_id
+
+        unmatched = [row.member.identity for row in gradebook.rows if not canvas_user_id(row)]
+        if unmatched:
+            print(
+                f"canvas.csv leaves out {len(unmatched)} students without a Canvas user id ({', '.join(unmatched[:5])}{', ...' if len(unmatched) > 5 else ''}): "  # noqa: E501
+                "pass --roster with a Canvas gradebook export (its ID column) to match them.",
+                file=sys.stderr,
+            )
     print(
         f"Graded {len(outcome.graded)} submissions"
         + (f" (reused {len(outcome.reused)} earlier reports)" if outcome.reused else "")
-        + f" into {args.out} (grades.csv) with seed {seed}"
+        + f" into {args.out} ({written}) with seed {seed}"
         + (f"; {errors} with grader errors (run again to retry them)" if errors else ""),
         file=sys.stderr,
     )
     return EXIT_ERROR if errors else 0
 
 
-def class_page_clash(page: Path, paths: Sequence[Path], out_dir: Path) -> str | None:
-    """Why `gymgrade grade --html` would overwrite one of the batch's files, or None."""
-    from grader.class_report.from_batch import page_clash
+def class_page_clash(page: Path, identities: Sequence[str], out_dir: Path) -> str | None:
+    """Why `gymgrade grade --html` would overwrite one of the batch's files (a student's report), or None."""
+    from grader.batch import identity_stem
+    from grader.class_report.from_batch import page_clash_of_reports
 
-    return page_clash(page, paths, out_dir)
+    reports = {out_dir / f"{identity_stem(identity)}.json": f"student {identity}" for identity in identities}
+    return page_clash_of_reports(page, reports, out_dir)
 
 
-def write_class_page(page: Path, paths: Sequence[Path], reports: Sequence[Report], out_dir: Path) -> None:
+def write_class_page(page: Path, gradebook: ClassGradebook, out_dir: Path) -> None:
     """`gymgrade grade --html`: the class report of the batch, and its JSON summary beside it."""
     from grader.class_report import write_class_report
-    from grader.class_report.from_batch import entries_from_batch
+    from grader.class_report.from_batch import entries_from_rows
 
-    summary = write_class_report(page, entries_from_batch(paths, reports, out_dir, page))
+    summary = write_class_report(page, entries_from_rows(gradebook.rows or [], out_dir, page))
     print(f"Wrote the class report {page} and its summary {summary}.", file=sys.stderr)
 
 

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from typing import Annotated
+
+from fastapi import APIRouter, Query
 from fastapi.responses import Response
 
 from api.deps import InstructorDep, SessionDep, SettingsDep
-from api.errors import InstructorOnly, NotAuthenticated
-from api.gradebook import gradebook_csv
+from api.errors import InstructorOnly, InvalidRequest, NotAuthenticated
+from api.gradebook import GRADEBOOK_FORMATS, gradebook_export
 from api.handlers import error_responses
+from grader.classroom.gradebooks import Assignment
 
 router = APIRouter(tags=["gradebook"])
 
@@ -18,13 +21,28 @@ router = APIRouter(tags=["gradebook"])
     response_class=Response,
     responses={
         200: {"content": {"text/csv": {}}, "description": "One row per student, one column per problem."},
-        **error_responses(NotAuthenticated, InstructorOnly),
+        **error_responses(NotAuthenticated, InstructorOnly, InvalidRequest),
     },
 )
-def get_gradebook(session: SessionDep, settings: SettingsDep, _instructor: InstructorDep) -> Response:
-    """The gradebook as CSV: each student's latest or best graded submission (GYMGRADE_GRADEBOOK_POLICY)."""
+def get_gradebook(
+    session: SessionDep,
+    settings: SettingsDep,
+    _instructor: InstructorDep,
+    format: Annotated[str, Query(pattern=f"^({'|'.join(GRADEBOOK_FORMATS)})$")] = "gymgrade",
+    assignment_title: str = "OpenGym AI lab",
+    assignment_id: Annotated[str, Query(pattern=r"^\d*$")] = "",
+) -> Response:
+    """The gradebook as CSV: each student's latest or best graded submission (GYMGRADE_GRADEBOOK_POLICY),
+    in gymgrade's columns or an LMS's import format (``canvas`` needs ``assignment_id``)."""
+    if format == "canvas" and not assignment_id:
+        message = (
+            "format=canvas needs assignment_id (the number in the assignment's Canvas URL .../assignments/ID)"
+        )
+        raise InvalidRequest(message, [(["query", "assignment_id"], message, "missing")])
     return Response(
-        gradebook_csv(session, settings.gradebook_policy),
+        gradebook_export(
+            session, settings.gradebook_policy, format, Assignment(assignment_title, assignment_id)
+        ),
         media_type="text/csv; charset=utf-8",
         headers={"Content-Disposition": 'attachment; filename="gradebook.csv"'},
     )

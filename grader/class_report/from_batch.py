@@ -7,12 +7,13 @@ else in the class report sees only ``ClassEntry``.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from grader.batch import GRADES_FILE, report_names
+from grader.batch import GRADES_FILE, identity_stem, report_names
 from grader.class_report import summary_path
-from grader.class_report.entries import ClassEntry
+from grader.class_report.entries import ClassEntry, EntryStatus
+from grader.classroom.gradebooks import GradeRow
 from grader.report import Report
 
 
@@ -46,6 +47,61 @@ def entries_from_batch(
             )
         )
     return entries
+
+
+def entries_from_rows(rows: Sequence[GradeRow], out_dir: Path, page: Path) -> list[ClassEntry]:
+    """One entry per student of a class batch (``grader.classroom``): their identity and roster name, their
+    report (a group's report for each member), late flag, and a link to ``<identity>.json``.
+
+    Args:
+        rows: The class's rows (``grader.classroom.gradebooks.class_rows``, as the batch last wrote them).
+        out_dir: The batch's output directory.
+        page: Where the class page will be written (links are relative to its folder).
+
+    Returns:
+        ``missing`` for a roster student with no submission, ``submission_error`` for a submission with no
+        gradable file or whose file could not be graded, else ``graded``.
+    """
+    folder = page.resolve().parent
+    entries: list[ClassEntry] = []
+    for row in rows:
+        submission, report = row.submission, row.report
+        status: EntryStatus
+        if submission is None:
+            status = "missing"
+        elif report is None or report.submission_error is not None:
+            status = "submission_error"
+        else:
+            status = "graded"
+        graded = submission.graded_file.relative if submission and submission.graded_file else ""
+        href = None
+        if submission is not None and report is not None:
+            target = (out_dir / f"{identity_stem(submission.identity)}.json").resolve()
+            href = Path(os.path.relpath(target, folder)).as_posix()
+        entries.append(
+            ClassEntry(
+                identity=row.member.identity,
+                name=row.name or None,
+                report=report,
+                late=bool(submission and submission.late),
+                status=status,
+                note=row.note or (f"graded {graded}" if graded else ""),
+                report_href=href,
+            )
+        )
+    return entries
+
+
+def page_clash_of_reports(page: Path, reports: Mapping[Path, str], out_dir: Path) -> str | None:
+    """:func:`page_clash` for a batch whose report files are given: ``{report file: whose it is}``."""
+    outputs = {path.resolve(): whose for path, whose in reports.items()}
+    for written in (page, summary_path(page)):
+        if written.resolve() == (out_dir / GRADES_FILE).resolve():
+            return f"--html {page} would write {written} over the batch's {GRADES_FILE}; name the page e.g. class.html or put it outside {out_dir}"  # noqa: E501
+        clashing = outputs.get(written.resolve())
+        if clashing is not None:
+            return f"--html {page} would write {written} over the report of {clashing}; put the page outside {out_dir} (e.g. {out_dir.parent / 'class.html'}) or give it another name"  # noqa: E501
+    return None
 
 
 def page_clash(page: Path, paths: Sequence[Path], out_dir: Path) -> str | None:

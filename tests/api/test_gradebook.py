@@ -81,3 +81,44 @@ def test_ungraded_submissions_are_not_in_the_gradebook(client: TestClient) -> No
             "max_score": "",
         }
     ]
+
+
+@pytest.mark.parametrize(
+    ("gradebook_format", "header"),
+    [
+        ("canvas", ["Student", "ID", "SIS User ID", "SIS Login ID", "Section", "OpenGym lab (77)"]),
+        ("gradescope", ["Name", "SID", "Email", "Total Score", "Max Points", "Status", "random_blackjack"]),
+        ("github-classroom", ["github_username", "roster_identifier", "points_awarded", "points_available"]),
+    ],
+    ids=["canvas", "gradescope", "github-classroom"],
+)
+def test_the_export_offers_the_formats_of_gymgrade_grade(
+    make_settings: SettingsFactory, gradebook_format: str, header: list[str]
+) -> None:
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        ada = add_student(client, "1234")
+        add_student(client, "octocat")
+        _graded(client, ada, {"random_blackjack": 1.0})
+        response = client.get(
+            "/gradebook.csv",
+            params={"format": gradebook_format, "assignment_id": "77", "assignment_title": "OpenGym lab"},
+            headers=instructor_headers(),
+        )
+    assert response.status_code == 200, response.text
+    rows = list(csv.reader(io.StringIO(response.text)))
+    assert rows[0] == header
+    if gradebook_format == "canvas":
+        assert rows[1:] == [["    Points Possible", "", "", "", "", "1"], ["1234", "1234", "", "", "", "1"]]
+    elif gradebook_format == "gradescope":
+        assert rows[1:] == [
+            ["1234", "1234", "", "1", "1", "Graded", "1"],
+            ["octocat", "octocat", "", "", "", "Missing", ""],
+        ]
+    else:
+        assert rows[1:] == [["1234", "", "1", "1"], ["octocat", "", "", "1"]]
+
+
+def test_a_canvas_export_without_the_assignment_id_is_refused(client: TestClient) -> None:
+    response = client.get("/gradebook.csv", params={"format": "canvas"}, headers=instructor_headers())
+    assert response.status_code == 422
+    assert "format=canvas needs assignment_id" in response.text

@@ -205,9 +205,10 @@ def test_grade_writes_reports_and_grades_csv_with_plain_progress(
     out = tmp_path / "out"
     assert cli.main(["grade", str(inputs), "--out", str(out), "--only", "car,taxi"]) == 0
     err = capsys.readouterr().err
-    assert "1/4 alice.py: car missing\n" in err and "4/4 bob.py: taxi error\n" in err
+    assert "1/4 alice: car missing\n" in err and "4/4 bob: taxi error\n" in err
+    assert "  alice: alice.py (the only .py/.ipynb file (nothing else))" in err
     rows = list(csv.DictReader((out / "grades.csv").open()))
-    assert [(row["submission"], row["car"], row["taxi"], row["total"]) for row in rows] == [
+    assert [(row["student"], row["car"], row["taxi"], row["total"]) for row in rows] == [
         ("alice", "0", "0", "0"),
         ("bob", "0", "0", "0"),
     ]
@@ -388,7 +389,9 @@ def test_ctrl_c_keeps_finished_reports_and_a_rerun_resumes(tmp_path: Path, fast_
         "other 1; the finished ones are skipped." in err
     )
     assert sorted(path.name for path in out.iterdir()) == ["empty.json", "grades.csv"]
-    assert [row["submission"] for row in csv.DictReader((out / "grades.csv").open())] == ["empty"]
+    rows = list(csv.DictReader((out / "grades.csv").open()))
+    assert [row["student"] for row in rows] == ["empty", "endless"]
+    assert rows[0]["seed"] == "736251" and (rows[1]["seed"], rows[1]["note"]) == ("", "not graded yet")
     time.sleep(0.5)
     assert workers and _alive(workers) == set(), "the interrupted grading left processes behind"
 
@@ -396,9 +399,10 @@ def test_ctrl_c_keeps_finished_reports_and_a_rerun_resumes(tmp_path: Path, fast_
     rerun = subprocess.run(argv, capture_output=True, text=True, timeout=120)
     assert rerun.returncode == 0, rerun.stderr
     assert f"Resuming in {out}: 1 of 2 submissions are already graded there" in rerun.stderr
-    assert "endless.py: random_blackjack missing" in rerun.stderr
-    assert "empty.py" not in rerun.stderr.split("grading 1.")[1]
-    assert [row["submission"] for row in csv.DictReader((out / "grades.csv").open())] == ["empty", "endless"]
+    assert "endless: random_blackjack missing" in rerun.stderr
+    assert "empty:" not in rerun.stderr.split("grading 1.")[1]
+    rows = list(csv.DictReader((out / "grades.csv").open()))
+    assert [(row["student"], row["seed"]) for row in rows] == [("empty", "736251"), ("endless", "736251")]
 
 
 def test_a_broken_executor_entry_point_is_refused_with_a_remedy(

@@ -135,7 +135,7 @@ def test_grade_refuses_a_page_that_would_overwrite_a_report_before_grading(
     arguments = ["grade", str(tmp_path / "class.py"), "--out", str(out), "--html", str(out / "class.html")]
     assert cli.main(arguments) == cli.EXIT_ERROR
     assert (
-        f"would write {out / 'class.json'} over the report of {tmp_path / 'class.py'}; put the page outside"
+        f"would write {out / 'class.json'} over the report of student class; put the page outside"
         in (capsys.readouterr().err)
     )
     assert not out.exists()

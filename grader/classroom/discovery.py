@@ -1,0 +1,212 @@
+"""Recognising a class download and making one submission per student (or group) of it."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from datetime import UTC, datetime
+from pathlib import Path
+
+from grader.classroom.errors import LayoutMismatch, UnknownLayout
+from grader.classroom.graded_file import GradedFileRule, choose
+from grader.classroom.layouts import LAYOUTS, Group, Layout
+from grader.classroom.model import ClassDownload, Member, Skipped, Submission, SubmittedFile
+from grader.classroom.tree import Entry, Limits, Tree, read_tree
+
+DEFAULT_RULE = GradedFileRule()
+DEFAULT_LIMITS = Limits()
+RECOGNISED = 0.5
+"""Share of a download's top-level names that must carry an LMS's marks for it to be taken as that LMS's."""
+
+
+def recognise(tree: Tree) -> Layout:
+    """The layout whose marks the download carries most (plain folders when no LMS's reach RECOGNISED)."""
+    scored = sorted(((layout.score(tree), name) for name, layout in LAYOUTS.items()), reverse=True)
+    best_score, best = scored[0]
+    return LAYOUTS[best] if best_score >= RECOGNISED else LAYOUTS["plain"]
+
+
+def layout_named(name: str) -> Layout:
+    """The layout of a ``--layout`` name.
+
+    Raises:
+        UnknownLayout: No layout has that name (the message lists them).
+    """
+    try:
+        return LAYOUTS[name]
+    except KeyError:
+        raise UnknownLayout(f"unknown layout {name!r}: use one of {', '.join(LAYOUTS)}") from None
+
+
+def discover(
+    path: Path,
+    *,
+    layout: str | None = None,
+    rule: GradedFileRule = DEFAULT_RULE,
+    scratch: Path | None = None,
+    limits: Limits = DEFAULT_LIMITS,
+    due: datetime | None = None,
+) -> ClassDownload:
+    """Read a class download: recognise its layout, group files by student, choose each graded file.
+
+    Reads only under ``path`` (links are refused, never followed) and writes only into ``scratch``
+    (zips, read within ``limits``).
+
+    Args:
+        path: The download: a folder, a zip as the LMS gave it, or one file.
+        layout: A ``LAYOUTS`` name; recognised from the download when None.
+        rule: How the graded file is chosen.
+        scratch: Folder zips are read into; zips are refused when None.
+        limits: Bounds on files, bytes and zip nesting.
+        due: The deadline; a submission whose source gives a time but no late mark is late after it.
+
+    Returns:
+        The submissions sorted by identity, with the unattributed and refused files.
+
+    Raises:
+        FileNotFoundError: ``path`` does not exist.
+        grader.classroom.errors.ClassroomError: ``layout`` is unknown or the download is not of it.
+    """
+    if not path.exists() and not path.is_symlink():
+        raise FileNotFoundError(f"{path} does not exist: pass the class folder or zip as downloaded")
+    chosen = layout_named(layout) if layout else None
+    tree = read_tree(path, scratch, limits)
+    chosen = chosen or recognise(tree)
+    if layout and chosen.name != "plain" and tree.entries and chosen.score(tree) == 0:
+        raise LayoutMismatch(
+            f"{path} does not look like a {chosen.title} download (none of its names carry its marks); "
+            f"leave out --layout to recognise it, or pass the download as {chosen.title} gives it"
+        )
+    grouping = chosen.group(tree)
+    download = ClassDownload(
+        layout=chosen.name,
+        root=path,
+        unattributed=grouping.unattributed,
+        refused=tree.refused,
+        ignored=tree.ignored,
+    )
+    refused_by = _refused_by_student(chosen, tree)
+    for group in _merged(grouping.groups):
+        refused = refused_by.pop(group.identity, (group.members, []))[1]
+        download.submissions.append(_submission(group, rule, chosen.name, due, refused))
+    for identity, (members, refused) in refused_by.items():
+        download.submissions.append(
+            Submission(
+                identity=identity,
+                display_name=_display(members, identity),
+                members=members,
+                files=(),
+                graded_file=None,
+                why=f"nothing to grade: every file was refused ({_refusals(refused)})",
+                source=chosen.name,
+            )
+        )
+    download.submissions.sort(key=lambda submission: submission.identity)
+    return download
+
+
+def discover_all(paths: Sequence[Path], *, scratch: Path | None = None, **options: object) -> ClassDownload:
+    """:func:`discover` each path (zips into a scratch subfolder of their own) and put the submissions
+    together (``layout`` "mixed" when they differ). A student found under two paths keeps the first
+    submission; the second is refused with a reason."""
+    found = [
+        discover(path, scratch=scratch / str(index) if scratch else None, **options)  # type: ignore[arg-type]
+        for index, path in enumerate(paths)
+    ]
+    if len(found) == 1:
+        return found[0]
+    layouts = {download.layout for download in found}
+    merged = ClassDownload(layout=layouts.pop() if len(layouts) == 1 else "mixed", root=paths[0].parent)
+    by_identity: dict[str, Submission] = {}
+    for download in found:
+        merged.unattributed += download.unattributed
+        merged.refused += download.refused
+        merged.ignored += download.ignored
+        for submission in download.submissions:
+            if submission.identity in by_identity:
+                merged.refused.append(_duplicate(submission, by_identity[submission.identity]))
+                continue
+            by_identity[submission.identity] = submission
+    merged.submissions = sorted(by_identity.values(), key=lambda submission: submission.identity)
+    return merged
+
+
+def _duplicate(later: Submission, kept: Submission) -> Skipped:
+    where = later.graded_file.relative if later.graded_file else later.identity
+    return Skipped(
+        where,
+        f"a second submission for {later.identity} (kept {kept.graded_file.relative if kept.graded_file else 'the first'}); pass each student once",  # noqa: E501
+    )
+
+
+def _regroup(layout: Layout, tree: Tree) -> list[Group]:
+    """The groups of the download with its refused files put back as stand-ins (``os.devnull``: nothing of
+    theirs is read), so that each refused file can be said to be some student's."""
+    stand_ins = [Entry(skipped.where, Path(os.devnull)) for skipped in tree.refused]
+    return layout.group(
+        Tree(root=tree.root, entries=sorted([*tree.entries, *stand_ins], key=lambda e: e.relative))
+    ).groups
+
+
+def _refused_by_student(layout: Layout, tree: Tree) -> dict[str, tuple[tuple[Member, ...], list[Skipped]]]:
+    """The refused files of each student a layout can name for them, with the student's members."""
+    if not tree.refused:
+        return {}
+    reasons = {skipped.where: skipped for skipped in tree.refused}
+    found: dict[str, tuple[tuple[Member, ...], list[Skipped]]] = {}
+    for group in _merged(_regroup(layout, tree)):
+        mine = [
+            reasons[entry.relative]
+            for entry, _ in group.files
+            if entry.relative in reasons and entry.path == Path(os.devnull)
+        ]
+        if mine:
+            found[group.identity] = (group.members, mine)
+    return found
+
+
+def _refusals(refused: list[Skipped]) -> str:
+    return "; ".join(f"{skipped.where}: {skipped.reason}" for skipped in refused)
+
+
+def _display(members: tuple[Member, ...], identity: str) -> str:
+    names = ", ".join(member.name for member in members if member.name)
+    return f"{names} ({identity})" if names else identity
+
+
+def _merged(groups: list[Group]) -> list[Group]:
+    """Groups of one identity (a student's folder and a file of their name) made one."""
+    by_identity: dict[str, Group] = {}
+    for group in groups:
+        if group.identity in by_identity:
+            by_identity[group.identity].files += group.files
+        else:
+            by_identity[group.identity] = group
+    return list(by_identity.values())
+
+
+def _submission(
+    group: Group, rule: GradedFileRule, source: str, due: datetime | None, refused: list[Skipped]
+) -> Submission:
+    files = tuple(SubmittedFile(entry.path, entry.relative, original) for entry, original in group.files)
+    graded, why = choose(files, rule)
+    if refused:
+        why = f"{why}; refused {_refusals(refused)}"
+    late = group.late
+    if late is None and due is not None and group.submitted_at is not None:
+        late = _aware(group.submitted_at) > _aware(due)
+    return Submission(
+        identity=group.identity,
+        display_name=_display(group.members, group.identity),
+        members=group.members,
+        files=files,
+        graded_file=graded,
+        why=f"{why}; {group.note}" if group.note else why,
+        submitted_at=group.submitted_at,
+        late=late,
+        source=source,
+    )
+
+
+def _aware(moment: datetime) -> datetime:
+    return moment if moment.tzinfo is not None else moment.replace(tzinfo=UTC)

@@ -1,0 +1,147 @@
+"""Every layout's realistic download is recognised and grouped: a submission per student under their
+identity, the right graded file, lateness, groups, refusals and unattributed files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from grader.classroom import GradedFileRule, discover
+
+from .downloads import BUILDERS, DUE, Expected
+
+RULE = GradedFileRule(functions=("random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues"))
+
+
+def _discover(expected: Expected, tmp_path: Path, layout: str | None = None):  # type: ignore[no-untyped-def]
+    return discover(expected.path, layout=layout, rule=RULE, scratch=tmp_path / "scratch", due=DUE)
+
+
+@pytest.mark.parametrize("layout", list(BUILDERS), ids=list(BUILDERS))
+def test_each_layout_is_recognised_and_grouped_by_student(layout: str, tmp_path: Path) -> None:
+    expected = BUILDERS[layout](tmp_path / "download", 4)
+    download = _discover(expected, tmp_path)
+    assert download.layout == expected.layout
+    graded = {
+        submission.identity: submission.graded_file.relative if submission.graded_file else None
+        for submission in download.submissions
+    }
+    assert graded == expected.graded
+    assert {submission.identity for submission in download.submissions if submission.late} == expected.late
+    for identity, members in expected.groups.items():
+        (group,) = [submission for submission in download.submissions if submission.identity == identity]
+        assert tuple(member.identity for member in group.members) == members
+    for identity, name in expected.names.items():
+        (submission,) = [submission for submission in download.submissions if submission.identity == identity]
+        assert submission.members[0].name == name
+    refused = [skipped.where for skipped in download.refused]
+    for where in expected.refused:
+        assert any(where in found for found in refused), (where, download.refused)
+    assert [skipped.where for skipped in download.unattributed] == expected.unattributed
+    for submission in download.submissions:
+        assert submission.why, submission
+
+
+@pytest.mark.parametrize("layout", list(BUILDERS), ids=list(BUILDERS))
+def test_naming_the_layout_gives_the_same_submissions(layout: str, tmp_path: Path) -> None:
+    expected = BUILDERS[layout](tmp_path / "download", 3)
+    named = _discover(expected, tmp_path / "a", layout=expected.layout)
+    recognised = _discover(expected, tmp_path / "b")
+    assert [s.identity for s in named.submissions] == [s.identity for s in recognised.submissions]
+
+
+def test_graded_file_choices_say_why(tmp_path: Path) -> None:
+    expected = BUILDERS["plain"](tmp_path / "download", 1)
+    download = _discover(expected, tmp_path)
+    why = {submission.identity: submission.why for submission in download.submissions}
+    assert why["bob"] == "named opengym.py, the lab's file name"
+    assert why["carol"] == "the only .py/.ipynb file (nothing else)"
+    assert why["dan"] == "defines 6 of the lab's 6 functions, more than helpers.py"
+    assert why["eve"] == (
+        "no .py or .ipynb file to grade (test files and checkpoints are never graded); "
+        "refused eve/opengym.py: a symbolic link (to /etc/passwd): links are never followed"
+    )
+
+
+def test_a_symlink_is_refused_with_its_target_and_never_read(tmp_path: Path) -> None:
+    expected = BUILDERS["plain"](tmp_path / "download", 1)
+    download = _discover(expected, tmp_path)
+    assert [(s.where, s.reason) for s in download.refused] == [
+        ("eve/opengym.py", "a symbolic link (to /etc/passwd): links are never followed")
+    ]
+    every_file = [file.path for submission in download.submissions for file in submission.files]
+    assert all(not path.is_symlink() for path in every_file)
+
+
+def test_a_hard_link_and_a_fifo_are_refused(tmp_path: Path) -> None:
+    folder = tmp_path / "class"
+    (folder / "ann").mkdir(parents=True)
+    (folder / "ann" / "opengym.py").write_text("x = 1\n")
+    outside = tmp_path / "secret.py"
+    outside.write_text("token = 1\n")
+    (folder / "ben").mkdir()
+    (folder / "ben" / "opengym.py").hardlink_to(outside)
+    (folder / "ben" / "notes.txt").write_text("mine\n")
+    import os
+
+    os.mkfifo(folder / "ann" / "pipe.py")
+    download = discover(folder, rule=RULE)
+    reasons = {s.where: s.reason for s in download.refused}
+    assert reasons["ben/opengym.py"].startswith("a hard link (2 names for one file")
+    assert reasons["ann/pipe.py"] == "not a regular file (a device, FIFO or socket)"
+    graded = {s.identity: s.graded_file for s in download.submissions}
+    assert graded["ben"] is None and graded["ann"] is not None
+
+
+def test_a_zip_needs_a_scratch_folder(tmp_path: Path) -> None:
+    expected = BUILDERS["canvas"](tmp_path / "download", 1)
+    download = discover(expected.path, rule=RULE)
+    assert download.submissions == []
+    assert [s.reason for s in download.refused] == ["a zip needs a scratch folder to be read into"]
+
+
+def test_an_unknown_layout_is_named_with_the_known_ones(tmp_path: Path) -> None:
+    from grader.classroom.errors import UnknownLayout
+
+    with pytest.raises(
+        UnknownLayout, match=r"unknown layout 'brightspace': use one of plain, canvas, gradescope"
+    ):
+        discover(tmp_path, layout="brightspace")
+
+
+def test_a_named_layout_that_does_not_fit_says_so(tmp_path: Path) -> None:
+    from grader.classroom.errors import LayoutMismatch
+
+    expected = BUILDERS["plain"](tmp_path / "download", 2)
+    with pytest.raises(LayoutMismatch, match="does not look like a Moodle Download all submissions download"):
+        discover(expected.path, layout="moodle")
+
+
+def test_a_student_whose_every_file_is_refused_gets_a_submission_saying_so(tmp_path: Path) -> None:
+    folder = tmp_path / "moodle"
+    (folder / "Ann Lee_501_assignsubmission_file_").mkdir(parents=True)
+    (folder / "Ann Lee_501_assignsubmission_file_" / "opengym.py").write_text("x = 1\n")
+    (folder / "Eve Ray_502_assignsubmission_file_").mkdir()
+    (folder / "Eve Ray_502_assignsubmission_file_" / "opengym.py").symlink_to(folder.parent)
+    download = discover(folder, rule=RULE)
+    eve = download.submissions[1]
+    assert (eve.identity, eve.display_name, eve.graded_file, eve.files) == ("502", "Eve Ray (502)", None, ())
+    assert eve.why == (
+        "nothing to grade: every file was refused (Eve Ray_502_assignsubmission_file_/opengym.py: "
+        f"a symbolic link (to {folder.parent}): links are never followed)"
+    )
+
+
+def test_several_downloads_are_read_apart_and_a_student_twice_is_refused(tmp_path: Path) -> None:
+    from grader.classroom import discover_all
+
+    first = BUILDERS["canvas"](tmp_path / "one", 2)
+    second = BUILDERS["canvas"](tmp_path / "two", 3)
+    download = discover_all([first.path, second.path], rule=RULE, scratch=tmp_path / "scratch", due=DUE)
+    assert download.layout == "canvas"
+    assert {s.identity for s in download.submissions} == set(first.graded) | set(second.graded)
+    twice = [s.where for s in download.refused if s.reason.startswith("a second submission for 1000 ")]
+    assert twice == ["student0_1000_5001_opengym.py"]
+    paths = [file.path for submission in download.submissions for file in submission.files]
+    assert len(set(paths)) == len(paths), "each zip keeps its own scratch files"
