@@ -42,6 +42,12 @@ of any other cell magic (``%%bash``, ``%%writefile``, ``%%timeit``, ...) is not 
 _MAIN_GUARD = "__main__"
 _DEFINED_IN_BROKEN_CELL = re.compile(r"^(?:async\s+)?(?:def|class)\s+([A-Za-z_]\w*)")
 _ASSIGNED_IN_BROKEN_CELL = re.compile(r"^([A-Za-z_]\w*)\s*(?::[^=]*)?=(?!=)")
+MAX_CELL_CHARS = 200_000
+"""A code cell longer than this is not read (the longest honest cells are a few thousand characters):
+it is left out like a cell that is not Python, so parsing stays cheap."""
+MAX_DEPTH = 500
+"""Deepest syntax tree a kept cell may have (honest code nests a few dozen levels; ``1+1+...+1`` nests
+once per ``+``). The reduction is recursive, so a deeper cell is left out before it is walked."""
 COMPUTED = "assignment computed by a call (a demo or training run, not run at import)"
 
 
@@ -123,6 +129,10 @@ def _skip(builder: _Builder, cell: Cell, line: int, reason: str, code: str) -> S
 
 
 def _add_cell(builder: _Builder, cell: Cell) -> None:
+    if len(cell.source) > MAX_CELL_CHARS:
+        too_large = f"the cell has {len(cell.source):,} characters, more than the {MAX_CELL_CHARS:,} the grader reads"
+        _broken_cell(builder, cell, cell.source, ValueError(too_large))
+        return
     defined = builder.scope.kinds.keys() | builder.skipped_bindings.keys()
     transformed = transform_cell(cell.source, defined)
     magic = transformed.cell_magic
@@ -139,6 +149,14 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
         tree = ast.parse(transformed.source)
     except (SyntaxError, ValueError) as error:
         _broken_cell(builder, cell, transformed.source, error)
+        return
+    except (MemoryError, RecursionError):  # the parser's "too complex", or building the tree from it
+        _broken_cell(builder, cell, transformed.source, ValueError("its code nests too deeply to parse"))
+        return
+    depth = _depth(tree)
+    if depth > MAX_DEPTH:
+        too_deep = ValueError(f"its code nests {depth:,} levels deep, more than the {MAX_DEPTH} the grader reads")
+        _broken_cell(builder, cell, transformed.source, too_deep)
         return
     lines = transformed.source.splitlines()
     kept_any = False
@@ -175,17 +193,22 @@ _DROPPED_DECORATOR = (
 
 
 def _broken_cell(builder: _Builder, cell: Cell, source: str, error: SyntaxError | ValueError) -> None:
-    """Leave out a cell that is not Python; what it defines raises an error naming it when called."""
+    """Leave out a cell that is not Python (or too big to read); what it defines raises an error naming it
+    when called."""
     if isinstance(error, SyntaxError):
-        where = f"{error.msg} (line {error.lineno} of the cell)"
+        where = f"is not valid Python: {error.msg} (line {error.lineno} of the cell)"
         line = error.lineno or 1
     else:
-        where, line = str(error), 1
+        where, line = f"cannot be read: {error}", 1
     lines = source.splitlines()
-    message = f"{builder.name}, {cell.label} is not valid Python: {where}"
+    message = f"{builder.name}, {cell.label} {where}"
     defined = [m.group(1) for m in map(_DEFINED_IN_BROKEN_CELL.match, lines) if m is not None]
     missing = [name for name in dict.fromkeys(defined) if name not in builder.scope.kinds]
-    reason = "not valid Python, so Jupyter ran none of it either: the whole cell is left out"
+    reason = (
+        "not valid Python, so Jupyter ran none of it either: the whole cell is left out"
+        if isinstance(error, SyntaxError)
+        else f"{error}: the whole cell is left out"
+    )
     if missing:
         reason += f" ({', '.join(f'{name}()' for name in missing)} raise an error naming this cell)"
     offending = lines[line - 1] if 0 < line <= len(lines) else cell.source.strip()
@@ -208,6 +231,18 @@ def _broken_cell(builder: _Builder, cell: Cell, source: str, error: SyntaxError 
         builder.kept.append(text)
         builder.origins += [None, (cell.number, start), (cell.number, start)]
         builder.scope.bind(name, Kind.STUDENT)
+
+
+def _depth(tree: ast.AST) -> int:
+    """The syntax tree's depth, walked without recursion (so an absurdly deep tree costs only its size)."""
+    deepest, stack = 0, [(tree, 1)]
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        if deepest > MAX_DEPTH:
+            return deepest
+        stack.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
+    return deepest
 
 
 def _defines(line: str, name: str) -> bool:

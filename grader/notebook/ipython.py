@@ -11,6 +11,7 @@ of one tokenization each, so a cell costs time linear in its size.
 
 from __future__ import annotations
 
+import ast
 import io
 import keyword
 import re
@@ -85,16 +86,16 @@ def transform_cell(source: str, defined: Container[str]) -> TransformedCell:
         result.cell_magic = lines[first].split()[0]
         lines[first] = ""
         # IPython runs the body of %%time/%%capture as Python; it has no escapes of its own.
-    for _ in range(PASSES):
-        found = _special_lines(lines)
-        if not found:
-            break
+    for _ in range(PASSES if not _is_python(lines) else 0):
+        found, complete = _special_lines(lines)
         for special, end in found:
             indent = _INDENT.match(lines[special.line - 1])
             lines[special.line - 1] = (indent.group(0) if indent else "") + "pass"
             for index in range(special.line, end):
                 lines[index] = ""
             result.special.append(special)
+        if complete or not found:  # a new pass only when the tokenizer stopped early (an unclosed quote)
+            break
     magic = _automagic(lines, defined) if result.cell_magic is None else None
     if magic is not None:
         result.special.append(magic)
@@ -121,8 +122,20 @@ def _without_prompts(lines: list[str], first: int) -> list[str]:
     return lines
 
 
-def _logical_lines(lines: list[str]) -> list[list[tokenize.TokenInfo]]:
-    """Tokens grouped by logical line, as IPython's ``make_tokens_by_line`` groups them."""
+def _is_python(lines: list[str]) -> bool:
+    """True when the cell parses as it is: then no token transformation applies (each one's trigger, a
+    line starting with ``!``, ``%``, ``?``, ``,``, ``;`` or ``/``, ``= !``, ``= %name`` or a trailing ``?``,
+    is a syntax error in Python), and the tokenizer, pure Python and slow, need not run."""
+    try:
+        ast.parse("\n".join(lines))
+    except (SyntaxError, ValueError, MemoryError, RecursionError):
+        return False
+    return True
+
+
+def _logical_lines(lines: list[str]) -> tuple[list[list[tokenize.TokenInfo]], bool]:
+    """Tokens grouped by logical line, as IPython's ``make_tokens_by_line`` groups them, and whether the
+    tokenizer reached the end."""
     by_line: list[list[tokenize.TokenInfo]] = [[]]
     depth = 0
     text = "".join(line + "\n" for line in lines)
@@ -136,14 +149,16 @@ def _logical_lines(lines: list[str]) -> list[list[tokenize.TokenInfo]]:
             elif token.string in ")]}" and token.type == tokenize.OP and depth > 0:
                 depth -= 1
     except (tokenize.TokenError, SyntaxError):  # an unclosed string or bracket: IPython stops there too
-        pass
-    return [tokens for tokens in by_line if tokens]
+        return [tokens for tokens in by_line if tokens], False
+    return [tokens for tokens in by_line if tokens], True
 
 
-def _special_lines(lines: list[str]) -> list[tuple[SpecialLine, int]]:
-    """Each special line of the cell with the index after its last (backslash-continued) line."""
+def _special_lines(lines: list[str]) -> tuple[list[tuple[SpecialLine, int]], bool]:
+    """Each special line of the cell with the index after its last (backslash-continued) line, and whether
+    the whole cell was tokenized."""
     found: list[tuple[SpecialLine, int]] = []
-    for tokens in _logical_lines(lines):
+    logical, complete = _logical_lines(lines)
+    for tokens in logical:
         body = [token for token in tokens if token.type not in (tokenize.INDENT, tokenize.DEDENT)]
         meaningful = [
             token
@@ -169,7 +184,7 @@ def _special_lines(lines: list[str]) -> list[tuple[SpecialLine, int]]:
             end += 1
         code = lines[start.start[0] - 1].strip()
         found.append((SpecialLine(start.start[0], kind, code, binds), end))
-    return found
+    return found, complete
 
 
 def _assigned_command(tokens: list[tokenize.TokenInfo]) -> tuple[str, tuple[str, ...], int] | None:

@@ -12,6 +12,9 @@ from grader.validation import FileVerdict
 MAX_NOTEBOOK_BYTES = 20_000_000
 """Outputs (plots, rendered frames) make notebooks large; only the code cells are graded, and they are
 held to the ``.py`` limit once extracted."""
+MAX_CODE_CHARS = 2_000_000
+"""Characters of code (all code cells together) the grader reads: twice the ``.py`` limit, as skipped
+demo cells do not count towards that."""
 MAX_IGNORED_DETAIL = 200
 PYTHON_LANGUAGES = ("python", "ipython")
 
@@ -104,6 +107,13 @@ def read_cells(data: bytes, name: str) -> NotebookCells | FileVerdict:
         count = raw.get("execution_count", raw.get("prompt_number"))
         if source.strip():
             cells.append(Cell(number, count if type(count) is int else None, source))
+    code_chars = sum(len(cell.source) for cell in cells)
+    if code_chars > MAX_CODE_CHARS:
+        return FileVerdict(
+            "error",
+            f"{name} holds {code_chars:,} characters of code; the grader reads at most {MAX_CODE_CHARS:,}. "
+            "Remove the cells that are not part of your solution (or your code as a .py file) and submit again.",
+        )
     if not cells:
         return FileVerdict(
             "missing",
@@ -157,7 +167,10 @@ def _schema_notes(notebook: dict[str, Any]) -> list[str]:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             nbformat.validate(light, version=4)  # type: ignore[no-untyped-call]
-    except nbformat.ValidationError as error:
+    except (nbformat.ValidationError, ValueError, KeyError, TypeError, AttributeError) as error:
         detail = str(getattr(error, "message", error)).splitlines()[0][:MAX_IGNORED_DETAIL]
-        return [f"its metadata does not follow the nbformat 4 schema ({detail}); Jupyter opens it all the same"]
+        return [
+            f"the file does not follow the nbformat 4 schema ({detail}); "
+            "as Jupyter opens it all the same, the grader read its code cells"
+        ]
     return []
