@@ -51,13 +51,14 @@ class _Reply(BaseModel):
     origins: list[tuple[int, int] | None] = []
 
 
-def build_module(data: bytes, name: str, graded: Collection[str] | None = None) -> NotebookModule | FileVerdict:
+def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) -> NotebookModule | FileVerdict:
     """Turn a notebook's bytes into the Python module the grader imports, in a bounded child process.
 
     Args:
         data: The ``.ipynb`` file's bytes (untrusted).
         name: Its file name, used in messages.
-        graded: The functions problems call (their globals are checked); None: every top-level function.
+        graded: The functions problems call (the globals they reach are checked, and a graded function in
+            a cell that cannot be read raises an error naming the cell); None: every top-level function.
 
     Returns:
         The module and its summary, or the verdict saying why the notebook cannot be graded, including

@@ -65,13 +65,14 @@ class _Builder:
     kept_statements: int = 0
     broken: list[str] = field(default_factory=list)
     postponed_annotations: bool = False
+    graded: Collection[str] | None = None
 
     @property
     def bound(self) -> set[str]:
         return set(self.scope.kinds)
 
 
-def build_module(data: bytes, name: str, graded: Collection[str] | None = None) -> NotebookModule | FileVerdict:
+def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) -> NotebookModule | FileVerdict:
     """Turn a notebook's bytes into the Python module the grader imports, without running any of it.
 
     Pure and unbounded in time and memory: call `grader.notebook.build_module`, which runs this in a
@@ -81,7 +82,8 @@ def build_module(data: bytes, name: str, graded: Collection[str] | None = None) 
         data: The ``.ipynb`` file's bytes.
         name: Its file name, used in messages.
         graded: The functions problems call; the global-use analysis follows only what they reach
-            (None: every top-level function).
+            (None: every top-level function, which costs time quadratic in their number: for tools and
+            tests on known files only).
 
     Returns:
         The module source and the summary of what was left out, or the verdict saying why the notebook
@@ -90,7 +92,7 @@ def build_module(data: bytes, name: str, graded: Collection[str] | None = None) 
     read = read_cells(data, name)
     if isinstance(read, FileVerdict):
         return read
-    builder = _Builder(name)
+    builder = _Builder(name, graded=graded)
     for cell in read.cells:
         _add_cell(builder, cell)
     if builder.kept_statements == 0:
@@ -187,6 +189,7 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
                     builder.skipped_bindings.setdefault(bound_name, skipped)
 
 
+_BROKEN = "the whole cell is left out"
 _DROPPED_DECORATOR = (
     "decorator not applied: applying it would run code at import (the function is graded without it)"
 )
@@ -203,17 +206,22 @@ def _broken_cell(builder: _Builder, cell: Cell, source: str, error: SyntaxError 
     lines = source.splitlines()
     message = f"{builder.name}, {cell.label} {where}"
     defined = [m.group(1) for m in map(_DEFINED_IN_BROKEN_CELL.match, lines) if m is not None]
-    missing = [name for name in dict.fromkeys(defined) if name not in builder.scope.kinds]
+    graded = builder.graded
+    missing = [
+        name
+        for name in dict.fromkeys(defined)
+        if name not in builder.scope.kinds and (graded is None or name in graded)
+    ]
     reason = (
-        "not valid Python, so Jupyter ran none of it either: the whole cell is left out"
+        f"not valid Python, so Jupyter ran none of it either: {_BROKEN}"
         if isinstance(error, SyntaxError)
-        else f"{error}: the whole cell is left out"
+        else f"{error}: {_BROKEN}"
     )
     if missing:
-        reason += f" ({', '.join(f'{name}()' for name in missing)} raise an error naming this cell)"
+        reason += f" (calling {', '.join(f'{name}()' for name in missing)} raises an error naming this cell)"
     offending = lines[line - 1] if 0 < line <= len(lines) else cell.source.strip()
     entry = _skip(builder, cell, line, reason, offending)
-    for match in map(_ASSIGNED_IN_BROKEN_CELL.match, lines):
+    for match in [*map(_ASSIGNED_IN_BROKEN_CELL.match, lines), *map(_DEFINED_IN_BROKEN_CELL.match, lines)]:
         if match is not None and match.group(1) not in builder.scope.kinds:
             builder.skipped_bindings.setdefault(match.group(1), entry)
     builder.broken.append(f"{message}. Fix the cell, run it, save the notebook and submit again.")
@@ -506,7 +514,10 @@ def unbound_globals(
         for name in sorted(missing):
             where = skipped_bindings[name]
             entries.append(
-                UnboundGlobal(function=function, name=name, cell=where.cell, line=where.line, code=where.code)
+                UnboundGlobal(
+                    function=function, name=name, cell=where.cell, line=where.line, code=where.code,
+                    broken_cell=where.reason.endswith(_BROKEN) or _BROKEN + " (" in where.reason,
+                )
             )
     return entries
 

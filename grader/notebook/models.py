@@ -30,9 +30,18 @@ class UnboundGlobal(BaseModel):
     cell: int = Field(description="Cell of the (first) skipped statement that sets it.")
     line: int = Field(description="Line of that statement within its cell.")
     code: str = Field(description="That statement's first line.")
+    broken_cell: bool = Field(
+        default=False, description="The statement sits in a cell that is not valid Python (so none of it ran)."
+    )
 
     def note(self) -> str:
         """The sentence added to the feedback of the problem named after ``function``."""
+        if self.broken_cell:
+            return (
+                f"Notebook: {self.function}() uses `{self.name}`, which only cell {self.cell} defines, and that cell "
+                f"cannot be read (line {self.line}: `{self.code}`), so Jupyter ran none of it either: "
+                "fix that cell, run it, save the notebook and submit again."
+            )
         return (
             f"Notebook: {self.function}() reads the global `{self.name}`, which only a skipped top-level statement sets (cell {self.cell}, line {self.line}: `{self.code}`). "  # noqa: E501
             f"The grader runs only imports, definitions and simple constants of a notebook, so there is no `{self.name}` when {self.function}() is called: "  # noqa: E501

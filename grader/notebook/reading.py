@@ -67,6 +67,11 @@ def read_cells(data: bytes, name: str) -> NotebookCells | FileVerdict:
         return FileVerdict("missing", f"{name} is empty: nothing to grade. Submit your saved notebook.")
     try:
         notebook = json.loads(data.decode("utf-8-sig"))
+    except RecursionError:
+        return FileVerdict(
+            "error",
+            f"{name} is not a readable notebook: its JSON nests too deeply for the reader. {_RESAVE}",
+        )
     except (UnicodeDecodeError, json.JSONDecodeError) as error:
         detail = str(error).splitlines()[0][:MAX_IGNORED_DETAIL] if str(error) else type(error).__name__
         return FileVerdict(

@@ -39,7 +39,7 @@ def hooked(*args, **kwargs):
 
 def built(*cells: str) -> NotebookModule:
     data = nbformat.writes(new_notebook(cells=[new_code_cell(PRELUDE), *map(new_code_cell, cells)])).encode()
-    module = build_module(data, "lab.ipynb")
+    module = build_module(data, "lab.ipynb", None)
     assert isinstance(module, NotebookModule), module
     return module
 
