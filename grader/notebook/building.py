@@ -48,6 +48,9 @@ it is left out like a cell that is not Python, so parsing stays cheap."""
 MAX_DEPTH = 500
 """Deepest syntax tree a kept cell may have (honest code nests a few dozen levels; ``1+1+...+1`` nests
 once per ``+``). The reduction is recursive, so a deeper cell is left out before it is walked."""
+MAX_NOTED_GLOBALS = 20
+"""Missing globals noted per graded function (the first, alphabetically): enough to say what to fix, and a
+notebook of thousands of them cannot swell the report."""
 COMPUTED = "assignment computed by a call (a demo or training run, not run at import)"
 
 
@@ -511,7 +514,7 @@ def unbound_globals(
                 if name in reads and name not in reachable:
                     reachable.add(name)
                     frontier.append(name)
-        for name in sorted(missing):
+        for name in sorted(missing)[:MAX_NOTED_GLOBALS]:
             where = skipped_bindings[name]
             entries.append(
                 UnboundGlobal(
