@@ -48,8 +48,12 @@ def generated() -> dict[str, bytes]:
     bangs = ["\n".join(["!echo hi"] * 20_000)] * 10
     big = ["x = [" + "1," * 99_500 + "]"] * 95
     return {
-        "generated: 200,000 shell escapes": nbformat.writes(new_notebook(cells=[new_code_cell(c) for c in bangs])).encode(),
-        "generated: 95 cells of 199,000 chars": nbformat.writes(new_notebook(cells=[new_code_cell(c) for c in big])).encode(),
+        "generated: 200,000 shell escapes": nbformat.writes(
+            new_notebook(cells=[new_code_cell(c) for c in bangs])
+        ).encode(),
+        "generated: 95 cells of 199,000 chars": nbformat.writes(
+            new_notebook(cells=[new_code_cell(c) for c in big])
+        ).encode(),
     }
 
 
@@ -101,8 +105,8 @@ def main() -> None:
         f"{platform.python_implementation()} {platform.python_version()}, {os.cpu_count()} cores, "
         f"load average {load:.1f} at the end (the machine was shared: wall times are inflated, CPU times are not). "  # noqa: E501
         f"Each file is read {arguments.rounds} times through `grader.notebook.build_module` (the bounded "
-        f"child: {CPU_SECONDS} s CPU, {MEMORY_BYTES // 2**20:,} MiB address space); medians. Child peak RSS is "
-        "the largest of any child so far (RUSAGE_CHILDREN), so it only grows down the table.",
+        f"child: {CPU_SECONDS} s CPU, {MEMORY_BYTES // 2**20:,} MiB address space); medians. "
+        "Child peak RSS is the largest of any child so far (RUSAGE_CHILDREN), so it only grows down the table.",  # noqa: E501
         "",
         "| file | bytes | wall s | child CPU s | parent CPU s | child peak RSS MiB | outcome |",
         "|---|---:|---:|---:|---:|---:|---|",
@@ -118,7 +122,9 @@ def main() -> None:
     if arguments.write:
         current = RESULTS.read_text(encoding="utf-8")
         pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.S | re.M)
-        updated = pattern.sub(text + "\n", current) if pattern.search(current) else current.rstrip() + "\n\n" + text
+        updated = (
+            pattern.sub(text + "\n", current) if pattern.search(current) else current.rstrip() + "\n\n" + text
+        )
         RESULTS.write_text(updated, encoding="utf-8")
 
 

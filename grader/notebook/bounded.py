@@ -97,8 +97,7 @@ def _unreadable(name: str, what: str) -> FileVerdict:
     return FileVerdict(
         "error",
         f"{name} cannot be read: {what}. A notebook of ordinary cells reads in well under a second; "
-        "look for a cell that is enormous or nests brackets or expressions thousands deep, remove it, "
-        "save the notebook and submit again (or submit your code as a .py file).",
+        "look for a cell that is enormous or nests brackets or expressions thousands deep, remove it, save the notebook and submit again (or submit your code as a .py file).",  # noqa: E501
     )
 
 
@@ -133,12 +132,15 @@ def _main() -> None:
         built = FileVerdict("error", _unreadable_message(name, "its code nests too deeply for the reader"))
     except MemoryError:
         built = FileVerdict(
-            "error", _unreadable_message(name, f"reading it needed more than {MEMORY_BYTES // 2**20:,} MiB of memory")
+            "error",
+            _unreadable_message(name, f"reading it needed more than {MEMORY_BYTES // 2**20:,} MiB of memory"),
         )
     if isinstance(built, FileVerdict):
         reply = _Reply(status=built.status, message=built.message)
     else:
-        reply = _Reply(status="module", source=built.source, summary=built.summary, origins=list(built.origins))
+        reply = _Reply(
+            status="module", source=built.source, summary=built.summary, origins=list(built.origins)
+        )
     sys.stdout.write(reply.model_dump_json())
 
 

@@ -127,7 +127,11 @@ def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) ->
 
 def _skip(builder: _Builder, cell: Cell, line: int, reason: str, code: str) -> SkippedCode:
     entry = SkippedCode(
-        cell=cell.number, execution_count=cell.execution_count, line=line, reason=reason, code=_shortened(code)
+        cell=cell.number,
+        execution_count=cell.execution_count,
+        line=line,
+        reason=reason,
+        code=_shortened(code),
     )
     builder.skipped.append(entry)
     return entry
@@ -135,7 +139,9 @@ def _skip(builder: _Builder, cell: Cell, line: int, reason: str, code: str) -> S
 
 def _add_cell(builder: _Builder, cell: Cell) -> None:
     if len(cell.source) > MAX_CELL_CHARS:
-        too_large = f"the cell has {len(cell.source):,} characters, more than the {MAX_CELL_CHARS:,} the grader reads"
+        too_large = (
+            f"the cell has {len(cell.source):,} characters, more than the {MAX_CELL_CHARS:,} the grader reads"
+        )
         _broken_cell(builder, cell, cell.source, ValueError(too_large))
         return
     defined = builder.scope.kinds.keys() | builder.skipped_bindings.keys()
@@ -145,7 +151,9 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
         _skip(builder, cell, 1, f"cell magic {magic}: the whole cell is left out", cell.source.strip())
         return
     if magic is not None:
-        _skip(builder, cell, 1, f"cell magic {magic} (the cell's statements are judged like any other's)", magic)
+        _skip(
+            builder, cell, 1, f"cell magic {magic} (the cell's statements are judged like any other's)", magic
+        )
     for special in transformed.special:
         entry = _skip(builder, cell, special.line, special.kind, special.code)
         for bound in special.binds:
@@ -160,7 +168,9 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
         return
     depth = _depth(tree)
     if depth > MAX_DEPTH:
-        too_deep = ValueError(f"its code nests {depth:,} levels deep, more than the {MAX_DEPTH} the grader reads")
+        too_deep = ValueError(
+            f"its code nests {depth:,} levels deep, more than the {MAX_DEPTH} the grader reads"
+        )
         _broken_cell(builder, cell, transformed.source, too_deep)
         return
     lines = transformed.source.splitlines()
@@ -230,10 +240,8 @@ def _broken_cell(builder: _Builder, cell: Cell, source: str, error: SyntaxError 
     builder.broken.append(f"{message}. Fix the cell, run it, save the notebook and submit again.")
     first = True
     for name in missing:
-        text = (
-            f"\ndef {name}(*args, **kwargs):\n    raise SyntaxError({message!r} "
-            f"+ ', so {name}() was never defined. Fix the cell, run it, save the notebook and submit again.')"
-        )
+        explained = f"{message}, so {name}() was never defined. Fix the cell, run it, save the notebook and submit again."  # noqa: E501
+        text = f"\ndef {name}(*args, **kwargs):\n    raise SyntaxError({explained!r})"
         if first:
             builder.kept.append(f"# --- notebook cell {cell.number} (not valid Python) ---")
             builder.origins.append(None)
@@ -261,7 +269,9 @@ def _defines(line: str, name: str) -> bool:
     return match is not None and match.group(1) == name
 
 
-def _skip_reason(builder: _Builder, statement: ast.stmt, scope: Scope | None = None) -> tuple[str | None, list[ast.expr]]:
+def _skip_reason(
+    builder: _Builder, statement: ast.stmt, scope: Scope | None = None
+) -> tuple[str | None, list[ast.expr]]:
     """(None when the statement runs at import, else what it is in the student's words; the decorators
     left out of a kept definition)."""
     scope = scope or builder.scope
@@ -269,7 +279,11 @@ def _skip_reason(builder: _Builder, statement: ast.stmt, scope: Scope | None = N
         case ast.Import():
             return None, []
         case ast.ImportFrom():
-            return (None, []) if statement.names[0].name != "*" or statement.level == 0 else ("relative `import *`", [])
+            return (
+                (None, [])
+                if statement.names[0].name != "*" or statement.level == 0
+                else ("relative `import *`", [])
+            )
         case ast.FunctionDef() | ast.AsyncFunctionDef():
             dropped = [d for d in statement.decorator_list if not rules.decorator_kept(d, scope)]
             evaluated = [*statement.args.defaults, *statement.args.kw_defaults]
@@ -283,7 +297,10 @@ def _skip_reason(builder: _Builder, statement: ast.stmt, scope: Scope | None = N
         case ast.Expr(value=ast.Constant()):
             return None, []
         case ast.Expr(value=ast.Call() as call):
-            return f"call of {rules.dotted_name(call.func) or 'an expression'}(...) (a demo, not run at import)", []
+            return (
+                f"call of {rules.dotted_name(call.func) or 'an expression'}(...) (a demo, not run at import)",
+                [],
+            )
         case ast.Expr():
             return "expression whose value Jupyter displays", []
         case ast.Assign() | ast.AnnAssign() | ast.AugAssign():
@@ -303,7 +320,9 @@ def _skip_reason(builder: _Builder, statement: ast.stmt, scope: Scope | None = N
     return f"top-level `{type(statement).__name__.lower()}` statement (not run at import)", []
 
 
-def _class_reason(builder: _Builder, statement: ast.ClassDef, scope: Scope) -> tuple[str | None, list[ast.expr]]:
+def _class_reason(
+    builder: _Builder, statement: ast.ClassDef, scope: Scope
+) -> tuple[str | None, list[ast.expr]]:
     dropped = [d for d in statement.decorator_list if not rules.decorator_kept(d, scope)]
     for base in statement.bases:
         kind = None if isinstance(base, ast.Starred) else rules.evaluate(base, scope)
@@ -319,7 +338,9 @@ def _class_reason(builder: _Builder, statement: ast.ClassDef, scope: Scope) -> t
             continue
         reason, inner_dropped = _skip_reason(builder, inner, body)
         if reason is not None or inner_dropped:
-            return f"class whose body runs code at import (line {inner.lineno - statement.lineno + 1} of the class: {reason or 'a decorator'})", []  # noqa: E501
+            line = inner.lineno - statement.lineno + 1
+            what = reason or "a decorator"
+            return f"class whose body runs code at import (line {line} of the class: {what})", []
         _bind(body, inner, builder)
     return None, dropped
 
@@ -330,12 +351,16 @@ def _assignment_reason(
     targets = statement.targets if isinstance(statement, ast.Assign) else [statement.target]
     if not all(_is_name_target(target) for target in targets):
         return "assignment into an object (not run at import)"
-    if isinstance(statement, ast.AnnAssign) and not builder.postponed_annotations:
-        if not rules.stored_ok(statement.annotation, scope):
-            return "annotation that runs code at import"
+    evaluated_annotation = isinstance(statement, ast.AnnAssign) and not builder.postponed_annotations
+    if evaluated_annotation and not rules.stored_ok(statement.annotation, scope):  # type: ignore[union-attr]
+        return "annotation that runs code at import"
     if isinstance(statement, ast.AugAssign):
         target = statement.target
-        if not (isinstance(target, ast.Name) and scope.lookup(target.id) is not None and target.id in _all_kinds(scope)):
+        if not (
+            isinstance(target, ast.Name)
+            and scope.lookup(target.id) is not None
+            and target.id in _all_kinds(scope)
+        ):
             return "update of a name no kept statement sets"
         if rules.safe(target, scope) and rules.safe(statement.value, scope):
             return None
@@ -349,7 +374,13 @@ def _assignment_reason(
     if rules.stored_ok(value, scope):
         return None
     missing = sorted(
-        {node.id for node in ast.walk(value) if isinstance(node, ast.Name) and node.id in builder.skipped_bindings and scope.lookup(node.id) is None}  # noqa: E501
+        {
+            node.id
+            for node in ast.walk(value)
+            if isinstance(node, ast.Name)
+            and node.id in builder.skipped_bindings
+            and scope.lookup(node.id) is None
+        }
     )
     if missing:
         return f"assignment using {', '.join(f'`{name}`' for name in missing)}, set by a skipped statement"
@@ -409,7 +440,11 @@ def _bindings(node: ast.stmt, scope: Scope, builder: _Builder) -> Iterator[tuple
         case ast.Import():
             for alias in node.names:
                 top = alias.name.split(".")[0]
-                yield (alias.asname or top), rules.import_kind(alias.name, 0), (alias.name if alias.asname else top)
+                yield (
+                    (alias.asname or top),
+                    rules.import_kind(alias.name, 0),
+                    (alias.name if alias.asname else top),
+                )
         case ast.ImportFrom():
             for alias in node.names:
                 if alias.name != "*":
@@ -418,7 +453,8 @@ def _bindings(node: ast.stmt, scope: Scope, builder: _Builder) -> Iterator[tuple
         case ast.FunctionDef() | ast.AsyncFunctionDef():
             decorators = [rules.dotted_name(d) for d in node.decorator_list]
             is_property = decorators == ["property"] or any(
-                isinstance(d, ast.Attribute) and d.attr in ("setter", "getter", "deleter") for d in node.decorator_list
+                isinstance(d, ast.Attribute) and d.attr in ("setter", "getter", "deleter")
+                for d in node.decorator_list
             )
             yield node.name, Kind.PROPERTY if is_property else Kind.STUDENT, None
         case ast.ClassDef():
@@ -518,7 +554,11 @@ def unbound_globals(
             where = skipped_bindings[name]
             entries.append(
                 UnboundGlobal(
-                    function=function, name=name, cell=where.cell, line=where.line, code=where.code,
+                    function=function,
+                    name=name,
+                    cell=where.cell,
+                    line=where.line,
+                    code=where.code,
                     broken_cell=where.reason.endswith(_BROKEN) or _BROKEN + " (" in where.reason,
                 )
             )
@@ -565,7 +605,9 @@ def _statement_text(lines: list[str], statement: ast.stmt, dropped: list[ast.exp
     return "\n".join(chunk)
 
 
-def _origins(lines: list[str], statement: ast.stmt, dropped: list[ast.expr], cell: int) -> list[tuple[int, int] | None]:
+def _origins(
+    lines: list[str], statement: ast.stmt, dropped: list[ast.expr], cell: int
+) -> list[tuple[int, int] | None]:
     start = _first_line(statement)
     end = statement.end_lineno or statement.lineno
     return [(cell, line) for line in range(start, end + 1)]

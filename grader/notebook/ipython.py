@@ -23,13 +23,105 @@ ESCAPES = {"!": "shell command", "%": "IPython magic", "?": "help request", ",":
            ";": "IPython autocall", "/": "IPython autocall"}  # fmt: skip
 """IPython's ESC_* characters (``!!``, ``%%`` and ``??`` start with one of them)."""
 LINE_MAGICS = frozenset(
-    """alias alias_magic autoawait autocall automagic autosave bookmark cat cd clear colors conda config
-    connect_info cp debug dhist dirs doctest_mode ed edit env gui hist history killbgscripts ldir less lf
-    lk ll load load_ext loadpy logoff logon logstart logstate logstop ls lsmagic lx macro magic man
-    matplotlib mkdir more mv notebook page pastebin pdb pdef pdoc pfile pinfo pinfo2 pip popd pprint
-    precision prun psearch psource pushd pwd pycat pylab qtconsole quickref recall rehashx reload_ext rep
-    rerun reset reset_selective rm rmdir run save sc set_env store sx system tb time timeit unalias
-    unload_ext who who_ls whos xdel xmode""".split()
+    [
+        "alias",
+        "alias_magic",
+        "autoawait",
+        "autocall",
+        "automagic",
+        "autosave",
+        "bookmark",
+        "cat",
+        "cd",
+        "clear",
+        "colors",
+        "conda",
+        "config",
+        "connect_info",
+        "cp",
+        "debug",
+        "dhist",
+        "dirs",
+        "doctest_mode",
+        "ed",
+        "edit",
+        "env",
+        "gui",
+        "hist",
+        "history",
+        "killbgscripts",
+        "ldir",
+        "less",
+        "lf",
+        "lk",
+        "ll",
+        "load",
+        "load_ext",
+        "loadpy",
+        "logoff",
+        "logon",
+        "logstart",
+        "logstate",
+        "logstop",
+        "ls",
+        "lsmagic",
+        "lx",
+        "macro",
+        "magic",
+        "man",
+        "matplotlib",
+        "mkdir",
+        "more",
+        "mv",
+        "notebook",
+        "page",
+        "pastebin",
+        "pdb",
+        "pdef",
+        "pdoc",
+        "pfile",
+        "pinfo",
+        "pinfo2",
+        "pip",
+        "popd",
+        "pprint",
+        "precision",
+        "prun",
+        "psearch",
+        "psource",
+        "pushd",
+        "pwd",
+        "pycat",
+        "pylab",
+        "qtconsole",
+        "quickref",
+        "recall",
+        "rehashx",
+        "reload_ext",
+        "rep",
+        "rerun",
+        "reset",
+        "reset_selective",
+        "rm",
+        "rmdir",
+        "run",
+        "save",
+        "sc",
+        "set_env",
+        "store",
+        "sx",
+        "system",
+        "tb",
+        "time",
+        "timeit",
+        "unalias",
+        "unload_ext",
+        "who",
+        "who_ls",
+        "whos",
+        "xdel",
+        "xmode",
+    ]
 )
 """The line magics (and shell aliases) of an IPython 8 kernel, which automagic runs without their ``%``."""
 PASSES = 20
@@ -163,7 +255,8 @@ def _special_lines(lines: list[str]) -> tuple[list[tuple[SpecialLine, int]], boo
         meaningful = [
             token
             for token in body
-            if token.type not in (tokenize.NEWLINE, tokenize.NL, tokenize.COMMENT) and not token.string.isspace()
+            if token.type not in (tokenize.NEWLINE, tokenize.NL, tokenize.COMMENT)
+            and not token.string.isspace()
         ]
         if not meaningful:
             continue
@@ -210,7 +303,9 @@ def _automagic(lines: list[str], defined: Container[str]) -> SpecialLine | None:
     """A one-line cell whose first word is a magic's name (``pip install gym``), as IPython's prefilter
     runs it: only for one-line cells, unless the name is a variable, builtin or keyword, and not when the
     rest of the line assigns (``time = 3``)."""
-    meaningful = [(index, line) for index, line in enumerate(lines) if line.strip() and line.strip() != "pass"]
+    meaningful = [
+        (index, line) for index, line in enumerate(lines) if line.strip() and line.strip() != "pass"
+    ]
     if len(meaningful) != 1 or any(line.strip() == "pass" for line in lines):
         return None
     index, line = meaningful[0]

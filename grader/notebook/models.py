@@ -31,15 +31,16 @@ class UnboundGlobal(BaseModel):
     line: int = Field(description="Line of that statement within its cell.")
     code: str = Field(description="That statement's first line.")
     broken_cell: bool = Field(
-        default=False, description="The statement sits in a cell that is not valid Python (so none of it ran)."
+        default=False,
+        description="The statement sits in a cell that is not valid Python (so none of it ran).",
     )
 
     def note(self) -> str:
         """The sentence added to the feedback of the problem named after ``function``."""
         if self.broken_cell:
             return (
-                f"Notebook: {self.function}() uses `{self.name}`, which only cell {self.cell} defines, and that cell "
-                f"cannot be read (line {self.line}: `{self.code}`), so Jupyter ran none of it either: "
+                f"Notebook: {self.function}() uses `{self.name}`, which only cell {self.cell} defines, "
+                f"and that cell cannot be read (line {self.line}: `{self.code}`), so Jupyter ran none of it either: "  # noqa: E501
                 "fix that cell, run it, save the notebook and submit again."
             )
         return (
@@ -62,8 +63,7 @@ class NotebookSummary(BaseModel):
     )
     ignored: list[str] = Field(
         default_factory=list,
-        description="What of the file itself the grader ignored to read the cells (metadata that does not "
-        "follow the nbformat schema, an old format version).",
+        description="What of the file itself the grader ignored to read the cells (metadata that does not follow the nbformat schema, an old format version).",  # noqa: E501
     )
 
     def notes_for(self, function: str) -> list[str]:

@@ -79,7 +79,9 @@ def read_cells(data: bytes, name: str) -> NotebookCells | FileVerdict:
             f"{name} is not a readable notebook: it is not valid JSON ({detail}). "
             "Open it in Jupyter, save it again (File > Save) and submit the saved .ipynb, or submit your code as a .py file.",  # noqa: E501
         )
-    if not isinstance(notebook, dict) or not isinstance(notebook.get("cells", notebook.get("worksheets")), list):
+    if not isinstance(notebook, dict) or not isinstance(
+        notebook.get("cells", notebook.get("worksheets")), list
+    ):
         return FileVerdict(
             "error",
             f'{name} is JSON but not a Jupyter notebook (expected an object with "nbformat" and a list of "cells"). '  # noqa: E501
@@ -89,7 +91,8 @@ def read_cells(data: bytes, name: str) -> NotebookCells | FileVerdict:
     language = _language(notebook.get("metadata"))
     if language is not None and not language.lower().startswith(PYTHON_LANGUAGES):
         return FileVerdict(
-            "error", f"{name} is a {language} notebook; the lab is graded in Python. Submit a Python notebook."
+            "error",
+            f"{name} is a {language} notebook; the lab is graded in Python. Submit a Python notebook.",
         )
     raw_cells = _raw_cells(notebook, ignored)
     if isinstance(raw_cells, str):
@@ -97,7 +100,9 @@ def read_cells(data: bytes, name: str) -> NotebookCells | FileVerdict:
     cells: list[Cell] = []
     for number, raw in enumerate(raw_cells, start=1):
         if not isinstance(raw, dict):
-            return FileVerdict("error", f"{name} is not a readable notebook: cell {number} is not an object. {_RESAVE}")
+            return FileVerdict(
+                "error", f"{name} is not a readable notebook: cell {number} is not an object. {_RESAVE}"
+            )
         if raw.get("cell_type") != "code":
             continue
         source = raw.get("source", raw.get("input", ""))
@@ -106,8 +111,8 @@ def read_cells(data: bytes, name: str) -> NotebookCells | FileVerdict:
         if not isinstance(source, str):
             return FileVerdict(
                 "error",
-                f"{name} is not a readable notebook: the source of code cell {number} is a "
-                f"{type(source).__name__}, not text. {_RESAVE}",
+                f"{name} is not a readable notebook: the source of code cell {number} is a {type(source).__name__}, not text. "  # noqa: E501
+                f"{_RESAVE}",
             )
         count = raw.get("execution_count", raw.get("prompt_number"))
         if source.strip():
@@ -117,7 +122,7 @@ def read_cells(data: bytes, name: str) -> NotebookCells | FileVerdict:
         return FileVerdict(
             "error",
             f"{name} holds {code_chars:,} characters of code; the grader reads at most {MAX_CODE_CHARS:,}. "
-            "Remove the cells that are not part of your solution (or your code as a .py file) and submit again.",
+            "Remove the cells that are not part of your solution (or submit your code as a .py file) and submit again.",  # noqa: E501
         )
     if not cells:
         return FileVerdict(

@@ -144,7 +144,7 @@ def _stored(node: ast.expr | None, scope: Scope) -> bool:
     return node is None or _evaluate(node, scope) is not None
 
 
-def _evaluate(node: ast.expr, scope: Scope) -> Kind | None:  # noqa: C901 - one case per kind of expression
+def _evaluate(node: ast.expr, scope: Scope) -> Kind | None:
     match node:
         case ast.Constant():
             return Kind.SAFE
@@ -159,7 +159,9 @@ def _evaluate(node: ast.expr, scope: Scope) -> Kind | None:  # noqa: C901 - one 
             # The container is library code, but what it holds may be anything (sys.modules["submission"]).
             return Kind.STUDENT if _safe(node.value, scope) and _safe(node.slice, scope) else None
         case ast.Slice():
-            return Kind.SAFE if all(_safe(part, scope) for part in (node.lower, node.upper, node.step)) else None
+            return (
+                Kind.SAFE if all(_safe(part, scope) for part in (node.lower, node.upper, node.step)) else None
+            )
         case ast.BinOp():
             return Kind.SAFE if _safe(node.left, scope) and _safe(node.right, scope) else None
         case ast.UnaryOp():
@@ -221,7 +223,9 @@ def _sequence(elements: Sequence[ast.expr], scope: Scope) -> Kind | None:
 def _call(node: ast.Call, scope: Scope) -> Kind | None:
     if scope.canonical(node.func) not in CHEAP_CALLS:
         return None
-    arguments = [_unstarred(argument) for argument in node.args] + [keyword.value for keyword in node.keywords]
+    arguments = [_unstarred(argument) for argument in node.args] + [
+        keyword.value for keyword in node.keywords
+    ]
     return Kind.SAFE if all(_safe(argument, scope) for argument in arguments) else None
 
 
@@ -233,7 +237,9 @@ def _comprehension(
         if generator.is_async or not _safe(generator.iter, inner):
             return None
         targets = list(ast.walk(generator.target))
-        if not all(isinstance(target, ast.Name | ast.Tuple | ast.List | ast.expr_context) for target in targets):
+        if not all(
+            isinstance(target, ast.Name | ast.Tuple | ast.List | ast.expr_context) for target in targets
+        ):
             return None  # a target such as `obj.attr` or `d[k]` assigns into an object
         for target in targets:
             if isinstance(target, ast.Name):
@@ -253,7 +259,9 @@ def decorator_kept(decorator: ast.expr, scope: Scope) -> bool:
     if scope.canonical(target) not in KEPT_DECORATORS:
         return False
     if isinstance(decorator, ast.Call):
-        arguments = [_unstarred(a) for a in decorator.args] + [keyword.value for keyword in decorator.keywords]
+        arguments = [_unstarred(a) for a in decorator.args] + [
+            keyword.value for keyword in decorator.keywords
+        ]
         return all(_safe(argument, scope) for argument in arguments)
     return True
 

@@ -49,7 +49,7 @@ def run(module: NotebookModule) -> list[str]:
     submission = types.ModuleType(MODULE_NAME)
     sys.modules[MODULE_NAME] = submission
     try:
-        exec(compile(module.source, "lab.ipynb.py", "exec"), vars(submission))  # noqa: S102 - our own samples
+        exec(compile(module.source, "lab.ipynb.py", "exec"), vars(submission))
     finally:
         del sys.modules[MODULE_NAME]
     called = vars(submission)["CALLED"]
@@ -82,7 +82,7 @@ EXPRESSIONS: dict[str, list[tuple[str, bool]]] = {
     "Compare": [("x = Hooked == 1", SKIPPED), ("x = 1 in Hooked", SKIPPED), ("x = 1 < 2", KEPT)],
     "Call": [("x = hooked()", SKIPPED), ("x = list(Hooked)", SKIPPED), ("x = Hooked()", SKIPPED),
              ("x = np.zeros((500, 6))", KEPT), ("env = gym.make('CartPole-v1')", KEPT)],
-    "FormattedValue": [("x = f'{Hooked:>10}'", SKIPPED), ("x = f'{Hooked!r}'", SKIPPED), ("x = f'{3:>4}'", KEPT)],
+    "FormattedValue": [("x = f'{Hooked:>10}'", SKIPPED), ("x = f'{Hooked!r}'", SKIPPED), ("x = f'{3:>4}'", KEPT)],  # noqa: E501
     "JoinedStr": [("x = f'{Hooked}'", SKIPPED), ("x = f'run {1}'", KEPT)],
     "Constant": [("x = 'text'", KEPT), ("x = ...", KEPT)],
     "Attribute": [("x = Hooked.anything", SKIPPED), ("x = hooked.__name__", SKIPPED), ("x = np.pi", KEPT)],
@@ -102,7 +102,9 @@ def test_every_kind_of_expression_has_cases() -> None:
 
 
 @pytest.mark.parametrize(("kind", "cell", "expected"), CASES, ids=[f"{k}: {c}" for k, c, _ in CASES])
-def test_an_expression_is_kept_only_when_it_cannot_call_student_code(kind: str, cell: str, expected: bool) -> None:
+def test_an_expression_is_kept_only_when_it_cannot_call_student_code(
+    kind: str, cell: str, expected: bool
+) -> None:
     assert any(type(node).__name__ == kind for node in ast.walk(ast.parse(cell)))
     module = built(cell)
     assert kept(module) is expected, module.summary.skipped
@@ -143,7 +145,10 @@ def test_a_statement_is_kept_only_when_it_cannot_call_student_code(cell: str, ex
 
 
 def test_a_student_decorator_is_not_applied_and_the_function_is_graded_without_it() -> None:
-    module = built("@hooked\ndef taxi():\n    return 1", "import functools\n@functools.lru_cache\ndef car():\n    return 2")
+    module = built(
+        "@hooked\ndef taxi():\n    return 1",
+        "import functools\n@functools.lru_cache\ndef car():\n    return 2",
+    )
     assert "def taxi" in module.source and "@hooked" not in module.source
     assert [(entry.cell, entry.code) for entry in module.summary.skipped] == [(2, "@hooked")]
     assert run(module) == []
