@@ -11,6 +11,7 @@ grader.notebook.bounded``, sends the bytes, and validates the reply; whatever go
 from __future__ import annotations
 
 import json
+import os
 import resource
 import signal
 import subprocess
@@ -78,6 +79,10 @@ def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) ->
             capture_output=True,
             timeout=WALL_SECONDS,
             cwd=ROOT,
+            env={
+                **os.environ,
+                "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
+            },
             check=False,
         )
     except subprocess.TimeoutExpired:
