@@ -48,6 +48,9 @@ it is left out like a cell that is not Python, so parsing stays cheap."""
 MAX_DEPTH = 500
 """Deepest syntax tree a kept cell may have (honest code nests a few dozen levels; ``1+1+...+1`` nests
 once per ``+``). The reduction is recursive, so a deeper cell is left out before it is walked."""
+MAX_LISTED_SKIPPED = 1_000
+"""Skipped statements listed one by one; the rest are counted in one last entry (a notebook of 200,000
+``!echo`` lines must not make a report of 200,000 rows)."""
 MAX_NOTED_GLOBALS = 20
 """Missing globals noted per graded function (the first, alphabetically): enough to say what to fix, and a
 notebook of thousands of them cannot swell the report."""
@@ -66,6 +69,7 @@ class _Builder:
     skipped_bindings: dict[str, SkippedCode] = field(default_factory=dict)
     scope: Scope = field(default_factory=Scope)
     kept_statements: int = 0
+    unlisted: list[SkippedCode] = field(default_factory=list)
     broken: list[str] = field(default_factory=list)
     postponed_annotations: bool = False
     graded: Collection[str] | None = None
@@ -117,7 +121,7 @@ def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) ->
     summary = NotebookSummary(
         code_cells=len(read.cells),
         kept_statements=builder.kept_statements,
-        skipped=builder.skipped,
+        skipped=_listed(builder),
         unbound_globals=unbound_globals(source, skipped_only, graded),
         ignored=read.ignored,
     )
@@ -133,8 +137,23 @@ def _skip(builder: _Builder, cell: Cell, line: int, reason: str, code: str) -> S
         reason=reason,
         code=_shortened(code),
     )
-    builder.skipped.append(entry)
+    (builder.skipped if len(builder.skipped) < MAX_LISTED_SKIPPED else builder.unlisted).append(entry)
     return entry
+
+
+def _listed(builder: _Builder) -> list[SkippedCode]:
+    """The skipped statements as the report lists them: the first ones, then one entry counting the rest."""
+    if not builder.unlisted:
+        return builder.skipped
+    first = builder.unlisted[0]
+    rest = SkippedCode(
+        cell=first.cell,
+        execution_count=first.execution_count,
+        line=first.line,
+        reason=f"this and {len(builder.unlisted) - 1:,} more statements left out (not listed one by one)",
+        code=first.code,
+    )
+    return [*builder.skipped, rest]
 
 
 def _add_cell(builder: _Builder, cell: Cell) -> None:

@@ -12,6 +12,7 @@ of one tokenization each, so a cell costs time linear in its size.
 from __future__ import annotations
 
 import ast
+import builtins
 import io
 import keyword
 import re
@@ -132,6 +133,7 @@ _CLASSIC_ANY = re.compile(r"^(>>>|\.\.\.)( |$)")
 _IPYTHON_PROMPT = re.compile(r"^(((\[nav\]|\[ins\])?\ )?In\ \[\d+\]:\ |\s*\.{3,}:\ ?)")
 _AUTOMAGIC = re.compile(r"^\s*([\w*.]+)(.*)$")
 _INDENT = re.compile(r"^[ \t]+")
+_BUILTIN_NAMES = frozenset(dir(builtins))
 
 
 @dataclass(frozen=True)
@@ -314,7 +316,7 @@ def _automagic(lines: list[str], defined: Container[str]) -> SpecialLine | None:
         return None
     word, rest = match.group(1), match.group(2)
     head = word.split(".", 1)[0]
-    if word not in LINE_MAGICS or head in defined or keyword.iskeyword(head) or head in dir(__builtins__):
+    if word not in LINE_MAGICS or head in defined or keyword.iskeyword(head) or head in _BUILTIN_NAMES:
         return None
     if rest.strip()[:1] in ("=", ","):
         return None

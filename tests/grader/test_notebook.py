@@ -17,7 +17,7 @@ from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 from grader import cli
 from grader.grading import grade_submission, with_notebook
 from grader.notebook import NotebookModule, bounded, build_module
-from grader.notebook.building import MAX_NOTED_GLOBALS
+from grader.notebook.building import MAX_LISTED_SKIPPED, MAX_NOTED_GLOBALS
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
 from grader.validation import FileVerdict
@@ -394,3 +394,11 @@ def test_a_batch_with_poisoned_notebooks_grades_every_honest_one(tmp_path: Path)
         "alice": "1", "bob": "0", "carol": "1", "dave": "1", "erin": "1",
     }  # fmt: skip
     assert rows["bob"]["note"].startswith("bob.ipynb is not a readable notebook: its JSON nests too deeply")
+
+
+def test_thousands_of_skipped_lines_are_listed_up_to_a_cap_and_counted() -> None:
+    module = built(DEFINITION, "\n".join(["!echo hi"] * 3000))
+    assert len(module.summary.skipped) == MAX_LISTED_SKIPPED + 1
+    assert module.summary.skipped[-1].reason == (
+        "this and 1,999 more statements left out (not listed one by one)"
+    )

@@ -79,3 +79,8 @@ def test_thousands_of_escapes_are_transformed_in_one_pass() -> None:
     transformed = transform_cell(cell, set())
     assert len(transformed.special) == 5000
     assert transformed.source.splitlines()[-1] == "x = 1"
+
+
+def test_a_builtin_or_keyword_is_never_automagic() -> None:
+    assert transform_cell("print", set()).special == []
+    assert transform_cell("pass", set()).special == []
