@@ -178,7 +178,7 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
         for bound in special.binds:
             builder.skipped_bindings.setdefault(bound, entry)
     try:
-        tree = ast.parse(transformed.source)
+        tree = transformed.tree or ast.parse(transformed.source)
     except (SyntaxError, ValueError) as error:
         _broken_cell(builder, cell, transformed.source, error)
         return

@@ -154,11 +154,13 @@ class TransformedCell:
         source: The Python source (as many lines as the cell).
         special: The lines turned into ``pass``.
         cell_magic: ``%%name`` when the cell is a cell magic (its first line is then blank in ``source``).
+        tree: ``source`` parsed, when it was already (a valid cell is parsed once).
     """
 
     source: str
     special: list[SpecialLine] = field(default_factory=list)
     cell_magic: str | None = None
+    tree: ast.Module | None = None
 
 
 def transform_cell(source: str, defined: Container[str]) -> TransformedCell:
@@ -180,7 +182,8 @@ def transform_cell(source: str, defined: Container[str]) -> TransformedCell:
         result.cell_magic = lines[first].split()[0]
         lines[first] = ""
         # IPython runs the body of %%time/%%capture as Python; it has no escapes of its own.
-    for _ in range(PASSES if not _is_python(lines) else 0):
+    parsed = _parsed(lines)
+    for _ in range(PASSES if parsed is None else 0):
         found, complete = _special_lines(lines)
         for special, end in found:
             indent = _INDENT.match(lines[special.line - 1])
@@ -196,6 +199,7 @@ def transform_cell(source: str, defined: Container[str]) -> TransformedCell:
         lines[magic.line - 1] = "pass"
     result.special.sort(key=lambda special: special.line)
     result.source = "\n".join(lines)
+    result.tree = parsed if not result.special else None
     return result
 
 
@@ -216,15 +220,14 @@ def _without_prompts(lines: list[str], first: int) -> list[str]:
     return lines
 
 
-def _is_python(lines: list[str]) -> bool:
-    """True when the cell parses as it is: then no token transformation applies (each one's trigger, a
+def _parsed(lines: list[str]) -> ast.Module | None:
+    """The cell's syntax tree when it parses as it is: then no token transformation applies (each one's trigger, a
     line starting with ``!``, ``%``, ``?``, ``,``, ``;`` or ``/``, ``= !``, ``= %name`` or a trailing ``?``,
     is a syntax error in Python), and the tokenizer, pure Python and slow, need not run."""
     try:
-        ast.parse("\n".join(lines))
+        return ast.parse("\n".join(lines))
     except (SyntaxError, ValueError, MemoryError, RecursionError):
-        return False
-    return True
+        return None
 
 
 def _logical_lines(lines: list[str]) -> tuple[list[list[tokenize.TokenInfo]], bool]:
