@@ -221,9 +221,9 @@ def _without_prompts(lines: list[str], first: int) -> list[str]:
 
 
 def _parsed(lines: list[str]) -> ast.Module | None:
-    """The cell's syntax tree when it parses as it is: then no token transformation applies (each one's trigger, a
-    line starting with ``!``, ``%``, ``?``, ``,``, ``;`` or ``/``, ``= !``, ``= %name`` or a trailing ``?``,
-    is a syntax error in Python), and the tokenizer, pure Python and slow, need not run."""
+    """The cell's syntax tree when it parses as it is: then no token transformation applies (each one's
+    trigger, a line starting with ``!``, ``%``, ``?``, ``,``, ``;`` or ``/``, ``= !``, ``= %name`` or a
+    trailing ``?``, is a syntax error in Python), and the tokenizer, pure Python and slow, need not run."""
     try:
         return ast.parse("\n".join(lines))
     except (SyntaxError, ValueError, MemoryError, RecursionError):
