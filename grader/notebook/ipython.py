@@ -134,6 +134,8 @@ _IPYTHON_PROMPT = re.compile(r"^(((\[nav\]|\[ins\])?\ )?In\ \[\d+\]:\ |\s*\.{3,}
 _AUTOMAGIC = re.compile(r"^\s*([\w*.]+)(.*)$")
 _INDENT = re.compile(r"^[ \t]+")
 _BUILTIN_NAMES = frozenset(dir(builtins))
+_TRIGGER = re.compile(r"[!%?]|^[ \t]*[,;/]", re.M)
+"""A character without which no token transformation applies (a cell of none is not tokenized)."""
 
 
 @dataclass(frozen=True)
@@ -183,7 +185,8 @@ def transform_cell(source: str, defined: Container[str]) -> TransformedCell:
         lines[first] = ""
         # IPython runs the body of %%time/%%capture as Python; it has no escapes of its own.
     parsed = _parsed(lines)
-    for _ in range(PASSES if parsed is None else 0):
+    special_syntax = parsed is None and _TRIGGER.search("\n".join(lines)) is not None
+    for _ in range(PASSES if special_syntax else 0):
         found, complete = _special_lines(lines)
         for special, end in found:
             indent = _INDENT.match(lines[special.line - 1])
