@@ -374,6 +374,7 @@ def notebook_lines(notebook: NotebookSummary) -> list[str]:
     for entry in notebook.skipped:
         label = f"In [{entry.execution_count}]" if entry.execution_count is not None else "no run"
         lines.append(f"  cell {entry.cell} ({label}), line {entry.line}: {entry.code}  <- {entry.reason}")
+    lines += [f"  ignored: {note}" for note in notebook.ignored]
     return [*lines, ""]
 
 

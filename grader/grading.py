@@ -143,7 +143,7 @@ def grade_files(
         graded: dict[Path, Path] = {}
         notebooks: dict[Path, NotebookModule] = {}
         for path, data in contents.items():
-            prepared = _prepare(path, data, Path(modules_dir))
+            prepared = _prepare(path, data, Path(modules_dir), plan.problems)
             if isinstance(prepared, FileVerdict):
                 reports[path] = _rejected_report(path, data or b"", plan, seed, prepared)
                 _announce(on_result, path, reports[path].problems)
@@ -191,12 +191,12 @@ def grade_files(
 
 
 def _prepare(
-    path: Path, data: bytes | None, modules_dir: Path
+    path: Path, data: bytes | None, modules_dir: Path, graded: Sequence[str]
 ) -> tuple[Path, NotebookModule | None] | FileVerdict:
     """The file the sandbox imports for a submission: the file itself, or the module built from a notebook."""
     if data is None or not is_notebook(path.name):
         return _file_verdict(path, data) or (path, None)
-    built = build_module(data, path.name)
+    built = build_module(data, path.name, graded)
     if isinstance(built, FileVerdict):
         return built
     module = modules_dir / f"{len(list(modules_dir.iterdir()))}" / f"{path.name}.py"

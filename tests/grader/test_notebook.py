@@ -2,16 +2,22 @@
 
 from __future__ import annotations
 
+import csv
 import json
+import signal
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import nbformat
 import pytest
 from grading_support import SUBMISSIONS
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 
+from grader import cli
 from grader.grading import grade_submission, with_notebook
-from grader.notebook import NotebookModule, build_module
+from grader.notebook import NotebookModule, bounded, build_module
+from grader.notebook.building import MAX_LISTED_SKIPPED, MAX_NOTED_GLOBALS
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
 from grader.validation import FileVerdict
@@ -24,7 +30,7 @@ def notebook_bytes(*sources: str, markdown_first: bool = False) -> bytes:
 
 
 def built(*sources: str) -> NotebookModule:
-    module = build_module(notebook_bytes(*sources), "lab.ipynb")
+    module = build_module(notebook_bytes(*sources), "lab.ipynb", None)
     assert isinstance(module, NotebookModule), module
     return module
 
@@ -148,22 +154,24 @@ def test_future_imports_move_to_the_top() -> None:
     [
         (b'{"cells": [', "error", "lab.ipynb is not a readable notebook: it is not valid JSON"),
         (b"", "missing", "lab.ipynb is empty: nothing to grade."),
-        (json.dumps({"nbformat": 3, "nbformat_minor": 0, "worksheets": [], "metadata": {}}).encode(), "error",
-         "lab.ipynb is a notebook in format version 3; the grader reads nbformat 4"),
+        (json.dumps({"nbformat": 3, "nbformat_minor": 0, "worksheets": [], "metadata": {}}).encode(), "missing",  # noqa: E501
+         "lab.ipynb has no code cells: nothing to grade."),
         (json.dumps({"nbformat": 4, "nbformat_minor": 5, "cells": "x", "metadata": {}}).encode(), "error",
-         "lab.ipynb is not a valid nbformat 4 notebook"),
+         "lab.ipynb is JSON but not a Jupyter notebook"),
+        (json.dumps({"nbformat": 4, "nbformat_minor": 5, "cells": [{"cell_type": "code", "source": 3}]}).encode(),  # noqa: E501
+         "error", "lab.ipynb is not a readable notebook: the source of code cell 1 is a int, not text."),
         (nbformat.writes(new_notebook(cells=[new_markdown_cell("# only text")])).encode(), "missing",
          "lab.ipynb has no code cells: nothing to grade."),
         (notebook_bytes("print('hello')", "%timeit 1"), "missing",
          "lab.ipynb has code cells, but none of them defines anything"),
-        (notebook_bytes(DEFINITION, "def taxi(:\n    pass", markdown_first=True), "error",
-         "lab.ipynb: code cell 3 is not valid Python: invalid syntax (line 1 of the cell)."),
+        (notebook_bytes("def taxi(:\n    pass", markdown_first=True), "error",
+         "lab.ipynb, code cell 2 is not valid Python: invalid syntax (line 1 of the cell). Fix the cell"),
         (nbformat.writes(new_notebook(cells=[new_code_cell("x <- 1")],
                                       metadata={"language_info": {"name": "R"}})).encode(), "error",
          "lab.ipynb is a R notebook; the lab is graded in Python."),
     ],
-    ids=["invalid-json", "empty", "nbformat-3", "not-a-notebook", "no-code-cells", "only-demos",
-         "syntax-error", "other-language"],
+    ids=["invalid-json", "empty", "nbformat-3-empty", "not-a-notebook", "unreadable-cell", "no-code-cells",
+         "only-demos", "only-a-broken-definition", "other-language"],
 )  # fmt: skip
 def test_bad_notebooks_get_a_clear_verdict(data: bytes, status: str, message: str) -> None:
     verdict = build_module(data, "lab.ipynb")
@@ -182,7 +190,9 @@ def test_a_bad_notebook_is_a_submission_error_without_running_anything(tmp_path:
 
 
 def test_the_report_carries_the_summary_and_the_notes() -> None:
-    module = build_module((SUBMISSIONS / "notebooks" / "taxi_global_table.ipynb").read_bytes(), "t.ipynb")
+    module = build_module(
+        (SUBMISSIONS / "notebooks" / "taxi_global_table.ipynb").read_bytes(), "t.ipynb", ["taxi"]
+    )
     assert isinstance(module, NotebookModule)
     result = ProblemResult(
         id="taxi", title="Taxi", status="error", score=0, max_score=1,
@@ -213,3 +223,182 @@ def test_the_check_summary_lists_what_was_skipped_cell_by_cell() -> None:
         "  cell 1 (no run), line 1: !pip install gym  <- shell command",
         "  cell 2 (no run), line 3: print(cartpole())  <- call of print(...) (a demo, not run at import)",
     ]
+
+
+HOSTILE = SUBMISSIONS / "hostile"
+NOTEBOOKS = SUBMISSIONS / "notebooks"
+
+
+def _json_notebook(*sources: str) -> dict[str, Any]:
+    loaded: dict[str, Any] = json.loads(notebook_bytes(*sources))
+    return loaded
+
+
+def _without_display_name(notebook: dict[str, Any]) -> None:
+    notebook["metadata"]["kernelspec"] = {"name": "python3", "language": "python"}
+
+
+def _odd_metadata(notebook: dict[str, Any]) -> None:
+    notebook["metadata"] = []
+    notebook["nbformat_minor"] = 99
+    for cell in notebook["cells"]:
+        del cell["id"]
+
+
+def _no_metadata(notebook: dict[str, Any]) -> None:
+    del notebook["metadata"]
+    del notebook["cells"][0]["outputs"]
+
+
+@pytest.mark.parametrize(
+    ("change", "ignored"),
+    [
+        (_without_display_name, "'display_name' is a required property"),
+        (_odd_metadata, "[] is not of type 'object'"),
+        (_no_metadata, "is a required property"),
+    ],
+    ids=["kernelspec-without-display-name", "odd-metadata-future-minor-no-ids", "no-metadata-no-outputs"],
+)
+def test_metadata_that_does_not_validate_is_noted_and_ignored(
+    change: Callable[[dict[str, Any]], None], ignored: str
+) -> None:
+    notebook = _json_notebook(DEFINITION)
+    change(notebook)
+    module = build_module(json.dumps(notebook).encode(), "lab.ipynb")
+    assert isinstance(module, NotebookModule), module
+    assert "def cartpole" in module.source
+    [note] = module.summary.ignored
+    assert ignored in note and "the grader read its code cells" in note
+
+
+def test_an_old_nbformat_3_notebook_is_read() -> None:
+    module = build_module((NOTEBOOKS / "old_format_v3.ipynb").read_bytes(), "old.ipynb")
+    assert isinstance(module, NotebookModule), module
+    assert "def cartpole" in module.source
+    assert module.summary.ignored == ["an nbformat 3 notebook (IPython 1-3); its cells were read as such"]
+    assert [(entry.cell, entry.execution_count) for entry in module.summary.skipped] == [(4, 3)]
+
+
+def test_a_half_written_cell_is_left_out_and_the_rest_is_graded() -> None:
+    module = build_module((NOTEBOOKS / "automagic_and_half_written.ipynb").read_bytes(), "lab.ipynb", ["car"])
+    assert isinstance(module, NotebookModule), module
+    assert "def cartpole" in module.source and "def car" in module.source
+    reasons = {entry.code: entry.reason for entry in module.summary.skipped}
+    assert reasons["pip install gym==0.17.3"] == "IPython magic (automagic)"
+    assert reasons["def plot_car_positions(:"] == (
+        "not valid Python, so Jupyter ran none of it either: the whole cell is left out"
+    )
+    assert "plot_car_positions" not in module.source
+
+
+def test_a_graded_function_in_a_broken_cell_raises_an_error_naming_the_cell() -> None:
+    module = build_module((NOTEBOOKS / "car_in_broken_cell.ipynb").read_bytes(), "opengym.ipynb", ["car"])
+    assert isinstance(module, NotebookModule), module
+    stand_in = module.source.split("# --- notebook cell 3 (not valid Python) ---\n")[1].split("# ---")[0]
+    namespace: dict[str, Any] = {}
+    exec(compile(stand_in, "opengym.ipynb.py", "exec"), namespace)
+    with pytest.raises(SyntaxError) as raised:
+        namespace["car"]()
+    assert str(raised.value).startswith(
+        "opengym.ipynb, code cell 3 (In [12]) is not valid Python: '(' was never closed (line 7 of the cell), "  # noqa: E501
+        "so car() was never defined."
+    )
+    line = module.source.splitlines().index("def car(*args, **kwargs):") + 1
+    assert module.cited(f'File "opengym.ipynb.py", line {line}', "opengym.ipynb.py") == (
+        'File "opengym.ipynb", cell 3, line 1'
+    )
+
+
+def test_a_helper_in_a_broken_cell_is_named_in_the_note_of_the_function_using_it() -> None:
+    data = notebook_bytes(
+        "def helper():\n    return 1\ndef unfinished(:\n", "def car():\n    return helper()"
+    )
+    module = build_module(data, "lab.ipynb", ["car"])
+    assert isinstance(module, NotebookModule), module
+    assert "def helper" not in module.source
+    assert module.summary.notes_for("car") == [
+        "Notebook: car() uses `helper`, which only cell 1 defines, and that cell cannot be read (line 3: "
+        "`def unfinished(:`), so Jupyter ran none of it either: fix that cell, run it, save the notebook and "
+        "submit again."
+    ]
+
+
+@pytest.mark.parametrize(
+    ("sample", "message"),
+    [
+        (
+            "deep_json.ipynb",
+            "deep_json.ipynb is not a readable notebook: its JSON nests too deeply for the reader.",
+        ),
+    ],
+    ids=["json-nesting"],
+)
+def test_a_file_the_reader_cannot_take_is_that_submissions_error(sample: str, message: str) -> None:
+    verdict = build_module((HOSTILE / sample).read_bytes(), sample, ["cartpole"])
+    assert isinstance(verdict, FileVerdict)
+    assert verdict.message.startswith(message)
+
+
+def test_cells_that_nest_too_deeply_or_are_too_large_are_left_out_with_a_note() -> None:
+    module = build_module((HOSTILE / "deep_nesting.ipynb").read_bytes(), "deep.ipynb", ["cartpole"])
+    assert isinstance(module, NotebookModule), module
+    assert [(entry.cell, entry.reason) for entry in module.summary.skipped] == [
+        (3, "its code nests too deeply to parse: the whole cell is left out"),
+        (4, "its code nests too deeply to parse: the whole cell is left out"),
+        (5, "its code nests too deeply to parse: the whole cell is left out"),
+    ]
+    too_large = built(DEFINITION, "x = [" + "1, " * 70_000 + "]")
+    assert too_large.summary.skipped[0].reason == (
+        "the cell has 210,006 characters, more than the 200,000 the grader reads: the whole cell is left out"
+    )
+
+
+def test_thousands_of_functions_are_read_and_the_graded_ones_analysed() -> None:
+    module = build_module((HOSTILE / "thousands_of_functions.ipynb").read_bytes(), "many.ipynb", ["cartpole"])
+    assert isinstance(module, NotebookModule), module
+    assert module.summary.kept_statements == 10_004
+    assert {entry.function for entry in module.summary.unbound_globals} == {"cartpole"}
+    assert len(module.summary.unbound_globals) == MAX_NOTED_GLOBALS  # of the 50 it reads
+
+
+@pytest.mark.parametrize(
+    ("returncode", "stderr", "expected"),
+    [
+        (-signal.SIGXCPU, b"", "reading it used more than 30 seconds of CPU"),
+        (-signal.SIGKILL, b"", "reading it used more than 30 seconds of CPU"),
+        (3, b"Traceback...\nMemoryError\n", "reading it needed more than 1,536 MiB of memory"),
+        (-signal.SIGSEGV, b"", "the reader crashed on it (signal 11)"),
+    ],
+    ids=["cpu-limit", "killed", "memory", "crash"],
+)
+def test_the_death_of_the_reading_child_is_worded(returncode: int, stderr: bytes, expected: str) -> None:
+    assert bounded._death(returncode, stderr) == expected
+
+
+def test_a_batch_with_poisoned_notebooks_grades_every_honest_one(tmp_path: Path) -> None:
+    inputs = tmp_path / "inputs"
+    inputs.mkdir()
+    samples = {
+        "alice.ipynb": NOTEBOOKS / "bad_metadata.ipynb",
+        "bob.ipynb": HOSTILE / "deep_json.ipynb",
+        "carol.ipynb": HOSTILE / "deep_nesting.ipynb",
+        "dave.ipynb": HOSTILE / "import_hooks.ipynb",
+        "erin.ipynb": NOTEBOOKS / "automagic_and_half_written.ipynb",
+    }
+    for name, sample in samples.items():
+        (inputs / name).write_bytes(sample.read_bytes())
+    out = tmp_path / "out"
+    assert cli.main(["grade", str(inputs), "--out", str(out), "--only", "cartpole", "--seed", "7"]) == 0
+    rows = {row["submission"]: row for row in csv.DictReader((out / "grades.csv").open())}
+    assert {name: row["cartpole"] for name, row in rows.items()} == {
+        "alice": "1", "bob": "0", "carol": "1", "dave": "1", "erin": "1",
+    }  # fmt: skip
+    assert rows["bob"]["note"].startswith("bob.ipynb is not a readable notebook: its JSON nests too deeply")
+
+
+def test_thousands_of_skipped_lines_are_listed_up_to_a_cap_and_counted() -> None:
+    module = built(DEFINITION, "\n".join(["!echo hi"] * 3000))
+    assert len(module.summary.skipped) == MAX_LISTED_SKIPPED + 1
+    assert module.summary.skipped[-1].reason == (
+        "this and 1,999 more statements left out (not listed one by one)"
+    )
