@@ -389,7 +389,7 @@ def test_a_batch_with_poisoned_notebooks_grades_every_honest_one(tmp_path: Path)
         (inputs / name).write_bytes(sample.read_bytes())
     out = tmp_path / "out"
     assert cli.main(["grade", str(inputs), "--out", str(out), "--only", "cartpole", "--seed", "7"]) == 0
-    rows = {row["submission"]: row for row in csv.DictReader((out / "grades.csv").open())}
+    rows = {row["student"]: row for row in csv.DictReader((out / "grades.csv").open())}
     assert {name: row["cartpole"] for name, row in rows.items()} == {
         "alice": "1", "bob": "0", "carol": "1", "dave": "1", "erin": "1",
     }  # fmt: skip
