@@ -38,9 +38,11 @@ class PythonPaths:
 
     Attributes:
         executable: The interpreter binary.
-        roots: Directories to expose read-only (prefixes and site directories, even when nested).
-        stdlib: Standard-library entries of the child's sys.path.
-        site_dirs: Site directories of the child's sys.path (after the stdlib).
+        roots: Directories to expose read-only (prefixes, the executable's directory, the stdlib and
+            site directories that exist), resolved, each once, even when nested (a layer that mounts
+            them decides which it needs: `grader.sandbox.isolation.bubblewrap.interpreter_binds`).
+        stdlib: Standard-library entries of the child's sys.path (resolved).
+        site_dirs: Existing site directories of the child's sys.path, after the stdlib (resolved).
         hidden: Files and directories inside `roots` the child must not see (.pth hooks, the editable
             install's finder, installed copies of the project's packages).
     """
@@ -110,13 +112,31 @@ def remove_host_scratch(scratch: Path) -> None:
     shutil.rmtree(scratch, ignore_errors=True)
 
 
+def _existing_directory(path: str) -> Path | None:
+    resolved = Path(path).resolve()
+    return resolved if resolved.is_dir() else None
+
+
 @functools.cache
 def python_paths() -> PythonPaths:
-    """The paths of the running interpreter (the child runs the same interpreter)."""
+    """The paths of the running interpreter (the child runs the same interpreter).
+
+    Derived from what the interpreter imports: its prefixes (shared libraries live there), the directory of
+    its executable, the standard-library entries of `sys.path` and the site directories that exist, each
+    resolved (symbolic links followed) so that the child's `sys.path` names the paths that are bound.
+    """
     prefixes = {Path(sys.base_prefix).resolve(), Path(sys.prefix).resolve()}
-    site_dirs = [p for p in site.getsitepackages() if os.path.isdir(p)]
-    stdlib = [p for p in sys.path if p and p not in site_dirs and any(p.startswith(str(x)) for x in prefixes)]
-    roots = prefixes | {Path(directory).resolve() for directory in site_dirs}
+    site_dirs = list(dict.fromkeys(str(d) for p in site.getsitepackages() if (d := _existing_directory(p))))
+    stdlib = [
+        str(Path(p).resolve())
+        for p in sys.path
+        if p
+        and str(Path(p).resolve()) not in site_dirs
+        and any(Path(p).resolve().is_relative_to(prefix) for prefix in prefixes)
+    ]
+    executable = Path(sys.executable).resolve()
+    candidates = [*prefixes, executable.parent, *map(Path, stdlib), *map(Path, site_dirs)]
+    roots = {path for path in candidates if path.is_dir()}
     hidden: list[Path] = []
     for site_dir in site_dirs:
         for entry in Path(site_dir).iterdir():
@@ -125,9 +145,9 @@ def python_paths() -> PythonPaths:
             if hook or (name in PROJECT_PACKAGES and entry.is_dir()):
                 hidden.append(entry)
     return PythonPaths(
-        executable=Path(sys.executable).resolve(),
+        executable=executable,
         roots=tuple(sorted(roots)),
-        stdlib=tuple(stdlib),
+        stdlib=tuple(dict.fromkeys(stdlib)),
         site_dirs=tuple(site_dirs),
         hidden=tuple(sorted(hidden)),
     )
