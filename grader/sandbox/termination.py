@@ -73,8 +73,8 @@ def classify_exit(child: ChildProcess, function: str | None, limits: Limits) -> 
     if function is None and code in (1, JOIN_FAILED_EXIT) and _looks_like_sandbox_failure(child):
         return Ending(
             OutcomeStatus.SANDBOX_ERROR,
-            f"the sandbox failed to start ({_start_failure(child)}); this is not your fault: tell the "
-            "instructor (`gymgrade doctor` shows the sandbox's binds and layers on this machine)",
+            f"the sandbox failed to start ({_start_failure(child)}); "
+            "this is not your fault: tell the instructor (`gymgrade doctor` shows the sandbox's binds and layers on this machine)",  # noqa: E501
         )
     if number == signal.SIGXCPU:
         return Ending(

@@ -9,6 +9,7 @@ import os
 import shutil
 import site
 import sys
+import sysconfig
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -127,12 +128,14 @@ def python_paths() -> PythonPaths:
     """
     prefixes = {Path(sys.base_prefix).resolve(), Path(sys.prefix).resolve()}
     site_dirs = list(dict.fromkeys(str(d) for p in site.getsitepackages() if (d := _existing_directory(p))))
+    stdlib_dirs = {Path(sysconfig.get_path(name)).resolve() for name in ("stdlib", "platstdlib")}
+    stdlib_zip = f"python{sys.version_info.major}{sys.version_info.minor}.zip"
     stdlib = [
         str(Path(p).resolve())
         for p in sys.path
         if p
+        and (Path(p).name == stdlib_zip or any(Path(p).resolve().is_relative_to(d) for d in stdlib_dirs))
         and str(Path(p).resolve()) not in site_dirs
-        and any(Path(p).resolve().is_relative_to(prefix) for prefix in prefixes)
     ]
     executable = Path(sys.executable).resolve()
     candidates = [*prefixes, executable.parent, *map(Path, stdlib), *map(Path, site_dirs)]

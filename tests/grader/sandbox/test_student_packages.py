@@ -7,10 +7,9 @@ from collections.abc import Iterator
 
 import pytest
 
+from grader.config import STUDENT_MODULES
 from grader.sandbox import Call, IsolationPolicy, Limits, OutcomeStatus, Sandbox
 
-STUDENT_PACKAGES = ("tqdm", "matplotlib", "scipy", "pandas", "IPython")
-"""What the course's students import besides numpy and gym (issue 19); pyproject.toml installs them."""
 SUBMISSION = textwrap.dedent(
     """
     import matplotlib.pyplot as plt
@@ -45,7 +44,7 @@ SUBMISSION = textwrap.dedent(
         test = st.binomtest(int(frame["win"].sum()), n, 1 / 3)
         return [plt.get_backend().lower(), round(float(frame["win"].mean()), 4), test.pvalue > 0.01]
     """
-).format(packages=STUDENT_PACKAGES)
+).format(packages=STUDENT_MODULES)
 
 
 @pytest.fixture(scope="module")
@@ -61,7 +60,7 @@ def sandbox(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Sandbox]:
 def test_every_student_package_imports_in_the_full_sandbox(sandbox: Sandbox) -> None:
     outcome = sandbox.call(Call("versions", (), record_episodes=False))
     assert outcome.status is OutcomeStatus.OK, outcome.message
-    assert isinstance(outcome.value, dict) and sorted(outcome.value) == sorted(STUDENT_PACKAGES)
+    assert isinstance(outcome.value, dict) and sorted(outcome.value) == sorted(STUDENT_MODULES)
 
 
 @pytest.mark.sandbox
