@@ -20,7 +20,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from grader.sandbox.errors import SandboxLayoutError
-from grader.sandbox.isolation.filesystem import SYSTEM_DIRS, ChildView, PythonPaths, python_paths
+from grader.sandbox.isolation.filesystem import (
+    SYSTEM_CONFIG_DIRS,
+    SYSTEM_DIRS,
+    ChildView,
+    PythonPaths,
+    python_paths,
+)
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 from grader.sandbox.isolation.privileges import running_as_root
 
@@ -52,6 +58,9 @@ def _system_binds() -> list[str]:
             arguments += ["--symlink", os.readlink(directory), directory]
         elif os.path.isdir(directory):
             arguments += ["--ro-bind", directory, directory]
+    for directory in SYSTEM_CONFIG_DIRS:
+        if os.path.isdir(directory):
+            arguments += [*_dirs_for(Path(directory), set()), "--ro-bind", directory, directory]
     return arguments
 
 

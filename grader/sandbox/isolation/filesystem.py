@@ -18,6 +18,9 @@ from grader.sandbox.isolation.scope import temp_root
 
 SYSTEM_DIRS = ("/usr", "/bin", "/sbin", "/lib", "/lib64", "/lib32")
 """System directories the child may read (bubblewrap binds them, Landlock allows reading them)."""
+SYSTEM_CONFIG_DIRS = ("/etc/fonts",)
+"""Configuration the child may read where it exists: fontconfig's, which matplotlib's font search runs
+(`fc-list`) the first time a child draws; without it every plot prints a "Fontconfig error"."""
 PROJECT_PACKAGES = ("grader", "reference", "api")
 """Top-level packages of the project; hidden wherever an installed copy would make them importable."""
 
