@@ -91,18 +91,20 @@ def interpreter_binds(
         masked: The directories covered by an empty tmpfs before them.
 
     Raises:
-        SandboxLayoutError: a directory would cover the whole file system or a system directory, so the
-            masks inside it would be lost.
+        SandboxLayoutError: a directory contains a system directory, a mask or the scratch /tmp (a Python
+            installed at / or at /tmp), so binding it would undo them.
     """
     mounts: dict[Path, str] = {path: "bind" for path in system}
     mounts.update({path: "mask" for path in masked})
     binds: list[Path] = []
     for root in sorted(set(roots), key=lambda path: (len(path.parts), path)):
-        if any(mount.is_relative_to(root) and mount != root for mount in mounts if mounts[mount] == "bind"):
+        covered = [mount for mount, kind in mounts.items() if kind == "bind" and mount.is_relative_to(root)]
+        covered = [mount for mount in covered if mount != root]
+        covered += [Path(SCRATCH_DIR)] if Path(SCRATCH_DIR).is_relative_to(root) else []
+        if covered:
             raise SandboxLayoutError(
-                f"the interpreter directory {root} contains the system directory bound read-only inside it; "
-                "binding it would undo the sandbox's hidden directories: install Python under its own prefix "
-                "(a virtualenv, pyenv, /opt/...) instead of /"
+                f"the interpreter directory {root} contains {covered[0]}, which the sandbox replaces or hides; "  # noqa: E501
+                "binding it read-only would undo that: install Python under a prefix of its own (a virtualenv, pyenv, /opt/python) and run gymgrade from there"  # noqa: E501
             )
         if _deepest_mount(root, mounts) == "bind":
             continue

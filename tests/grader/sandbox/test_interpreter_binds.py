@@ -101,11 +101,23 @@ def test_nothing_the_usr_bind_shows_is_bound_again_so_the_usr_local_mask_stays_a
     assert not any(bind != Path("/usr/local") and Path("/usr/local").is_relative_to(bind) for bind in binds)
 
 
-def test_an_interpreter_directory_containing_a_system_directory_is_refused_by_name() -> None:
-    with pytest.raises(
-        SandboxLayoutError, match=r"the interpreter directory / contains the system directory"
-    ):
-        interpreter_binds((Path("/"), Path("/usr/lib/python3.11")), SYSTEM, MASKED)
+@pytest.mark.parametrize(
+    ("root", "contained"),
+    [("/", "/usr"), ("/tmp", "/tmp"), ("/usr/local", None)],
+    ids=["root", "tmp", "usr-local"],
+)
+def test_an_interpreter_directory_over_the_sandboxs_own_mounts_is_refused_by_name(
+    root: str, contained: str | None
+) -> None:
+    roots = (Path(root), Path(root) / "lib" / "python3.11")
+    if contained is None:  # a Python built into /usr/local is bound over the /usr/local mask, as it should
+        assert interpreter_binds(roots, SYSTEM, MASKED) == (Path(root),)
+        return
+    with pytest.raises(SandboxLayoutError) as raised:
+        interpreter_binds(roots, SYSTEM, MASKED)
+    assert str(raised.value).startswith(
+        f"the interpreter directory {root} contains {contained}, which the sandbox"
+    )
 
 
 def test_bwrap_messages_name_the_hosts_path() -> None:
