@@ -250,6 +250,19 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_similarity_command(subparsers)
 
+    doctor = subparsers.add_parser(
+        "doctor",
+        help="show the interpreter, the sandbox's binds and layers, and the student modules (instructors)",
+    )
+    doctor.add_argument(
+        "--config",
+        type=Path,
+        default=None,
+        metavar="PATH",
+        help="assignment configuration (its student_modules)",
+    )
+    doctor.set_defaults(handler=run_doctor)
+
     for entry_point in entry_points(group=COMMAND_GROUP):
         try:
             entry_point.load()(subparsers)
@@ -294,6 +307,16 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _interrupt(signum: int, _frame: object) -> None:
     raise KeyboardInterrupt(signal.Signals(signum).name)
+
+
+def run_doctor(args: argparse.Namespace) -> int:
+    """`gymgrade doctor`: what the sandbox is made of here; exit 0 only when it is ready to grade."""
+    from grader.config import load_config
+    from grader.doctor import diagnose, render
+
+    diagnosis = diagnose(load_config(args.config).sandbox.student_modules)
+    print(render(diagnosis))
+    return 0 if diagnosis.healthy else EXIT_ERROR
 
 
 def run_check(args: argparse.Namespace) -> int:

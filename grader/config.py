@@ -32,6 +32,8 @@ from grader.problems import PROBLEMS
 from grader.sandbox.limits import Limits
 
 DEFAULT_CONFIG_PATH = Path(__file__).with_name("assignment.toml")
+STUDENT_MODULES = ("tqdm", "matplotlib", "scipy", "pandas", "IPython")
+"""What this course's students import in their own code (pyproject.toml's dependencies install them)."""
 
 
 class SandboxConfig(StrictModel):
@@ -46,6 +48,11 @@ class SandboxConfig(StrictModel):
     file_bytes: int = Field(gt=0, description="Largest file the student may write.")
     open_files: int = Field(gt=0, description="File descriptors the child may hold.")
     frame_bytes: int = Field(gt=0, description="Largest result (return value + episode logs) accepted.")
+    student_modules: tuple[Annotated[str, Field(pattern=r"^[A-Za-z_]\w*$")], ...] = Field(
+        default=STUDENT_MODULES,
+        description="Top-level modules the course's students import besides the standard library, numpy and gym; "  # noqa: E501
+        "`gymgrade doctor` checks that each one imports inside the sandbox.",
+    )
 
     def to_limits(self, call_seconds: float) -> Limits:
         """The sandbox `Limits` for calls of one problem.
@@ -53,7 +60,7 @@ class SandboxConfig(StrictModel):
         Args:
             call_seconds: The problem's per-call wall-clock limit.
         """
-        return Limits(call_seconds=call_seconds, **self.model_dump())
+        return Limits(call_seconds=call_seconds, **self.model_dump(exclude={"student_modules"}))
 
 
 class AssignmentConfig(StrictModel):

@@ -14,3 +14,10 @@ class IsolationUnavailable(SandboxError):
 
 class SandboxClosedError(SandboxError):
     """Raised when a call is made on a `Sandbox` that has already been closed."""
+
+
+class SandboxLayoutError(SandboxError):
+    """Raised when the interpreter's directories cannot be shown to the child as they are on the host.
+
+    The message names the directory, why it cannot be bound, and what to install instead.
+    """

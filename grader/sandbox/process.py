@@ -5,6 +5,7 @@ from __future__ import annotations
 import atexit
 import contextlib
 import os
+import re
 import selectors
 import signal
 import subprocess
@@ -29,19 +30,45 @@ def _close_running() -> None:
         child.close()
 
 
+_CARRIAGE_RETURN = re.compile(rb"\r(?!\n)")
+"""A carriage return that does not end a line: the terminal goes back to the start of the line."""
+
+
 class CappedOutput:
-    """Keeps the first `cap` bytes of a stream and counts the rest."""
+    """Keeps the first `cap` bytes of a stream as a terminal would show them, and counts the rest.
+
+    A line rewritten in place (`\r`, as progress bars such as tqdm and `clear_output` do thousands of
+    times) keeps only its last state, so a progress bar costs one line of the cap, not the whole cap.
+    """
 
     def __init__(self, cap: int) -> None:
         self.cap = cap
         self.head = bytearray()
         self.dropped = 0
+        self._line_start = 0
+        self._pending_return = False
 
     def add(self, data: bytes) -> None:
-        """Appends `data`, keeping at most `cap` bytes in total."""
-        room = self.cap - len(self.head)
-        self.head += data[: max(room, 0)]
-        self.dropped += max(len(data) - max(room, 0), 0)
+        """Appends `data`, keeping at most `cap` bytes in total (nothing more once anything was dropped)."""
+        if self._pending_return:
+            data, self._pending_return = b"\r" + data, False
+        if data.endswith(b"\r"):  # "\r\n" may be split between two reads
+            data, self._pending_return = data[:-1], True
+        first, *rewrites = _CARRIAGE_RETURN.split(data)
+        self._append(first)
+        for text in rewrites:
+            if not self.dropped:
+                del self.head[self._line_start :]
+            self._append(text)
+
+    def _append(self, data: bytes) -> None:
+        room = 0 if self.dropped else max(self.cap - len(self.head), 0)
+        kept = data[:room]
+        self.head += kept
+        self.dropped += len(data) - len(kept)
+        newline = kept.rfind(b"\n")
+        if newline >= 0:
+            self._line_start = len(self.head) - len(kept) + newline + 1
 
     def take(self) -> str:
         """The kept text (NULs replaced, a note on what was dropped), then starts afresh."""
@@ -50,6 +77,8 @@ class CappedOutput:
             text += f"\n[... {self.dropped} more bytes of output were dropped (limit {self.cap} bytes)]\n"
         self.head = bytearray()
         self.dropped = 0
+        self._line_start = 0
+        self._pending_return = False
         return text
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import signal
 from dataclasses import dataclass
 
+from grader.sandbox.isolation.bubblewrap import without_new_root
 from grader.sandbox.isolation.cgroup import JOIN_FAILED_EXIT
 from grader.sandbox.limits import Limits
 from grader.sandbox.outcome import OutcomeStatus
@@ -72,7 +73,8 @@ def classify_exit(child: ChildProcess, function: str | None, limits: Limits) -> 
     if function is None and code in (1, JOIN_FAILED_EXIT) and _looks_like_sandbox_failure(child):
         return Ending(
             OutcomeStatus.SANDBOX_ERROR,
-            "the sandbox failed to start; this is not your fault: tell the instructor",
+            f"the sandbox failed to start ({_start_failure(child)}); "
+            "this is not your fault: tell the instructor (`gymgrade doctor` shows the sandbox's binds and layers on this machine)",  # noqa: E501
         )
     if number == signal.SIGXCPU:
         return Ending(
@@ -100,6 +102,16 @@ def classify_exit(child: ChildProcess, function: str | None, limits: Limits) -> 
         OutcomeStatus.EXITED,
         f"{what} ended the process with exit status {code} {where} (sys.exit(), exit() or os._exit()); {fix}",
     )
+
+
+_START_FAILURE_CHARS = 300
+
+
+def _start_failure(child: ChildProcess) -> str:
+    """The wrapper's first line (bwrap names the path and the reason), as the host names the path."""
+    lines = child.stderr.head.decode("utf-8", errors="replace").strip().splitlines() or ["no message"]
+    first = lines[0] if lines[0].startswith(("bwrap:", "gymgrade-join:", "setpriv:")) else lines[-1]
+    return without_new_root(first)[:_START_FAILURE_CHARS]
 
 
 def _looks_like_sandbox_failure(child: ChildProcess) -> bool:

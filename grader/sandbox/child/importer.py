@@ -57,9 +57,20 @@ def import_submission(path: Path) -> ModuleType | ImportFailure:
     return module
 
 
+MISSING_MODULE_HINT = (
+    "; the grader has no module `{name}`: "
+    "use the packages your course provides, or ask your instructor to add it; "
+    "instructors install the package into the grader's Python (for example in pyproject.toml's dependencies) and list `{name}` in [sandbox] student_modules of the assignment (docs/operations.md)"  # noqa: E501
+)
+
+
 def describe_exception(error: BaseException) -> str:
-    """`TypeName: message`, the last line of a traceback."""
-    return "".join(traceback.format_exception_only(type(error), error)).strip().splitlines()[-1]
+    """`TypeName: message`, the last line of a traceback (with how to get a missing module added)."""
+    line = "".join(traceback.format_exception_only(type(error), error)).strip().splitlines()[-1]
+    name = getattr(error, "name", None) if isinstance(error, ModuleNotFoundError) else None
+    if isinstance(name, str) and name.partition(".")[0].isidentifier():
+        line += MISSING_MODULE_HINT.format(name=name.partition(".")[0])
+    return line
 
 
 def student_traceback(error: BaseException, path: Path) -> str:

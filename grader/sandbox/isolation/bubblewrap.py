@@ -1,7 +1,13 @@
 """Bubblewrap: every namespace unshared, a read-only minimal file system and a size-limited scratch tmpfs.
 
-The child sees /usr (without /usr/local), the interpreter's prefix and site directories, the harness
+The child sees /usr (without /usr/local), the interpreter's directories (`interpreter_binds`), the harness
 tree at /gymgrade, its own file at /submission, a private /proc and /dev, and a tmpfs at /tmp.
+
+Mount order: the system directories, the tmpfs masks over /usr/local and /tmp, then each interpreter
+directory not already visible read-only (ancestors first), then the hidden hooks. An interpreter directory
+that lies inside the /usr bind (Debian's prefix /usr, /usr/lib/python3/dist-packages) is not bound again:
+a second bind of /usr would cover the /usr/local mask and leave nothing there for bubblewrap to remount
+read-only ("Can't remount readonly on /newroot/usr/local").
 """
 
 from __future__ import annotations
@@ -13,7 +19,14 @@ import subprocess
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from grader.sandbox.isolation.filesystem import SYSTEM_DIRS, ChildView, PythonPaths
+from grader.sandbox.errors import SandboxLayoutError
+from grader.sandbox.isolation.filesystem import (
+    SYSTEM_CONFIG_DIRS,
+    SYSTEM_DIRS,
+    ChildView,
+    PythonPaths,
+    python_paths,
+)
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 from grader.sandbox.isolation.privileges import running_as_root
 
@@ -24,6 +37,8 @@ HARNESS_DIR = "/gymgrade"
 SUBMISSION_DIR = "/submission"
 SCRATCH_DIR = "/tmp"
 LOCAL_DIR = "/usr/local"
+MASKED_DIRS = (LOCAL_DIR, SCRATCH_DIR)
+"""Directories covered by an empty tmpfs in the sandbox (interpreter directories in them are bound again)."""
 _REMEDY = "install bubblewrap >= 0.8 (`apt-get install bubblewrap`) and allow user namespaces (`sysctl kernel.unprivileged_userns_clone=1`, or run as root)"  # noqa: E501
 
 
@@ -43,20 +58,100 @@ def _system_binds() -> list[str]:
             arguments += ["--symlink", os.readlink(directory), directory]
         elif os.path.isdir(directory):
             arguments += ["--ro-bind", directory, directory]
+    for directory in SYSTEM_CONFIG_DIRS:
+        if os.path.isdir(directory):
+            arguments += [*_dirs_for(Path(directory), set()), "--ro-bind", directory, directory]
     return arguments
+
+
+def _system_bind_targets() -> tuple[Path, ...]:
+    return tuple(Path(d) for d in SYSTEM_DIRS if os.path.isdir(d) and not os.path.islink(d))
+
+
+def _deepest_mount(path: Path, mounts: dict[Path, str]) -> str | None:
+    covering = [mount for mount in mounts if path.is_relative_to(mount)]
+    return mounts[max(covering, key=lambda mount: len(mount.parts))] if covering else None
+
+
+def interpreter_binds(
+    roots: tuple[Path, ...],
+    system: tuple[Path, ...] = (),
+    masked: tuple[Path, ...] = tuple(map(Path, MASKED_DIRS)),
+) -> tuple[Path, ...]:
+    """The interpreter directories to bind read-only, in mount order (ancestors first), each once.
+
+    A directory is left out when the mount that would show it is already a read-only bind: a system
+    directory (`/usr` holds Debian's prefix, stdlib and /usr/lib/python3/dist-packages) or an interpreter
+    directory bound before it (a virtualenv's site-packages inside the virtualenv). One under a mask
+    (/usr/local, /tmp) is bound again on top of the mask.
+
+    Args:
+        roots: The interpreter's directories (`PythonPaths.roots`), resolved.
+        system: The system directories bound read-only before them (`SYSTEM_DIRS` that are directories).
+        masked: The directories covered by an empty tmpfs before them.
+
+    Raises:
+        SandboxLayoutError: a directory contains a system directory, a mask or the scratch /tmp (a Python
+            installed at / or at /tmp), so binding it would undo them.
+    """
+    mounts: dict[Path, str] = {path: "bind" for path in system}
+    mounts.update({path: "mask" for path in masked})
+    binds: list[Path] = []
+    for root in sorted(set(roots), key=lambda path: (len(path.parts), path)):
+        covered = [mount for mount, kind in mounts.items() if kind == "bind" and mount.is_relative_to(root)]
+        covered = [mount for mount in covered if mount != root]
+        covered += [Path(SCRATCH_DIR)] if Path(SCRATCH_DIR).is_relative_to(root) else []
+        if covered:
+            raise SandboxLayoutError(
+                f"the interpreter directory {root} contains {covered[0]}, which the sandbox replaces or hides; "  # noqa: E501
+                "binding it read-only would undo that: install Python under a prefix of its own (a virtualenv, pyenv, /opt/python) and run gymgrade from there"  # noqa: E501
+            )
+        if _deepest_mount(root, mounts) == "bind":
+            continue
+        mounts[root] = "bind"
+        binds.append(root)
+    return tuple(binds)
 
 
 def _scratch(size: int) -> list[str]:
     return ["--perms", "1777", "--size", str(size), "--tmpfs", SCRATCH_DIR]
 
 
-def _dirs_for(path: Path) -> list[str]:
-    """Creates the parents of a bind target world-traversable (bwrap would copy /root's 0700)."""
+def _dirs_for(path: Path, created: set[str]) -> list[str]:
+    """Creates the parents of a bind target world-traversable (bwrap would copy /root's 0700), once each."""
     arguments: list[str] = []
     for parent in reversed(path.parents):
-        if str(parent) != "/":
+        if str(parent) != "/" and str(parent) not in created:
+            created.add(str(parent))
             arguments += ["--perms", "0755", "--dir", str(parent)]
     return arguments
+
+
+def file_system_argv(paths: PythonPaths, scratch_bytes: int) -> list[str]:
+    """The mounts showing the child the system, the interpreter's directories and a scratch tmpfs.
+
+    Raises:
+        SandboxLayoutError: the interpreter's directories cannot be bound (`interpreter_binds`).
+    """
+    argv = _system_binds()
+    hide_local = os.path.isdir(LOCAL_DIR) and not os.path.islink(LOCAL_DIR)
+    if hide_local:  # site-specific programs and data; the interpreter's directories are bound again below
+        argv += ["--tmpfs", LOCAL_DIR]
+    # The scratch tmpfs comes before the interpreter's directories: a virtualenv under /tmp (or anywhere
+    # below it) is bound on top of it and stays visible, instead of being hidden by it.
+    argv += _scratch(scratch_bytes)
+    masked = tuple(Path(d) for d in MASKED_DIRS if d != LOCAL_DIR or hide_local)
+    created: set[str] = set()
+    for root in interpreter_binds(paths.roots, _system_bind_targets(), masked):
+        argv += [*_dirs_for(root, created), "--ro-bind", str(root), str(root)]
+    if hide_local:
+        argv += ["--remount-ro", LOCAL_DIR]
+    for hidden in paths.hidden:
+        if hidden.is_dir():
+            argv += ["--tmpfs", str(hidden), "--remount-ro", str(hidden)]
+        else:
+            argv += ["--ro-bind", "/dev/null", str(hidden)]
+    return argv
 
 
 def bwrap_argv(
@@ -76,22 +171,7 @@ def bwrap_argv(
     """
     binary = shutil.which("bwrap") or "bwrap"
     argv = [binary, *_namespaces(), "--die-with-parent", "--new-session", "--clearenv"]
-    argv += _system_binds()
-    hide_local = os.path.isdir(LOCAL_DIR) and not os.path.islink(LOCAL_DIR)
-    if hide_local:  # site-specific programs and data; the interpreter's directories are bound again below
-        argv += ["--tmpfs", LOCAL_DIR]
-    # The scratch tmpfs comes before the interpreter's directories: a virtualenv under /tmp (or anywhere
-    # below it) is bound on top of it and stays visible, instead of being hidden by it.
-    argv += _scratch(scratch_bytes)
-    for root in paths.roots:
-        argv += [*_dirs_for(root), "--ro-bind", str(root), str(root)]
-    if hide_local:
-        argv += ["--remount-ro", LOCAL_DIR]
-    for hidden in paths.hidden:
-        if hidden.is_dir():
-            argv += ["--tmpfs", str(hidden), "--remount-ro", str(hidden)]
-        else:
-            argv += ["--ro-bind", "/dev/null", str(hidden)]
+    argv += file_system_argv(paths, scratch_bytes)
     argv += ["--ro-bind", str(harness_tree), HARNESS_DIR]
     argv += [
         "--perms",
@@ -113,22 +193,63 @@ def bwrap_argv(
     return [*argv, "--"]
 
 
+_SEES_DIRECTORIES = "import os, sys; sys.exit(' '.join(p for p in sys.argv[1:] if not os.path.isdir(p)) or 0)"
+"""Run by the probe's interpreter inside bwrap: exits naming each directory of its sys.path it cannot see."""
+_LAYOUT_REMEDY = "run `gymgrade doctor` and report its output; meanwhile install gymgrade in a virtualenv of a Python under its own prefix (pyenv, /opt/...)"  # noqa: E501
+
+
+def without_new_root(text: str) -> str:
+    """bwrap's message with its own mount point taken out, so that it names the host's path."""
+    return text.strip().replace("/newroot/", "/").replace('"/newroot"', '"/"')
+
+
+def _run(argv: list[str]) -> subprocess.CompletedProcess[str] | str:
+    try:
+        return subprocess.run(argv, capture_output=True, text=True, timeout=20, check=False)
+    except (OSError, subprocess.TimeoutExpired) as error:
+        return f"bwrap could not run ({error})"
+
+
+def _probe_interpreter(binary: str) -> str | None:
+    """Why the interpreter cannot start in the child's file system, or None when it can."""
+    paths = python_paths()
+    try:
+        mounts = file_system_argv(paths, 1 << 20)
+    except SandboxLayoutError as error:
+        return str(error)
+    wanted = [*paths.stdlib, *paths.site_dirs]
+    wanted = [directory for directory in wanted if os.path.isdir(directory)]
+    argv = [binary, *_namespaces(), "--die-with-parent", "--clearenv", *mounts]
+    argv += ["--dev", "/dev", "--proc", "/proc"]
+    result = _run([*argv, "--", str(paths.executable), "-S", "-c", _SEES_DIRECTORIES, *wanted])
+    if isinstance(result, str):
+        return result
+    if result.returncode == 0:
+        return None
+    message = without_new_root(result.stderr)
+    if not message.startswith("bwrap:"):
+        message = f"{paths.executable} started but cannot see these directories of its sys.path: {message}"
+    return f"the child's file system could not be built from the interpreter's directories: {message}"
+
+
 @functools.cache
 def _probe_machine() -> LayerReport:
-    """Runs `true` in a sandbox like the children's to see that bwrap and its namespaces work (once)."""
+    """Runs `true`, then the interpreter, in a sandbox like the children's (once): bwrap and its namespaces
+    work, and the interpreter's directories can be bound and are all visible to it."""
     name = BubblewrapLayer.name
     binary = shutil.which("bwrap")
     if binary is None:
         return LayerReport(name, False, "bubblewrap (bwrap) is not installed", _REMEDY)
     argv = [binary, *_namespaces(), "--die-with-parent", "--clearenv"]
     argv += _system_binds()
-    argv += ["--proc", "/proc", "--dev", "/dev", *_scratch(1 << 20), "--", "true"]
-    try:
-        result = subprocess.run(argv, capture_output=True, text=True, timeout=10, check=False)
-    except (OSError, subprocess.TimeoutExpired) as error:
-        return LayerReport(name, False, f"bwrap could not run ({error})", _REMEDY)
+    result = _run([*argv, "--proc", "/proc", "--dev", "/dev", *_scratch(1 << 20), "--", "true"])
+    if isinstance(result, str):
+        return LayerReport(name, False, result, _REMEDY)
     if result.returncode != 0:
-        return LayerReport(name, False, f"bwrap failed: {result.stderr.strip()}", _REMEDY)
+        return LayerReport(name, False, f"bwrap failed: {without_new_root(result.stderr)}", _REMEDY)
+    problem = _probe_interpreter(binary)
+    if problem is not None:
+        return LayerReport(name, False, problem, _LAYOUT_REMEDY)
     return LayerReport(
         name,
         True,

@@ -9,6 +9,7 @@ import os
 import shutil
 import site
 import sys
+import sysconfig
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,6 +18,9 @@ from grader.sandbox.isolation.scope import temp_root
 
 SYSTEM_DIRS = ("/usr", "/bin", "/sbin", "/lib", "/lib64", "/lib32")
 """System directories the child may read (bubblewrap binds them, Landlock allows reading them)."""
+SYSTEM_CONFIG_DIRS = ("/etc/fonts",)
+"""Configuration the child may read where it exists: fontconfig's, which matplotlib's font search runs
+(`fc-list`) the first time a child draws; without it every plot prints a "Fontconfig error"."""
 PROJECT_PACKAGES = ("grader", "reference", "api")
 """Top-level packages of the project; hidden wherever an installed copy would make them importable."""
 
@@ -38,9 +42,11 @@ class PythonPaths:
 
     Attributes:
         executable: The interpreter binary.
-        roots: Directories to expose read-only (prefixes and site directories, even when nested).
-        stdlib: Standard-library entries of the child's sys.path.
-        site_dirs: Site directories of the child's sys.path (after the stdlib).
+        roots: Directories to expose read-only (prefixes, the executable's directory, the stdlib and
+            site directories that exist), resolved, each once, even when nested (a layer that mounts
+            them decides which it needs: `grader.sandbox.isolation.bubblewrap.interpreter_binds`).
+        stdlib: Standard-library entries of the child's sys.path (resolved).
+        site_dirs: Existing site directories of the child's sys.path, after the stdlib (resolved).
         hidden: Files and directories inside `roots` the child must not see (.pth hooks, the editable
             install's finder, installed copies of the project's packages).
     """
@@ -110,13 +116,33 @@ def remove_host_scratch(scratch: Path) -> None:
     shutil.rmtree(scratch, ignore_errors=True)
 
 
+def _existing_directory(path: str) -> Path | None:
+    resolved = Path(path).resolve()
+    return resolved if resolved.is_dir() else None
+
+
 @functools.cache
 def python_paths() -> PythonPaths:
-    """The paths of the running interpreter (the child runs the same interpreter)."""
+    """The paths of the running interpreter (the child runs the same interpreter).
+
+    Derived from what the interpreter imports: its prefixes (shared libraries live there), the directory of
+    its executable, the standard-library entries of `sys.path` and the site directories that exist, each
+    resolved (symbolic links followed) so that the child's `sys.path` names the paths that are bound.
+    """
     prefixes = {Path(sys.base_prefix).resolve(), Path(sys.prefix).resolve()}
-    site_dirs = [p for p in site.getsitepackages() if os.path.isdir(p)]
-    stdlib = [p for p in sys.path if p and p not in site_dirs and any(p.startswith(str(x)) for x in prefixes)]
-    roots = prefixes | {Path(directory).resolve() for directory in site_dirs}
+    site_dirs = list(dict.fromkeys(str(d) for p in site.getsitepackages() if (d := _existing_directory(p))))
+    stdlib_dirs = {Path(sysconfig.get_path(name)).resolve() for name in ("stdlib", "platstdlib")}
+    stdlib_zip = f"python{sys.version_info.major}{sys.version_info.minor}.zip"
+    stdlib = [
+        str(Path(p).resolve())
+        for p in sys.path
+        if p
+        and (Path(p).name == stdlib_zip or any(Path(p).resolve().is_relative_to(d) for d in stdlib_dirs))
+        and str(Path(p).resolve()) not in site_dirs
+    ]
+    executable = Path(sys.executable).resolve()
+    candidates = [*prefixes, executable.parent, *map(Path, stdlib), *map(Path, site_dirs)]
+    roots = {path for path in candidates if path.is_dir()}
     hidden: list[Path] = []
     for site_dir in site_dirs:
         for entry in Path(site_dir).iterdir():
@@ -125,9 +151,9 @@ def python_paths() -> PythonPaths:
             if hook or (name in PROJECT_PACKAGES and entry.is_dir()):
                 hidden.append(entry)
     return PythonPaths(
-        executable=Path(sys.executable).resolve(),
+        executable=executable,
         roots=tuple(sorted(roots)),
-        stdlib=tuple(stdlib),
+        stdlib=tuple(dict.fromkeys(stdlib)),
         site_dirs=tuple(site_dirs),
         hidden=tuple(sorted(hidden)),
     )

@@ -7,10 +7,11 @@ directory, and (Landlock ABI >= 4) TCP bind and connect are denied. The system c
 
 from __future__ import annotations
 
+import os
 from typing import TYPE_CHECKING
 
 from grader.sandbox.isolation import landlock_syscalls
-from grader.sandbox.isolation.filesystem import SYSTEM_DIRS
+from grader.sandbox.isolation.filesystem import SYSTEM_CONFIG_DIRS, SYSTEM_DIRS
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 
 if TYPE_CHECKING:
@@ -52,5 +53,6 @@ class LandlockLayer:
     def apply(self, spec: LaunchSpec) -> None:
         """Asks the bootstrap to restrict the child to the paths it needs, as the child sees them."""
         view = spec.child_view()
-        read = [*map(str, spec.paths.roots), *SYSTEM_DIRS, view.harness, *READABLE_FILES]
+        config = [directory for directory in SYSTEM_CONFIG_DIRS if os.path.isdir(directory)]
+        read = [*map(str, spec.paths.roots), *SYSTEM_DIRS, *config, view.harness, *READABLE_FILES]
         spec.bootstrap.landlock = {"read": read, "write": [view.scratch]}

@@ -277,7 +277,9 @@ IMPORT_FAILURES = [
     ),
     (
         "import numpy_but_misspelled\n",
-        "importing submission.py raised ModuleNotFoundError",
+        "importing submission.py raised ModuleNotFoundError: No module named 'numpy_but_misspelled'; "
+        "the grader has no module `numpy_but_misspelled`: use the packages your course provides, or ask your "
+        "instructor to add it; instructors install the package into the grader's Python",
         ["line 1, in <module>", "No module named 'numpy_but_misspelled'"],
     ),
 ]
