@@ -16,6 +16,7 @@ from grader.checks.integrity import (
     all_resets,
     games_budget,
     integrity_problem,
+    noting_post_terminal_steps,
     played_episodes,
     repeated_seed_problem,
     seed_problem,
@@ -140,6 +141,7 @@ class TaxiCheck:
         )
         return [Call("taxi", budget=budget)]
 
+    @noting_post_terminal_steps
     @paused_gc
     def judge(self, settings: TaxiConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned means against the replayed scenarios and the exact expectations."""
