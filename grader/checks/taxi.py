@@ -175,9 +175,11 @@ class TaxiCheck:
             # taxi() that trains its own table plays the training episodes first.
             scenarios = split_scenarios(episodes[-played:], random_mean, greedy_mean)
         if scenarios is None:
+            # Steps after a time limit ended the episode count in the returned means, not in the replay.
+            cause = ignored_truncation(episodes) or _mismatch_cause(episodes, random_mean, greedy_mean)
             return _fail(
                 f"taxi returned ({random_mean:.6g}, {greedy_mean:.6g}), which no split of the replayed episodes supports; "  # noqa: E501
-                f"{_mismatch_cause(episodes, random_mean, greedy_mean)}.",
+                f"{cause}.",
                 measurements,
             )
         for name, scenario in (("random", scenarios.random), ("Q-table", scenarios.greedy)):
