@@ -97,7 +97,8 @@ def test_a_call_beyond_its_budget_is_a_described_wrong_answer() -> None:
     assert verdict.feedback == (
         "cartpole(): cartpole() played 101 games in one call (it reset its environment 101 times); "
         "the grader records at most 10 resets per call of cartpole(); one call of cartpole() is graded on "
-        "1 game, so this result is not the one asked for. Play exactly the games one call of cartpole() is asked to "
-        "play, each until it ends, and return that call's result (the grader calls it again for more games)"
+        "1 game, so this call's result is not the one asked for. Play exactly the games one call of "
+        "cartpole() is asked to play, each until it ends, and return that call's result (the grader calls "
+        "it again for more games)"
     )
     assert "easy start" not in verdict.feedback
