@@ -16,7 +16,7 @@ from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, P
 from grader.sandbox.child.frames import decode_value, encode_value
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
 from grader.sandbox.child.recorder import Recorder
-from grader.sandbox.child.stubs import stub_body
+from grader.sandbox.child.stubs import RAISING_STUB, stub_body
 
 MAX_COMPAT_EVENTS = 100
 MAX_EVENT_DETAIL = 1000
@@ -160,14 +160,15 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
             f"`{name}` in your file is a {type(function).__name__}, not a function; "
             f"define `def {name}(...):`",
         )
+    mismatch = _signature_mismatch(name, function, request)
     stub = stub_body(function)
-    if stub is not None:
+    # A stub that raises NotImplementedError and accepts the call is called: it says so itself.
+    if stub is not None and (mismatch or stub != RAISING_STUB):
         return _status(
             "missing_function",
             f"`{name}` is still the template's stub (its body {stub}): not attempted yet. "
             f"Replace the body of `def {name}` with your solution.",
         )
-    mismatch = _signature_mismatch(name, function, request)
     if mismatch:
         return _status("bad_signature", mismatch)
     started = time.perf_counter()

@@ -8,6 +8,8 @@ import textwrap
 from typing import Any
 
 _NOT_IMPLEMENTED = frozenset({"NotImplementedError", "NotImplemented"})
+RAISING_STUB = "only raises NotImplementedError"
+"""`stub_body` of a stub that raises NotImplementedError (with or without a docstring or `pass`)."""
 
 
 def stub_body(function: Any) -> str | None:
@@ -38,7 +40,7 @@ def stub_body(function: Any) -> str | None:
             raises = True
             continue
         return None
-    return "only raises NotImplementedError" if raises else "holds nothing but `pass` or `...`"
+    return RAISING_STUB if raises else "holds nothing but `pass` or `...`"
 
 
 def _raises_not_implemented(statement: ast.Raise) -> bool:
