@@ -7,8 +7,13 @@ counts against a rule when the verdict is not the one an instructor would give (
 targeted: failed, with the rule's own words in the feedback). The honest functions are the in-process
 twins of the files in `submissions/honest/` (same loops, same resets, same post-terminal steps).
 
-    python bench/honest.py                 # 200 regrades of every pattern
-    python bench/honest.py --regrades 20   # a smoke run
+The selection rule reads only the starts a call dealt and which of them it played, so its false-fail
+rate on the honest "double reset" (two resets, the second played) is also measured on its own, cheaply:
+`--null-regrades` regrades deal each call's starts from the grader's reset stream (fresh call seeds),
+play the second, and apply the rule's own code (`selection_tests`) to them, with the assignment's sizes.
+
+    python bench/honest.py                 # 200 regrades of every pattern, 200 null regrades
+    python bench/honest.py --regrades 20 --null-regrades 20   # a smoke run
 """
 
 from __future__ import annotations
@@ -20,7 +25,11 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
+
+import gymnasium
+import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
@@ -29,6 +38,7 @@ from grader.checks.starts import SELECTION_ALPHA, selection_tests
 from grader.config import load_config
 from grader.problem_config import ProblemConfig
 from grader.problems import PROBLEMS
+from grader.sandbox.child.seeding import reset_seeds
 from grader.testing.behaviours import (
     MISTAKES,
     car_policy,
@@ -235,13 +245,62 @@ def regrade(pattern: Pattern, seed: int) -> tuple[bool, float]:
     return verdict.status == "failed" and pattern.words in verdict.feedback, smallest
 
 
+NULL_SIZES: dict[str, tuple[str, dict[str, Any], int, int]] = {
+    "cartpole": ("CartPole-v0", {}, 100, 1),
+    "car": ("MountainCar-v0", {}, 100, 1),
+    "random_blackjack": ("Blackjack-v1", {"natural": False, "sab": False}, 1, 2_000),
+    "blackjack (sab)": ("Blackjack-v1", {}, 1, 2_000),
+    "taxi": ("Taxi-v4", {}, 1, 2_000),
+}
+"""Game, arguments, calls and games per call: cartpole and car as graded (100 calls); Blackjack and Taxi
+with 2,000 games instead of 10,000 to fit 200 regrades (Hoeffding's bound holds for every number of groups)."""
+
+
+def null_regrade(env_id: str, env_kwargs: dict[str, Any], calls: int, games: int, seed: int) -> float:
+    """The smallest selection p-value of one honest double-reset grading (every game: two resets, the second
+    played), from the grader's reset stream of fresh call seeds; only the starts are dealt, not played."""
+    env = gymnasium.make(env_id, **env_kwargs)
+    records = []
+    for call in range(calls):
+        seeds = reset_seeds(int(np.random.SeedSequence((seed, call)).generate_state(1)[0]), 2 * games)
+        logs, replays = [], []
+        for number, reset_seed in enumerate(seeds):
+            observation, _ = env.reset(seed=reset_seed)
+            played = [0] if number % 2 else []
+            logs.append(
+                SimpleNamespace(actions=played, env_id=env_id, env_kwargs=env_kwargs, reset_seed=reset_seed)
+            )
+            replays.append(SimpleNamespace(observations=[observation]))
+        records.append(SimpleNamespace(outcome=SimpleNamespace(episodes=logs), replays=replays))
+    tests = selection_tests(records)  # type: ignore[arg-type]
+    return min(test.p_value / test.threshold for test in tests)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--regrades", type=int, default=200, help="regrades of each honest pattern")
     parser.add_argument("--catch-regrades", type=int, default=50, help="regrades of each targeted pattern")
     parser.add_argument("--only", nargs="*", default=None, help="patterns whose name contains one of these")
+    parser.add_argument("--null-regrades", type=int, default=200, help="null regrades of the selection rule")
     parser.add_argument("--first-seed", type=int, default=19_000_000)
     arguments = parser.parse_args()
+    print("Selection rule alone on honest double resets (starts dealt, the second of each pair played):")
+    print("| problem | calls x games | regrades | failed | smallest p / threshold | seconds |")
+    print("|---|---|---|---|---|---|")
+    for name, (env_id, env_kwargs, calls, games) in NULL_SIZES.items():
+        if arguments.only and not any(word in name for word in arguments.only):
+            continue
+        started = time.perf_counter()
+        ratios = [
+            null_regrade(env_id, env_kwargs, calls, games, arguments.first_seed + number)
+            for number in range(arguments.null_regrades)
+        ]
+        failed = sum(ratio <= 1.0 for ratio in ratios)
+        print(
+            f"| {name} | {calls} x {games} | {len(ratios)} | {failed} | {min(ratios):.3g} | {time.perf_counter() - started:.0f} |"  # noqa: E501
+        )
+        sys.stdout.flush()
+    print()
     print(
         f"{arguments.regrades} regrades per honest pattern, {arguments.catch_regrades} per targeted one, "
         f"seeds {arguments.first_seed}..; selection alpha {SELECTION_ALPHA:g}"
