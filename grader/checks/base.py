@@ -123,8 +123,7 @@ def _over_budget_text(outcome: CallOutcome) -> str:
     )
     return (
         f"{_call_text(call)}: {outcome.message}{planned}, so this call's result is not the one asked for. "
-        f"Play exactly the games one call of {call.function}() is asked to play, each until it ends, "
-        "and return that call's result (the grader calls it again for more games)"
+        f"Play exactly the games one call of {call.function}() is asked to play, each until it ends, and return that call's result (the grader calls it again for more games)"  # noqa: E501
     )
 
 

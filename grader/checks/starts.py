@@ -146,8 +146,7 @@ def selection_problem(records: Sequence[CallRecord], alpha: float = SELECTION_AL
     share = 0.5 + worst.statistic / worst.groups
     return (
         f"{unplayed} reset(s) were left unplayed, and the starts that were played are not a fair sample of the starts dealt: "  # noqa: E501
-        f"in {worst.groups} games that had unplayed resets beside them, the played start ranked on average at {share:.2f} of its group by {worst.feature} (0.50 when the choice ignores the starts; {direction}), "  # noqa: E501
-        f"which a choice that ignores the starts produces with probability at most {worst.p_value:.1e}. "
+        f"in {worst.groups} games that had unplayed resets beside them, the played start ranked on average at {share:.2f} of its group by {worst.feature} (0.50 when the choice ignores the starts: yours played the {direction}), which a choice that ignores the starts produces with probability at most {worst.p_value:.1e}. "  # noqa: E501
         "Every reset deals a game that counts, and choosing which start to play by looking at it chooses the games. "  # noqa: E501
         "Reset once per game and play every game you reset"
     )
