@@ -257,7 +257,8 @@ def _blackjack_win(episode: Episode) -> float:
 
 @cache
 def _taxi_values() -> np.ndarray[Any, np.dtype[np.float64]]:
-    return optimal_q_table(TAXI_GAMMA).max(axis=1)
+    values: np.ndarray[Any, np.dtype[np.float64]] = optimal_q_table(TAXI_GAMMA).max(axis=1)
+    return values
 
 
 def _taxi_value(episode: Episode) -> float:
