@@ -35,9 +35,10 @@ __all__ = [
 def games_budget(games: int, steps_per_game: int) -> CallBudget:
     """What a call that plays `games` games of at most `steps_per_game` steps each may record.
 
-    Twice the games in resets (every unplayed reset is then diagnosed by `scouting_problem`, not cut
-    off), and the steps of the games plus a few more (`RESET_SLACK`). Beyond it the child stops recording
-    and the call fails, so the grader never replays more than this.
+    Twice the games in resets plus `RESET_SLACK` (room for an extra reset per game, judged by the
+    selection test of `grader.checks.starts`, not cut off), and the steps of the games plus
+    `RESET_SLACK` games' worth. Beyond it the child stops recording and the call is `failed` with a
+    description of what it played (`outcome_verdict`), so the grader never replays more than this.
     """
     return CallBudget(2 * games + RESET_SLACK, (games + RESET_SLACK) * steps_per_game)
 
