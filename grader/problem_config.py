@@ -83,6 +83,14 @@ class PlayedProblemConfig(ProblemConfig):
         "absent = all of them.",
     )
 
+    post_terminal_steps_deduction: float = Field(
+        default=0.0,
+        ge=0.0,
+        le=1.0,
+        description="Share of the points deducted from a passing verdict when games kept stepping after they were over (steps that change nothing counted: each game is judged up to its end); "  # noqa: E501
+        "0 = a note in the feedback only.",
+    )
+
     def for_problem(self, problem_id: ProblemId) -> Self:
         """These settings bound to their problem, once `accepted_envs` names only games it accepts."""
         accepted = accepted_game_names(problem_id)

@@ -94,6 +94,9 @@ def paused_gc(judge: Callable[P, R]) -> Callable[P, R]:
 
 _NOT_IMPLEMENTED = "NotImplementedError"
 
+RESET_SLACK = 8
+"""Resets beyond twice the planned games a call may record (`grader.checks.integrity.games_budget`)."""
+
 
 def _is_not_implemented(outcome: CallOutcome) -> bool:
     return outcome.status is OutcomeStatus.EXCEPTION and _NOT_IMPLEMENTED in outcome.message
@@ -108,12 +111,31 @@ def _call_text(call: Call) -> str:
     return f"{call.function}({', '.join(arguments)})"
 
 
+def _over_budget_text(outcome: CallOutcome) -> str:
+    """A wrong answer, described: the call played far more than the games it is graded on."""
+    call = outcome.call
+    budget = call.budget
+    games = None if budget is None else max((budget.max_episodes - RESET_SLACK) // 2, 0)
+    planned = (
+        ""
+        if games is None
+        else f"; one call of {call.function}() is graded on {games} game{'' if games == 1 else 's'}"
+    )
+    return (
+        f"{_call_text(call)}: {outcome.message}{planned}, so this call's result is not the one asked for. "
+        f"Play exactly the games one call of {call.function}() is asked to play, each until it ends, and return that call's result (the grader calls it again for more games)"  # noqa: E501
+    )
+
+
 def outcome_verdict(records: Sequence[CallRecord]) -> Verdict | None:
     """The verdict implied by the sandbox outcomes alone, or None when every call returned normally.
 
     Shared by all checks so the same outcome always reads the same way: a missing function or a
-    ``NotImplementedError`` is "missing", a timeout is "timeout", any other non-OK outcome (import error,
-    exception, crash, invalid value, ...) is "error" with the sandbox's own student-readable message.
+    ``NotImplementedError`` (or an untouched stub, whatever its parameters) is "missing", a timeout is
+    "timeout", a call that played far more games than it is graded on (beyond its `CallBudget`) is
+    "failed" with a description of what it did (a wrong answer, not a crash), any other non-OK outcome
+    (import error, exception, crash, invalid value, ...) is "error" with the sandbox's own
+    student-readable message.
 
     Args:
         records: The problem's call records in planned order.
@@ -140,5 +162,7 @@ def outcome_verdict(records: Sequence[CallRecord]) -> Verdict | None:
         )
         return Verdict("missing", 0.0, feedback, measurements)
     first = failed[0]
+    if first.status is OutcomeStatus.EPISODE_LIMIT:
+        return Verdict("failed", 0.0, _over_budget_text(first), measurements)
     status: Status = "timeout" if first.status is OutcomeStatus.TIMEOUT else "error"
     return Verdict(status, 0.0, f"{_call_text(first.call)}: {first.message}", measurements)

@@ -16,6 +16,7 @@ from grader.checks.integrity import (
     episodes_per_call,
     games_budget,
     integrity_problem,
+    noting_post_terminal_steps,
     played_episodes,
     repeated_seed_problem,
 )
@@ -134,6 +135,7 @@ class BlackjackCheck:
         budget = games_budget(settings.games_per_call, GAME_STEPS)
         return [Call("blackjack", (n,), budget=budget) for n in settings.thresholds]
 
+    @noting_post_terminal_steps
     @paused_gc
     def judge(self, settings: BlackjackConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge every call's rule, game count, returned rate and exact win probability."""

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from pydantic import Field
 
 from grader.checks.base import CallRecord, Verdict, paused_gc
-from grader.checks.integrity import games_budget
+from grader.checks.integrity import games_budget, noting_post_terminal_steps
 from grader.checks.lengths import judge_lengths
 from grader.problem_config import CountedStepsConfig
 from grader.sandbox.outcome import Call, FunctionInfo
@@ -33,6 +33,7 @@ class CarCheck:
         budget = games_budget(1, EPISODE_STEPS)
         return [Call("car", budget=budget) for _ in range(settings.calls)]
 
+    @noting_post_terminal_steps
     @paused_gc
     def judge(self, settings: CarConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned lengths against the replays, then the goal and the mean against the bar."""

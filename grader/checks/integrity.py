@@ -2,123 +2,43 @@
 
 from __future__ import annotations
 
+import functools
 from collections import Counter
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
-from grader.checks.base import CallRecord
+from grader.checks.base import RESET_SLACK, CallRecord, Verdict
+from grader.checks.episodes import Episode, all_resets, episodes_per_call, played_episodes
+from grader.checks.starts import selection_problem
 from grader.sandbox.outcome import CallBudget
 from grader.sandbox.replay import not_replayed, replay_episodes, verify_reset_seeds
 
 if TYPE_CHECKING:
     from grader.games import GameRules
+    from grader.problem_config import PlayedProblemConfig
     from grader.sandbox.episode_log import EpisodeLog
     from grader.sandbox.outcome import CallOutcome
-    from grader.sandbox.replay import Replay
 
-RESET_SLACK = 8
-"""Resets beyond the planned games a call may record, so that extra resets get a diagnosis, not a cut-off."""
-
-
-@dataclass(slots=True)
-class Episode:
-    """One played episode: the student's actions with the outcome the grader's own replay produced.
-
-    Attributes:
-        call_index: Index of the call (in planned order) that played it.
-        position: Index of the episode among the call's played episodes.
-        log: The student's log (untrusted: only actions, ids and seeds are read from it).
-        replay: The grader's replay of those actions.
-    """
-
-    call_index: int
-    position: int
-    log: EpisodeLog
-    replay: Replay
-
-    @property
-    def length(self) -> int:
-        """Steps until the episode ended (or all steps, when it never ended)."""
-        return int(self.replay.length)
-
-    @property
-    def finished(self) -> bool:
-        """Whether the episode reached a terminal state or its time limit."""
-        last = self.length - 1
-        return last >= 0 and bool(self.replay.terminated[last] or self.replay.truncated[last])
-
-    @property
-    def reached_terminal(self) -> bool:
-        """Whether the episode ended in a terminal state (not by the time limit)."""
-        last = self.length - 1
-        return last >= 0 and bool(self.replay.terminated[last])
-
-    @property
-    def actions(self) -> list[Any]:
-        """The actions taken before the episode ended."""
-        return list(self.log.actions[: self.length])
-
-    @property
-    def rewards(self) -> list[float]:
-        """The replayed rewards of the steps before the episode ended."""
-        return [float(reward) for reward in self.replay.rewards[: self.length]]
-
-    @property
-    def total_reward(self) -> float:
-        """Sum of the replayed rewards."""
-        return float(self.replay.total_reward)
-
-    @property
-    def final_reward(self) -> float:
-        """The replayed reward of the last step (0 for an empty episode)."""
-        rewards = self.rewards
-        return rewards[-1] if rewards else 0.0
-
-    def decisions(self) -> list[tuple[Any, Any]]:
-        """(observation seen, action taken) for every step before the episode ended."""
-        length = self.replay.length
-        return list(zip(self.replay.observations[:length], self.log.actions[:length], strict=True))
-
-
-def played_episodes(records: Sequence[CallRecord]) -> list[Episode]:
-    """Every episode of the records in which at least one action was taken, in play order."""
-    episodes = []
-    for call_index, record in enumerate(records):
-        played = [
-            (log, replay)
-            for log, replay in zip(record.outcome.episodes, record.replays, strict=True)
-            if len(log.actions) > 0
-        ]
-        episodes += [
-            Episode(call_index, position, log, replay) for position, (log, replay) in enumerate(played)
-        ]
-    return episodes
-
-
-def episodes_per_call(records: Sequence[CallRecord], episodes: Sequence[Episode]) -> list[list[Episode]]:
-    """The played episodes (from `played_episodes(records)`) grouped by call."""
-    grouped: list[list[Episode]] = [[] for _ in records]
-    for episode in episodes:
-        grouped[episode.call_index].append(episode)
-    return grouped
-
-
-def all_resets(records: Sequence[CallRecord]) -> list[Episode]:
-    """Every reset of the records, played or not, in reset order (``position``: index among the call's)."""
-    return [
-        Episode(call_index, position, log, replay)
-        for call_index, record in enumerate(records)
-        for position, (log, replay) in enumerate(zip(record.outcome.episodes, record.replays, strict=True))
-    ]
+__all__ = [
+    "Episode",
+    "all_resets",
+    "episodes_per_call",
+    "games_budget",
+    "integrity_problem",
+    "played_episodes",
+    "repeated_seed_problem",
+    "replay_call",
+    "settled_by",
+]
 
 
 def games_budget(games: int, steps_per_game: int) -> CallBudget:
     """What a call that plays `games` games of at most `steps_per_game` steps each may record.
 
-    Twice the games in resets (every unplayed reset is then diagnosed by `scouting_problem`, not cut
-    off), and the steps of the games plus a few more (`RESET_SLACK`). Beyond it the child stops recording
-    and the call fails, so the grader never replays more than this.
+    Twice the games in resets plus `RESET_SLACK` (room for an extra reset per game, judged by the
+    selection test of `grader.checks.starts`, not cut off), and the steps of the games plus
+    `RESET_SLACK` games' worth. Beyond it the child stops recording and the call is `failed` with a
+    description of what it played (`outcome_verdict`), so the grader never replays more than this.
     """
     return CallBudget(2 * games + RESET_SLACK, (games + RESET_SLACK) * steps_per_game)
 
@@ -131,15 +51,16 @@ def settled_by(record: CallRecord, rules: GameRules | None) -> str | None:
     """Why a problem's verdict can no longer change after this call, or None.
 
     A call that did not return normally scores the problem 0 (`outcome_verdict`); episodes that are not
-    the problem's game, resets with options and unplayed resets fail it (`integrity_problem`). Either way
-    more calls cannot change the verdict and are not made.
+    the problem's game and resets with options fail it (`integrity_problem`). Either way more calls
+    cannot change the verdict and are not made. (Unplayed resets are judged over all calls together by
+    the selection test, `grader.checks.starts`.)
     """
     status = record.outcome.status.value
     if status == "timeout":
         return "it did not return in time"
     if status != "ok":
         return f"it ended with {status.replace('_', ' ')}"
-    if _replay_refusal(record.outcome.episodes, rules) is not None or scouting_problem([record]) is not None:
+    if _replay_refusal(record.outcome.episodes, rules) is not None:
         return "it broke a rule of the game"
     return None
 
@@ -184,46 +105,6 @@ def options_problem(logs: Sequence[EpisodeLog]) -> str | None:
     )
 
 
-def scouting_problem(records: Sequence[CallRecord]) -> str | None:
-    """Why some call reset an environment without playing the game it dealt, or None.
-
-    Every reset deals a game the grader counts. A reset that is not played abandons that game; resetting
-    until the start looks easy and playing only that one ("scouting") would choose the starts the
-    statistics rely on. The lab's code needs no such reset, so per environment a call may only leave
-    unplayed its first reset when another reset of that environment follows (the reset right after
-    ``gym.make``, or the one the classic API needed before the first step) and its last reset when an
-    earlier one was played (a reset at the end of the game loop).
-    """
-    for call_index, record in enumerate(records):
-        resets: dict[int, list[int]] = {}
-        for position, log in enumerate(record.outcome.episodes):
-            resets.setdefault(log.env_index, []).append(position)
-        unplayed = [
-            position
-            for positions in resets.values()
-            for order, position in enumerate(positions)
-            if not _tolerated_unplayed(record.outcome.episodes, positions, order)
-        ]
-        if unplayed:
-            total = len(record.outcome.episodes)
-            shown = ", ".join(str(position + 1) for position in unplayed[:5])
-            more = ", ..." if len(unplayed) > 5 else ""
-            return (
-                f"call {call_index + 1} reset its environment {total} times and left {len(unplayed)} of those games unplayed (resets {shown}{more} took no step before the next reset): "  # noqa: E501
-                "every reset deals a game that counts, and resetting until the start looks easy chooses the games. "  # noqa: E501
-                "Reset once per game and play every game you reset until `done` is True"
-            )
-    return None
-
-
-def _tolerated_unplayed(logs: Sequence[EpisodeLog], positions: list[int], order: int) -> bool:
-    if logs[positions[order]].steps > 0:
-        return True
-    first_then_more = order == 0 and len(positions) > 1
-    last_after_played = order == len(positions) - 1 and any(logs[p].steps > 0 for p in positions[:order])
-    return first_then_more or last_after_played
-
-
 def seed_problem(records: Sequence[CallRecord]) -> str | None:
     """Why some call's episodes did not start from the seeds the grader's stream prescribes, or None."""
     for record in records:
@@ -240,9 +121,12 @@ def integrity_problem(
 
     Checks every reset, played or not, in order: a reset seed differs from the grader's stream (an
     altered log); the environment or its arguments differ from the lab's game; a reset passed
-    ``options``; a reset was left unplayed (`scouting_problem`); the replay disagrees with the student's
-    log; steps were taken after an episode ended; an episode was abandoned before it ended (reset in the
-    middle of a game, or stopped early).
+    ``options``; the played starts are not a fair sample of the dealt ones (`selection_problem`: unplayed
+    resets alone are harmless); the replay disagrees with the student's log; an episode was abandoned
+    before it ended (reset in the middle of a game, or stopped early). Steps after an episode ended are
+    not a problem here: every check judges each game up to its end, so they change nothing counted
+    unless the returned result counted them (then it disagrees with the replay and fails there);
+    `post_terminal_note` describes them.
     """
     altered = seed_problem(records)
     if altered:
@@ -250,9 +134,9 @@ def integrity_problem(
     refused = _replay_refusal([episode.log for episode in all_resets(records)], rules)
     if refused:
         return refused
-    scouted = scouting_problem(records)
-    if scouted:
-        return scouted
+    selected = selection_problem(records)
+    if selected:
+        return selected
     for episode in episodes:
         if episode.replay.mismatch:
             return (
@@ -260,13 +144,6 @@ def integrity_problem(
                 "The grader replays every episode in its own environment; "
                 "results that the real game does not produce cannot count"
             )
-    after_done = [episode for episode in episodes if episode.replay.steps_after_done > 0]
-    if after_done:
-        first = after_done[0]
-        return (
-            f"{len(after_done)} episode(s) kept stepping after the game was over (e.g. episode {_where(first)} ended after {first.length} steps and you took {first.replay.steps_after_done} more). "  # noqa: E501
-            "Stop as soon as `done` (terminated or truncated) is True"
-        )
     unfinished = [episode for episode in episodes if not episode.finished]
     if unfinished:
         first = unfinished[0]
@@ -276,6 +153,52 @@ def integrity_problem(
             "Play each game until `done` is True and reset only between games"
         )
     return None
+
+
+def post_terminal_note(episodes: Sequence[Episode], deduction: float = 0.0) -> str:
+    """The feedback sentence on steps taken after games had ended ("" when there were none).
+
+    Such steps change nothing the grader counts: each game is judged up to its end (its decisions, its
+    result), and a returned result that counted them disagrees with the replay and fails on that.
+    """
+    after_done = [episode for episode in episodes if episode.replay.steps_after_done > 0]
+    if not after_done:
+        return ""
+    first = after_done[0]
+    steps = sum(episode.replay.steps_after_done for episode in after_done)
+    cost = f" ({deduction:.0%} of the points deducted)" if deduction else ""
+    return (
+        f" Note: {len(after_done)} game(s) kept stepping after the game was over ({steps} step(s) in all; e.g. episode {_where(first)} ended after {first.length} steps and {first.replay.steps_after_done} more followed). "  # noqa: E501
+        f"Those steps change nothing counted here: every game is judged up to its end{cost}. "
+        "Stop stepping as soon as `done` (terminated or truncated) is True."
+    )
+
+
+JudgeT = Callable[[Any, Any, Sequence[CallRecord]], Verdict]
+
+
+def noting_post_terminal_steps(judge: JudgeT) -> JudgeT:
+    """Add `post_terminal_note` to a passing verdict, less the configured `post_terminal_steps_deduction`."""
+
+    @functools.wraps(judge)
+    def noted(check: Any, settings: PlayedProblemConfig, records: Sequence[CallRecord]) -> Verdict:
+        verdict = judge(check, settings, records)
+        if verdict.status != "passed":
+            return verdict
+        deduction = settings.post_terminal_steps_deduction
+        episodes = played_episodes(records)
+        note = post_terminal_note(episodes, deduction)
+        if not note:
+            return verdict
+        steps = sum(episode.replay.steps_after_done for episode in episodes)
+        return Verdict(
+            verdict.status,
+            max(verdict.fraction - deduction, 0.0),
+            verdict.feedback + note,
+            {**verdict.measurements, "steps_after_done": steps},
+        )
+
+    return noted
 
 
 def repeated_seed_problem(episodes: Sequence[Episode], *, across_calls: bool) -> str | None:

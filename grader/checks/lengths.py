@@ -129,11 +129,16 @@ def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]
     for call_number, (record, episode) in enumerate(zip(records, chosen, strict=True), 1):
         returned = as_number(record.outcome.value)
         if returned is None or not same_number(returned, float(episode.length)):
-            cause = (
-                "expected a number"
-                if returned is None
-                else step_count_mismatch_cause(returned, episode.length, record.outcome.wall_time)
-            )
+            after_done = episode.replay.steps_after_done
+            if returned is None:
+                cause = "expected a number"
+            elif after_done and same_number(returned, float(episode.length + after_done)):
+                cause = (
+                    f"the loop kept stepping after the game was over and counted those {after_done} steps. "
+                    "Stop as soon as `done` (terminated or truncated) is True"
+                )
+            else:
+                cause = step_count_mismatch_cause(returned, episode.length, record.outcome.wall_time)
             return Verdict(
                 "failed",
                 0.0,

@@ -14,6 +14,7 @@ from grader.checks.integrity import (
     all_resets,
     games_budget,
     integrity_problem,
+    noting_post_terminal_steps,
     played_episodes,
     repeated_seed_problem,
 )
@@ -49,6 +50,7 @@ class RandomBlackjackCheck:
         games = settings.games
         return [Call("random_blackjack", (games,), budget=games_budget(games, GAME_STEPS))]
 
+    @noting_post_terminal_steps
     @paused_gc
     def judge(self, settings: RandomBlackjackConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the call against its replayed games and the exact random-policy win probability."""

@@ -16,6 +16,7 @@ from grader.checks.integrity import (
     all_resets,
     games_budget,
     integrity_problem,
+    noting_post_terminal_steps,
     played_episodes,
     repeated_seed_problem,
     seed_problem,
@@ -140,6 +141,7 @@ class TaxiCheck:
         )
         return [Call("taxi", budget=budget)]
 
+    @noting_post_terminal_steps
     @paused_gc
     def judge(self, settings: TaxiConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned means against the replayed scenarios and the exact expectations."""
@@ -173,9 +175,11 @@ class TaxiCheck:
             # taxi() that trains its own table plays the training episodes first.
             scenarios = split_scenarios(episodes[-played:], random_mean, greedy_mean)
         if scenarios is None:
+            # Steps after a time limit ended the episode count in the returned means, not in the replay.
+            cause = ignored_truncation(episodes) or _mismatch_cause(episodes, random_mean, greedy_mean)
             return _fail(
                 f"taxi returned ({random_mean:.6g}, {greedy_mean:.6g}), which no split of the replayed episodes supports; "  # noqa: E501
-                f"{_mismatch_cause(episodes, random_mean, greedy_mean)}.",
+                f"{cause}.",
                 measurements,
             )
         for name, scenario in (("random", scenarios.random), ("Q-table", scenarios.greedy)):

@@ -6,6 +6,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, Literal
 
+import numpy as np
+
 Scale = Literal["fraction", "percentage"]
 _SCALES: tuple[tuple[Scale, float], ...] = (("fraction", 1.0), ("percentage", 100.0))
 
@@ -28,10 +30,13 @@ def describe(value: Any) -> str:
 def same_number(returned: float, recomputed: float) -> bool:
     """Whether a returned number is the recomputed one, allowing float rounding and rounding to >= 2 decimals.
 
-    A student may return ``round(100 * wins / n, 2)``; that is still the replayed result. Any rounding
-    coarser than two decimals, or any other difference, is not.
+    A student may return ``round(100 * wins / n, 2)`` or the result in single precision
+    (``np.float32(wins / n)``, a numpy array's sum or mean); that is still the replayed result. Any
+    rounding coarser than two decimals, or any other difference, is not.
     """
     if math.isclose(returned, recomputed, rel_tol=1e-9, abs_tol=1e-12):
+        return True
+    if returned == float(np.float32(recomputed)):
         return True
     return any(math.isclose(returned, round(recomputed, digits), abs_tol=1e-12) for digits in range(2, 16))
 

@@ -205,6 +205,53 @@ def _step_after_done(lab: Lab) -> int:
     return steps
 
 
+def _counts_steps_after_done(lab: Lab) -> int:
+    env = lab.make("CartPole-v0")
+    observation, _ = env.reset()
+    for _ in range(200):  # counts every step, those after the pole fell too
+        observation, _, _, _, _ = env.step(velocity_policy(observation))
+    return 200
+
+
+def _sticks_after_bust(lab: Lab, n: int, games: int = BLACKJACK_GAMES) -> float:
+    # A real pattern: hit while the hand is <= n, then an unconditional stick (after a bust too).
+    env = lab.make("Blackjack-v0")
+    wins = 0
+    for _ in range(games):
+        observation, _ = env.reset()
+        while observation[0] <= n:
+            observation, _, _, _, _ = env.step(1)
+        _, reward, _, _, _ = env.step(0)
+        wins += reward > 0
+    return wins / games
+
+
+def _coin_hits_after_bust(lab: Lab, n: int) -> float:
+    # A real pattern: hit while a coin says so (a busted hand too), then stick; a bust never becomes a win.
+    env = lab.make("Blackjack-v0")
+    wins = 0
+    for _ in range(n):
+        env.reset()
+        while env.action_space.sample():
+            env.step(1)
+        _, reward, _, _, _ = env.step(0)
+        wins += reward > 0
+    return wins / n
+
+
+def _sticks_first(lab: Lab, n: int, games: int = BLACKJACK_GAMES) -> float:
+    # Sticks at once, then plays the threshold rule on the finished game: the games played ignore n.
+    env = lab.make("Blackjack-v0")
+    wins = 0
+    for _ in range(games):
+        observation, _ = env.reset()
+        observation, reward, _, _, _ = env.step(0)
+        while observation[0] <= n:
+            observation, _, _, _, _ = env.step(1)
+        wins += reward > 0  # the stick's reward: the right count of the games played
+    return wins / games
+
+
 def _strategy_not_random(lab: Lab, n: int) -> float:
     env = lab.make("Blackjack-v0")
 
@@ -352,8 +399,36 @@ MISTAKES: tuple[Behaviour, ...] = (
         "cartpole_step_after_done",
         "cartpole",
         {"cartpole": _step_after_done},
+        "passed",
+        "kept stepping after the game was over",
+    ),
+    Behaviour(
+        "cartpole_counts_steps_after_done",
+        "cartpole",
+        {"cartpole": _counts_steps_after_done},
         "failed",
-        "after the game was over",
+        "kept stepping after the game was over and counted those",
+    ),
+    Behaviour(
+        "blackjack_sticks_after_bust",
+        "blackjack",
+        {"blackjack": _sticks_after_bust},
+        "passed",
+        "kept stepping after the game was over",
+    ),
+    Behaviour(
+        "random_blackjack_coin_hits_after_bust",
+        "random_blackjack",
+        {"random_blackjack": _coin_hits_after_bust},
+        "passed",
+        "kept stepping after the game was over",
+    ),
+    Behaviour(
+        "blackjack_sticks_first",
+        "blackjack",
+        {"blackjack": _sticks_first},
+        "failed",
+        "draw while the sum is <= 12",
     ),
     Behaviour(
         "cartpole_v1",
@@ -380,7 +455,7 @@ MISTAKES: tuple[Behaviour, ...] = (
         {"random_blackjack": _reset_at_loop_end},
         "passed",
     ),
-    Behaviour("car_scouting", "car", {"car": _scouting}, "failed", "games unplayed"),
+    Behaviour("car_scouting", "car", {"car": _scouting}, "failed", "not a fair sample of the starts dealt"),
     Behaviour("car_reset_options", "car", {"car": _chosen_start}, "failed", "call reset() without options"),
     Behaviour(
         "car_random_step_first",

@@ -5,6 +5,7 @@ from reference.oracles.blackjack import (
     evaluate_policy,
     random_policy_outcome,
     threshold_policy_outcome,
+    threshold_start_outcome,
 )
 from reference.oracles.guessing_game import GuessCounts, midpoint_guess_counts
 from reference.oracles.taxi import (
@@ -27,4 +28,5 @@ __all__ = [
     "random_policy_outcome",
     "random_policy_return",
     "threshold_policy_outcome",
+    "threshold_start_outcome",
 ]

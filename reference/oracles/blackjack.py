@@ -122,6 +122,42 @@ def threshold_policy_outcome(n: int, *, sab: bool = False) -> Outcome:
     return _threshold_policy_outcome(_checked_threshold(n), sab)
 
 
+def threshold_start_outcome(observation: tuple[int, int, bool], n: int, *, sab: bool = False) -> Outcome:
+    """Exact outcome of the threshold player from one dealt start (the reset's observation).
+
+    Args:
+        observation: `(player_sum, dealer_card, usable_ace)` of a fresh reset (two cards each); a
+            player sum of 21 with a usable ace is a natural.
+        n: the threshold, 0..21 (hit while the observed player sum is <= n).
+        sab: evaluate the `sab=True` game instead of the lab's.
+
+    Returns:
+        The win, draw and loss probabilities of the game from that start.
+
+    Raises:
+        ThresholdOutOfRangeError: `n` is not an integer in 0..21.
+    """
+    return Outcome(
+        *_threshold_start(
+            int(observation[0]), int(observation[1]), bool(observation[2]), _checked_threshold(n), sab
+        )
+    )
+
+
+@cache
+def _threshold_start(
+    player_sum: int, dealer_card: int, usable_ace: bool, n: int, sab: bool
+) -> _Probabilities:
+    game = _threshold_game(dealer_card, n, sab)
+    hard_sum = player_sum - 10 if usable_ace else player_sum
+    return game.start(hard_sum, usable_ace, usable_ace and player_sum == BLACKJACK)
+
+
+@cache
+def _threshold_game(dealer_card: int, n: int, sab: bool) -> _PlayerGame:
+    return _PlayerGame(lambda player_sum, _card, _ace: float(player_sum <= n), dealer_card, sab)
+
+
 @cache
 def _random_policy_outcome(sab: bool) -> Outcome:
     return evaluate_policy(lambda _sum, _card, _ace: 0.5, sab=sab)

@@ -24,6 +24,7 @@ from grader.report import Report
 from grader.sandbox import IsolationPolicy
 
 VERDICTS = SUBMISSIONS / "verdicts.toml"
+HONEST_VERDICTS = SUBMISSIONS / "honest" / "verdicts.toml"
 HOSTILE_OUTCOMES = SUBMISSIONS / "hostile" / "outcomes.toml"
 SEED = 20261122
 CONCURRENT_RUNS = 3
@@ -64,6 +65,7 @@ class Sample:
 
 def _samples() -> list[Sample]:
     entries = tomllib.loads(VERDICTS.read_text(encoding="utf-8"))["sample"]
+    entries += tomllib.loads(HONEST_VERDICTS.read_text(encoding="utf-8"))["sample"]
     entries += tomllib.loads(HOSTILE_OUTCOMES.read_text(encoding="utf-8"))["verdict"]
     return [Sample(entry["file"], entry["status"], entry.get("feedback", {})) for entry in entries]
 

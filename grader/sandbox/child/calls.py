@@ -16,6 +16,7 @@ from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, P
 from grader.sandbox.child.frames import decode_value, encode_value
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
 from grader.sandbox.child.recorder import Recorder
+from grader.sandbox.child.stubs import RAISING_STUB, stub_body
 
 MAX_COMPAT_EVENTS = 100
 MAX_EVENT_DETAIL = 1000
@@ -132,14 +133,15 @@ def _budget_message(function: str, recorder: Recorder) -> str:
     budget = recorder.budget
     if budget is None:  # only a call with a budget can exceed it
         return ""
+    played = f"{recorder.played:,} game" + ("" if recorder.played == 1 else "s")
     if recorder.exceeded == "episodes":
         return (
-            f"{function}() reset its environment {recorder.resets:,} times in one call; "
-            f"the grader records at most {budget.max_episodes:,} resets per call of {function}() — reset once per game and don't reset to look for an easy start"  # noqa: E501
+            f"{function}() played {played} in one call (it reset its environment {recorder.resets:,} times); "
+            f"the grader records at most {budget.max_episodes:,} resets per call of {function}()"
         )
     return (
-        f"{function}() took {recorder.steps:,} environment steps in one call; "
-        f"the grader records at most {budget.max_steps:,} steps per call of {function}() — play only the games {function}() is asked to play and end each one when `terminated` or `truncated` is true"  # noqa: E501
+        f"{function}() took {recorder.steps:,} environment steps in one call (over {played}); "
+        f"the grader records at most {budget.max_steps:,} steps per call of {function}()"
     )
 
 
@@ -159,6 +161,14 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
             f"define `def {name}(...):`",
         )
     mismatch = _signature_mismatch(name, function, request)
+    stub = stub_body(function)
+    # A stub that raises NotImplementedError and accepts the call is called: it says so itself.
+    if stub is not None and (mismatch or stub != RAISING_STUB):
+        return _status(
+            "missing_function",
+            f"`{name}` is still the template's stub (its body {stub}): not attempted yet. "
+            f"Replace the body of `def {name}` with your solution.",
+        )
     if mismatch:
         return _status("bad_signature", mismatch)
     started = time.perf_counter()

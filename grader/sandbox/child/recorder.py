@@ -129,6 +129,8 @@ class Recorder:
         self.budget: WireBudget | None = None
         self.resets = 0
         self.steps = 0
+        self.played = 0
+        """Resets of the call followed by at least one step (the games it played), counted like `resets`."""
         self.exceeded: str | None = None
         """"episodes" or "steps" once the call went beyond its budget."""
         self.episodes: list[EpisodeRecord] = []
@@ -162,6 +164,7 @@ class Recorder:
         self.budget = budget
         self.resets = 0
         self.steps = 0
+        self.played = 0
         self.exceeded = None
         self.overflowed = False
         self.episodes = []
@@ -245,12 +248,23 @@ class Recorder:
         return episode
 
     def record_step(
-        self, episode: EpisodeRecord | None, action: Any, reward: Any, terminated: Any, truncated: Any
+        self,
+        episode: EpisodeRecord | None,
+        action: Any,
+        reward: Any,
+        terminated: Any,
+        truncated: Any,
+        *,
+        first: bool = False,
     ) -> None:
-        """Count one step against the call's budget and append it to `episode` while recording."""
+        """Count one step against the call's budget and append it to `episode` while recording.
+
+        `first`: the step is the first since its env's last reset (the game counts as played).
+        """
         if not self.record_call:
             return
         self.steps += 1
+        self.played += first
         if self.budget is not None and self.steps > self.budget.max_steps:
             self._exceed("steps")
         if episode is None or not self.recording or not self._spend_step():
@@ -286,6 +300,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         self.recorder = recorder
         self.made = made
         self._episode: EpisodeRecord | None = None
+        self._fresh = False
 
     def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset with the next seed of the grader's stream, whatever seed the student passed.
@@ -308,6 +323,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         result = self.env.reset(seed=actual_seed, options=options)
         logged_options = dict(options) if type(options) is dict else options
         self._episode = self.recorder.start_episode(self, actual_seed, student_seed, logged_options)
+        self._fresh = True
         return result
 
     def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
@@ -315,7 +331,8 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         result = self.env.step(action)
         if self.recorder.record_call:
             _, reward, terminated, truncated, _ = result
-            self.recorder.record_step(self._episode, action, reward, terminated, truncated)
+            self.recorder.record_step(self._episode, action, reward, terminated, truncated, first=self._fresh)
+        self._fresh = False
         return result
 
 

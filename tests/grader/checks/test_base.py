@@ -3,6 +3,7 @@
 import pytest
 
 from grader.checks.base import CallRecord, outcome_verdict
+from grader.checks.integrity import games_budget
 from grader.sandbox.outcome import Call, CallOutcome, OutcomeStatus
 
 
@@ -84,3 +85,20 @@ def test_missing_wins_over_an_earlier_error() -> None:
 
 def test_all_ok_leaves_judging_to_the_check() -> None:
     assert outcome_verdict([_record(OutcomeStatus.OK)] * 3) is None
+
+
+def test_a_call_beyond_its_budget_is_a_described_wrong_answer() -> None:
+    call = Call("cartpole", budget=games_budget(1, 1_000))
+    message = "cartpole() played 101 games in one call (it reset its environment 101 times); the grader records at most 10 resets per call of cartpole()"  # noqa: E501
+    outcome = CallOutcome(call, OutcomeStatus.EPISODE_LIMIT, None, [], [], "", "", message, 0.0, 7)
+    verdict = outcome_verdict([CallRecord(outcome, [])])
+    assert verdict is not None
+    assert (verdict.status, verdict.fraction) == ("failed", 0.0)
+    assert verdict.feedback == (
+        "cartpole(): cartpole() played 101 games in one call (it reset its environment 101 times); "
+        "the grader records at most 10 resets per call of cartpole(); one call of cartpole() is graded on "
+        "1 game, so this call's result is not the one asked for. Play exactly the games one call of "
+        "cartpole() is asked to play, each until it ends, and return that call's result (the grader calls "
+        "it again for more games)"
+    )
+    assert "easy start" not in verdict.feedback

@@ -92,8 +92,9 @@ def test_plans_name_the_functions() -> None:
     assert velocity_policy([0, 0, 0, 0.1]) == 1
 
 
-def _velocity_run(env) -> int:  # type: ignore[no-untyped-def]
-    observation, _ = env.reset()
+def _velocity_run(env, observation=None) -> int:  # type: ignore[no-untyped-def]
+    if observation is None:
+        observation, _ = env.reset()
     steps, done = 0, False
     while not done:
         observation, _, terminated, truncated, _ = env.step(velocity_policy(observation))
@@ -120,14 +121,34 @@ def _honest_reset_patterns():  # type: ignore[no-untyped-def]
         env.reset()
         return steps
 
-    return {"reset after make": reset_after_make, "reset at loop end": reset_at_loop_end, "both": both}
+    def double_reset(lab):  # type: ignore[no-untyped-def]
+        env = lab.make("CartPole-v0")
+        env.reset()
+        env.reset()  # a slip: the first start is never looked at
+        return _velocity_run(env)
+
+    def two_resets_at_the_end(lab):  # type: ignore[no-untyped-def]
+        env = lab.make("CartPole-v0")
+        steps = _velocity_run(env)
+        env.reset()
+        env.reset()
+        return steps
+
+    return {
+        "reset after make": reset_after_make,
+        "reset at loop end": reset_at_loop_end,
+        "both": both,
+        "double reset": double_reset,
+        "two resets at the end": two_resets_at_the_end,
+    }
 
 
 @pytest.mark.parametrize("pattern", list(_honest_reset_patterns()))
 def test_the_lab_s_unplayed_resets_are_tolerated(pattern: str, seed: int) -> None:
     function = _honest_reset_patterns()[pattern]
     # Only the integrity rules are under test: the step bars are lowered so 5 runs never miss them by chance.
-    settings = small_config("cartpole", calls=5, min_mean_steps=100.0, min_steps=50)
+    # 100 calls, the lab's number: the selection test sees 100 groups of unplayed starts.
+    settings = small_config("cartpole", calls=100, min_mean_steps=100.0, min_steps=50)
     verdict = grade("cartpole", {"cartpole": function}, seed, settings)
     assert verdict.status == "passed", verdict.feedback
 
@@ -146,26 +167,26 @@ def _scouting(lab):  # type: ignore[no-untyped-def]
 
 def _scouting_many_envs(lab):  # type: ignore[no-untyped-def]
     envs = [lab.make("CartPole-v0") for _ in range(5)]
-    starts = [abs(env.reset()[0][2]) for env in envs]
-    env = envs[starts.index(min(starts))]
-    return _velocity_run(env)
+    starts = [env.reset()[0] for env in envs]
+    best = min(range(5), key=lambda number: abs(starts[number][2]))
+    return _velocity_run(envs[best], starts[best])
 
 
-def _double_reset(lab):  # type: ignore[no-untyped-def]
+def _centre_scout(lab):  # type: ignore[no-untyped-def]
     env = lab.make("CartPole-v0")
-    steps = _velocity_run(env)
-    env.reset()
-    env.reset()
-    return steps
+    observation, _ = env.reset()
+    while abs(observation[0]) > 0.02:  # reset until the cart starts near the centre
+        observation, _ = env.reset()
+    return _velocity_run(env, observation)
 
 
 @pytest.mark.parametrize(
-    "function", [_scouting, _scouting_many_envs, _double_reset], ids=["scouting", "many envs", "double reset"]
+    "function", [_scouting, _scouting_many_envs, _centre_scout], ids=["scouting", "many envs", "centre scout"]
 )
-def test_unplayed_resets_fail_as_scouting(function, seed: int) -> None:  # type: ignore[no-untyped-def]
-    verdict = grade("cartpole", {"cartpole": function}, seed, small_config("cartpole", calls=5))
+def test_chosen_starts_fail_the_selection_test(function, seed: int) -> None:  # type: ignore[no-untyped-def]
+    verdict = grade("cartpole", {"cartpole": function}, seed, small_config("cartpole", calls=100))
     assert verdict.status == "failed"
-    assert "games unplayed" in verdict.feedback
+    assert "the starts that were played are not a fair sample of the starts dealt" in verdict.feedback
     assert "Reset once per game and play every game you reset" in verdict.feedback
 
 

@@ -1,5 +1,6 @@
 """Reading returned numbers: fractions, percentages, rounded values and the causes of mismatches."""
 
+import numpy as np
 import pytest
 
 from grader.checks.values import (
@@ -110,3 +111,10 @@ def test_step_count_mismatch_cause(returned: float, steps: int, wall_time: float
 def test_chance_text() -> None:
     assert chance_text(1e-6) == "the 1-in-1,000,000 chance"
     assert chance_text(0.0) == "a practically impossible chance"
+
+
+@pytest.mark.parametrize("wins", [570, 1, 2806, 7413])
+def test_a_single_precision_rate_is_the_replayed_rate(wins: int) -> None:
+    rate = wins / 10_000
+    assert same_number(float(np.float32(rate)), rate)
+    assert not same_number(float(np.float32(rate + 1e-4)), rate)

@@ -421,21 +421,20 @@ BUDGET = {"max_episodes": 4, "max_steps": 20}
         (
             "scouting",
             (3000,),
-            "scouting() reset its environment 3,001 times in one call; the grader records at most 4 resets "
-            "per call of scouting() — reset once per game and don't reset to look for an easy start",
+            "scouting() played 1 game in one call (it reset its environment 3,001 times); "
+            "the grader records at most 4 resets per call of scouting()",
         ),
         (
             "scouting",
             (4, True),  # seed=True is not logged (not a grader-mapped seed), but still counted
-            "scouting() reset its environment 5 times in one call; the grader records at most 4 resets "
-            "per call of scouting() — reset once per game and don't reset to look for an easy start",
+            "scouting() played 1 game in one call (it reset its environment 5 times); "
+            "the grader records at most 4 resets per call of scouting()",
         ),
         (
             "stepping",
             (25,),
-            "stepping() took 25 environment steps in one call; the grader records at most 20 steps per "
-            "call of stepping() — play only the games stepping() is asked to play and end each one when "
-            "`terminated` or `truncated` is true",
+            "stepping() took 25 environment steps in one call (over 1 game); "
+            "the grader records at most 20 steps per call of stepping()",
         ),
     ],
     ids=["zero-step-resets", "unlogged-resets", "steps"],

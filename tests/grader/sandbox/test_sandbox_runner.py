@@ -138,7 +138,7 @@ CLASSIFIED = [
         "episode limit",
         Call("resets", (10,), budget=CallBudget(max_episodes=4, max_steps=100)),
         OutcomeStatus.EPISODE_LIMIT,
-        "resets() reset its environment 10 times in one call; the grader records at most 4 resets per call",
+        "(it reset its environment 10 times); the grader records at most 4 resets per call of resets()",
     ),
 ]
 

@@ -20,6 +20,7 @@ from reference.oracles.blackjack import (
     evaluate_policy,
     random_policy_outcome,
     threshold_policy_outcome,
+    threshold_start_outcome,
 )
 
 Z_LIMIT = 5.0
@@ -232,3 +233,17 @@ def test_hit_probability_outside_0_1_is_refused(value: object) -> None:
         "return 1.0 to always hit and 0.0 to always stick"
     )
     assert str(raised.value).startswith("hit_probability(")
+
+
+@pytest.mark.parametrize("sab", [False, True], ids=["lab", "sab"])
+@pytest.mark.parametrize("n", [0, 12, 13, 20])
+def test_start_outcomes_average_to_the_policy_outcome(n: int, sab: bool) -> None:
+    win = 0.0
+    for dealer, dealer_probability in CARD_PROBABILITIES.items():
+        for first, first_probability in CARD_PROBABILITIES.items():
+            for second, second_probability in CARD_PROBABILITIES.items():
+                usable = 1 in (first, second) and first + second + 10 <= 21
+                player_sum = first + second + (10 if usable else 0)
+                start = threshold_start_outcome((player_sum, dealer, usable), n, sab=sab)
+                win += dealer_probability * first_probability * second_probability * start.win
+    assert win == pytest.approx(threshold_policy_outcome(n, sab=sab).win, abs=1e-12)
