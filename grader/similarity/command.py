@@ -90,7 +90,7 @@ def run_similarity_command(args: argparse.Namespace) -> int:
         report = write_similarity(
             sources, args.out, args.reference, template=template, cache=cache, reports=args.reports
         )
-    _summarise(report, args.out, sys.stdout)
+    summarise(report, args.out, sys.stdout)
     return 0
 
 
@@ -137,7 +137,8 @@ def write_similarity(
     return report
 
 
-def _summarise(report: SimilarityReport, out: Path, stream: Any) -> None:
+def summarise(report: SimilarityReport, out: Path, stream: Any) -> None:
+    """Print what was compared, the notes, every file left out and what was written."""
     print(
         f"Compared {len(report.students)} students"
         + (
