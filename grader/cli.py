@@ -198,8 +198,7 @@ def build_parser() -> argparse.ArgumentParser:
     grade.add_argument(
         "--similarity",
         action="store_true",
-        help="also rank pairs of students whose code is alike beyond the template into --out "
-        "(similarity.csv/.html/.json, as `gymgrade similarity`; changes no grade)",
+        help="also rank pairs of students whose code is alike beyond the template into --out (similarity.csv/.html/.json, as `gymgrade similarity`; changes no grade)",  # noqa: E501
     )
     grade.add_argument(
         "--reference",
@@ -522,8 +521,7 @@ def run_grade(args: argparse.Namespace) -> int:
                 return EXIT_ERROR
         if args.reference and not args.similarity:
             print(
-                "gymgrade grade: --reference is used by the similarity check; add --similarity "
-                "(or leave out --reference)",
+                "gymgrade grade: --reference is used by the similarity check; add --similarity (or leave out --reference)",  # noqa: E501
                 file=sys.stderr,
             )
             return EXIT_ERROR
@@ -575,8 +573,8 @@ def _similarity_beside_grading(args: argparse.Namespace, download: ClassDownload
         )
     except (GraderError, ValueError, OSError) as error:
         print(
-            f"gymgrade grade: the similarity check could not run ({error}); the grades in {args.out} are "
-            "written and unaffected; run `gymgrade similarity` on the download to retry it",
+            f"gymgrade grade: the similarity check could not run ({error}); the grades in {args.out} are written and unaffected; "  # noqa: E501
+            "run `gymgrade similarity` on the download to retry it",
             file=sys.stderr,
         )
         return EXIT_ERROR

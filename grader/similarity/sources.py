@@ -87,7 +87,7 @@ def submissions_from(
     *,
     layout: str | None = None,
     scratch: Path | None = None,
-    rule: GradedFileRule = GradedFileRule(),
+    rule: GradedFileRule | None = None,
 ) -> ClassSources:
     """The documents of a class download, read by grader/classroom/ as `gymgrade grade` reads it.
 
@@ -96,7 +96,8 @@ def submissions_from(
         layout: A ``grader.classroom.LAYOUTS`` name (``--layout``); recognised from the download when None.
         scratch: Where zips are extracted (the caller removes it after the report is written); zips are
             listed as refused when None.
-        rule: How the graded file (compared first) is chosen.
+        rule: How the graded file (compared first) is chosen; by default as `gymgrade grade` chooses it
+            with the bundled configuration (every enabled problem's function).
 
     Raises:
         ClassDirectoryError: When ``path`` does not exist.
@@ -107,6 +108,10 @@ def submissions_from(
             f"expected a class folder or zip (as the learning platform gave it), found {_what(path)} at {path}; "  # noqa: E501
             "pass the folder the submissions were downloaded into"
         )
+    if rule is None:
+        from grader.grading import GradingPlan
+
+        rule = GradedFileRule(functions=GradingPlan.load(None, None).problems)
     try:
         download = discover(path, layout=layout, rule=rule, scratch=scratch)
     except FileNotFoundError as error:
@@ -121,10 +126,14 @@ def sources_of(download: ClassDownload) -> ClassSources:
     claimed: set[str] = set()
     for submission in download.submissions:
         # discovery names a student's refused files in its reason (``where: reason``): list them as theirs
-        mine = [skipped for skipped in download.refused if f"{skipped.where}: {skipped.reason}" in submission.why]
+        mine = [
+            skipped for skipped in download.refused if f"{skipped.where}: {skipped.reason}" in submission.why
+        ]
         claimed.update(skipped.where for skipped in mine)
         sources.skipped += [
-            UnreadableFile(identity=submission.identity, file=skipped.where, reason=f"refused: {skipped.reason}.")  # noqa: E501
+            UnreadableFile(
+                identity=submission.identity, file=skipped.where, reason=f"refused: {skipped.reason}."
+            )
             for skipped in mine
         ]
         candidates = [file for file in submission.files if is_candidate(file.original_name)]
@@ -135,7 +144,9 @@ def sources_of(download: ClassDownload) -> ClassSources:
             sources.submissions.append((submission.identity, [file.path for file in candidates]))
             continue
         sources.skipped += [
-            UnreadableFile(identity=submission.identity, file=file.relative, reason=_not_candidate(file.relative))  # noqa: E501
+            UnreadableFile(
+                identity=submission.identity, file=file.relative, reason=_not_candidate(file.relative)
+            )
             for file in submission.files
         ]
         if not submission.files and not mine:
@@ -152,7 +163,11 @@ def sources_of(download: ClassDownload) -> ClassSources:
         if skipped.where not in claimed
     ]
     sources.skipped += [
-        UnreadableFile(identity=UNATTRIBUTED, file=skipped.where, reason=f"not attributed to a student: {skipped.reason}.")  # noqa: E501
+        UnreadableFile(
+            identity=UNATTRIBUTED,
+            file=skipped.where,
+            reason=f"not attributed to a student: {skipped.reason}.",
+        )
         for skipped in download.unattributed
     ]
     return sources

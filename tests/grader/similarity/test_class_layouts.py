@@ -29,7 +29,7 @@ CLASS = Path(__file__).resolve().parents[3] / "submissions" / "similarity" / "cl
 ORIGINAL = (CLASS / "h01_loops.py").read_bytes()
 COPY = (CLASS / "c_renamed_from_h01.py").read_bytes()
 HONEST = [(CLASS / name).read_bytes() for name in ("h02_helpers.py", "h03_class.py", "h07_terse.py")]
-TEST_FILE = b"from opengym import random_blackjack\n\ndef test_rate():\n    assert random_blackjack(10) >= 0\n"
+TEST_FILE = b"from opengym import random_blackjack\n\ndef test_rate():\n    assert random_blackjack(9) >= 0\n"
 
 
 def _rows(out: Path) -> list[dict[str, str]]:
