@@ -526,7 +526,7 @@ def run_grade(args: argparse.Namespace) -> int:
             )
             return EXIT_ERROR
         if args.similarity:
-            clash = similarity_clash(list(identities.values()))
+            clash = similarity_clash(list(identities.values()), args.out, args.html)
             if clash is not None:
                 print(f"gymgrade grade: {clash}", file=sys.stderr)
                 return EXIT_ERROR
@@ -537,11 +537,19 @@ def run_grade(args: argparse.Namespace) -> int:
         return code
 
 
-def similarity_clash(identities: Sequence[str]) -> str | None:
-    """Why `gymgrade grade --similarity` would overwrite a student's report with similarity.json, or None."""
+def similarity_clash(identities: Sequence[str], out_dir: Path, page: Path | None) -> str | None:
+    """Why `gymgrade grade --similarity` would overwrite a student's report or the --html class page (or its
+    JSON summary) with one of its own files, or None."""
     from grader.batch import identity_stem
-    from grader.similarity.command import JSON_FILE
+    from grader.similarity.command import CSV_FILE, HTML_FILE, JSON_FILE
 
+    if page is not None:
+        own = {(out_dir / name).resolve() for name in (CSV_FILE, HTML_FILE, JSON_FILE)}
+        if {page.resolve(), page.with_suffix(".json").resolve()} & own:
+            return (
+                f"--similarity writes {HTML_FILE} and {JSON_FILE} into --out, and --html {page} (or its JSON summary) is one of them; "  # noqa: E501
+                "name the class page e.g. class.html"
+            )
     stem = JSON_FILE.removesuffix(".json")
     clashing = [identity for identity in identities if identity_stem(identity) == stem]
     if not clashing:

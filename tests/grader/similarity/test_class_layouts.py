@@ -245,3 +245,16 @@ def test_a_student_whose_report_would_be_similarity_json_stops_before_grading(
     assert cli.main(argv) != 0
     assert "student 'similarity''s report has that name" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_class_page_named_like_the_similarity_page_stops_before_grading(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folder = tmp_path / "class"
+    (folder / "ana").mkdir(parents=True)
+    (folder / "ana" / "opengym.py").write_bytes(ORIGINAL)
+    out = tmp_path / "out"
+    argv = ["grade", str(folder), "--out", str(out), "--similarity", "--html", str(out / "similarity.html")]
+    assert cli.main(argv) != 0
+    assert "is one of them; name the class page e.g. class.html" in capsys.readouterr().err
+    assert not out.exists()
