@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from classroom.downloads import BUILDERS
 from grading_support import FAST_OVERRIDES, write_config
 
 import grader
@@ -24,6 +25,8 @@ from grader import cli
 from grader.batch import identity_stem
 from grader.grading import GradingPlan
 from grader.report import ProblemResult, Report
+from grader.similarity.run import run_similarity
+from grader.similarity.sources import submissions_from
 
 CLASS = Path(__file__).resolve().parents[3] / "submissions" / "similarity" / "class"
 ORIGINAL = (CLASS / "h01_loops.py").read_bytes()
@@ -258,3 +261,20 @@ def test_a_class_page_named_like_the_similarity_page_stops_before_grading(
     assert cli.main(argv) != 0
     assert "is one of them; name the class page e.g. class.html" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("layout", sorted(BUILDERS))
+def test_every_layout_grade_reads_is_compared_one_document_per_graded_student(
+    layout: str, tmp_path: Path
+) -> None:
+    """The classroom tests' downloads of each layout: every student grading would grade is compared, under
+    the same identity; nothing stops the run."""
+    expected = BUILDERS[layout](tmp_path / "download", 2)
+    with tempfile.TemporaryDirectory() as scratch:
+        sources = submissions_from(expected.path, scratch=Path(scratch))
+        report = run_similarity(sources, workers=1).report
+    graded = sorted(identity for identity, file in expected.graded.items() if file is not None)
+    assert sources.layout == expected.layout
+    assert set(graded) <= set(report.students)
+    for where in expected.refused + expected.unattributed:
+        assert any(entry.file == where for entry in report.unreadable), (where, report.unreadable)
