@@ -195,6 +195,19 @@ def build_parser() -> argparse.ArgumentParser:
         help="also write a self-contained class report (scores, pass rates, common diagnoses, links to each report); "  # noqa: E501
         "its JSON summary goes beside it (class.html -> class.json)",
     )
+    grade.add_argument(
+        "--similarity",
+        action="store_true",
+        help="also rank pairs of students whose code is alike beyond the template into --out (similarity.csv/.html/.json, as `gymgrade similarity`; changes no grade)",  # noqa: E501
+    )
+    grade.add_argument(
+        "--reference",
+        type=Path,
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="with --similarity: a folder of known solutions to compare against; may be repeated",
+    )
     grade.set_defaults(handler=run_grade)
 
     bundle = subparsers.add_parser(
@@ -530,8 +543,75 @@ def run_grade(args: argparse.Namespace) -> int:
             if clash is not None:
                 print(f"gymgrade grade: {clash}", file=sys.stderr)
                 return EXIT_ERROR
+        if args.reference and not args.similarity:
+            print(
+                "gymgrade grade: --reference is used by the similarity check; add --similarity (or leave out --reference)",  # noqa: E501
+                file=sys.stderr,
+            )
+            return EXIT_ERROR
+        if args.similarity:
+            clash = similarity_clash(list(identities.values()), args.out, args.html)
+            if clash is not None:
+                print(f"gymgrade grade: {clash}", file=sys.stderr)
+                return EXIT_ERROR
         gradebook = ClassGradebook(download, identities, plan.problems, roster, args.gradebook, assignment)
-        return _grade_class(args, list(identities), identities, gradebook)
+        code = _grade_class(args, list(identities), identities, gradebook)
+        if args.similarity and code != EXIT_INTERRUPTED:
+            return _similarity_beside_grading(args, download) or code
+        return code
+
+
+def similarity_clash(identities: Sequence[str], out_dir: Path, page: Path | None) -> str | None:
+    """Why `gymgrade grade --similarity` would overwrite a student's report or the --html class page (or its
+    JSON summary) with one of its own files, or None."""
+    from grader.batch import identity_stem
+    from grader.similarity.command import CSV_FILE, HTML_FILE, JSON_FILE
+
+    if page is not None:
+        own = {(out_dir / name).resolve() for name in (CSV_FILE, HTML_FILE, JSON_FILE)}
+        if {page.resolve(), page.with_suffix(".json").resolve()} & own:
+            return (
+                f"--similarity writes {HTML_FILE} and {JSON_FILE} into --out, and --html {page} (or its JSON summary) is one of them; "  # noqa: E501
+                "name the class page e.g. class.html"
+            )
+    stem = JSON_FILE.removesuffix(".json")
+    clashing = [identity for identity in identities if identity_stem(identity) == stem]
+    if not clashing:
+        return None
+    return (
+        f"--similarity writes {JSON_FILE} into --out, but student {clashing[0]!r}'s report has that name; "
+        "leave out --similarity and run `gymgrade similarity` with another --out after grading"
+    )
+
+
+def _similarity_beside_grading(args: argparse.Namespace, download: ClassDownload) -> int:
+    """The similarity check of a graded batch, written into --out with the batch's reports as behaviour
+    evidence. It reads only the download and the reports: grades.csv and the reports are left as they are.
+
+    Returns:
+        0, or EXIT_ERROR when the check could not run (the grades are written either way).
+    """
+    from grader.similarity.cache import IndexCache, default_cache_dir
+    from grader.similarity.command import summarise, write_similarity
+    from grader.similarity.sources import sources_of
+
+    try:
+        report = write_similarity(
+            sources_of(download),
+            args.out,
+            args.reference,
+            cache=IndexCache(default_cache_dir()),
+            reports=args.out,
+        )
+    except (GraderError, ValueError, OSError) as error:
+        print(
+            f"gymgrade grade: the similarity check could not run ({error}); the grades in {args.out} are written and unaffected; "  # noqa: E501
+            "run `gymgrade similarity` on the download to retry it",
+            file=sys.stderr,
+        )
+        return EXIT_ERROR
+    summarise(report, args.out, sys.stderr)
+    return 0
 
 
 def class_summary(download: ClassDownload) -> str:

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
+from grader.batch import identity_stem
 from grader.report import Report
 from grader.similarity.frequency import RARE_MAXIMUM
 
@@ -39,7 +40,8 @@ def wrong_results(report: Report) -> WrongResults:
 
 
 def load_wrong_results(reports_dir: Path, identities: list[str]) -> tuple[dict[str, WrongResults], list[str]]:
-    """Read ``reports_dir/<identity>.json`` (gymgrade's grading reports) for each student that has one.
+    """Read each student's grading report from ``reports_dir``, named as `gymgrade grade` names it
+    (``grader.batch.identity_stem``: the identity, with unsafe characters percent-encoded).
 
     Returns:
         The wrong results by identity, and a note per report that could not be read.
@@ -47,7 +49,7 @@ def load_wrong_results(reports_dir: Path, identities: list[str]) -> tuple[dict[s
     found: dict[str, WrongResults] = {}
     notes: list[str] = []
     for identity in identities:
-        path = reports_dir / f"{identity}.json"
+        path = reports_dir / f"{identity_stem(identity)}.json"
         if not path.is_file():
             continue
         try:

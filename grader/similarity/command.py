@@ -4,8 +4,16 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from grader.similarity.cache import IndexCache
+    from grader.similarity.report import SimilarityReport
+    from grader.similarity.sources import ClassSources
+    from grader.similarity.template import Template
 
 CSV_FILE = "similarity.csv"
 HTML_FILE = "similarity.html"
@@ -14,12 +22,23 @@ JSON_FILE = "similarity.json"
 
 def add_similarity_command(subparsers: Any) -> None:
     """Register the subcommand on `gymgrade`'s subparsers."""
+    from grader.classroom.layouts import LAYOUTS
+
     parser = subparsers.add_parser(
         "similarity",
         help="rank pairs of submissions whose code is alike beyond the template (changes no grade)",
     )
     parser.add_argument(
-        "class_dir", type=Path, metavar="CLASS_DIR", help="one folder or one file per student"
+        "class_dir",
+        type=Path,
+        metavar="CLASS_DIR",
+        help="the class download as `gymgrade grade` takes it (folder or zip, any layout)",
+    )
+    parser.add_argument(
+        "--layout",
+        choices=tuple(LAYOUTS),
+        default=None,
+        help="the download's layout (default: recognised from its names; see docs/instructors.md)",
     )
     parser.add_argument(
         "--reference",
@@ -60,30 +79,66 @@ def add_similarity_command(subparsers: Any) -> None:
 
 def run_similarity_command(args: argparse.Namespace) -> int:
     """Run the comparison and write ``similarity.csv``, ``similarity.html`` and ``similarity.json``."""
-    from grader.similarity.behaviour import WrongResults, load_wrong_results
     from grader.similarity.cache import IndexCache, default_cache_dir
-    from grader.similarity.csv_output import render_csv
-    from grader.similarity.html_output import render_html
-    from grader.similarity.run import run_similarity
     from grader.similarity.sources import submissions_from
     from grader.similarity.template import BUNDLED, load_template
 
     template = load_template(tuple(args.template) if args.template else BUNDLED)
     cache = None if args.no_cache else IndexCache(args.cache or default_cache_dir())
+    with tempfile.TemporaryDirectory(prefix="gymgrade-similarity-") as scratch:
+        sources = submissions_from(args.class_dir, layout=args.layout, scratch=Path(scratch))
+        report = write_similarity(
+            sources, args.out, args.reference, template=template, cache=cache, reports=args.reports
+        )
+    summarise(report, args.out, sys.stdout)
+    return 0
+
+
+def write_similarity(
+    sources: ClassSources,
+    out: Path,
+    references: Sequence[Path] = (),
+    *,
+    template: Template | None = None,
+    cache: IndexCache | None = None,
+    reports: Path | None = None,
+) -> SimilarityReport:
+    """Compare a class's documents and write ``out/similarity.csv``, ``.html`` and ``.json``.
+
+    The files of ``sources`` must still exist (a zip's scratch folder is removed only after this returns).
+
+    Args:
+        sources: The class's documents (``grader.similarity.sources.submissions_from`` or ``sources_of``).
+        out: The folder written into.
+        references: Folders of known solutions.
+        template: What to remove (every edition's template by default).
+        cache: Where reference indexes are kept (none: index every time).
+        reports: A folder of gymgrade grading reports, named as `gymgrade grade` names them: identical
+            wrong results count as evidence.
+    """
+    from grader.similarity.behaviour import WrongResults, load_wrong_results
+    from grader.similarity.csv_output import render_csv
+    from grader.similarity.html_output import render_html
+    from grader.similarity.run import run_similarity
+
     behaviour: dict[str, WrongResults] | None = None
     notes: list[str] = []
-    if args.reports is not None:
-        identities = sorted({identity for identity, _ in submissions_from(args.class_dir)})
-        behaviour, notes = load_wrong_results(args.reports, identities)
+    if reports is not None:
+        behaviour, notes = load_wrong_results(reports, sources.identities)
     outcome = run_similarity(
-        args.class_dir, args.reference, template=template, cache=cache, behaviour=behaviour, notes=notes
+        sources, references, template=template, cache=cache, behaviour=behaviour, notes=notes
     )
     report = outcome.report
-    args.out.mkdir(parents=True, exist_ok=True)
-    with (args.out / CSV_FILE).open("w", encoding="utf-8", newline="") as stream:
+    out.mkdir(parents=True, exist_ok=True)
+    with (out / CSV_FILE).open("w", encoding="utf-8", newline="") as stream:
         stream.write(render_csv(report))
-    (args.out / HTML_FILE).write_text(render_html(report, outcome.lines_of), encoding="utf-8")
-    (args.out / JSON_FILE).write_text(report.model_dump_json(indent=2) + "\n", encoding="utf-8")
+    (out / HTML_FILE).write_text(render_html(report, outcome.lines_of), encoding="utf-8")
+    (out / JSON_FILE).write_text(report.model_dump_json(indent=2) + "\n", encoding="utf-8")
+    return report
+
+
+def summarise(report: SimilarityReport, out: Path, stream: Any) -> None:
+    """Print what was compared, the notes, every file left out and what was written."""
     print(
         f"Compared {len(report.students)} students"
         + (
@@ -94,8 +149,10 @@ def run_similarity_command(args: argparse.Namespace) -> int:
         + f": {len(report.pairs)} pairs flagged for reading, in {len(report.clusters)} groups"
         + (f"; {len(report.unreadable)} files left out (listed in {HTML_FILE})" if report.unreadable else "")
         + ".",
+        file=stream,
     )
     for note in report.notes:
-        print(f"  {note}")
-    print(f"Wrote {args.out / CSV_FILE}, {args.out / HTML_FILE} and {args.out / JSON_FILE}.", file=sys.stdout)
-    return 0
+        print(f"  {note}", file=stream)
+    for left_out in report.unreadable:
+        print(f"  left out {left_out.file} ({left_out.identity}): {left_out.reason}", file=stream)
+    print(f"Wrote {out / CSV_FILE}, {out / HTML_FILE} and {out / JSON_FILE}.", file=stream)

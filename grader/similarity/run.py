@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,14 +22,13 @@ from grader.similarity.document import (
 from grader.similarity.report import SimilarityReport, UnreadableFile
 from grader.similarity.sources import (
     MAX_FILES_PER_SUBMISSION,
+    ClassSources,
     SourceText,
     Unreadable,
     references_from,
     submissions_from,
 )
 from grader.similarity.template import Template, load_template
-
-Discovery = Callable[[Path], list[tuple[str, Path]]]
 
 
 @dataclass(frozen=True)
@@ -51,25 +50,24 @@ class Outcome:
 
 
 def run_similarity(
-    class_dir: Path,
+    class_dir: Path | ClassSources,
     references: Sequence[Path] = (),
     *,
     template: Template | None = None,
     cache: IndexCache | None = None,
     behaviour: dict[str, WrongResults] | None = None,
-    discover: Discovery = submissions_from,
     notes: Sequence[str] = (),
     workers: int | None = None,
 ) -> Outcome:
     """Compare a class with itself and with reference folders.
 
     Args:
-        class_dir: The class folder (`discover` reads its layout).
+        class_dir: The class download (a plain folder here; zips and a ``--layout`` need
+            ``submissions_from(path, layout=..., scratch=...)`` first), or its documents already found.
         references: Folders of known solutions; every file in them is a document.
         template: What to remove (the bundled lab templates by default).
         cache: Where reference indexes are kept between runs (none: index every time).
         behaviour: Wrong results by student identity, from grading reports.
-        discover: The class layout reader.
         notes: Extra notes for the report.
         workers: Processes that index files (default: one per core; 1 indexes in this process).
 
@@ -77,12 +75,10 @@ def run_similarity(
         ClassDirectoryError: When a folder does not exist.
     """
     template = template or load_template()
-    grouped: dict[str, list[Path]] = {}
-    for identity, path in discover(class_dir):
-        grouped.setdefault(identity, []).append(path)
-    unreadable: list[UnreadableFile] = []
+    sources = class_dir if isinstance(class_dir, ClassSources) else submissions_from(class_dir)
+    unreadable: list[UnreadableFile] = list(sources.skipped)
     jobs: list[tuple[str, bool, list[Path]]] = []
-    for identity, paths in grouped.items():
+    for identity, paths in sources.submissions:
         unreadable.extend(
             UnreadableFile(
                 identity=identity,

@@ -1,19 +1,25 @@
-"""Where the submissions are and what text each holds: the one adapter from a class folder to documents.
+"""Where the submissions are and what text each holds: the one adapter from a class download to documents.
 
-`submissions_from` is the single place that knows a class layout. It reads plain folders: one folder per
-student (every ``.py``/``.ipynb`` inside is theirs) or one file per student in a flat folder. The class
-layouts of learning platforms (grader/classroom/) plug in here by replacing this one function.
+`submissions_from` is the single place that knows a class layout, and it knows none itself: it asks
+grader/classroom/ (the same discovery `gymgrade grade` uses), so every layout grading takes (plain folders,
+Canvas, Gradescope exports, GitHub Classroom, Moodle, nbgrader, Blackboard, zips of them) is compared, one
+document per student keyed by the gradebook's identity. A student's document is every candidate file of
+theirs (``grader.classroom.graded_file.is_candidate``: Python or a notebook, never a test, checkpoint or
+setup file), the graded file first; docs/similarity.md says why not the graded file alone.
 """
 
 from __future__ import annotations
 
 import ast
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
+from grader.classroom import ClassDownload, GradedFileRule, discover
+from grader.classroom.graded_file import is_candidate
 from grader.notebook import MAX_NOTEBOOK_BYTES
 from grader.similarity.errors import ClassDirectoryError
+from grader.similarity.report import UnreadableFile
 
 SOURCE_SUFFIXES = (".py", ".ipynb")
 MAX_COMPARED_BYTES = 200_000
@@ -22,6 +28,10 @@ MAX_COMPARED_BYTES = 200_000
 MAX_FILES_PER_SUBMISSION = 20
 """A student's folder may hold helpers beside the lab file; files beyond this many are listed, not read."""
 IGNORED_PARTS = ("__pycache__", ".ipynb_checkpoints", "__MACOSX")
+UNATTRIBUTED = "(not attributed)"
+"""The identity column of a file no student can be named for."""
+REFUSED = "(refused)"
+"""The identity column of a file refused for safety that no student can be named for."""
 
 
 @dataclass(frozen=True)
@@ -52,34 +62,122 @@ class Unreadable:
     reason: str
 
 
-def submissions_from(path: Path) -> list[tuple[str, Path]]:
-    """The submissions of a class folder as ``(identity, source file)`` pairs, sorted.
+@dataclass
+class ClassSources:
+    """The documents of a class: each student's files to compare, and every file left out with its reason.
 
-    A sub-folder is one student (identity: the folder's name) and every ``.py``/``.ipynb`` file in it,
-    at any depth, is theirs (a student may appear in several pairs). A ``.py``/``.ipynb`` file directly
-    in ``path`` is one student (identity: the file name without its suffix). Hidden files, caches and
-    notebook checkpoints are skipped.
+    Attributes:
+        layout: The layout the download was read as ("canvas", "plain", ...).
+        submissions: ``(identity, files)`` per student with at least one candidate file, sorted by identity.
+        skipped: Files refused, not attributable, or of a student with nothing to compare (with reasons).
+    """
+
+    layout: str
+    submissions: list[tuple[str, list[Path]]] = field(default_factory=list)
+    skipped: list[UnreadableFile] = field(default_factory=list)
+
+    @property
+    def identities(self) -> list[str]:
+        """Every compared student's identity, sorted."""
+        return [identity for identity, _ in self.submissions]
+
+
+def submissions_from(
+    path: Path,
+    *,
+    layout: str | None = None,
+    scratch: Path | None = None,
+    rule: GradedFileRule | None = None,
+) -> ClassSources:
+    """The documents of a class download, read by grader/classroom/ as `gymgrade grade` reads it.
+
+    Args:
+        path: The download: a folder, a zip as the LMS gave it, or one file.
+        layout: A ``grader.classroom.LAYOUTS`` name (``--layout``); recognised from the download when None.
+        scratch: Where zips are extracted (the caller removes it after the report is written); zips are
+            listed as refused when None.
+        rule: How the graded file (compared first) is chosen; by default as `gymgrade grade` chooses it
+            with the bundled configuration (every enabled problem's function).
 
     Raises:
-        ClassDirectoryError: When ``path`` is not a directory.
+        ClassDirectoryError: When ``path`` does not exist.
+        grader.classroom.errors.ClassroomError: When ``layout`` is unknown or the download is not of it.
     """
-    if not path.is_dir():
+    if not path.exists() and not path.is_symlink():
         raise ClassDirectoryError(
-            f"expected a class folder (one sub-folder or one file per student), found {_what(path)} at {path}; "  # noqa: E501
+            f"expected a class folder or zip (as the learning platform gave it), found {_what(path)} at {path}; "  # noqa: E501
             "pass the folder the submissions were downloaded into"
         )
-    found: list[tuple[str, Path]] = []
-    for entry in sorted(path.iterdir()):
-        if _ignored(entry.name):
+    if rule is None:
+        from grader.grading import GradingPlan
+
+        rule = GradedFileRule(functions=GradingPlan.load(None, None).problems)
+    try:
+        download = discover(path, layout=layout, rule=rule, scratch=scratch)
+    except FileNotFoundError as error:
+        raise ClassDirectoryError(str(error)) from None
+    return sources_of(download)
+
+
+def sources_of(download: ClassDownload) -> ClassSources:
+    """The documents of an already discovered class download (``gymgrade grade --similarity`` reuses the
+    batch's): each student's candidate files, the graded one first; the rest listed with a reason."""
+    sources = ClassSources(layout=download.layout)
+    claimed: set[str] = set()
+    for submission in download.submissions:
+        # discovery names a student's refused files in its reason (``where: reason``): list them as theirs
+        mine = [
+            skipped for skipped in download.refused if f"{skipped.where}: {skipped.reason}" in submission.why
+        ]
+        claimed.update(skipped.where for skipped in mine)
+        sources.skipped += [
+            UnreadableFile(
+                identity=submission.identity, file=skipped.where, reason=f"refused: {skipped.reason}."
+            )
+            for skipped in mine
+        ]
+        candidates = [file for file in submission.files if is_candidate(file.original_name)]
+        if submission.graded_file is not None and submission.graded_file in candidates:
+            candidates.remove(submission.graded_file)
+            candidates.insert(0, submission.graded_file)
+        if candidates:
+            sources.submissions.append((submission.identity, [file.path for file in candidates]))
             continue
-        if entry.is_dir() and not entry.is_symlink():
-            files = [file for file in sorted(entry.rglob("*")) if _is_source(file, entry)]
-            found.extend((entry.name, file) for file in files)
-            if not files:
-                found.append((entry.name, entry))
-        elif entry.is_file() or entry.is_symlink():
-            found.append((entry.stem if _has_source_suffix(entry) else entry.name, entry))
-    return found
+        sources.skipped += [
+            UnreadableFile(
+                identity=submission.identity, file=file.relative, reason=_not_candidate(file.relative)
+            )
+            for file in submission.files
+        ]
+        if not submission.files and not mine:
+            sources.skipped.append(
+                UnreadableFile(
+                    identity=submission.identity,
+                    file=submission.identity,
+                    reason=f"nothing to compare: {submission.why}.",
+                )
+            )
+    sources.skipped += [
+        UnreadableFile(identity=REFUSED, file=skipped.where, reason=f"refused: {skipped.reason}.")
+        for skipped in download.refused
+        if skipped.where not in claimed
+    ]
+    sources.skipped += [
+        UnreadableFile(
+            identity=UNATTRIBUTED,
+            file=skipped.where,
+            reason=f"not attributed to a student: {skipped.reason}.",
+        )
+        for skipped in download.unattributed
+    ]
+    return sources
+
+
+def _not_candidate(relative: str) -> str:
+    name = relative.rsplit("/", 1)[-1]
+    if Path(name).suffix.lower() not in SOURCE_SUFFIXES:
+        return f"{name} is neither a .py nor an .ipynb file: only Python sources and notebooks are compared."
+    return f"{name} is a test, checkpoint or setup file, not a solution: not compared."
 
 
 def references_from(path: Path) -> list[tuple[str, Path]]:

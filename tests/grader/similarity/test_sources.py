@@ -28,7 +28,7 @@ BAD_FILES: dict[str, tuple[bytes, str]] = {
         json.dumps({"nbformat": 4, "cells": [{"cell_type": "markdown", "source": "hi"}]}).encode(),
         "has no code cells",
     ),
-    "notes.txt": (b"my answers are in the notebook", "is neither a .py nor an .ipynb file"),
+    "notes.txt": (b"my answers are in the notebook", "not attributed to a student: a file outside every"),
 }
 
 
@@ -41,6 +41,8 @@ def class_dir(tmp_path: Path) -> Path:
     for name, (data, _) in BAD_FILES.items():
         (folder / name).write_bytes(data)
     (folder / "empty_folder").mkdir()
+    (folder / "fay").mkdir()
+    (folder / "fay" / "README.md").write_text("my answers are in the notebook I forgot\n", encoding="utf-8")
     (folder / ".hidden.py").write_text("x = 1\n", encoding="utf-8")
     return folder
 
@@ -50,7 +52,8 @@ def test_every_bad_file_is_listed_with_its_reason_and_the_rest_is_still_compared
     reasons = {entry.file: entry.reason for entry in report.unreadable}
     for name, (_, expected) in BAD_FILES.items():
         assert expected in reasons[name], (name, reasons.get(name))
-    assert "holds no .py or .ipynb file" in reasons["empty_folder"]
+    assert "is neither a .py nor an .ipynb file" in reasons["fay/README.md"]
+    assert "empty_folder" not in reasons, "an empty folder is no submission, as for gymgrade grade"
     assert ".hidden.py" not in reasons
     assert report.students == ["ana", "ben"]
     assert [(pair.a, pair.b) for pair in report.pairs] == [("ana", "ben")]
@@ -69,19 +72,24 @@ def test_a_missing_class_folder_is_an_error_that_says_what_to_pass(tmp_path: Pat
         run_similarity(tmp_path / "missing")
 
 
-def test_a_student_folder_holds_every_source_file_of_the_student(tmp_path: Path) -> None:
+def test_a_student_folder_holds_every_candidate_file_of_the_student_the_graded_one_first(
+    tmp_path: Path,
+) -> None:
     (tmp_path / "cara" / "lab").mkdir(parents=True)
     (tmp_path / "cara" / "lab" / "opengym.py").write_text("x = 1\n", encoding="utf-8")
     (tmp_path / "cara" / "helpers.ipynb").write_text("{}", encoding="utf-8")
     (tmp_path / "cara" / ".ipynb_checkpoints").mkdir()
     (tmp_path / "cara" / ".ipynb_checkpoints" / "helpers-checkpoint.ipynb").write_text("{}", encoding="utf-8")
+    (tmp_path / "cara" / "test_opengym.py").write_text("def test_x():\n    pass\n", encoding="utf-8")
     (tmp_path / "dan.ipynb").write_text("{}", encoding="utf-8")
+    sources = submissions_from(tmp_path)
+    assert sources.layout == "plain"
     assert [
-        (identity, path.relative_to(tmp_path).as_posix()) for identity, path in submissions_from(tmp_path)
+        (identity, [path.relative_to(tmp_path).as_posix() for path in paths])
+        for identity, paths in sources.submissions
     ] == [
-        ("cara", "cara/helpers.ipynb"),
-        ("cara", "cara/lab/opengym.py"),
-        ("dan", "dan.ipynb"),
+        ("cara", ["cara/lab/opengym.py", "cara/helpers.ipynb"]),
+        ("dan", ["dan.ipynb"]),
     ]
 
 
@@ -141,6 +149,6 @@ def test_a_symbolic_link_is_listed_and_never_followed(tmp_path: Path) -> None:
     (tmp_path / "ivy.py").symlink_to("/dev/zero")
     (tmp_path / "jon.py").write_text(GOOD, encoding="utf-8")
     report = run_similarity(tmp_path).report
-    assert [(entry.file, entry.reason) for entry in report.unreadable] == [
-        ("ivy.py", "ivy.py is a symbolic link: only regular files are read, left out.")
+    assert [(entry.identity, entry.file, entry.reason) for entry in report.unreadable] == [
+        ("ivy", "ivy.py", "refused: a symbolic link (to /dev/zero): links are never followed.")
     ]
