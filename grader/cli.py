@@ -74,8 +74,7 @@ def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
         "--edition",
         choices=tuple(EDITIONS),
         default=None,
-        help="the edition of the lab graded (default: the configuration's `edition`, else detected from the "
-        "file for check, else classic)",
+        help="the edition of the lab graded (default: the configuration's `edition`, else detected from the file for check, else classic)",  # noqa: E501
     )
     parser.add_argument(
         "--config",

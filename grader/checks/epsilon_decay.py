@@ -84,28 +84,23 @@ def exponential(episode: int, n: int, start: float, end: float) -> float:
 
 MISTAKES: tuple[tuple[str, Formula], ...] = (
     (
-        "your values are those of 0-based episodes (episode i gets start - i * delta); the lab numbers "
-        "episodes from 1, so episode 1 must get epsilon_start exactly",
+        "your values are those of 0-based episodes (episode i gets start - i * delta); the lab numbers episodes from 1, so episode 1 must get epsilon_start exactly",  # noqa: E501
         lambda i, n, s, e: s - i * (s - e) / n,
     ),
     (
-        "your values divide by N - 1 (delta = (epsilon_start - epsilon_end) / (N - 1)); the lab's delta "
-        "divides by N, so the last episode gets epsilon_start - (N - 1) * delta, not epsilon_end",
+        "your values divide by N - 1 (delta = (epsilon_start - epsilon_end) / (N - 1)); the lab's delta divides by N, so the last episode gets epsilon_start - (N - 1) * delta, not epsilon_end",  # noqa: E501
         lambda i, n, s, e: s - (i - 1) * (s - e) / (n - 1),
     ),
     (
-        "your values are right except at the last episode, where you return epsilon_end; the formula "
-        "gives the last episode epsilon_start - (N - 1) * delta, which is not epsilon_end",
+        "your values are right except at the last episode, where you return epsilon_end; the formula gives the last episode epsilon_start - (N - 1) * delta, which is not epsilon_end",  # noqa: E501
         lambda i, n, s, e: e if i == n else linear(i, n, s, e),
     ),
     (
-        "your values ignore the epsilon_start and epsilon_end passed in (they are those of 1.0 and 1e-6); "
-        "use the parameters, not constants",
+        "your values ignore the epsilon_start and epsilon_end passed in (they are those of 1.0 and 1e-6); use the parameters, not constants",  # noqa: E501
         lambda i, n, s, e: linear(i, n, DEFAULT_START, DEFAULT_END),
     ),
     (
-        "your values decay to 0 rather than to epsilon_end (delta = epsilon_start / N); subtract "
-        "epsilon_end: delta = (epsilon_start - epsilon_end) / N",
+        "your values decay to 0 rather than to epsilon_end (delta = epsilon_start / N); subtract epsilon_end: delta = (epsilon_start - epsilon_end) / N",  # noqa: E501
         lambda i, n, s, e: s - (i - 1) * s / n,
     ),
     (
@@ -133,8 +128,7 @@ class EpsilonDecayConfig(ProblemConfig):
         default=1e-9,
         gt=0.0,
         lt=1e-3,
-        description="Floating-point tolerance of an exact answer (the same formula written another way, or "
-        "applied episode by episode), relative to the value or to epsilon_start's scale.",
+        description="Floating-point tolerance of an exact answer (the same formula written another way, or applied episode by episode), relative to the value or to epsilon_start's scale.",  # noqa: E501
     )
 
 
@@ -219,14 +213,10 @@ def _mismatch(values: Sequence[float | None], formula: Formula, tolerance: float
     rule = (
         f"epsilon_start * (epsilon_end / epsilon_start) ** (episode / N) = {expected[first]!r}"
         if exp
-        else f"epsilon_start - (episode - 1) * delta with delta = ({start!r} - {end!r}) / {point.n} "
-        f"= {expected[first]!r}"
+        else f"epsilon_start - (episode - 1) * delta with delta = ({start!r} - {end!r}) / {point.n} = {expected[first]!r}"  # noqa: E501
     )
     returned = "no finite number" if found is None else describe(found)
-    message = (
-        f"{point.text(exp)} returned {returned}; expected {rule} "
-        f"({len(wrong)} of {len(GRID)} argument sets wrong)."
-    )
+    message = f"{point.text(exp)} returned {returned}; expected {rule} ({len(wrong)} of {len(GRID)} argument sets wrong)."  # noqa: E501
     if found is None:
         return message + " Return a float."
     if not exp:

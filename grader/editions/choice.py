@@ -40,6 +40,8 @@ def configured_edition(config: Path) -> str:
     """
     try:
         raw = tomllib.loads(config.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(f"assignment configuration {config} not found: pass an existing TOML file") from None
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
         raise ConfigError(f"{config} is not a readable UTF-8 TOML file ({error}): fix the path or the syntax") from None
     name = raw.get("edition", DEFAULT_EDITION)
