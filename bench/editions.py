@@ -55,22 +55,30 @@ def _statuses(function: Any, regrades: int, **updates: Any) -> Counter[str]:
 
 
 def calibrate(regrades: int, mistake_regrades: int) -> None:
-    print(f"epsilon_decay calibration: {regrades} regrades per honest student, {mistake_regrades} per mistake")
+    print(
+        f"epsilon_decay calibration: {regrades} regrades per honest student, {mistake_regrades} per mistake"
+    )
     for name, function in students.HONEST.items():
         print(f"  honest {name:<22} linear only: {dict(_statuses(function, regrades))}")
-    print(f"  honest {'formula':<22} with exp:    {dict(_statuses(students.honest, regrades, grade_exp=True))}")
+    print(
+        f"  honest {'formula':<22} with exp:    {dict(_statuses(students.honest, regrades, grade_exp=True))}"
+    )
     for name, (function, _) in students.MISTAKES.items():
         print(f"  mistake {name:<21} {dict(_statuses(function, mistake_regrades))}")
-    print(f"  mistake {'exp_off_by_one':<21} with exp: {dict(_statuses(students.exp_off_by_one, mistake_regrades, grade_exp=True))}")  # noqa: E501
+    print(
+        f"  mistake {'exp_off_by_one':<21} with exp: {dict(_statuses(students.exp_off_by_one, mistake_regrades, grade_exp=True))}"  # noqa: E501
+    )
 
 
 def sandbox() -> None:
-    paths = sorted(SAMPLES.glob("epsilon_decay_*.py")) + [RL1.reference, RL1.template]
+    paths = [*sorted(SAMPLES.glob("epsilon_decay_*.py")), RL1.reference, RL1.template]
     plan = GradingPlan.load(RL1.default_config, ["epsilon_decay"])
     started = time.perf_counter()
     reports = grade_files(paths, plan, seed=1, workers=2, policy=IsolationPolicy.ALLOW_FALLBACK)
     elapsed = time.perf_counter() - started
-    print(f"real sandbox: {len(paths)} files graded on epsilon_decay in {elapsed:.1f} s (one session, 2 workers)")
+    print(
+        f"real sandbox: {len(paths)} files graded on epsilon_decay in {elapsed:.1f} s (one session, 2 workers)"  # noqa: E501
+    )
     for path, report in zip(paths, reports, strict=True):
         (result,) = report.problems
         print(f"  {path.name:<36} {result.status:<8} {result.timings.wall_seconds:.2f} s wall")
@@ -82,7 +90,9 @@ def detection() -> None:
         for path in (edition.template, edition.reference):
             started = time.perf_counter()
             found = detect_edition(path)
-            print(f"  {edition.name:<8} {path.name:<28} -> {found.edition.name:<8} {1000 * (time.perf_counter() - started):.1f} ms")  # noqa: E501
+            print(
+                f"  {edition.name:<8} {path.name:<28} -> {found.edition.name:<8} {1000 * (time.perf_counter() - started):.1f} ms"  # noqa: E501
+            )
     with tempfile.TemporaryDirectory() as directory:
         large = Path(directory) / "opengym.py"
         body = RL1.reference.read_text(encoding="utf-8")
@@ -92,7 +102,9 @@ def detection() -> None:
             started = time.perf_counter()
             detect_edition(large)
             times.append(time.perf_counter() - started)
-        print(f"  a {large.stat().st_size:,}-byte source: median {1000 * statistics.median(times):.1f} ms of 5")
+        print(
+            f"  a {large.stat().st_size:,}-byte source: median {1000 * statistics.median(times):.1f} ms of 5"
+        )
 
 
 def main() -> None:

@@ -10,9 +10,9 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from grader.editions import EDITIONS, all_problem_ids
 from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError
 from grader.notebook import NotebookSummary
-from grader.editions import EDITIONS, all_problem_ids
 from grader.progress import ProgressBar, result_line
 from grader.report import IsolationSummary, ProblemResult, Report
 from grader.sandbox import IsolationPolicy
@@ -228,7 +228,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _choose_edition(args: argparse.Namespace) -> None:
-    """Resolve `--edition`, the configuration's edition or detection into the configuration graded; say which."""
+    """Resolve `--edition`, the configuration's edition or detection into the configuration; say which."""
     if args.command not in ("check", "grade"):
         return
     from grader.editions.choice import choose_edition

@@ -145,7 +145,9 @@ def assignment_file_model(registry: Registry) -> type[BaseModel]:
         sandbox=(SandboxConfig, Field(description="Resource limits of the sandbox.")),
         edition=(
             str,
-            Field(default=DEFAULT_EDITION, description="The edition graded (grader/editions/); default the first."),
+            Field(
+                default=DEFAULT_EDITION, description="The edition graded (grader/editions/), else the first."
+            ),
         ),
     )
 

@@ -79,7 +79,7 @@ def linear(episode: int, n: int, start: float, end: float) -> float:
 
 def exponential(episode: int, n: int, start: float, end: float) -> float:
     """The optional `decay_type="exp"`: `start * (end / start) ** (episode / N)`."""
-    return start * (end / start) ** (episode / n)
+    return float(start * (end / start) ** (episode / n))
 
 
 MISTAKES: tuple[tuple[str, Formula], ...] = (
@@ -149,7 +149,9 @@ class EpsilonDecayCheck:
 
     def plan(self, settings: EpsilonDecayConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """One unrecorded call per grid point (and per grid point again with decay_type='exp')."""
-        calls = [Call("epsilon_decay", point.args(), record_episodes=False, budget=NO_EPISODES) for point in GRID]
+        calls = [
+            Call("epsilon_decay", point.args(), record_episodes=False, budget=NO_EPISODES) for point in GRID
+        ]
         if settings.grade_exp:
             calls += [
                 Call(
@@ -190,9 +192,7 @@ class EpsilonDecayCheck:
         problems = [problem for _, problem in parts if problem is not None]
         graded = f"{len(GRID)} argument sets" + (" for each decay type" if settings.grade_exp else "")
         if not problems:
-            return Verdict(
-                "passed", 1.0, f"epsilon_decay: every value is exact over {graded}.", measurements
-            )
+            return Verdict("passed", 1.0, f"epsilon_decay: every value is exact over {graded}.", measurements)
         return Verdict("failed", fraction, " ".join(problems), measurements)
 
 

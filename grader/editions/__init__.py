@@ -36,6 +36,6 @@ def edition_of(name: object, *, where: str = "edition") -> Edition:
 
 
 def all_problem_ids() -> tuple[ProblemId, ...]:
-    """Every problem id some edition grades, each once, oldest edition's order first (`--only` accepts them)."""
+    """Every problem id some edition grades, each once, oldest edition's first (what `--only` accepts)."""
     ids = (problem for edition in EDITIONS.values() for problem in edition.registry.ids)
     return tuple(dict.fromkeys(ids))

@@ -1,4 +1,4 @@
-"""Which edition a command grades: `--edition NAME`, else the configuration's `edition = "..."`, else detection.
+"""Which edition a command grades: `--edition NAME`, else the configuration's `edition`, else detection.
 
 The choice ends in an assignment configuration path: the edition travels inside it (its `edition` key picks
 the pack's registry wherever the configuration is loaded: the plan, every xdist worker, a batch), so nothing
@@ -41,9 +41,13 @@ def configured_edition(config: Path) -> str:
     try:
         raw = tomllib.loads(config.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise ConfigError(f"assignment configuration {config} not found: pass an existing TOML file") from None
+        raise ConfigError(
+            f"assignment configuration {config} not found: pass an existing TOML file"
+        ) from None
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
-        raise ConfigError(f"{config} is not a readable UTF-8 TOML file ({error}): fix the path or the syntax") from None
+        raise ConfigError(
+            f"{config} is not a readable UTF-8 TOML file ({error}): fix the path or the syntax"
+        ) from None
     name = raw.get("edition", DEFAULT_EDITION)
     edition_of(name, where=f"{config}: edition")
     return str(name)
@@ -68,10 +72,10 @@ def choose_edition(flag: str | None, config: Path | None, submission: Path | Non
             return EditionChoice(chosen, _default_config(chosen), "chosen with --edition")
         named = edition_of(configured_edition(config))
         if named.registry is not chosen.registry:
+            graded, configured = ", ".join(chosen.registry.ids), ", ".join(named.registry.ids)
             raise EditionConflict(
-                f"--edition {chosen.name} grades {', '.join(chosen.registry.ids)}, but {config} configures "
-                f"edition {named.name} ({', '.join(named.registry.ids)}): write edition = \"{chosen.name}\" and "
-                f"its tables in {config} (start from {chosen.default_config}), or drop --edition"
+                f"--edition {chosen.name} grades {graded}, but {config} configures edition {named.name} ({configured}): "  # noqa: E501
+                f'write edition = "{chosen.name}" and its tables in {config} (start from {chosen.default_config}), or drop --edition'  # noqa: E501
             )
         return EditionChoice(chosen, config, f"chosen with --edition, configured by {config}")
     if config is not None:
@@ -82,7 +86,9 @@ def choose_edition(flag: str | None, config: Path | None, submission: Path | Non
         return EditionChoice(first, None, "no --edition and no configuration: the first edition")
     detected = detect_edition(submission)
     return EditionChoice(
-        detected.edition, _default_config(detected.edition), f"detected from {submission.name}: {detected.reason}"
+        detected.edition,
+        _default_config(detected.edition),
+        f"detected from {submission.name}: {detected.reason}",
     )
 
 

@@ -52,7 +52,9 @@ def detect_edition(path: Path) -> Detection:
     """The edition of a `.py` or `.ipynb` submission, from the functions it defines and what it imports."""
     trees = _parse(path)
     if trees is None:
-        return Detection(CLASSIC, f"{path.name} could not be read as Python, so no later edition's mark was found")
+        return Detection(
+            CLASSIC, f"{path.name} could not be read as Python, so no later edition's mark was found"
+        )
     functions = {
         node.name: _signature(node)
         for tree in trees
@@ -61,7 +63,9 @@ def detect_edition(path: Path) -> Detection:
     }
     imports = {name for tree in trees for name in _imported(tree)}
     other_names = {function.name for edition in (CLASSIC, GYM026, VOLUME2) for function in edition.functions}
-    only_rl1 = [function for name, function in functions.items() if name not in other_names and RL1.function(name)]
+    only_rl1 = [
+        function for name, function in functions.items() if name not in other_names and RL1.function(name)
+    ]
     if only_rl1:
         names = ", ".join(f"{function.name}({', '.join(function.parameters)})" for function in only_rl1)
         return Detection(RL1, f"it defines {names}, which only edition {RL1.number} ({RL1.title}) asks for")
@@ -70,19 +74,23 @@ def detect_edition(path: Path) -> Detection:
         return Detection(
             RL1, f"its taxi({', '.join(taxi.parameters)}) takes two tables, as only edition {RL1.number} asks"
         )
-    rendered = [name for name in ("cartpole", "car") if name in functions and "render" in functions[name].parameters]
+    rendered = [
+        name for name in ("cartpole", "car") if name in functions and "render" in functions[name].parameters
+    ]
     if rendered:
         return Detection(
             VOLUME2,
             f"its {' and '.join(f'{name}(render=...)' for name in rendered)} take a render flag, as editions "
-            f"{VOLUME2.number} and {RL1.number} write them, and it defines none of edition {RL1.number}'s new functions",
+            f"{VOLUME2.number} and {RL1.number} write them, and it defines none of edition {RL1.number}'s new functions",  # noqa: E501
         )
     if "gymnasium" in imports:
         return Detection(VOLUME2, "it imports gymnasium and defines none of edition 4's new functions")
     if "gym_toytext" in imports:
         return Detection(GYM026, "it imports gym_toytext, as the gym 0.26 notebook does")
     if "gym" in imports and any(_new_gym_api(tree) for tree in trees):
-        return Detection(GYM026, "it imports gym and unpacks the five values of gym 0.26's step (or reset's two)")
+        return Detection(
+            GYM026, "it imports gym and unpacks the five values of gym 0.26's step (or reset's two)"
+        )
     return Detection(CLASSIC, "it shows no mark of a later edition (their functions, render flags or APIs)")
 
 
@@ -120,7 +128,9 @@ def _notebook_cells(data: bytes) -> list[bytes] | None:
         if not isinstance(cell, dict) or cell.get("cell_type") != "code":
             continue
         source = cell.get("source")
-        text = "".join(part for part in source if isinstance(part, str)) if isinstance(source, list) else source
+        text = (
+            "".join(part for part in source if isinstance(part, str)) if isinstance(source, list) else source
+        )
         if isinstance(text, str):
             lines = [line for line in text.splitlines() if not line.lstrip().startswith(("%", "!"))]
             sources.append("\n".join(lines).encode("utf-8", "replace"))

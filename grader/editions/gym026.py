@@ -13,7 +13,8 @@ GYM026 = Edition(
     api="gym026",
     registry=PROBLEMS,
     functions=tuple(
-        ExpectedFunction(f.name, f.parameters, f.provided, _ENVS.get(f.name, f.env_ids)) for f in CLASSIC_FUNCTIONS
+        ExpectedFunction(f.name, f.parameters, f.provided, _ENVS.get(f.name, f.env_ids))
+        for f in CLASSIC_FUNCTIONS
     ),
     template=REPOSITORY / "submissions" / "templates" / "gym026.py",
     reference=REPOSITORY / "submissions" / "gym026_complete.py",

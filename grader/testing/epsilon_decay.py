@@ -12,18 +12,26 @@ from typing import Any
 
 
 def honest(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6,  # noqa: N803
+    _lab: Any,
+    episode: int,
+    N: int,
+    epsilon_start: float = 1.0,
+    epsilon_end: float = 1e-6,
     decay_type: str = "linear",
 ) -> float:
     """The lab's linear decay, and the additional materials' exponential one."""
     if decay_type == "exp":
-        return epsilon_start * (epsilon_end / epsilon_start) ** (episode / N)
+        return float(epsilon_start * (epsilon_end / epsilon_start) ** (episode / N))
     delta = (epsilon_start - epsilon_end) / N
     return epsilon_start - (episode - 1) * delta
 
 
 def honest_rewritten(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6  # noqa: N803
+    _lab: Any,
+    episode: int,
+    N: int,
+    epsilon_start: float = 1.0,
+    epsilon_end: float = 1e-6,
 ) -> float:
     """The same decay written another way (a fraction of the way from start to end): equal up to rounding."""
     fraction = (episode - 1) / N
@@ -31,7 +39,11 @@ def honest_rewritten(
 
 
 def honest_loop(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6  # noqa: N803
+    _lab: Any,
+    episode: int,
+    N: int,
+    epsilon_start: float = 1.0,
+    epsilon_end: float = 1e-6,
 ) -> float:
     """The decay applied once per episode: rounding accumulates, within the check's tolerance."""
     delta = (epsilon_start - epsilon_end) / N
@@ -49,55 +61,83 @@ def _linear(episode: int, n: int, start: float, end: float) -> float:
     return start - (episode - 1) * (start - end) / n
 
 
-def zero_based(_lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6) -> float:  # noqa: N803
+def zero_based(
+    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6
+) -> float:
     return epsilon_start - episode * (epsilon_start - epsilon_end) / N
 
 
 def divides_by_n_minus_1(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6  # noqa: N803
+    _lab: Any,
+    episode: int,
+    N: int,
+    epsilon_start: float = 1.0,
+    epsilon_end: float = 1e-6,
 ) -> float:
     return epsilon_start - (episode - 1) * (epsilon_start - epsilon_end) / (N - 1)
 
 
-def end_at_last(_lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6) -> float:  # noqa: N803
+def end_at_last(
+    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6
+) -> float:
     if episode >= N:
         return epsilon_end
     return _linear(episode, N, epsilon_start, epsilon_end)
 
 
 def ignores_bounds(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6  # noqa: N803
+    _lab: Any,
+    episode: int,
+    N: int,
+    epsilon_start: float = 1.0,
+    epsilon_end: float = 1e-6,
 ) -> float:
     return _linear(episode, N, 1.0, 1e-6)
 
 
 def decays_to_zero(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6  # noqa: N803
+    _lab: Any,
+    episode: int,
+    N: int,
+    epsilon_start: float = 1.0,
+    epsilon_end: float = 1e-6,
 ) -> float:
     return epsilon_start - (episode - 1) * epsilon_start / N
 
 
-def exponential(_lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6) -> float:  # noqa: N803
-    return epsilon_start * (epsilon_end / epsilon_start) ** (episode / N)
+def exponential(
+    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6
+) -> float:
+    return float(epsilon_start * (epsilon_end / epsilon_start) ** (episode / N))
 
 
 def floor_division(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6  # noqa: N803
+    _lab: Any,
+    episode: int,
+    N: int,
+    epsilon_start: float = 1.0,
+    epsilon_end: float = 1e-6,
 ) -> float:
     return epsilon_start - (episode - 1) * ((epsilon_start - epsilon_end) // N)
 
 
 def exp_off_by_one(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6,  # noqa: N803
+    _lab: Any,
+    episode: int,
+    N: int,
+    epsilon_start: float = 1.0,
+    epsilon_end: float = 1e-6,
     decay_type: str = "linear",
 ) -> float:
     """Right linear decay; the optional exponential one counts episodes from 0."""
     if decay_type == "exp":
-        return epsilon_start * (epsilon_end / epsilon_start) ** ((episode - 1) / N)
+        return float(epsilon_start * (epsilon_end / epsilon_start) ** ((episode - 1) / N))
     return _linear(episode, N, epsilon_start, epsilon_end)
 
 
-def returns_nan(_lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6) -> float:  # noqa: N803
+def returns_nan(
+    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6
+) -> float:
     return math.nan if episode == N else _linear(episode, N, epsilon_start, epsilon_end)
 
 

@@ -66,10 +66,14 @@ def test_the_scan_finds_every_spelling_of_the_list(source: str) -> None:
 
 def test_one_acceptance_module_per_problem_and_no_other() -> None:
     modules = {path.stem for path in ACCEPTANCE.glob("test_*.py")}
-    assert modules == {problem.acceptance_module for edition in EDITIONS.values() for problem in edition.registry}
+    assert modules == {
+        problem.acceptance_module for edition in EDITIONS.values() for problem in edition.registry
+    }
 
 
-EVERY_PROBLEM = list({problem.id: problem for edition in EDITIONS.values() for problem in edition.registry}.values())
+EVERY_PROBLEM = list(
+    {problem.id: problem for edition in EDITIONS.values() for problem in edition.registry}.values()
+)
 
 
 @pytest.mark.parametrize("problem", EVERY_PROBLEM, ids=lambda problem: problem.id)

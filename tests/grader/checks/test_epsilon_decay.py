@@ -4,8 +4,8 @@ from typing import Any
 
 import pytest
 
-from grader.checks.epsilon_decay import GRID, EpsilonDecayConfig
 from grader.checks.base import Verdict
+from grader.checks.epsilon_decay import GRID, EpsilonDecayConfig
 from grader.config import load_config
 from grader.editions.rl1 import RL1
 from grader.testing import epsilon_decay as students
@@ -83,7 +83,7 @@ def test_no_decay_type_parameter_fails_the_exponential_part_only() -> None:
 
 
 def test_a_stub_is_missing_and_an_absent_function_too() -> None:
-    def stub(_lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6) -> float:  # noqa: N803
+    def stub(_lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6) -> float:
         raise NotImplementedError("Problem 5 incomplete")
 
     assert _judge(stub).status == "missing"

@@ -26,7 +26,11 @@ def test_each_reference_is_detected_as_its_edition_or_an_edition_grading_the_sam
 @pytest.mark.parametrize(
     ("source", "edition", "reason"),
     [
-        ("def epsilon_decay(i, n, a=1.0, b=1e-6):\n    pass\n", "rl1", "it defines epsilon_decay(i, n, a, b)"),
+        (
+            "def epsilon_decay(i, n, a=1.0, b=1e-6):\n    pass\n",
+            "rl1",
+            "it defines epsilon_decay(i, n, a, b)",
+        ),
         ("def taxi(q, q2):\n    pass\n", "rl1", "its taxi(q, q2) takes two tables"),
         ("def taxi(q, q2=None):\n    pass\n", "classic", "no mark of a later edition"),
         ("def cartpole(render=False):\n    pass\n", "volume2", "its cartpole(render=...) take"),
@@ -36,8 +40,17 @@ def test_each_reference_is_detected_as_its_edition_or_an_edition_grading_the_sam
         ("import gym\nobs, r, done, info = env.step(0)\n", "classic", "no mark of a later edition"),
         ("def cartpole(:\n", "classic", "no mark of a later edition"),
     ],
-    ids=["epsilon_decay", "two_table_taxi", "optional_second_table", "render", "gymnasium", "step5", "reset2",
-         "classic_step", "syntax_error"],
+    ids=[
+        "epsilon_decay",
+        "two_table_taxi",
+        "optional_second_table",
+        "render",
+        "gymnasium",
+        "step5",
+        "reset2",
+        "classic_step",
+        "syntax_error",
+    ],
 )
 def test_rules_and_their_reasons(tmp_path: Path, source: str, edition: str, reason: str) -> None:
     path = tmp_path / "opengym.py"
@@ -66,7 +79,7 @@ def test_a_notebook_is_read_cell_by_cell_skipping_magics_and_broken_cells(tmp_pa
     "data",
     [
         b"[" * 200_000 + b"]" * 200_000,  # nesting that would overflow a recursive parser
-        b"{\"cells\": 3}",
+        b'{"cells": 3}',
         b"\xff\xfe not json",
         b" " * (MAX_NOTEBOOK_BYTES + 1),
     ],
@@ -82,5 +95,7 @@ def test_a_hostile_notebook_shows_no_mark_and_never_raises(tmp_path: Path, data:
 
 def test_deeply_nested_python_is_no_crash(tmp_path: Path) -> None:
     path = tmp_path / "opengym.py"
-    path.write_text("x = " + "(" * 100_000 + ")" * 100_000 + "\ndef sarsa0(env):\n    pass\n", encoding="utf-8")
+    path.write_text(
+        "x = " + "(" * 100_000 + ")" * 100_000 + "\ndef sarsa0(env):\n    pass\n", encoding="utf-8"
+    )
     assert detect_edition(path).edition.name == "classic"  # the file does not parse: no mark is read

@@ -1,4 +1,4 @@
-"""`gymgrade check` chooses the edition (flag, configuration, detection), says which and why, grades its problems."""
+"""`gymgrade check` chooses the edition (flag, configuration or detection), says which and why, grades it."""
 
 import json
 from pathlib import Path
@@ -12,11 +12,16 @@ RL1 = EDITIONS["rl1"]
 CLASSIC_COMPLETE = EDITIONS["classic"].reference
 
 
-def test_the_rl1_template_is_detected_and_its_epsilon_decay_is_missing(capsys: pytest.CaptureFixture[str]) -> None:
+def test_the_rl1_template_is_detected_and_its_epsilon_decay_is_missing(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     argv = ["check", str(RL1.template), "--only", "epsilon_decay", "--format", "json", "--workers", "1"]
     assert cli.main(argv) == cli.EXIT_NOT_FULL
     captured = capsys.readouterr()
-    assert "Edition: rl1 (Reinforcement Learning 1: Gymnasium): detected from rl1.py: it defines epsilon_decay(" in captured.err
+    assert (
+        "Edition: rl1 (Reinforcement Learning 1: Gymnasium): detected from rl1.py: it defines epsilon_decay("
+        in captured.err
+    )
     (result,) = json.loads(captured.out)["problems"]
     assert (result["id"], result["status"]) == ("epsilon_decay", "missing")
     assert "not attempted yet" in result["feedback"]
@@ -26,14 +31,20 @@ def test_a_problem_the_detected_edition_does_not_grade_is_refused(capsys: pytest
     assert cli.main(["check", str(CLASSIC_COMPLETE), "--only", "epsilon_decay"]) == cli.EXIT_ERROR
     err = capsys.readouterr().err
     assert "Edition: classic (OpenGym AI (classic gym)): detected from classic_complete.py" in err
-    assert "unknown problem epsilon_decay; expected ids among random_blackjack, blackjack, cartpole, car, taxi" in err
+    assert (
+        "unknown problem epsilon_decay; expected ids among random_blackjack, blackjack, cartpole, car, taxi"
+        in err
+    )
 
 
 def test_a_flag_against_the_configuration_is_a_usage_error(capsys: pytest.CaptureFixture[str]) -> None:
     config = EDITIONS["classic"].default_config
     argv = ["check", str(RL1.template), "--edition", "rl1", "--config", str(config)]
     assert cli.main(argv) == cli.EXIT_ERROR
-    assert f"--edition rl1 grades random_blackjack, blackjack, cartpole, car, epsilon_decay, but {config}" in capsys.readouterr().err
+    assert (
+        f"--edition rl1 grades random_blackjack, blackjack, cartpole, car, epsilon_decay, but {config}"
+        in capsys.readouterr().err
+    )
 
 
 def test_the_edition_flag_lists_every_edition(capsys: pytest.CaptureFixture[str]) -> None:

@@ -54,7 +54,10 @@ SAMPLES = [
 
 def _toml(config: dict[str, Any]) -> str:
     lines = [f"edition = {json.dumps(config['edition'])}"]
-    for table, fields in [*(("problems." + name, f) for name, f in config["problems"].items()), ("sandbox", config["sandbox"])]:
+    for table, fields in [
+        *(("problems." + name, f) for name, f in config["problems"].items()),
+        ("sandbox", config["sandbox"]),
+    ]:
         lines.append(f"[{table}]")
         lines += [f"{name} = {json.dumps(value)}" for name, value in fields.items()]
     return "\n".join(lines) + "\n"

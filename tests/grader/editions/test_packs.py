@@ -42,16 +42,22 @@ def test_rl1_grades_the_shared_problems_and_its_own() -> None:
 def test_an_unknown_edition_in_a_configuration_is_a_config_error(tmp_path: Path) -> None:
     path = tmp_path / "assignment.toml"
     path.write_text('edition = "rl9"\n', encoding="utf-8")
-    with pytest.raises(UnknownEdition, match=r"unknown edition 'rl9'; expected one of classic, gym026, volume2, rl1"):
+    with pytest.raises(
+        UnknownEdition, match=r"unknown edition 'rl9'; expected one of classic, gym026, volume2, rl1"
+    ):
         load_config(path)
     assert issubclass(UnknownEdition, ConfigError)
 
 
 def test_a_configuration_without_the_editions_tables_names_them(tmp_path: Path) -> None:
     path = tmp_path / "assignment.toml"
-    path.write_text(Path(EDITIONS["classic"].default_config).read_text(encoding="utf-8").replace(
-        "[problems.random_blackjack]", 'edition = "rl1"\n[problems.random_blackjack]', 1), encoding="utf-8")
-    with pytest.raises(ConfigError, match="problems.epsilon_decay"):
+    path.write_text(
+        Path(EDITIONS["classic"].default_config)
+        .read_text(encoding="utf-8")
+        .replace("[problems.random_blackjack]", 'edition = "rl1"\n[problems.random_blackjack]', 1),
+        encoding="utf-8",
+    )
+    with pytest.raises(ConfigError, match=r"problems\.epsilon_decay"):
         load_config(path)
 
 
@@ -64,14 +70,18 @@ def test_choice_flag_config_detection(tmp_path: Path) -> None:
     assert named.edition is rl1 and "named by" in named.reason
     detected = choose_edition(None, None, rl1.template)
     assert detected.edition is rl1 and detected.config == rl1.default_config
-    assert detected.line.startswith("Edition: rl1 (Reinforcement Learning 1: Gymnasium): detected from rl1.py: ")
+    assert detected.line.startswith(
+        "Edition: rl1 (Reinforcement Learning 1: Gymnasium): detected from rl1.py: "
+    )
     assert choose_edition(None, None, None).edition.name == "classic"
     # Editions 1-3 grade the same problems: the bundled configuration serves each.
     assert choose_edition("gym026", EDITIONS["classic"].default_config, None).edition.name == "gym026"
 
 
 def test_a_flag_that_contradicts_the_configuration_says_what_to_do() -> None:
-    with pytest.raises(EditionConflict, match=r'--edition rl1 grades .* configures edition classic .* write edition = "rl1"'):
+    with pytest.raises(
+        EditionConflict, match=r'--edition rl1 grades .* configures edition classic .* write edition = "rl1"'
+    ):
         choose_edition("rl1", EDITIONS["classic"].default_config, None)
     with pytest.raises(UnknownEdition, match="--edition: unknown edition 'x'"):
         choose_edition("x", None, None)
