@@ -140,6 +140,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bundle.add_argument("--out", type=Path, default=Path("autograder.zip"), metavar="ZIP")
     bundle.add_argument("--config", type=Path, default=None, metavar="PATH", help="assignment configuration")
+    bundle.add_argument(
+        "--edition",
+        choices=tuple(EDITIONS),
+        default=None,
+        help="the edition graded (default: the configuration's `edition`, else classic)",
+    )
     bundle.set_defaults(handler=run_gradescope_bundle)
 
     gradescope_run = subparsers.add_parser(
@@ -229,7 +235,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _choose_edition(args: argparse.Namespace) -> None:
     """Resolve `--edition`, the configuration's edition or detection into the configuration; say which."""
-    if args.command not in ("check", "grade"):
+    if args.command not in ("check", "grade", "gradescope-bundle"):
         return
     from grader.editions.choice import choose_edition
 

@@ -17,6 +17,10 @@ def test_each_template_is_detected_as_its_edition(name: str) -> None:
     assert detect_edition(edition.template).edition is edition
 
 
+def test_the_rl1_notebook_template_is_detected_as_rl1() -> None:
+    assert detect_edition(SUBMISSIONS / "templates" / "rl1.ipynb").edition is EDITIONS["rl1"]
+
+
 @pytest.mark.parametrize("name", list(EDITIONS))
 def test_each_reference_is_detected_as_its_edition_or_an_edition_grading_the_same(name: str) -> None:
     edition = EDITIONS[name]

@@ -1,6 +1,7 @@
 """`gymgrade check` chooses the edition (flag, configuration or detection), says which and why, grades it."""
 
 import json
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -60,3 +61,13 @@ def test_grade_without_edition_or_configuration_grades_the_first_edition(
     cli._choose_edition(args)
     assert args.config is None
     assert "Edition: classic" in capsys.readouterr().err
+
+
+def test_the_gradescope_bundle_carries_the_editions_configuration(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bundle = tmp_path / "autograder.zip"
+    assert cli.main(["gradescope-bundle", "--edition", "rl1", "--out", str(bundle)]) == 0
+    assert "Edition: rl1" in capsys.readouterr().err
+    with zipfile.ZipFile(bundle) as archive:
+        assert archive.read("assignment.toml") == RL1.default_config.read_bytes()
