@@ -15,6 +15,9 @@ from grader.editions import DEFAULT_EDITION, EDITIONS, edition_of
 from grader.editions.detection import detect_edition
 from grader.editions.errors import EditionConflict
 from grader.editions.pack import BUNDLED_CONFIG, Edition
+from grader.editions.rl1 import RL1
+
+RL1_NAME = RL1.name
 from grader.errors import ConfigError
 
 
@@ -83,7 +86,8 @@ def choose_edition(flag: str | None, config: Path | None, submission: Path | Non
         return EditionChoice(EDITIONS[name], config, f"named by {config}")
     if submission is None:
         first = EDITIONS[DEFAULT_EDITION]
-        return EditionChoice(first, None, "no --edition and no configuration: the first edition")
+        reason = f"no --edition and no configuration: the first edition (pass --edition {RL1_NAME} for today's)"
+        return EditionChoice(first, None, reason)
     detected = detect_edition(submission)
     return EditionChoice(
         detected.edition,
