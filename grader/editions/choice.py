@@ -16,8 +16,6 @@ from grader.editions.detection import detect_edition
 from grader.editions.errors import EditionConflict
 from grader.editions.pack import BUNDLED_CONFIG, Edition
 from grader.editions.rl1 import RL1
-
-RL1_NAME = RL1.name
 from grader.errors import ConfigError
 
 
@@ -86,7 +84,7 @@ def choose_edition(flag: str | None, config: Path | None, submission: Path | Non
         return EditionChoice(EDITIONS[name], config, f"named by {config}")
     if submission is None:
         first = EDITIONS[DEFAULT_EDITION]
-        reason = f"no --edition and no configuration: the first edition (pass --edition {RL1_NAME} for today's)"
+        reason = f"no --edition and no configuration: the first edition (--edition {RL1.name} grades today's)"
         return EditionChoice(first, None, reason)
     detected = detect_edition(submission)
     return EditionChoice(
