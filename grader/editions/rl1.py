@@ -1,11 +1,12 @@
 """Edition 4, "Reinforcement Learning 1: Gymnasium" (2024 onwards), the one taught today.
 
-Problems 1-4 are the shared declarations of `grader.problems`; `epsilon_decay` is this edition's own. The
-two-table `taxi(q_table, q_table_decay)`, `sarsa0` and `compare()` are declared as expected functions (the
-template defines them, detection reads them) but not graded yet (`not_graded`).
+Problems 1-4 are the shared declarations of `grader.problems`; `epsilon_decay` and the two-table
+`taxi(q_table, q_table_decay)` are this edition's own. `sarsa0` and `compare()` are declared as expected
+functions (the template defines them, detection reads them) but not graded yet (`not_graded`).
 """
 
 from grader.checks.epsilon_decay import EpsilonDecayCheck, EpsilonDecayConfig
+from grader.checks.taxi_tables import TaxiTablesCheck, TaxiTablesConfig
 from grader.editions.pack import PACKAGE, REPOSITORY, Edition, ExpectedFunction
 from grader.problem_registry import Problem, Registry
 from grader.problems import PROBLEMS
@@ -42,6 +43,13 @@ RL1 = Edition(
                 config=EpsilonDecayConfig,
                 check=EpsilonDecayCheck(),
             ),
+            Problem(
+                id="taxi",
+                title="Problem 6: Taxi with two tables",
+                points=1.0,
+                config=TaxiTablesConfig,
+                check=TaxiTablesCheck(),
+            ),
         )
     ),
     functions=FUNCTIONS,
@@ -50,10 +58,9 @@ RL1 = Edition(
     default_config=PACKAGE / "rl1.toml",
     notebook_name="gymnasium.ipynb",
     not_graded=(
-        ("qlearn", "provided by the template; no verdict needs it until taxi and sarsa0 are graded"),
-        ("taxi", "the two-table taxi(q_table, q_table_decay) is not graded yet"),
+        ("qlearn", "provided by the template; taxi gets the grader's own tables, so no verdict needs it"),
         ("sarsa0", "SARSA(0) verified by replaying its updates is not graded yet"),
         ("compare", "compare() needs the notebook's own training cells; not graded yet"),
     ),
 )
-"""The current edition: problems 1-5 graded; qlearn, taxi, sarsa0 and compare() listed in `not_graded`."""
+"""The current edition: problems 1-6 graded; qlearn, sarsa0 and compare() listed in `not_graded`."""
