@@ -33,6 +33,7 @@ from grader.editions.rl1 import RL1
 from grader.grading import GradingPlan, grade_files
 from grader.sandbox import IsolationPolicy
 from grader.testing import epsilon_decay as students
+from grader.testing import taxi_tables
 from grader.testing.simulation import simulate_calls
 
 SAMPLES = Path(__file__).resolve().parents[1] / "submissions" / "editions"
@@ -68,6 +69,29 @@ def calibrate(regrades: int, mistake_regrades: int) -> None:
     print(
         f"  mistake {'exp_off_by_one':<21} with exp: {dict(_statuses(students.exp_off_by_one, mistake_regrades, grade_exp=True))}"  # noqa: E501
     )
+
+
+def calibrate_taxi(regrades: int, mistake_regrades: int) -> None:
+    """The two-table taxi: honest greedy play on fresh seeds, and each mistake (in-process, real check)."""
+    problem = RL1.registry.problem("taxi")
+    settings = load_config(RL1.default_config).problems["taxi"]
+    calls = problem.check.plan(settings, {})
+
+    def statuses(function: Any, count: int) -> Counter[str]:
+        found: Counter[str] = Counter()
+        for seed in range(count):
+            records = simulate_calls(calls, {"taxi": function}, 1_000_003 * seed + 7)
+            found[problem.check.judge(settings, records).status] += 1
+        return found
+
+    started = time.perf_counter()
+    honest = statuses(taxi_tables.honest, regrades)
+    elapsed = time.perf_counter() - started
+    print(
+        f"taxi(q_table, q_table_decay): honest {dict(honest)} in {regrades} regrades ({elapsed / regrades:.2f} s each)"
+    )  # noqa: E501
+    for name, (function, _) in taxi_tables.MISTAKES.items():
+        print(f"  mistake {name:<21} {dict(statuses(function, mistake_regrades))}")
 
 
 def sandbox() -> None:
@@ -111,9 +135,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--regrades", type=int, default=200)
     parser.add_argument("--mistake-regrades", type=int, default=50)
+    parser.add_argument("--taxi-regrades", type=int, default=200)
     parser.add_argument("--no-sandbox", action="store_true")
+    parser.add_argument("--only-taxi", action="store_true")
     args = parser.parse_args()
+    if args.only_taxi:
+        calibrate_taxi(args.taxi_regrades, args.mistake_regrades)
+        return
     calibrate(args.regrades, args.mistake_regrades)
+    calibrate_taxi(args.taxi_regrades, args.mistake_regrades)
     detection()
     if not args.no_sandbox:
         sandbox()
