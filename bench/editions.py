@@ -88,7 +88,7 @@ def calibrate_taxi(regrades: int, mistake_regrades: int) -> None:
     honest = statuses(taxi_tables.honest, regrades)
     elapsed = time.perf_counter() - started
     print(
-        f"taxi(q_table, q_table_decay): honest {dict(honest)} in {regrades} regrades ({elapsed / regrades:.2f} s each)"
+        f"taxi(q_table, q_table_decay): honest {dict(honest)} in {regrades} regrades ({elapsed / max(regrades, 1):.2f} s each)"
     )  # noqa: E501
     for name, (function, _) in taxi_tables.MISTAKES.items():
         print(f"  mistake {name:<21} {dict(statuses(function, mistake_regrades))}")
