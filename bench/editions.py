@@ -87,9 +87,8 @@ def calibrate_taxi(regrades: int, mistake_regrades: int) -> None:
     started = time.perf_counter()
     honest = statuses(taxi_tables.honest, regrades)
     elapsed = time.perf_counter() - started
-    print(
-        f"taxi(q_table, q_table_decay): honest {dict(honest)} in {regrades} regrades ({elapsed / max(regrades, 1):.2f} s each)"
-    )  # noqa: E501
+    each = elapsed / max(regrades, 1)
+    print(f"taxi(q_table, q_table_decay): honest {dict(honest)} in {regrades} regrades ({each:.2f} s each)")
     for name, (function, _) in taxi_tables.MISTAKES.items():
         print(f"  mistake {name:<21} {dict(statuses(function, mistake_regrades))}")
 
