@@ -12,9 +12,9 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError, UnknownProblem
+from grader.editions import EDITIONS, all_problem_ids
+from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError
 from grader.notebook import NotebookSummary
-from grader.problems import PROBLEMS
 from grader.progress import ProgressBar, result_line
 from grader.report import IsolationSummary, ProblemResult, Report
 from grader.sandbox import IsolationPolicy
@@ -37,10 +37,15 @@ Handler = Callable[[argparse.Namespace], int]
 
 
 def _problem_ids(text: str) -> list[str]:
-    try:
-        return list(PROBLEMS.select(text.split(",")))
-    except UnknownProblem as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
+    """Problem ids of any edition (the chosen edition's plan then refuses those it does not grade)."""
+    chosen = [name.strip() for name in text.split(",") if name.strip()]
+    known = all_problem_ids()
+    unknown = [name for name in chosen if name not in known]
+    if unknown or not chosen:
+        raise argparse.ArgumentTypeError(
+            f"unknown problem {', '.join(unknown) or '(none)'}; expected ids among {', '.join(known)}"
+        )
+    return [problem for problem in known if problem in chosen]
 
 
 def _positive(text: str) -> int:
@@ -76,7 +81,13 @@ def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
         type=_problem_ids,
         default=None,
         metavar="ID[,ID...]",
-        help=f"grade only these problems ({', '.join(PROBLEMS.ids)})",
+        help=f"grade only these problems ({', '.join(all_problem_ids())}; each edition grades its own)",
+    )
+    parser.add_argument(
+        "--edition",
+        choices=tuple(EDITIONS),
+        default=None,
+        help="the edition of the lab graded (default: the configuration's `edition`, else detected from the file for check, else classic)",  # noqa: E501
     )
     parser.add_argument(
         "--config",
@@ -215,6 +226,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bundle.add_argument("--out", type=Path, default=Path("autograder.zip"), metavar="ZIP")
     bundle.add_argument("--config", type=Path, default=None, metavar="PATH", help="assignment configuration")
+    bundle.add_argument(
+        "--edition",
+        choices=tuple(EDITIONS),
+        default=None,
+        help="the edition graded (default: the configuration's `edition`, else classic)",
+    )
     bundle.set_defaults(handler=run_gradescope_bundle)
 
     gradescope_run = subparsers.add_parser(
@@ -307,6 +324,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     # A terminated run unwinds like Ctrl-C, so the grading processes it started are ended too.
     previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
+        _choose_edition(args)
         return handler(args)
     except (GraderError, SandboxError, ValueError, OSError) as error:
         print(f"gymgrade {args.command}: {error}", file=sys.stderr)
@@ -316,6 +334,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def _choose_edition(args: argparse.Namespace) -> None:
+    """Resolve `--edition`, the configuration's edition or detection into the configuration; say which."""
+    if args.command not in ("check", "grade", "gradescope-bundle"):
+        return
+    from grader.editions.choice import choose_edition
+
+    submission = args.file if args.command == "check" and args.file.is_file() else None
+    choice = choose_edition(args.edition, args.config, submission)
+    args.config = choice.config
+    print(choice.line, file=sys.stderr, flush=True)
 
 
 def _interrupt(signum: int, _frame: object) -> None:

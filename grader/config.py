@@ -25,6 +25,7 @@ from pydantic import (
     model_validator,
 )
 
+from grader.editions import DEFAULT_EDITION, edition_of
 from grader.errors import ConfigError, UnknownProblem
 from grader.problem_config import ProblemConfig, StrictModel
 from grader.problem_registry import Problem, ProblemId, Registry
@@ -74,6 +75,7 @@ class AssignmentConfig(StrictModel):
     )
     sandbox: SandboxConfig = Field(description="Resource limits of the sandbox.")
     _registry: Registry = PrivateAttr(default=PROBLEMS)
+    _edition: str = PrivateAttr(default=DEFAULT_EDITION)
 
     @model_validator(mode="after")
     def _scoring(self) -> AssignmentConfig:
@@ -85,6 +87,11 @@ class AssignmentConfig(StrictModel):
     def registry(self) -> Registry:
         """The problems this configuration was loaded for (the lab's unless `load_config` was told)."""
         return self._registry
+
+    @property
+    def edition(self) -> str:
+        """The edition this configuration grades (`edition = "..."`; the first edition when it names none)."""
+        return self._edition
 
     def problem(self, problem_id: ProblemId) -> ProblemConfig:
         """The settings of one problem; `registry.problem(problem_id).settings(self)` gives them typed.
@@ -143,6 +150,12 @@ def assignment_file_model(registry: Registry) -> type[BaseModel]:
         __doc__="The TOML file as written.",
         problems=(tables, Field(description="One table per problem.")),
         sandbox=(SandboxConfig, Field(description="Resource limits of the sandbox.")),
+        edition=(
+            str,
+            Field(
+                default=DEFAULT_EDITION, description="The edition graded (grader/editions/), else the first."
+            ),
+        ),
     )
 
 
@@ -158,12 +171,13 @@ def _describe(error: ValidationError, path: Path) -> str:
     return "\n".join(lines)
 
 
-def load_config(path: Path | None = None, registry: Registry = PROBLEMS) -> AssignmentConfig:
+def load_config(path: Path | None = None, registry: Registry | None = None) -> AssignmentConfig:
     """Load and validate the assignment configuration.
 
     Args:
         path: A TOML file; the bundled `grader/assignment.toml` when None.
-        registry: The problems it configures; the lab's by default.
+        registry: The problems it configures; by default those of the edition the file names
+            (`edition = "..."`, the first edition when it names none).
 
     Returns:
         The validated configuration.
@@ -181,10 +195,14 @@ def load_config(path: Path | None = None, registry: Registry = PROBLEMS) -> Assi
         ) from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
         raise ConfigError(f"{source} is not valid UTF-8 TOML ({error}): fix the syntax") from None
+    edition_name = raw.get("edition", DEFAULT_EDITION)
+    if registry is None:
+        registry = edition_of(edition_name, where=f"{source}: edition").registry
     try:
         parsed = dict(assignment_file_model(registry).model_validate(raw))
         config = AssignmentConfig(problems=dict(parsed["problems"]), sandbox=parsed["sandbox"])
     except ValidationError as error:
         raise ConfigError(_describe(error, source)) from None
     config._registry = registry
+    config._edition = parsed["edition"]
     return config

@@ -17,7 +17,7 @@ from grader.errors import UnknownProblem
 from grader.execution import problem_seed
 from grader.notebook import NotebookModule, build_module, is_notebook
 from grader.plugin import CaseOutcome, GraderFailure, ProblemCase, SessionPlan
-from grader.problems import PROBLEM_IDS, PROBLEMS, ProblemId
+from grader.problems import ProblemId
 from grader.report import GradingTimings, ProblemResult, ProblemRun, Report, Visibility
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import IsolationUnavailable
@@ -48,13 +48,14 @@ class GradingPlan:
             ValueError: ``only`` names a problem that does not exist.
             grader.errors.ConfigError: The configuration is invalid.
         """
-        unknown = sorted(set(only or ()) - set(PROBLEM_IDS))
-        if unknown:
-            raise UnknownProblem(PROBLEMS.unknown_message(unknown))
         assignment = load_config(config)
+        registry = assignment.registry  # the edition's problems (the configuration names its edition)
+        unknown = sorted(set(only or ()) - set(registry.ids))
+        if unknown:
+            raise UnknownProblem(registry.unknown_message(unknown))
         problems = tuple(
             problem
-            for problem in PROBLEM_IDS
+            for problem in registry.ids
             if assignment.problem(problem).enabled and (not only or problem in only)
         )
         return cls(

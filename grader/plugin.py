@@ -24,8 +24,7 @@ from pydantic import BaseModel, ConfigDict, TypeAdapter, ValidationError
 from xdist.workermanage import parse_tx_spec_config
 
 from grader.config import AssignmentConfig, load_config
-from grader.problem_registry import ProblemId
-from grader.problems import PROBLEM_IDS, PROBLEMS
+from grader.problem_registry import ProblemId, acceptance_module_name
 from grader.report import ProblemResult, ProblemRun
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import IsolationUnavailable
@@ -54,7 +53,7 @@ class ProblemCase:
     @property
     def node_id(self) -> str:
         """The pytest node id of this case's acceptance test (rootdir ``grader/acceptance``)."""
-        module = PROBLEMS.problem(self.problem).acceptance_module
+        module = acceptance_module_name(self.problem)
         return f"{module}.py::{module}[{self.test_id}]"
 
 
@@ -211,7 +210,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         if case is None:
             return (0.0, 0, 0)
         expected = session.assignment.problem(case.problem).expected_seconds
-        return (-expected, PROBLEM_IDS.index(case.problem), case.index)
+        return (-expected, session.assignment.registry.ids.index(case.problem), case.index)
 
     chosen.sort(key=longest_first)
     items[:] = with_slots(chosen) if hasattr(config, "workerinput") else chosen
@@ -232,7 +231,7 @@ def _case_of(item: pytest.Item) -> ProblemCase | None:
 
 def _check_node_id(item: pytest.Item, case: ProblemCase) -> None:
     if item.nodeid != case.node_id:
-        module = PROBLEMS.problem(case.problem).acceptance_module
+        module = acceptance_module_name(case.problem)
         raise pytest.UsageError(
             f"acceptance test {item.nodeid!r} grades {case.problem} but the controller expects its results "
             f"under {case.node_id!r}: "

@@ -25,6 +25,11 @@ table and the acceptance module `grader/acceptance/test_<id>.py`. Checked where 
 ConfigT = TypeVar("ConfigT", bound="ProblemConfig")
 
 
+def acceptance_module_name(problem_id: ProblemId) -> str:
+    """The name of a problem's acceptance module in `grader/acceptance/` (one test per submission)."""
+    return f"test_{problem_id}"
+
+
 @dataclass(frozen=True)
 class Problem(Generic[ConfigT]):
     """One problem, declared once: the configuration, `--only`, acceptance modules and reports derive from it.
@@ -49,7 +54,7 @@ class Problem(Generic[ConfigT]):
     @property
     def acceptance_module(self) -> str:
         """The name of its acceptance module in `grader/acceptance/` (one test per submission)."""
-        return f"test_{self.id}"
+        return acceptance_module_name(self.id)
 
     def table_defaults(self) -> dict[str, Any]:
         """The fields its configuration table takes from this declaration when the table leaves them out."""

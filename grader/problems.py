@@ -3,7 +3,8 @@
 Everything that lists problems derives from `PROBLEMS`: the assignment configuration's tables
 (`grader.config`), `--only`, the acceptance modules (`grader/acceptance/test_<id>.py`), the report's titles
 and points. Adding a problem is one entry here, its module in `grader/checks/` (settings model + check), its
-acceptance module and its `[problems.<id>]` table (ARCHITECTURE.md, "Adding a problem for a later RL lab").
+acceptance module and its `[problems.<id>]` table (ARCHITECTURE.md, "Adding an edition or a lab").
+This registry is the first edition's (`grader.editions.classic`); later editions reuse its declarations.
 """
 
 from grader.checks.blackjack import BlackjackCheck, BlackjackConfig

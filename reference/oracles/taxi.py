@@ -229,3 +229,39 @@ def _checked_steps(max_steps: int) -> int:
             f"found {max_steps!r}"
         )
     return int(max_steps)
+
+
+DETOUR_WALL = ((2, 1, 2), (2, 2, 3))
+"""An extra wall in the middle row between columns 1 and 2, as (row, column, blocked action): east from
+(2, 1) and west from (2, 2). Left and right still meet through rows 3 and 4: every trip ends, by a detour."""
+
+
+def detour_q_table(gamma: float = 0.6) -> FloatArray:
+    """Optimal action values for Taxi with `DETOUR_WALL` added, ties broken towards the first action.
+
+    Greedy play on it in the real Taxi takes exactly the walled map's optimal routes (each move it picks
+    behaves the same without the wall), so every episode ends, later than optimal play: its exact return is
+    `greedy_policy_return(detour_q_table())` (5.757 per episode against the optimum's 7.930). Subtracting
+    1e-6 per action index makes every row's maximum unique (values of distinct actions differ far more), so
+    any greedy rule, first maximiser or a random one among ties, plays the same policy.
+
+    Raises:
+        InvalidParameterError: `gamma` is outside [0, 1).
+    """
+    if not 0.0 <= gamma < 1.0:
+        raise InvalidParameterError(f"expected a discount factor gamma in [0, 1), found {gamma!r}")
+    model = taxi_model()
+    next_state, reward = model.next_state.copy(), model.reward.copy()
+    for state in range(STATES):
+        row, column = state // 100, (state // 20) % 5
+        for wall_row, wall_column, action in DETOUR_WALL:
+            if (row, column) == (wall_row, wall_column):
+                next_state[state, action], reward[state, action] = state, -1000.0
+    q_table = np.zeros((STATES, ACTIONS))
+    while True:
+        bootstrap = np.where(model.terminates, 0.0, q_table.max(axis=1)[next_state])
+        updated = reward + gamma * bootstrap
+        delta = float(np.max(np.abs(updated - q_table)))
+        q_table = updated
+        if gamma * delta <= VALUE_ITERATION_TOLERANCE * (1.0 - gamma):
+            return q_table - 1e-6 * np.arange(ACTIONS)

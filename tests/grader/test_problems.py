@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from grader.config import load_config
+from grader.editions import EDITIONS
 from grader.problems import PROBLEM_IDS, PROBLEMS
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -65,10 +66,17 @@ def test_the_scan_finds_every_spelling_of_the_list(source: str) -> None:
 
 def test_one_acceptance_module_per_problem_and_no_other() -> None:
     modules = {path.stem for path in ACCEPTANCE.glob("test_*.py")}
-    assert modules == {problem.acceptance_module for problem in PROBLEMS}
+    assert modules == {
+        problem.acceptance_module for edition in EDITIONS.values() for problem in edition.registry
+    }
 
 
-@pytest.mark.parametrize("problem", PROBLEMS, ids=lambda problem: problem.id)
+EVERY_PROBLEM = list(
+    {problem.id: problem for edition in EDITIONS.values() for problem in edition.registry}.values()
+)
+
+
+@pytest.mark.parametrize("problem", EVERY_PROBLEM, ids=lambda problem: problem.id)
 def test_each_acceptance_module_grades_its_own_problem(problem: object) -> None:
     module = importlib.import_module(f"grader.acceptance.{problem.acceptance_module}")  # type: ignore[attr-defined]
     assert problem.id == module.PROBLEM  # type: ignore[attr-defined]

@@ -1,0 +1,168 @@
+"""Which edition a submission was written for, read statically from its source (never run) in the parent.
+
+The source is untrusted: it is read up to a bound, parsed with `ast` only (nothing is executed or imported),
+and a file that cannot be read or parsed simply shows no marker. The rules, newest edition first, each with
+the reason the command line prints:
+
+1. a function only the current edition asks for (`epsilon_decay`, `qlearn`, `sarsa0`, `compare`), or a
+   `taxi` with two required parameters: `rl1`;
+2. `cartpole`/`car` with a `render` parameter, or `import gymnasium`: `volume2`;
+3. `import gym_toytext`, or gym 0.26's five-value `step` / two-value `reset` unpacking: `gym026`;
+4. otherwise the first edition, `classic`.
+
+Editions 1-3 grade the same problems (the compatibility layer runs every gym API), so telling them apart
+only names the edition; rule 1 changes what is graded.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from grader.editions.classic import CLASSIC
+from grader.editions.gym026 import GYM026
+from grader.editions.pack import Edition
+from grader.editions.rl1 import RL1
+from grader.editions.volume2 import VOLUME2
+from grader.validation import MAX_SUBMISSION_BYTES
+
+MAX_NOTEBOOK_BYTES = 32 * MAX_SUBMISSION_BYTES
+"""A notebook's outputs (plots) make it larger than its code; beyond this it is not read for detection."""
+MAX_CELLS = 10_000
+
+
+@dataclass(frozen=True)
+class Detection:
+    """The edition a submission was detected as, and why (one sentence a person reads)."""
+
+    edition: Edition
+    reason: str
+
+
+@dataclass(frozen=True)
+class _Function:
+    name: str
+    parameters: tuple[str, ...]
+    required: int
+
+
+def detect_edition(path: Path) -> Detection:
+    """The edition of a `.py` or `.ipynb` submission, from the functions it defines and what it imports."""
+    trees = _parse(path)
+    if trees is None:
+        return Detection(
+            CLASSIC, f"{path.name} could not be read as Python, so no later edition's mark was found"
+        )
+    functions = {
+        node.name: _signature(node)
+        for tree in trees
+        for node in tree.body
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+    }
+    imports = {name for tree in trees for name in _imported(tree)}
+    other_names = {function.name for edition in (CLASSIC, GYM026, VOLUME2) for function in edition.functions}
+    only_rl1 = [
+        function for name, function in functions.items() if name not in other_names and RL1.function(name)
+    ]
+    if only_rl1:
+        names = ", ".join(f"{function.name}({', '.join(function.parameters)})" for function in only_rl1)
+        return Detection(RL1, f"it defines {names}, which only edition {RL1.number} ({RL1.title}) asks for")
+    taxi = functions.get("taxi")
+    if taxi is not None and taxi.required >= 2:
+        return Detection(
+            RL1, f"its taxi({', '.join(taxi.parameters)}) takes two tables, as only edition {RL1.number} asks"
+        )
+    rendered = [
+        name for name in ("cartpole", "car") if name in functions and "render" in functions[name].parameters
+    ]
+    if rendered:
+        return Detection(
+            VOLUME2,
+            f"its {' and '.join(f'{name}(render=...)' for name in rendered)} take a render flag, as editions "
+            f"{VOLUME2.number} and {RL1.number} write them, and it defines none of edition {RL1.number}'s new functions",  # noqa: E501
+        )
+    if "gymnasium" in imports:
+        return Detection(VOLUME2, "it imports gymnasium and defines none of edition 4's new functions")
+    if "gym_toytext" in imports:
+        return Detection(GYM026, "it imports gym_toytext, as the gym 0.26 notebook does")
+    if "gym" in imports and any(_new_gym_api(tree) for tree in trees):
+        return Detection(
+            GYM026, "it imports gym and unpacks the five values of gym 0.26's step (or reset's two)"
+        )
+    return Detection(CLASSIC, "it shows no mark of a later edition (their functions, render flags or APIs)")
+
+
+def _parse(path: Path) -> list[ast.Module] | None:
+    limit = MAX_NOTEBOOK_BYTES if path.suffix == ".ipynb" else MAX_SUBMISSION_BYTES
+    try:
+        with path.open("rb") as handle:
+            data = handle.read(limit + 1)
+    except OSError:
+        return None
+    if len(data) > limit:
+        return None
+    sources = _notebook_cells(data) if path.suffix == ".ipynb" else [data]
+    if sources is None or sum(len(source) for source in sources) > MAX_SUBMISSION_BYTES:
+        return None
+    trees: list[ast.Module] = []
+    for source in sources:
+        try:
+            trees.append(ast.parse(source))
+        except (SyntaxError, ValueError, RecursionError, MemoryError):
+            continue  # a cell with IPython syntax or a broken cell: the others still count
+    return trees
+
+
+def _notebook_cells(data: bytes) -> list[bytes] | None:
+    try:
+        notebook = json.loads(data)
+    except (ValueError, RecursionError, MemoryError):
+        return None
+    cells = notebook.get("cells") if isinstance(notebook, dict) else None
+    if not isinstance(cells, list) or len(cells) > MAX_CELLS:
+        return None
+    sources: list[bytes] = []
+    for cell in cells:
+        if not isinstance(cell, dict) or cell.get("cell_type") != "code":
+            continue
+        source = cell.get("source")
+        text = (
+            "".join(part for part in source if isinstance(part, str)) if isinstance(source, list) else source
+        )
+        if isinstance(text, str):
+            lines = [line for line in text.splitlines() if not line.lstrip().startswith(("%", "!"))]
+            sources.append("\n".join(lines).encode("utf-8", "replace"))
+    return sources
+
+
+def _signature(node: ast.FunctionDef | ast.AsyncFunctionDef) -> _Function:
+    positional = [*node.args.posonlyargs, *node.args.args]
+    names = tuple(argument.arg for argument in [*positional, *node.args.kwonlyargs])
+    required = len(positional) - len(node.args.defaults)
+    return _Function(node.name, names, required)
+
+
+def _imported(tree: ast.Module) -> set[str]:
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            names.add(node.module.split(".")[0])
+    return names
+
+
+def _new_gym_api(tree: ast.Module) -> bool:
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Assign) or not isinstance(node.value, ast.Call):
+            continue
+        function = node.value.func
+        method = function.attr if isinstance(function, ast.Attribute) else None
+        for target in node.targets:
+            if isinstance(target, ast.Tuple) and (
+                (method == "step" and len(target.elts) == 5) or (method == "reset" and len(target.elts) == 2)
+            ):
+                return True
+    return False

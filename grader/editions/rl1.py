@@ -1,0 +1,66 @@
+"""Edition 4, "Reinforcement Learning 1: Gymnasium" (2024 onwards), the one taught today.
+
+Problems 1-4 are the shared declarations of `grader.problems`; `epsilon_decay` and the two-table
+`taxi(q_table, q_table_decay)` are this edition's own. `sarsa0` and `compare()` are declared as expected
+functions (the template defines them, detection reads them) but not graded yet (`not_graded`).
+"""
+
+from grader.checks.epsilon_decay import EpsilonDecayCheck, EpsilonDecayConfig
+from grader.checks.taxi_tables import TaxiTablesCheck, TaxiTablesConfig
+from grader.editions.pack import PACKAGE, REPOSITORY, Edition, ExpectedFunction
+from grader.problem_registry import Problem, Registry
+from grader.problems import PROBLEMS
+
+_LEARNER = ("env", "alpha=0.1", "gamma=0.6", "epsilon=0.1", "N=70_000", "decay=False")
+
+FUNCTIONS = (
+    ExpectedFunction("random_blackjack", ("n",), env_ids=("Blackjack-v1",)),
+    ExpectedFunction("blackjack", ("n=11",), env_ids=("Blackjack-v1",)),
+    ExpectedFunction("cartpole", ("render=False",), env_ids=("CartPole-v1",)),
+    ExpectedFunction("car", ("render=False",), env_ids=("MountainCar-v0",)),
+    ExpectedFunction("epsilon_decay", ("episode", "N", "epsilon_start=1.0", "epsilon_end=1e-6")),
+    ExpectedFunction("qlearn", _LEARNER, provided=True, env_ids=("Taxi-v3",)),
+    ExpectedFunction("taxi", ("q_table", "q_table_decay"), env_ids=("Taxi-v3",)),
+    ExpectedFunction("sarsa0", _LEARNER, env_ids=("Taxi-v3",)),
+    ExpectedFunction("compare", (), env_ids=("Taxi-v3",)),
+)
+
+RL1 = Edition(
+    name="rl1",
+    number=4,
+    title="Reinforcement Learning 1: Gymnasium",
+    api="gymnasium",
+    registry=Registry(
+        (
+            PROBLEMS.problem("random_blackjack"),
+            PROBLEMS.problem("blackjack"),
+            PROBLEMS.problem("cartpole"),
+            PROBLEMS.problem("car"),
+            Problem(
+                id="epsilon_decay",
+                title="Problem 5: epsilon_decay",
+                points=1.0,
+                config=EpsilonDecayConfig,
+                check=EpsilonDecayCheck(),
+            ),
+            Problem(
+                id="taxi",
+                title="Problem 6: Taxi with two tables",
+                points=1.0,
+                config=TaxiTablesConfig,
+                check=TaxiTablesCheck(),
+            ),
+        )
+    ),
+    functions=FUNCTIONS,
+    template=REPOSITORY / "submissions" / "templates" / "rl1.py",
+    reference=REPOSITORY / "submissions" / "editions" / "rl1_complete.py",
+    default_config=PACKAGE / "rl1.toml",
+    notebook_name="gymnasium.ipynb",
+    not_graded=(
+        ("qlearn", "provided by the template; taxi gets the grader's own tables, so no verdict needs it"),
+        ("sarsa0", "SARSA(0) verified by replaying its updates is not graded yet"),
+        ("compare", "compare() needs the notebook's own training cells; not graded yet"),
+    ),
+)
+"""The current edition: problems 1-6 graded; qlearn, sarsa0 and compare() listed in `not_graded`."""

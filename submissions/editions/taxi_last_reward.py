@@ -1,0 +1,20 @@
+# gymnasium.py
+"""Reinforcement Learning 1: Gymnasium (problem 6 only). Averages each episode's last reward instead of its total."""
+import gymnasium as gym
+import numpy as np
+
+
+def taxi(q_table, q_table_decay):
+    env = gym.make("Taxi-v3")
+    means = []
+    for table in (q_table, q_table_decay):
+        rewards = []
+        for _ in range(1000):
+            state, info = env.reset()
+            done = False
+            while not done:
+                state, reward, terminated, truncated, info = env.step(np.argmax(table[state]))
+                done = terminated or truncated
+            rewards.append(reward)
+        means.append(np.mean(rewards))
+    return means[0], means[1]
