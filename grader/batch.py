@@ -101,33 +101,6 @@ class LocalExecutor:
             )
 
 
-def collect_submissions(targets: Sequence[Path]) -> list[Path]:
-    """The ``.py`` and ``.ipynb`` files named, and those under the directories named (recursively, sorted).
-
-    Jupyter's ``.ipynb_checkpoints`` copies are left out with every other hidden directory.
-
-    Raises:
-        FileNotFoundError: A target does not exist.
-    """
-    files: list[Path] = []
-    for target in targets:
-        if target.is_dir():
-            files += sorted(
-                path
-                for path in target.rglob("*")
-                if path.suffix.lower() in SUBMISSION_SUFFIXES
-                and path.is_file()
-                and not any(part.startswith(".") for part in path.relative_to(target).parts)
-            )
-        elif target.exists():
-            files.append(target)
-        else:
-            raise FileNotFoundError(
-                f"{target} does not exist: pass .py or .ipynb files or directories holding them"
-            )
-    return files
-
-
 def report_names(paths: Sequence[Path]) -> dict[Path, str]:
     """A distinct report file stem per submission (its name, made unique with a counter when needed)."""
     names: dict[Path, str] = {}

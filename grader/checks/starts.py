@@ -26,12 +26,12 @@ from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
-import gymnasium
 import numpy as np
 
 from grader.checks.base import CallRecord
 from grader.checks.episodes import Episode, all_resets
 from grader.games import default_kwargs
+from grader.sandbox.replay import policy_rollout_steps
 from reference.oracles import optimal_q_table, threshold_start_outcome
 from reference.solutions import cartpole_policy, mountain_car_policy
 
@@ -275,16 +275,4 @@ def _car_steps(episode: Episode) -> float:
 
 def _reference_steps(episode: Episode, policy: Callable[[Any], int]) -> int:
     """Steps the reference policy plays from the episode's start (its reset seed, the grader's env)."""
-    log = episode.log
-    env = _reference_env(log.env_id, tuple(sorted(log.env_kwargs.items())))
-    observation, _ = env.reset(seed=log.reset_seed)
-    for step in range(1, REFERENCE_STEP_LIMIT + 1):
-        observation, _, terminated, truncated, _ = env.step(policy(observation))
-        if terminated or truncated:
-            return step
-    return REFERENCE_STEP_LIMIT
-
-
-@cache
-def _reference_env(env_id: str, env_kwargs: tuple[tuple[str, Any], ...]) -> gymnasium.Env[Any, Any]:
-    return gymnasium.make(env_id, **dict(env_kwargs))
+    return policy_rollout_steps(episode.log, policy, REFERENCE_STEP_LIMIT)

@@ -93,33 +93,12 @@ def entries_from_rows(rows: Sequence[GradeRow], out_dir: Path, page: Path) -> li
 
 
 def page_clash_of_reports(page: Path, reports: Mapping[Path, str], out_dir: Path) -> str | None:
-    """:func:`page_clash` for a batch whose report files are given: ``{report file: whose it is}``."""
-    outputs = {path.resolve(): whose for path, whose in reports.items()}
-    for written in (page, summary_path(page)):
-        if written.resolve() == (out_dir / GRADES_FILE).resolve():
-            return f"--html {page} would write {written} over the batch's {GRADES_FILE}; name the page e.g. class.html or put it outside {out_dir}"  # noqa: E501
-        clashing = outputs.get(written.resolve())
-        if clashing is not None:
-            return f"--html {page} would write {written} over the report of {clashing}; put the page outside {out_dir} (e.g. {out_dir.parent / 'class.html'}) or give it another name"  # noqa: E501
-    return None
-
-
-def page_clash(page: Path, paths: Sequence[Path], out_dir: Path) -> str | None:
     """Why the class page or its summary would overwrite a file of the batch, or None when neither does.
 
-    A student whose file is ``class.py`` has the report ``class.json``: ``--html gradebook/class.html``
-    would replace it with the summary. Checked before grading, so the batch never starts.
-
-    Args:
-        page: Where the class page goes; its summary goes beside it (``summary_path``).
-        paths: The batch's submission files.
-        out_dir: The batch's output directory.
-
-    Returns:
-        The message to show, or None.
+    Checked before grading, so the batch never starts. ``reports`` maps each report file the batch writes
+    to whose it is (a student whose identity is ``class`` has the report ``class.json``).
     """
-    names = report_names(paths)
-    outputs = {(out_dir / f"{name}.json").resolve(): path for path, name in names.items()}
+    outputs = {path.resolve(): whose for path, whose in reports.items()}
     for written in (page, summary_path(page)):
         if written.resolve() == (out_dir / GRADES_FILE).resolve():
             return f"--html {page} would write {written} over the batch's {GRADES_FILE}; name the page e.g. class.html or put it outside {out_dir}"  # noqa: E501

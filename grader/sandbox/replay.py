@@ -12,8 +12,9 @@ import json
 import math
 import threading
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cache
 from typing import Any
 
 import gymnasium
@@ -306,3 +307,23 @@ def _cached_env(env_id: str, env_kwargs: dict[str, Any]) -> tuple[gymnasium.Env[
         cache.pop(next(iter(cache))).close()
     cache[key] = env
     return env, ""
+
+
+def policy_rollout_steps(log: EpisodeLog, policy: Callable[[Any], int], limit: int) -> int:
+    """Steps a (reference) policy plays from a logged episode's start: its reset seed in the grader's env.
+
+    The env is built from the log's id and arguments, which the integrity rules accepted before any
+    start is valued; at most ``limit`` steps are played.
+    """
+    env = _rollout_env(log.env_id, tuple(sorted(log.env_kwargs.items())))
+    observation, _ = env.reset(seed=log.reset_seed)
+    for step in range(1, limit + 1):
+        observation, _, terminated, truncated, _ = env.step(policy(observation))
+        if terminated or truncated:
+            return step
+    return limit
+
+
+@cache
+def _rollout_env(env_id: str, env_kwargs: tuple[tuple[str, Any], ...]) -> gymnasium.Env[Any, Any]:
+    return gymnasium.make(env_id, **dict(env_kwargs))

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from grader import cli
-from grader.class_report.from_batch import entries_from_batch, page_clash
+from grader.class_report.from_batch import entries_from_batch, page_clash_of_reports
 
 from .support import report, result
 
@@ -109,8 +109,8 @@ def test_grade_refuses_a_json_name_for_the_page_before_grading(
     ("page", "clash"),
     [
         ("class.html", None),
-        ("out/class.html", "would write {out}/class.json over the report of {inputs}/class.py"),
-        ("out/alice.html", "would write {out}/alice.json over the report of {inputs}/alice.py"),
+        ("out/class.html", "would write {out}/class.json over the report of class"),
+        ("out/alice.html", "would write {out}/alice.json over the report of alice"),
         ("out/grades.csv", "would write {out}/grades.csv over the batch's grades.csv"),
         ("out/summary.html", None),
     ],
@@ -120,7 +120,8 @@ def test_the_class_page_never_overwrites_a_file_of_the_batch(
     tmp_path: Path, page: str, clash: str | None
 ) -> None:
     inputs, out = tmp_path / "in", tmp_path / "out"
-    found = page_clash(tmp_path / page, [inputs / "alice.py", inputs / "class.py"], out)
+    reports = {out / "alice.json": "alice", out / "class.json": "class"}
+    found = page_clash_of_reports(tmp_path / page, reports, out)
     if clash is None:
         assert found is None
     else:
