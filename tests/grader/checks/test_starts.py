@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from grader.checks.starts import features_of, hoeffding_p_value, selection_tests, start_groups
-from grader.testing.behaviours import cartpole, velocity_policy
+from grader.testing.behaviours import _scouting, cartpole, velocity_policy
 
 from .support import grade, simulate, small_config
 
@@ -95,3 +95,13 @@ def test_a_double_reset_in_taxi_passes_and_a_taxi_scout_fails(seed: int) -> None
     scout = grade("taxi", {"taxi": _taxi_scout}, seed)
     assert scout.status == "failed"
     assert "by the optimal value of the start" in scout.feedback
+
+
+def test_a_scout_is_failed_on_the_cheap_features_before_any_reference_rollout(seed: int) -> None:
+    records = simulate("car", {"car": _scouting}, seed, small_config("car", calls=100))
+    costly = {feature.name for feature in features_of("MountainCar-v0") if feature.costly}
+    every = selection_tests(records)
+    first = selection_tests(records, until_failure=True)
+    assert any(test.fails for test in every) and any(test.fails for test in first)  # the same decision
+    assert costly <= {test.feature for test in every}
+    assert not costly & {test.feature for test in first}  # no rollout from the 100 calls' dealt starts
