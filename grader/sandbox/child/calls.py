@@ -10,10 +10,13 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+import gymnasium
+
 from grader.compat import events as compat_events
+from grader.compat import register_envs, resolve_env_id
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
-from grader.sandbox.child.frames import decode_value, encode_value
+from grader.sandbox.child.frames import EnvArgument, decode_value, encode_value
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
 from grader.sandbox.child.recorder import Recorder
 from grader.sandbox.child.stubs import RAISING_STUB, stub_body
@@ -61,8 +64,8 @@ def parse_call(frame: dict[str, Any]) -> CallRequest:
     if wrong:
         raise ProtocolError(f"call frame fields of the wrong type: {', '.join(wrong)}")
     try:
-        args = decode_value(frame["args"], "the call's arguments")
-        kwargs = decode_value(frame["kwargs"], "the call's keyword arguments")
+        args = decode_value(frame["args"], "the call's arguments", allow_envs=True)
+        kwargs = decode_value(frame["kwargs"], "the call's keyword arguments", allow_envs=True)
         budget = WireBudget.from_plain(frame["budget"])
     except InvalidValueError as error:
         raise ProtocolError(error.message) from None
@@ -171,9 +174,16 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
         )
     if mismatch:
         return _status("bad_signature", mismatch)
+    try:
+        args = [_made(arg) for arg in request.args]
+        kwargs = {key: _made(arg) for key, arg in request.kwargs.items()}
+    except Exception as error:  # the grader's own env could not be made: not the student's doing
+        return _status(
+            "sandbox_error", f"the grader could not make the environment it passes to {name}(): {error}"
+        )
     started = time.perf_counter()
     try:
-        value = function(*request.args, **request.kwargs)
+        value = function(*args, **kwargs)
     except MemoryError:
         return _status(
             "memory_limit",
@@ -206,6 +216,20 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
             "memory_limit", f"{name}() returned more data than fits in memory", wall_time=wall_time
         )
     return {**_status("ok", ""), "value": encoded, "wall_time": wall_time}
+
+
+def _made(argument: Any) -> Any:
+    """An `EnvArgument` made into an env (through the recorder, like any env of the call), else itself.
+
+    A lab id gymnasium no longer registers is resolved quietly: the student did not name it.
+    """
+    if type(argument) is not EnvArgument:
+        return argument
+    register_envs()
+    target = resolve_env_id(argument.env_id)
+    return gymnasium.make(
+        target.gymnasium_id, max_episode_steps=argument.max_episode_steps, **target.merged_kwargs({})
+    )
 
 
 def _signature_mismatch(name: str, function: Any, request: CallRequest) -> str:
