@@ -1,4 +1,4 @@
-"""Edition rl1, problem 7: sarsa0() returns the SARSA(0) table of the transitions it played, exploring epsilon-greedily."""
+"""Edition rl1, problem 7: sarsa0() returns the SARSA(0) table of the transitions it played."""
 
 from grader.editions.rl1 import RL1
 from grader.plugin import GradeCase, ProblemCase

@@ -1,4 +1,4 @@
-"""Edition rl1, problem 7: `sarsa0(env, alpha, gamma, epsilon, N, decay)`, verified by replaying its own updates.
+"""Edition rl1, problem 7: `sarsa0(env, alpha, gamma, epsilon, N, decay)`, verified by replaying its updates.
 
 The grader calls `sarsa0` twice with its own hyper-parameters and a small N (a constant epsilon, then
 `decay=True`), passing a Taxi env it makes and records. Every step is replayed, so the grader knows each
@@ -120,7 +120,7 @@ class Run:
             f"the decay=True call (N={self.episodes})"
             if self.decay
             else f"the call with epsilon constant (N={self.episodes})"
-        )  # noqa: E501
+        )
 
 
 def _runs(settings: SarsaConfig) -> list[Run]:
@@ -132,7 +132,7 @@ def _runs(settings: SarsaConfig) -> list[Run]:
 
 @dataclass(frozen=True)
 class SarsaCheck:
-    """sarsa0 called with the grader's Taxi env and hyper-parameters; updates and behaviour verified by replay."""
+    """sarsa0 called with the grader's Taxi env and hyper-parameters; updates and exploration verified."""
 
     def plan(self, settings: SarsaConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The sarsa0 calls, then (for the decay call) the student's epsilon_decay(i, N) for i = 1..N.
@@ -277,8 +277,8 @@ def _judge_run(
         )
     if any(not episode.reached_terminal for episode in episodes):
         return _fail(
-            f"sarsa0, {run.text}: an episode ended without delivering the passenger; play each episode until `terminated`."
-        )  # noqa: E501
+            f"sarsa0, {run.text}: an episode ended without delivering the passenger; play each episode until `terminated`."  # noqa: E501
+        )
     rates = schedule if run.decay and schedule is not None else [settings.epsilon] * run.episodes
     played = [episode_steps(episode, rate) for episode, rate in zip(episodes, rates, strict=True)]
     honest = recompute(played, TAXI_SHAPE, settings.alpha, settings.gamma)
@@ -330,7 +330,7 @@ def _mismatch_text(
         episode, step = where
         place = (
             f"at episode {episode + 1}, step {step + 1} (the last update of that cell) your table's Q[{state}, {action}] is "  # noqa: E501
-            f"{table[state, action]:.6g}; SARSA(0) from the transitions you played gives {expected[state, action]:.6g}"
+            f"{table[state, action]:.6g}; SARSA(0) from the transitions you played gives {expected[state, action]:.6g}"  # noqa: E501
         )
     for rule in RULES:
         variant = recompute(played, TAXI_SHAPE, settings.alpha, settings.gamma, rule, judge_actions=False)

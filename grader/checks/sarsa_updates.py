@@ -1,4 +1,4 @@
-"""SARSA(0) recomputed from the transitions a learner played: the exact table, its update mistakes, its behaviour.
+"""SARSA(0) recomputed from the transitions a learner played: the table, typical update mistakes, exploration.
 
 Pure functions of trusted data: the states come from the grader's replay, the actions from the log (each
 one is played, so it is what the learner chose). `recompute` applies `Q[s, a] += alpha * (r + gamma *
