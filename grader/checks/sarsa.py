@@ -277,7 +277,7 @@ def _judge_run(
         )
     if any(not episode.reached_terminal for episode in episodes):
         return _fail(
-            f"sarsa0, {run.text}: an episode ended without delivering the passenger; play each episode until `terminated`."  # noqa: E501
+            f"sarsa0, {run.text}: an episode ended without delivering the passenger; play each episode until `terminated`."  # noqa: E501  # noqa: E501
         )
     rates = schedule if run.decay and schedule is not None else [settings.epsilon] * run.episodes
     played = [episode_steps(episode, rate) for episode, rate in zip(episodes, rates, strict=True)]
