@@ -121,7 +121,7 @@ HONEST: dict[str, Callable[..., Any]] = {
     "random_ties": _learner(argmax=_random_argmax),
     "stops_on_truncated": _learner(stop_on_truncated=True),
 }
-"""Honest learners: the lab's loop, returning the table alone, breaking ties at random, stopping on truncated."""
+"""Honest learners: the lab's loop, the table alone returned, ties broken at random, a stop on truncated."""
 
 MISTAKES: dict[str, tuple[Callable[..., Any], str]] = {
     "q_learning": (_learner(target="max"), "which is Q-learning"),

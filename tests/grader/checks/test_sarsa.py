@@ -1,4 +1,4 @@
-"""sarsa0(env, alpha, gamma, epsilon, N, decay) (edition rl1): honest learners pass; each typical mistake is named.
+"""sarsa0(env, alpha, gamma, epsilon, N, decay) (edition rl1): honest learners pass; each mistake is named.
 
 The behaviour test's false-fail probability is 1e-6 per call (two calls per judgement), so the honest
 cases here fail falsely with probability below 1e-5 in all.
