@@ -131,7 +131,7 @@ MISTAKES: dict[str, tuple[Callable[..., Any], str]] = {
     "missing_gamma": (_learner(gamma_used=False), "did not discount"),
     "no_end_update": (_learner(end_update=False), "skips the update of the last step"),
     "default_parameters": (_learner(fixed=(0.1, 0.6)), "alpha=0.1 and gamma=0.6"),
-    "trains_twice": (_learner(runs=2), "you played 50 episode(s)"),
+    "trains_twice": (_learner(runs=2), "episode(s); N="),
     "table_of_another_run": (_learner(keeps_first_table=True), "nor any typical variant"),
     "never_explores": (_learner(explore=False), "you explored less than epsilon asks"),
     "ignores_decay": (_learner(decays=False), "less than the decayed schedule"),
