@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -39,6 +40,7 @@ from grader.checks.values import as_number, describe
 from grader.games import TAXI, Game, GameRules
 from grader.problem_config import Probability, ProblemConfig
 from grader.sandbox.child.frames import EnvArgument
+from grader.sandbox.child.provided import epsilon_decay
 from grader.sandbox.outcome import Call, CallBudget, FunctionInfo, OutcomeStatus, PlainValue
 
 TAXI_SHAPE = (500, 6)
@@ -76,6 +78,12 @@ class SarsaConfig(ProblemConfig):
         ge=1_000,
         le=5_000_000,
         description="Steps one call may take (its budget); the env's time limit lies beyond it.",
+    )
+    decay_schedule: Literal["student", "grader"] = Field(
+        default="student",
+        description="Whose epsilon_decay the decay=True call uses: 'student' (the submission's own, read by "
+        "calling it for i = 1..N, and the behaviour judged against its values) or 'grader' (the child binds "
+        "the lab's formula in its place for that call). Either way a wrong decay counts in epsilon_decay only.",  # noqa: E501
     )
     table_tolerance: float = Field(
         default=1e-8,
@@ -141,7 +149,7 @@ class SarsaCheck:
         """
         calls = []
         for run in _runs(settings):
-            if run.decay:
+            if run.decay and settings.decay_schedule == "student":
                 calls += [
                     Call("epsilon_decay", (episode, run.episodes), budget=CallBudget(0, 0))
                     for episode in range(1, run.episodes + 1)
@@ -155,7 +163,8 @@ class SarsaCheck:
                 run.decay,
             )
             budget = CallBudget(2 * run.episodes + RESET_SLACK, settings.max_steps)
-            calls.append(Call("sarsa0", arguments, budget=budget))
+            provided = ("epsilon_decay",) if run.decay and settings.decay_schedule == "grader" else ()
+            calls.append(Call("sarsa0", arguments, budget=budget, provided=provided))
         return calls
 
     @paused_gc
@@ -177,7 +186,7 @@ class SarsaCheck:
         passes = []
         runs = _runs(settings)
         for run, record in zip(runs, sarsa_records, strict=False):
-            schedule = _schedule(decay_records, run) if run.decay else None
+            schedule = _schedule(settings, decay_records, run) if run.decay else None
             verdict = _judge_run(settings, run, record, schedule, measurements)
             if verdict is not None:
                 return Verdict(
@@ -193,8 +202,13 @@ class SarsaCheck:
         )
 
 
-def _schedule(decay_records: Sequence[CallRecord], run: Run) -> list[float] | None:
-    """The student's epsilon_decay(i, N) for i = 1..N, clipped to [0, 1]; None when any is no number."""
+def _schedule(settings: SarsaConfig, decay_records: Sequence[CallRecord], run: Run) -> list[float] | None:
+    """The decay call's epsilon_decay(i, N) for i = 1..N, clipped to [0, 1]; None when any is no number.
+
+    The grader's formula when it provided its own; else the student's values, read by calling it.
+    """
+    if settings.decay_schedule == "grader":
+        return [epsilon_decay(episode, run.episodes) for episode in range(1, run.episodes + 1)]
     values = [returned_number(record.outcome.value) for record in decay_records]
     if len(values) != run.episodes or any(value is None for value in values):
         return None
@@ -344,7 +358,8 @@ def _mismatch_text(
 
 
 def _behaviour_text(settings: SarsaConfig, run: Run, honest: Recomputed, tolerance: float) -> str:
-    rate = "epsilon_decay(i, N) of your own epsilon_decay" if run.decay else f"epsilon={settings.epsilon}"
+    whose = "your own" if settings.decay_schedule == "student" else "the grader's"
+    rate = f"epsilon_decay(i, N) of {whose} epsilon_decay" if run.decay else f"epsilon={settings.epsilon}"
     stated = (
         f"{honest.non_greedy} of your {honest.actions} actions were not a greedy action of the table as it was when you chose them; "  # noqa: E501
         f"epsilon-greedy with {rate} gives {honest.expected_non_greedy:.1f} ± {tolerance:.1f} "

@@ -18,6 +18,7 @@ from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
 from grader.sandbox.child.frames import EnvArgument, decode_value, encode_value
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
+from grader.sandbox.child.provided import PROVIDED
 from grader.sandbox.child.recorder import Recorder
 from grader.sandbox.child.stubs import RAISING_STUB, stub_body
 
@@ -25,6 +26,7 @@ MAX_COMPAT_EVENTS = 100
 MAX_EVENT_DETAIL = 1000
 """Characters kept of a compat event's detail (100 events stay far below the frame's allowance)."""
 _CALL_FIELDS = {"type", "id", "nonce", "function", "args", "kwargs", "seed", "record", "budget"}
+_OPTIONAL_CALL_FIELDS = {"provided"}
 
 
 @dataclass(frozen=True)
@@ -39,6 +41,7 @@ class CallRequest:
     seed: int
     record: bool
     budget: WireBudget | None = None
+    provided: tuple[str, ...] = ()
 
 
 def parse_call(frame: dict[str, Any]) -> CallRequest:
@@ -47,7 +50,7 @@ def parse_call(frame: dict[str, Any]) -> CallRequest:
     Raises:
         ProtocolError: a field is missing, extra or of the wrong type.
     """
-    if frame.keys() != _CALL_FIELDS or frame["type"] != "call":
+    if not _CALL_FIELDS <= frame.keys() <= _CALL_FIELDS | _OPTIONAL_CALL_FIELDS or frame["type"] != "call":
         raise ProtocolError(
             f"expected a call frame with fields {sorted(_CALL_FIELDS)}, found {sorted(frame)}"
         )
@@ -59,6 +62,8 @@ def parse_call(frame: dict[str, Any]) -> CallRequest:
         "kwargs": type(frame["kwargs"]) is dict,
         "seed": type(frame["seed"]) is int and frame["seed"] >= 0,
         "record": type(frame["record"]) is bool,
+        "provided": type(frame.get("provided", [])) is list
+        and all(type(name) is str and name in PROVIDED for name in frame.get("provided", [])),
     }
     wrong = [name for name, ok in checks.items() if not ok]
     if wrong:
@@ -72,7 +77,15 @@ def parse_call(frame: dict[str, Any]) -> CallRequest:
     except ValueError as error:
         raise ProtocolError(str(error)) from None
     return CallRequest(
-        frame["id"], frame["nonce"], frame["function"], args, kwargs, frame["seed"], frame["record"], budget
+        frame["id"],
+        frame["nonce"],
+        frame["function"],
+        args,
+        kwargs,
+        frame["seed"],
+        frame["record"],
+        budget,
+        tuple(frame.get("provided", [])),
     )
 
 
@@ -181,6 +194,9 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
         return _status(
             "sandbox_error", f"the grader could not make the environment it passes to {name}(): {error}"
         )
+    namespace = vars(module)
+    replaced = {provided: namespace[provided] for provided in request.provided if provided in namespace}
+    namespace.update({provided: PROVIDED[provided] for provided in request.provided})
     started = time.perf_counter()
     try:
         value = function(*args, **kwargs)
@@ -199,6 +215,12 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
             traceback=student_traceback(error, submission),
             wall_time=time.perf_counter() - started,
         )
+    finally:
+        for provided in request.provided:
+            if provided in replaced:
+                namespace[provided] = replaced[provided]
+            else:
+                namespace.pop(provided, None)
     wall_time = time.perf_counter() - started
     try:
         encoded = encode_value(value, f"the value returned by {name}()", max_bytes=max_frame)
