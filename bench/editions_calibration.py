@@ -19,6 +19,7 @@ import sys
 import time
 from collections import Counter
 from concurrent.futures import ProcessPoolExecutor
+from functools import cache
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -30,6 +31,7 @@ from grader.testing import sarsa as students
 from grader.testing.simulation import simulate_calls
 
 
+@cache
 def _settings() -> SarsaConfig:
     settings = load_config(RL1.default_config).problems["sarsa0"]
     assert isinstance(settings, SarsaConfig)
@@ -64,6 +66,7 @@ def main() -> None:
         for name in students.MISTAKES
         for seed in range(arguments.mistake_regrades)
     ]
+    _settings()  # read once, before the workers fork
     started = time.perf_counter()
     with ProcessPoolExecutor(arguments.workers) as pool:
         results = list(pool.map(regrade, *zip(*jobs, strict=True), chunksize=4))
