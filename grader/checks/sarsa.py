@@ -70,8 +70,7 @@ class SarsaConfig(ProblemConfig):
         ge=0,
         le=10_000,
         description="N of the decay=True call, which explores with epsilon_decay(i, N); 0 = no decay call. "
-        "Keep it small: the last episodes explore with about 1/N, and a nearly greedy learner on a poorly "
-        "trained table can circle for a long time.",
+        "Keep it small: the last episodes explore with about 1/N, and a nearly greedy learner on a poorly trained table can circle for a long time.",  # noqa: E501
     )
     max_steps: int = Field(
         default=400_000,
@@ -81,9 +80,8 @@ class SarsaConfig(ProblemConfig):
     )
     decay_schedule: Literal["student", "grader"] = Field(
         default="student",
-        description="Whose epsilon_decay the decay=True call uses: 'student' (the submission's own, read by "
-        "calling it for i = 1..N, and the behaviour judged against its values) or 'grader' (the child binds "
-        "the lab's formula in its place for that call). Either way a wrong decay counts in epsilon_decay only.",  # noqa: E501
+        description="Whose epsilon_decay the decay=True call uses: 'student' (the submission's own, read by calling it for i = 1..N, and the behaviour judged against its values) or 'grader' (the child binds the lab's formula in its place for that call). "  # noqa: E501
+        "Either way a wrong decay counts in epsilon_decay only.",
     )
     table_tolerance: float = Field(
         default=1e-8,
@@ -176,8 +174,8 @@ class SarsaCheck:
         if any(record.outcome.status is not OutcomeStatus.OK for record in decay_records):
             failed = next(r for r in decay_records if r.outcome.status is not OutcomeStatus.OK)
             schedule_note = (
-                f" The decay=True call was not made: epsilon_decay{failed.outcome.call.args} did not return "
-                f"({failed.outcome.message or failed.outcome.status.value}); it is graded in problem 5."
+                f" The decay=True call was not made: epsilon_decay{failed.outcome.call.args} did not return ({failed.outcome.message or failed.outcome.status.value}); "  # noqa: E501
+                "it is graded in problem 5."
             )
         early = outcome_verdict(sarsa_records)
         if early is not None:
@@ -217,10 +215,7 @@ def _schedule(settings: SarsaConfig, decay_records: Sequence[CallRecord], run: R
 
 def _passed_text(run: Run, measurements: Mapping[str, PlainValue]) -> str:
     key = "decay" if run.decay else "constant"
-    return (
-        f"{run.text}: {measurements[f'{key}_updates']} updates, {measurements[f'{key}_non_greedy']} non-greedy actions "  # noqa: E501
-        f"where {float(measurements[f'{key}_expected_non_greedy']):.1f} ± {float(measurements[f'{key}_tolerance']):.1f} were expected"  # noqa: E501
-    )
+    return f"{run.text}: {measurements[f'{key}_updates']} updates, {measurements[f'{key}_non_greedy']} non-greedy actions where {float(measurements[f'{key}_expected_non_greedy']):.1f} ± {float(measurements[f'{key}_tolerance']):.1f} were expected"  # noqa: E501
 
 
 def returned_table(value: PlainValue) -> tuple[npt.NDArray[np.float64] | None, PlainValue, str]:
@@ -362,8 +357,7 @@ def _behaviour_text(settings: SarsaConfig, run: Run, honest: Recomputed, toleran
     rate = f"epsilon_decay(i, N) of {whose} epsilon_decay" if run.decay else f"epsilon={settings.epsilon}"
     stated = (
         f"{honest.non_greedy} of your {honest.actions} actions were not a greedy action of the table as it was when you chose them; "  # noqa: E501
-        f"epsilon-greedy with {rate} gives {honest.expected_non_greedy:.1f} ± {tolerance:.1f} "
-        f"(Bernstein's inequality, false-fail probability {settings.behaviour_alpha:g})"
+        f"epsilon-greedy with {rate} gives {honest.expected_non_greedy:.1f} ± {tolerance:.1f} (Bernstein's inequality, false-fail probability {settings.behaviour_alpha:g})"  # noqa: E501
     )
     if honest.non_greedy > honest.expected_non_greedy and honest.greedy_on_previous > honest.non_greedy // 2:
         cause = f"{honest.greedy_on_previous} of them were greedy on the previous state's row: choose the next action from next_state, not from state"  # noqa: E501
