@@ -211,7 +211,9 @@ def bernstein_half_width(variance: float, alpha: float) -> float:
 
     Bernstein's inequality, P(|X - E X| >= t) <= 2 exp(-t^2 / (2 variance + 2 t / 3)), solved for t;
     written by hand because no kept library states it (it holds for every sample size, unlike a normal
-    approximation of the Poisson-binomial count in its far tail).
+    approximation of the Poisson-binomial count in its far tail). The learner's probabilities depend on
+    its earlier draws, so the centred count is a martingale: this is Freedman's form, at the realised
+    predictable variance.
     """
     level = math.log(2.0 / alpha)
     return level / 3.0 + math.sqrt((level / 3.0) ** 2 + 2.0 * variance * level)
