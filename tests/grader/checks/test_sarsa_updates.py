@@ -1,4 +1,4 @@
-"""The pure SARSA(0) core: exact recomputation, the mistaken rules, the greedy judgement, Bernstein's bound."""
+"""The pure SARSA(0) core: exact recomputation, mistaken rules, the greedy judgement, Bernstein's bound."""
 
 import math
 
