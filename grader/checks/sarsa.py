@@ -177,6 +177,20 @@ class SarsaCheck:
                 f" The decay=True call was not made: epsilon_decay{failed.outcome.call.args} did not return ({failed.outcome.message or failed.outcome.status.value}); "  # noqa: E501
                 "it is graded in problem 5."
             )
+        decay_run = next((run for run in _runs(settings) if run.decay), None)
+        broken_schedule = (
+            settings.decay_schedule == "student"
+            and decay_run is not None
+            and len(sarsa_records) == 2
+            and _schedule(settings, decay_records, decay_run) is None
+        )
+        if broken_schedule and sarsa_records[1].outcome.status is not OutcomeStatus.OK:
+            message = sarsa_records[1].outcome.message
+            sarsa_records = sarsa_records[:1]
+            schedule_note = (
+                f" The decay=True call is not counted: your epsilon_decay returned something that is not a number and sarsa0 failed with it ({message}); "  # noqa: E501
+                "epsilon_decay is graded in problem 5."
+            )
         early = outcome_verdict(sarsa_records)
         if early is not None:
             return early

@@ -90,3 +90,21 @@ def test_a_returned_value_that_is_no_table_is_refused(value: Any, found: str) ->
 def test_a_list_table_and_penalties_are_read() -> None:
     table, penalties, wrong = returned_table(([[1, 2, 3, 4, 5, 6]] * 500, 7))
     assert table is not None and table.shape == (500, 6) and penalties == 7 and wrong == ""
+
+
+def test_an_epsilon_decay_returning_no_number_is_not_counted_again(seed: int) -> None:
+    """sarsa0 crashes on the student's None epsilon; the decay call is dropped, the constant one graded."""
+
+    def no_number(lab: Any, episode: int, n: int) -> None:
+        return None
+
+    def crashes_on_decay(
+        lab: Any, env: Any, alpha: float, gamma: float, epsilon: float, n: int, decay: bool
+    ) -> Any:
+        if decay:
+            raise TypeError("'<' not supported between instances of 'float' and 'NoneType'")
+        return students.HONEST["lab_loop"](lab, env, alpha, gamma, epsilon, n, decay)
+
+    verdict = _judge(crashes_on_decay, seed, decay=no_number)
+    assert verdict.status == "passed", verdict.feedback
+    assert "The decay=True call is not counted" in verdict.feedback
