@@ -76,7 +76,7 @@ def main() -> None:
     )
     print("| student | regrades | verdicts | named | steps per regrade (median, max) | judge s (median) |")
     print("|---|---|---|---|---|---|")
-    for kind, names in (("honest", students.HONEST), ("mistake", students.MISTAKES)):
+    for kind, names in (("honest", honest), ("mistake", mistakes)):
         for name in names:
             rows = [row for row in results if row[0] == kind and row[1] == name]
             statuses = Counter(row[2] for row in rows)
