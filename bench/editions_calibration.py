@@ -59,11 +59,19 @@ def main() -> None:
     parser.add_argument("--regrades", type=int, default=200)
     parser.add_argument("--mistake-regrades", type=int, default=50)
     parser.add_argument("--workers", type=int, default=1)
+    parser.add_argument("--only", default="", help="comma-separated student names (default: all)")
+    parser.add_argument(
+        "--first-seed", type=int, default=0, help="seed of the first regrade (to extend a run)"
+    )
     arguments = parser.parse_args()
-    jobs = [("honest", name, seed) for name in students.HONEST for seed in range(arguments.regrades)]
+    chosen = set(filter(None, arguments.only.split(",")))
+    honest = [name for name in students.HONEST if not chosen or name in chosen]
+    mistakes = [name for name in students.MISTAKES if not chosen or name in chosen]
+    first = arguments.first_seed
+    jobs = [("honest", name, first + seed) for name in honest for seed in range(arguments.regrades)]
     jobs += [
-        ("mistake", name, 10_000 + seed)
-        for name in students.MISTAKES
+        ("mistake", name, 10_000 + first + seed)
+        for name in mistakes
         for seed in range(arguments.mistake_regrades)
     ]
     _settings()  # read once, before the workers fork
