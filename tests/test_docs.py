@@ -158,7 +158,7 @@ def link_problem(document: Path, target: str) -> str | None:
         return f"{target} names {shown}, which does not exist"
     if fragment and destination.suffix == ".md" and fragment not in anchors(destination):
         known = sorted(anchors(destination))
-        return f"{target}: {destination.name} has no heading with the anchor #{fragment}; expected one of {known}"
+        return f"{target}: {destination.name} has no heading with the anchor #{fragment}; expected {known}"
     return None
 
 
