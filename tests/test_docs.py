@@ -284,3 +284,103 @@ def test_a_missing_anchor_is_a_problem() -> None:
     assert problem is not None and problem.startswith(
         "docs/students.md#no-such-heading: students.md has no heading"
     )
+
+
+def shown_gymgrade_commands(document: Path) -> list[tuple[int, list[str]]]:
+    """(line, arguments) of every `gymgrade ...` line of every fenced block, runnable or not.
+
+    Continuation lines are joined; `scripts/run`, leading VARIABLE=value assignments, a trailing `&` and
+    redirections are taken off, since they are the shell's, not gymgrade's.
+    """
+    shown = []
+    for block in fenced_blocks(document):
+        text = "\n".join(block.lines).replace("\\\n", " ")
+        for offset, line in enumerate(text.splitlines(), start=1):
+            words = shlex.split(line, comments=True) if line.strip() else []
+            if words[:1] == ["scripts/run"]:
+                words = words[1:]
+            while words and re.fullmatch(r"[A-Z_]+=\S*", words[0]):
+                words = words[1:]
+            if words[:1] != ["gymgrade"]:
+                continue
+            arguments = []
+            for word in words[1:]:
+                if word in REDIRECTIONS or word in ("&", "|", "&&", ";"):
+                    break
+                arguments.append(word)
+            shown.append((block.line + offset, arguments))
+    return shown
+
+
+SHOWN = [
+    (document, line, arguments)
+    for document in DOCUMENTS
+    for line, arguments in shown_gymgrade_commands(document)
+]
+
+
+def test_shown_commands_leave_the_shell_out(tmp_path: Path) -> None:
+    page = tmp_path / "page.md"
+    page.write_text(
+        "```\n"
+        "GYMGRADE_BROKER_URL=redis://h:1/0 gymgrade serve --port 8000 &\n"
+        "scripts/run gymgrade doctor   # a comment\n"
+        "gymgrade check a.py --json > report.json\n"
+        "gymgrade-other x\n"
+        "gymgrade gradescope-seed --bundle z.zip \\\n"
+        "    --metadata m.json\n"
+        "```\n",
+        encoding="utf-8",
+    )
+    assert [arguments for _, arguments in shown_gymgrade_commands(page)] == [
+        ["serve", "--port", "8000"],
+        ["doctor"],
+        ["check", "a.py", "--json"],
+        ["gradescope-seed", "--bundle", "z.zip", "--metadata", "m.json"],
+    ]
+
+
+def test_the_documents_show_gymgrade_commands() -> None:
+    assert len(SHOWN) >= 30, f"expected the documents' gymgrade commands, found {len(SHOWN)}"
+
+
+@pytest.mark.parametrize(
+    ("document", "line", "arguments"),
+    SHOWN,
+    ids=[f"{document.relative_to(ROOT)}:{line}" for document, line, _ in SHOWN],
+)
+def test_each_shown_gymgrade_command_parses(document: Path, line: int, arguments: list[str]) -> None:
+    from grader.cli import build_parser
+
+    try:
+        build_parser().parse_args(arguments)
+    except SystemExit as exit_:
+        assert exit_.code == 0, (
+            f"{document.relative_to(ROOT)}:{line}: the parser refuses `gymgrade {shlex.join(arguments)}` "
+            "(an option or subcommand the CLI does not have): change the page or the CLI"
+        )
+
+
+def known_variables() -> set[str]:
+    """Every GYMGRADE_* variable the code reads: the service's settings and the names the code spells out."""
+    from api.settings import Settings
+
+    spelled = set()
+    for package in ("grader", "api", "scripts"):
+        for path in (ROOT / package).rglob("*"):
+            if path.is_file() and path.suffix in ("", ".py", ".sh"):
+                spelled |= set(
+                    re.findall(r"GYMGRADE_[A-Z_]+", path.read_text(encoding="utf-8", errors="replace"))
+                )
+    return spelled | {f"GYMGRADE_{name.upper()}" for name in Settings.model_fields}
+
+
+def test_every_documented_variable_is_one_the_code_reads() -> None:
+    known = known_variables()
+    unknown = sorted(
+        f"{document.relative_to(ROOT)}: {variable}"
+        for document in DOCUMENTS
+        for variable in set(re.findall(r"GYMGRADE_[A-Z_]+", document.read_text(encoding="utf-8")))
+        if variable not in known
+    )
+    assert unknown == [], "the documents name variables no code reads: correct them"
