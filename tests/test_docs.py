@@ -12,6 +12,7 @@ import re
 import shlex
 import shutil
 import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -239,9 +240,11 @@ def fresh_copy(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.mark.sandbox
 @pytest.mark.parametrize("command", COMMANDS, ids=[command.name for command in COMMANDS])
 def test_each_runnable_command_succeeds(command: Command, fresh_copy: Path) -> None:
+    # This checkout's code, and the `gymgrade` script of the interpreter running the tests, come first.
     environment = {
         **os.environ,
         "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
+        "PATH": os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")]),
     }
     result = subprocess.run(
         ["bash", "-c", command.text], cwd=fresh_copy, env=environment, capture_output=True, text=True,
