@@ -268,7 +268,7 @@ def run_worker(settings: Settings, concurrency: int | None) -> int:
 
     Args:
         settings: Service settings with a broker URL.
-        concurrency: Gradings at once (None: GYMGRADE_WORKERS).
+        concurrency: Gradings at once (None: one per core, see :func:`split_cores`).
 
     Returns:
         The worker's exit code.
