@@ -313,8 +313,8 @@ def run_worker(settings: Settings, concurrency: int | None) -> int:
         _restart_in_place([*history, now])
     if exitcode and not runtime.stop.is_set():
         logger.critical(
-            "the Celery worker stopped on errors %d times in %.0f s; exiting. Check the broker "
-            "(`gymgrade doctor`), then start `gymgrade worker` again: queued submissions are kept",
+            "the Celery worker stopped on errors %d times in %.0f s; exiting. "
+            "Check the broker (`gymgrade doctor`), then start `gymgrade worker` again: queued submissions are kept",  # noqa: E501
             len(history),
             RESTART_WINDOW_SECONDS,
         )
