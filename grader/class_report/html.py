@@ -1,15 +1,13 @@
 """The class page: one self-contained HTML file under the student report's Content-Security-Policy.
 
 No script, no network: images are ``data:`` URIs and the only style is the page's own, pinned by hash,
-exactly as in ``grader.html_report``. Every string from a student or a roster is escaped by the template
-and shown through ``display_text`` (bounded, no controls or bidi overrides, inside ``<bdi>``); links to
-the students' reports are relative paths checked by ``safe_href``.
+under the one policy of ``grader.render.csp``. Every string from a student or a roster is escaped by
+the template and shown through ``display_text`` (bounded, no controls or bidi overrides, inside
+``<bdi>``); links to the students' reports are relative paths checked by ``safe_href``.
 """
 
 from __future__ import annotations
 
-import base64
-import hashlib
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -20,6 +18,7 @@ from grader.class_report.figures import class_figures
 from grader.class_report.summary import ClassSummary, summarise
 from grader.class_report.text import MAX_NAME_CHARS, MAX_NOTE_CHARS, display_identity, display_text
 from grader.figures import Figure
+from grader.render.csp import content_security_policy
 
 TEMPLATES = Path(__file__).resolve().parents[1] / "templates"
 TEMPLATE = "class_report.html"
@@ -36,15 +35,6 @@ STYLE = (
     ".count{font-weight:bold}.diagnosis{white-space:pre-wrap}.who{font-size:.85rem;color:#333}"
     ".late{color:#a60}.error{color:#a00}.missing{color:#777}"
 )
-
-
-def content_security_policy(style: str) -> str:
-    """The report pages' policy for a page whose only stylesheet is ``style``: nothing loads or runs but
-    its ``data:`` images and that stylesheet (the same policy as ``grader.html_report.CSP``)."""
-    digest = base64.b64encode(hashlib.sha256(style.encode()).digest()).decode()
-    return (
-        f"default-src 'none'; img-src data:; style-src 'sha256-{digest}'; base-uri 'none'; form-action 'none'"
-    )
 
 
 CSP = content_security_policy(STYLE)
