@@ -9,9 +9,6 @@ the template and shown through ``display_text`` (bounded, no controls or bidi ov
 from __future__ import annotations
 
 from collections.abc import Sequence
-from pathlib import Path
-
-from jinja2 import Environment, FileSystemLoader, select_autoescape
 
 from grader.class_report.entries import ClassEntry
 from grader.class_report.figures import class_figures
@@ -19,8 +16,8 @@ from grader.class_report.summary import ClassSummary, summarise
 from grader.class_report.text import MAX_NAME_CHARS, MAX_NOTE_CHARS, display_identity, display_text
 from grader.figures import Figure
 from grader.render.csp import content_security_policy
+from grader.render.page import page_environment
 
-TEMPLATES = Path(__file__).resolve().parents[1] / "templates"
 TEMPLATE = "class_report.html"
 DIAGNOSES_SHOWN = 20
 """Diagnosis groups on the page (most common first); class.json lists more."""
@@ -39,9 +36,7 @@ STYLE = (
 
 CSP = content_security_policy(STYLE)
 
-_environment = Environment(
-    loader=FileSystemLoader(TEMPLATES), autoescape=select_autoescape(["html"]), keep_trailing_newline=True
-)
+_environment = page_environment()
 _environment.filters["identity"] = lambda text: display_identity(text, IDENTITY_SHOWN_CHARS)
 _environment.filters["name"] = lambda text: display_text(text, MAX_NAME_CHARS)
 _environment.filters["note"] = lambda text: display_text(text, MAX_NOTE_CHARS)

@@ -7,12 +7,10 @@ a learning platform or opened from disk.
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import TYPE_CHECKING
 
-from jinja2 import Environment, FileSystemLoader, select_autoescape
-
 from grader.render.csp import content_security_policy
+from grader.render.page import page_environment
 from grader.render.text import isolation_lines
 from grader.report import Report
 
@@ -20,7 +18,6 @@ if TYPE_CHECKING:
     from grader.config import AssignmentConfig
     from grader.figures import Figure
 
-TEMPLATES = Path(__file__).resolve().parents[1] / "templates"
 STYLE = (
     "body{font-family:system-ui,sans-serif;max-width:52rem;margin:2rem auto;padding:0 1rem;color:#222}"
     ".meta{color:#555;font-size:.9rem}.badge{font-size:.8rem;padding:.1rem .4rem;border-radius:.3rem;"
@@ -34,9 +31,7 @@ STYLE = (
 CSP = content_security_policy(STYLE)
 """The page's policy: nothing loads or runs except its images (data: URIs) and its own style."""
 
-_environment = Environment(
-    loader=FileSystemLoader(TEMPLATES), autoescape=select_autoescape(["html"]), keep_trailing_newline=True
-)
+_environment = page_environment()
 
 
 def render_html(

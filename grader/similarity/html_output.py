@@ -10,9 +10,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from jinja2 import Environment, FileSystemLoader, select_autoescape
-
 from grader.render.csp import content_security_policy
+from grader.render.page import page_environment
 from grader.similarity.report import Fragment, Pair, SimilarityReport
 
 MAX_LINES_SHOWN = 60
@@ -28,11 +27,7 @@ STYLE = (
 )
 CSP = content_security_policy(STYLE, images=False)
 
-_environment = Environment(
-    loader=FileSystemLoader(Path(__file__).with_name("templates")),
-    autoescape=select_autoescape(["html"]),
-    keep_trailing_newline=True,
-)
+_environment = page_environment(Path(__file__).with_name("templates"))
 
 
 @dataclass(frozen=True)
