@@ -165,7 +165,7 @@ def _instructor_note(name: str, number: str, output: str) -> GradescopeTest:
 
 
 def seed_record(upload: UploadSeed) -> dict[str, object]:
-    """The upload's grading seed as ``extra_data`` records it (stored by Gradescope, never shown to students)."""
+    """The upload's grading seed as ``extra_data`` records it (kept by Gradescope, hidden from students)."""
     return {
         "gymgrade": {"seed": upload.seed, "seed_source": upload.source, "identity": list(upload.identity)}
     }
