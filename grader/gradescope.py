@@ -168,8 +168,8 @@ def run_autograder(
     """Grade ``<root>/submission`` into ``<root>/results/results.json`` (what ``run_autograder`` runs).
 
     Never raises for a student's file: no file, a bad file, a crash are all results. The policy is
-    ``ALLOW_FALLBACK``: Gradescope's containers do not allow every isolation layer (see the README), and
-    the results' output names the missing ones.
+    ``ALLOW_FALLBACK``: Gradescope's containers do not allow every isolation layer (see
+    docs/operations.md, "Isolation on Gradescope"), and the results' output names the missing ones.
 
     Args:
         root: The autograder's root (``/autograder``).
