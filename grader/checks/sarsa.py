@@ -41,7 +41,8 @@ from grader.games import TAXI, Game, GameRules
 from grader.problem_config import Probability, ProblemConfig
 from grader.sandbox.child.frames import EnvArgument
 from grader.sandbox.child.provided import epsilon_decay
-from grader.sandbox.outcome import Call, CallBudget, FunctionInfo, OutcomeStatus, PlainValue
+from grader.sandbox.limits import CallBudget
+from grader.sandbox.outcome import Call, FunctionInfo, OutcomeStatus, PlainValue
 
 TAXI_SHAPE = (500, 6)
 PENALTY_REWARD = -10.0
