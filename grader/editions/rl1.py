@@ -1,11 +1,13 @@
 """Edition 4, "Reinforcement Learning 1: Gymnasium" (2024 onwards), the one taught today.
 
 Problems 1-4 are the shared declarations of `grader.problems`; `epsilon_decay` and the two-table
-`taxi(q_table, q_table_decay)` are this edition's own. `sarsa0` and `compare()` are declared as expected
-functions (the template defines them, detection reads them) but not graded yet (`not_graded`).
+`taxi(q_table, q_table_decay)` are this edition's own, and `sarsa0`, verified by replaying its updates
+(`grader.checks.sarsa`). `compare()` is declared as an expected function (the template defines it,
+detection reads it) but not graded yet (`not_graded`).
 """
 
 from grader.checks.epsilon_decay import EpsilonDecayCheck, EpsilonDecayConfig
+from grader.checks.sarsa import SarsaCheck, SarsaConfig
 from grader.checks.taxi_tables import TaxiTablesCheck, TaxiTablesConfig
 from grader.editions.pack import PACKAGE, REPOSITORY, Edition, ExpectedFunction
 from grader.problem_registry import Problem, Registry
@@ -50,6 +52,13 @@ RL1 = Edition(
                 config=TaxiTablesConfig,
                 check=TaxiTablesCheck(),
             ),
+            Problem(
+                id="sarsa0",
+                title="Problem 7: SARSA(0)",
+                points=1.0,
+                config=SarsaConfig,
+                check=SarsaCheck(),
+            ),
         )
     ),
     functions=FUNCTIONS,
@@ -59,8 +68,7 @@ RL1 = Edition(
     notebook_name="gymnasium.ipynb",
     not_graded=(
         ("qlearn", "provided by the template; taxi gets the grader's own tables, so no verdict needs it"),
-        ("sarsa0", "SARSA(0) verified by replaying its updates is not graded yet"),
         ("compare", "compare() needs the notebook's own training cells; not graded yet"),
     ),
 )
-"""The current edition: problems 1-6 graded; qlearn, sarsa0 and compare() listed in `not_graded`."""
+"""The current edition: problems 1-7 graded (sarsa0 included); qlearn and compare() listed in `not_graded`."""
