@@ -12,7 +12,7 @@ from grader.editions.gym026 import GYM026
 from grader.editions.pack import Edition, ExpectedFunction
 from grader.editions.rl1 import RL1
 from grader.editions.volume2 import VOLUME2
-from grader.problem_registry import ProblemId
+from grader.problem_id import ProblemId
 
 __all__ = ["DEFAULT_EDITION", "EDITIONS", "Edition", "ExpectedFunction", "all_problem_ids", "edition_of"]
 
