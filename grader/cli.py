@@ -12,7 +12,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from grader.editions import EDITIONS, all_problem_ids
+from grader.editions import EDITIONS, all_problem_ids, edition_label
 from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError
 from grader.notebook import NotebookSummary
 from grader.progress import ProgressBar, result_line
@@ -423,6 +423,7 @@ def summary(report: Report) -> str:
     lines.append(
         f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
     )
+    lines.append(f"Edition: {edition_label(report.edition)}")
     lines.append(
         f"Practice seed {report.seed}: your instructor grades on different, unseen starts (a held-out seed), so code that only does well from these starts will fail there."  # noqa: E501
     )

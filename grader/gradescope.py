@@ -23,6 +23,7 @@ from pydantic import BaseModel, ConfigDict, Field
 import grader
 from grader.batch import SUBMISSION_SUFFIXES
 from grader.cli import isolation_lines, notebook_lines
+from grader.editions import edition_label
 from grader.errors import GradescopeError
 from grader.gradescope_upload import METADATA_FILE, UploadSeed, read_metadata
 from grader.report import SHOWN_AT_ONCE, Report, errors_shown, withheld_ids
@@ -125,7 +126,10 @@ def results(
             tests.append(
                 _instructor_note(f"{problem.title}: what the code printed", f"{index}.1", problem.output)
             )
-    lines = [f"gymgrade {report.grader_version}, gymnasium {report.gymnasium_version}."]
+    lines = [
+        f"gymgrade {report.grader_version}, gymnasium {report.gymnasium_version}.",
+        f"Edition: {edition_label(report.edition)}.",
+    ]
     if report.notebook is not None:
         lines += notebook_lines(report.notebook)
     if report.submission_error is not None:

@@ -15,6 +15,7 @@ from jinja2 import Environment, FileSystemLoader, select_autoescape
 
 from grader.cli import isolation_lines
 from grader.config import AssignmentConfig
+from grader.editions import edition_label
 from grader.figures import Figure, all_figures
 from grader.report import Report
 
@@ -57,5 +58,10 @@ def render_html(
     drawn = figures if figures is not None else all_figures(report.problems, config)
     isolation = " ".join(isolation_lines(report.isolation))
     return _environment.get_template("report.html").render(
-        report=report, figures=drawn, csp=CSP, style=STYLE, isolation=isolation
+        report=report,
+        figures=drawn,
+        csp=CSP,
+        style=STYLE,
+        isolation=isolation,
+        edition=edition_label(report.edition),
     )

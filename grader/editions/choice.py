@@ -96,3 +96,10 @@ def choose_edition(flag: str | None, config: Path | None, submission: Path | Non
 
 def _default_config(edition: Edition) -> Path | None:
     return None if edition.default_config == BUNDLED_CONFIG else edition.default_config
+
+
+def edition_config(name: str) -> Path | None:
+    """The default configuration of the edition a report names (None: the bundled one), to draw its
+    figures with; a name no pack has (a report from a newer gymgrade) gets the first edition's."""
+    found = EDITIONS.get(name)
+    return None if found is None else _default_config(found)
