@@ -105,8 +105,8 @@ class PlayedProblemConfig(ProblemConfig):
         """
         if not games:
             raise ValueError(
-                f"{problem_id} plays episodes, so its declaration must list the games it accepts "
-                "(Problem(games=...)); found none"
+                f"{problem_id} plays episodes, so its declaration must list the games it accepts (Problem(games=...)); "  # noqa: E501
+                "found none"
             )
         accepted = game_names(games)
         chosen = self.accepted_envs

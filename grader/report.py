@@ -212,8 +212,8 @@ class Report(BaseModel):
     )
     edition: str = Field(
         default=FIRST_EDITION,
-        description="The edition of the lab graded (grader/editions/); absent in reports older than editions "
-        "(all graded in the first, 'classic').",
+        description="The edition of the lab graded (grader/editions/). "
+        "Absent in reports older than editions, all graded in the first, 'classic'.",
     )
     gymnasium_version: str = Field(description="Gymnasium version the episodes were replayed with.")
     grader_version: str = Field(description="gymgrade version.")
