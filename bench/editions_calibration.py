@@ -103,6 +103,7 @@ def calibrate(
     mistake_regrades: int,
     budget_seconds: float | None,
     caps: Mapping[str, int] | None = None,
+    parts: tuple[str, ...] = ("mistakes", "honest"),
 ) -> bool:
     """Run one calibration and print it; True when no honest regrade failed and every mistake was named.
 
@@ -113,12 +114,12 @@ def calibrate(
     started, cpu = time.perf_counter(), time.process_time()
     ok = True
     print(f"## {calibration.edition} {calibration.problem}")
-    for student, (function, words) in calibration.mistakes.items():
+    for student, (function, words) in calibration.mistakes.items() if "mistakes" in parts else ():
         count = min(mistake_regrades, (caps or {}).get(student, mistake_regrades))
         tally = regrade(calibration, function, range(SEED_BASE, SEED_BASE + count), words)
         ok &= tally.named == tally.runs == count
         print(f"  mistake {student:<22} {tally.line()}")
-    for student, function in calibration.honest.items():
+    for student, function in calibration.honest.items() if "honest" in parts else ():
         done = Tally(statuses=Counter())
         seed = SEED_BASE
         while done.runs < regrades:
@@ -149,11 +150,15 @@ def main() -> int:
     parser.add_argument(
         "--cap", action="append", default=[], metavar="MISTAKE=N", help="fewer regrades of one mistake"
     )
+    parser.add_argument(
+        "--part", choices=("mistakes", "honest"), default=None, help="run only this part (default: both)"
+    )
     args = parser.parse_args()
+    parts = ("mistakes", "honest") if args.part is None else (args.part,)
     budget = None if args.budget_minutes is None else 60 * args.budget_minutes
     caps = {name: int(count) for name, _, count in (cap.partition("=") for cap in args.cap)}
     results = [
-        calibrate(name, args.regrades, args.mistake_regrades, budget, caps)
+        calibrate(name, args.regrades, args.mistake_regrades, budget, caps, parts)
         for name in args.only or CALIBRATIONS
     ]
     print("all calibrations held" if all(results) else "SOME CALIBRATION FAILED")
