@@ -23,14 +23,12 @@ from PIL import Image
 
 from grader.config import AssignmentConfig
 from grader.errors import UnknownProblem
-from grader.problem_plots import (  # noqa: F401 (re-exported: the class report draws with the same look)
-    BAR_COLOUR,
-    EXACT_COLOUR,
-    PLOT_DPI,
-    PLOT_SIZE,
-    REFERENCE_COLOUR,
-    STUDENT_COLOUR,
-)
+from grader.problem_plots import BAR_COLOUR as BAR_COLOUR  # the class report draws with the same look
+from grader.problem_plots import EXACT_COLOUR as EXACT_COLOUR
+from grader.problem_plots import PLOT_DPI as PLOT_DPI
+from grader.problem_plots import PLOT_SIZE as PLOT_SIZE
+from grader.problem_plots import REFERENCE_COLOUR as REFERENCE_COLOUR
+from grader.problem_plots import STUDENT_COLOUR as STUDENT_COLOUR
 from grader.report import EpisodeReplay, ProblemResult
 
 MAX_GIF_FRAMES = 60
