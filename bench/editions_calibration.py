@@ -23,7 +23,7 @@ import sys
 import time
 from collections import Counter
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -48,12 +48,14 @@ class Calibration:
         problem: The problem id.
         honest: Honest students by name (each must pass every regrade).
         mistakes: Typical mistakes by name: the student and the words its feedback must contain.
+        others: The student's other functions its calls need (sarsa0's `epsilon_decay`, say).
     """
 
     edition: str
     problem: str
     honest: Mapping[str, Callable[..., Any]]
     mistakes: Mapping[str, tuple[Callable[..., Any], str]]
+    others: Mapping[str, Callable[..., Any]] = field(default_factory=dict)
 
 
 CALIBRATIONS: dict[str, Calibration] = {
@@ -86,7 +88,7 @@ def regrade(calibration: Calibration, student: Callable[..., Any], seeds: range,
     tally = Tally(statuses=Counter())
     started = time.perf_counter()
     for seed in seeds:
-        records = simulate_calls(calls, {calibration.problem: student}, seed)
+        records = simulate_calls(calls, {**calibration.others, calibration.problem: student}, seed)
         verdict = problem.check.judge(settings, records)
         assert tally.statuses is not None
         tally.statuses[verdict.status] += 1
