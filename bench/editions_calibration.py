@@ -106,6 +106,7 @@ def calibrate(
     budget_seconds: float | None,
     caps: Mapping[str, int] | None = None,
     parts: tuple[str, ...] = ("mistakes", "honest"),
+    first_seed: int = SEED_BASE,
 ) -> bool:
     """Run one calibration and print it; True when no honest regrade failed and every mistake was named.
 
@@ -118,12 +119,12 @@ def calibrate(
     print(f"## {calibration.edition} {calibration.problem}")
     for student, (function, words) in calibration.mistakes.items() if "mistakes" in parts else ():
         count = min(mistake_regrades, (caps or {}).get(student, mistake_regrades))
-        tally = regrade(calibration, function, range(SEED_BASE, SEED_BASE + count), words)
+        tally = regrade(calibration, function, range(first_seed, first_seed + count), words)
         ok &= tally.named == tally.runs == count
         print(f"  mistake {student:<22} {tally.line()}")
     for student, function in calibration.honest.items() if "honest" in parts else ():
         done = Tally(statuses=Counter())
-        seed = SEED_BASE
+        seed = first_seed
         while done.runs < regrades:
             if budget_seconds is not None and time.perf_counter() - started > budget_seconds:
                 break
@@ -137,7 +138,7 @@ def calibrate(
         ok &= done.statuses["passed"] == done.runs
         print(f"  honest  {student:<22} {done.line()}")
     wall, used = time.perf_counter() - started, time.process_time() - cpu
-    print(f"  ({wall:.0f} s wall, {used:.0f} s CPU for {name}; seeds from {SEED_BASE})")
+    print(f"  ({wall:.0f} s wall, {used:.0f} s CPU for {name}; seeds from {first_seed})")
     return ok
 
 
@@ -155,12 +156,15 @@ def main() -> int:
     parser.add_argument(
         "--part", choices=("mistakes", "honest"), default=None, help="run only this part (default: both)"
     )
+    parser.add_argument(
+        "--first-seed", type=int, default=SEED_BASE, help="continue a run: the seed of the first regrade"
+    )
     args = parser.parse_args()
     parts = ("mistakes", "honest") if args.part is None else (args.part,)
     budget = None if args.budget_minutes is None else 60 * args.budget_minutes
     caps = {name: int(count) for name, _, count in (cap.partition("=") for cap in args.cap)}
     results = [
-        calibrate(name, args.regrades, args.mistake_regrades, budget, caps, parts)
+        calibrate(name, args.regrades, args.mistake_regrades, budget, caps, parts, args.first_seed)
         for name in args.only or CALIBRATIONS
     ]
     print("all calibrations held" if all(results) else "SOME CALIBRATION FAILED")
