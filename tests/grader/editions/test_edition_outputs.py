@@ -1,5 +1,7 @@
 """The edition travels in the report: JSON (old reports read as the first edition), text, HTML, Gradescope."""
 
+import pytest
+
 from grader.cli import summary
 from grader.config import load_config
 from grader.editions import EDITIONS, edition_label
@@ -49,3 +51,19 @@ def test_a_reports_figures_are_drawn_with_its_editions_configuration() -> None:
     assert edition_config("rl1") == RL1.default_config
     assert edition_config("classic") is None and edition_config("volume2") is None
     assert edition_config("rl9") is None, "a report from a newer gymgrade: the first edition's"
+
+
+@pytest.mark.parametrize("name", list(EDITIONS))
+def test_every_editions_report_renders_in_every_format(name: str) -> None:
+    edition = EDITIONS[name]
+    first = edition.registry.problems[0]
+    result = ProblemResult(id=first.id, title=first.title, status="missing", score=0.0, max_score=1.0,
+                           feedback="not attempted yet")  # fmt: skip
+    report = Report(submission=edition.notebook_name, sha256="0" * 64, seed=1, edition=name,
+                    gymnasium_version="1", grader_version="1", score=0.0, max_score=1.0,
+                    problems=[result])  # fmt: skip
+    label = edition_label(name)
+    assert f"Edition: {label}" in summary(report).splitlines()
+    assert f"edition {label}" in render_html(report, load_config(edition_config(name)))
+    assert f"Edition: {label}." in results(report).output
+    assert Report.model_validate_json(report.to_json()).edition == name
