@@ -1,4 +1,4 @@
-"""What a sandboxed call asks for and what it produced: `Call`, its `CallBudget`, `CallOutcome`."""
+"""What a sandboxed call asks for and what it produced: `Call` (with its `CallBudget`), `CallOutcome`."""
 
 from __future__ import annotations
 
@@ -8,6 +8,8 @@ from enum import StrEnum
 from typing import TYPE_CHECKING, Any, TypeAlias
 
 from pydantic import BaseModel, ConfigDict, Field
+
+from grader.sandbox.limits import CallBudget
 
 if TYPE_CHECKING:
     from grader.sandbox.episode_log import EpisodeLog
@@ -33,29 +35,6 @@ class OutcomeStatus(StrEnum):
     EPISODE_LIMIT = "episode_limit"
     """The call reset its envs or stepped them more often than its `CallBudget` allows."""
     SANDBOX_ERROR = "sandbox_error"
-
-
-@dataclass(frozen=True)
-class CallBudget:
-    """What one call may record: resets (played or not) and steps summed over its episodes.
-
-    The child stops recording once either is exceeded and the call ends with
-    `OutcomeStatus.EPISODE_LIMIT`; the parent also derives from it the largest result frame it parses
-    (`grader.sandbox.child.budget.frame_limits`).
-
-    Attributes:
-        max_episodes: Resets the call may make (every `reset`, whether or not a step follows).
-        max_steps: Steps the call may take, summed over all its episodes.
-    """
-
-    max_episodes: int
-    max_steps: int
-
-    def __post_init__(self) -> None:
-        for name in ("max_episodes", "max_steps"):
-            value = getattr(self, name)
-            if type(value) is not int or value < 0:
-                raise ValueError(f"CallBudget.{name} must be a non-negative int; found {value!r}")
 
 
 @dataclass(frozen=True)
