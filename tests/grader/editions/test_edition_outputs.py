@@ -2,12 +2,12 @@
 
 import pytest
 
-from grader.cli import summary
 from grader.config import load_config
 from grader.editions import EDITIONS, edition_label
 from grader.editions.choice import edition_config
-from grader.gradescope import results
-from grader.html_report import render_html
+from grader.render.gradescope import results
+from grader.render.html import render_html
+from grader.render.text import summary
 from grader.report import FIRST_EDITION, ProblemResult, Report
 
 RL1 = EDITIONS["rl1"]
