@@ -122,6 +122,12 @@ class Settings(BrokerSettings):
         default="grader.grading:grade_submission",
         description="module:function with grade_submission's signature that grades one file.",
     )
+    edition: str | None = Field(
+        default=None,
+        pattern=r"^[a-z][a-z0-9_]*$",
+        description="The edition of the lab every upload is graded as (grader/editions/: classic, gym026, volume2, rl1); "  # noqa: E501
+        "unset: detected per upload from the functions it defines (the report names the edition).",
+    )
     nice: int = Field(default=10, ge=0, le=19, description="Niceness added to grading processes.")
     lease_seconds: float = Field(
         default=60.0,

@@ -12,6 +12,7 @@ from fastapi.templating import Jinja2Templates
 
 from api.plots import problem_plots
 from grader.config import load_config
+from grader.editions.choice import edition_config
 from grader.figures import Figure, all_figures
 from grader.report import Report
 
@@ -59,7 +60,7 @@ def _figure_inputs(report: Mapping[str, Any]) -> dict[str, Any]:
 @functools.lru_cache(maxsize=32)
 def _figures(report_json: str) -> dict[str, list[Figure]]:
     report = Report.model_validate_json(report_json)
-    return all_figures(report.problems, load_config(None))
+    return all_figures(report.problems, load_config(edition_config(report.edition)))
 
 
 templates.env.globals["report_figures"] = report_figures

@@ -336,6 +336,9 @@ def _choose_edition(args: argparse.Namespace) -> None:
         return
     from grader.editions.choice import choose_edition
 
+    if args.command == "grade" and args.edition is None and args.config is None:
+        args.detect_editions = True  # per submission, once the class's files are known (run_grade)
+        return
     submission = args.file if args.command == "check" and args.file.is_file() else None
     choice = choose_edition(args.edition, args.config, submission)
     args.config = choice.config
@@ -475,7 +478,6 @@ def run_grade(args: argparse.Namespace) -> int:
     from grader.classroom.roster import read_roster
     from grader.grading import GradingPlan
 
-    plan = GradingPlan.load(args.config, args.only)
     roster = read_roster(args.roster) if args.roster is not None else None
     assignment = Assignment(title=args.assignment_title, lms_id=args.assignment_id)
     if "canvas" in args.gradebook and not assignment.lms_id:
@@ -483,14 +485,26 @@ def run_grade(args: argparse.Namespace) -> int:
             "--gradebook canvas needs --assignment-id ID (the number in the assignment's Canvas URL .../assignments/ID), so Canvas puts the scores in that assignment's column"  # noqa: E501
         )
     with tempfile.TemporaryDirectory(prefix="gymgrade-class-") as scratch:
+        # Every enabled problem, not just --only's: the graded file must not change with --only.
+        functions = GradingPlan.load(args.config, None).problems
         download = discover_all(
             args.targets,
             layout=args.layout,
-            # Every enabled problem, not just --only's: the graded file must not change with --only.
-            rule=GradedFileRule(functions=GradingPlan.load(args.config, None).problems),
-            scratch=Path(scratch),
+            rule=GradedFileRule(functions=functions),
+            scratch=Path(scratch) / "first",
             due=args.due,
         )
+        if getattr(args, "detect_editions", False):
+            asked = _detect_class_edition(args, download)
+            if asked != functions:  # the class's edition asks other functions: choose each file by them
+                download = discover_all(
+                    args.targets,
+                    layout=args.layout,
+                    rule=GradedFileRule(functions=asked),
+                    scratch=Path(scratch) / "second",
+                    due=args.due,
+                )
+        plan = GradingPlan.load(args.config, args.only)
         print(class_summary(download), file=sys.stderr, flush=True)
         graded = [submission for submission in download.submissions if submission.graded_file is not None]
         if not download.submissions and roster is None:
@@ -522,6 +536,24 @@ def run_grade(args: argparse.Namespace) -> int:
         if args.similarity and code != EXIT_INTERRUPTED:
             return _similarity_beside_grading(args, download) or code
         return code
+
+
+def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> tuple[str, ...]:
+    """Detect each submission's edition, grade the class as the edition most were written for (into
+    ``args.config``), print which and why; return the functions of its enabled problems."""
+    from grader.editions.per_submission import class_editions
+    from grader.grading import GradingPlan
+
+    files = {
+        submission.identity: submission.graded_file.path
+        for submission in download.submissions
+        if submission.graded_file is not None
+    }
+    editions = class_editions(files)
+    for line in editions.lines():
+        print(line, file=sys.stderr, flush=True)
+    args.config = editions.choice.config
+    return GradingPlan.load(args.config, None).problems
 
 
 def similarity_clash(identities: Sequence[str], out_dir: Path, page: Path | None) -> str | None:

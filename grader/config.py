@@ -109,8 +109,8 @@ def _with_defaults(problem: Problem[Any], table: object) -> object:
     return {**problem.table_defaults(), **table} if isinstance(table, dict) else table
 
 
-def _bound(problem_id: ProblemId, settings: ProblemConfig) -> ProblemConfig:
-    return settings.for_problem(problem_id)
+def _bound(problem: Problem[Any], settings: ProblemConfig) -> ProblemConfig:
+    return settings.for_problem(problem.id, problem.games)
 
 
 def _table(problem: Problem[Any]) -> tuple[Any, Any]:
@@ -118,7 +118,7 @@ def _table(problem: Problem[Any]) -> tuple[Any, Any]:
     annotation: Any = Annotated[
         problem.config,
         BeforeValidator(partial(_with_defaults, problem)),
-        AfterValidator(partial(_bound, problem.id)),
+        AfterValidator(partial(_bound, problem)),
     ]
     description = f"{problem.title}. {problem.config.__doc__ or problem.config.__name__}"
     if problem.enabled:

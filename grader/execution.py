@@ -144,7 +144,7 @@ def run_problem(
         compat_events=_distinct_events(outcomes),
         seed=seed,
         visibility=settings.visibility,
-        replay=showcase_episode(problem, records),
+        replay=showcase_episode(entry.showcase, records),
         timings=Timings(
             wall_seconds=wall_seconds,
             student_seconds=student_seconds,

@@ -9,37 +9,33 @@ seed and actions. Both are small: a plot is 480x256 pixels; a GIF keeps at most 
 from __future__ import annotations
 
 import base64
-import functools
 import io
 import math
 import os
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure as PlotFigure
 from PIL import Image
 
-from grader.checks.blackjack import BlackjackConfig
-from grader.checks.car import CarConfig
-from grader.checks.cartpole import CartpoleConfig
 from grader.config import AssignmentConfig
+from grader.errors import UnknownProblem
+from grader.problem_plots import BAR_COLOUR as BAR_COLOUR  # the class report draws with the same look
+from grader.problem_plots import EXACT_COLOUR as EXACT_COLOUR
+from grader.problem_plots import PLOT_DPI as PLOT_DPI
+from grader.problem_plots import PLOT_SIZE as PLOT_SIZE
+from grader.problem_plots import REFERENCE_COLOUR as REFERENCE_COLOUR
+from grader.problem_plots import STUDENT_COLOUR as STUDENT_COLOUR
 from grader.report import EpisodeReplay, ProblemResult
-from grader.stats import binomial_acceptance
 
 MAX_GIF_FRAMES = 60
 MAX_GIF_WIDTH = 240
 GIF_COLOURS = 64
 GIF_SECONDS = 5.0
 """Target playing time of a replay; each frame shows for 40 to 200 ms."""
-PLOT_SIZE = (6.0, 3.2)
-PLOT_DPI = 80
-REFERENCE_EPISODES = 100
-STUDENT_COLOUR, REFERENCE_COLOUR, EXACT_COLOUR, BAR_COLOUR = "#1f77b4", "#7f7f7f", "#2ca02c", "#d62728"
 
 
 @dataclass(frozen=True)
@@ -78,10 +74,13 @@ def problem_figures(result: ProblemResult, config: AssignmentConfig) -> list[Fig
         The figures, plot first; none for a result without measurements or replay.
     """
     figures: list[Figure] = []
-    plotter = PLOTTERS.get(result.id)
+    try:
+        plotter = config.registry.problem(result.id).plot
+    except UnknownProblem:
+        plotter = None  # a result of a problem this edition does not declare: its replay only
     if plotter is not None:
         started = time.perf_counter()
-        drawn = plotter(result, config)
+        drawn = plotter(result, config.problem(result.id))
         if drawn is not None:
             title, caption, plot = drawn
             figures.append(Figure(result.id, title, caption, "image/png", _png(plot), _since(started)))
@@ -99,157 +98,10 @@ def _since(started: float) -> float:
     return time.perf_counter() - started
 
 
-def _new_plot() -> tuple[PlotFigure, Any]:
-    figure = PlotFigure(figsize=PLOT_SIZE, dpi=PLOT_DPI, layout="constrained")
-    FigureCanvasAgg(figure)
-    return figure, figure.add_subplot()
-
-
 def _png(figure: PlotFigure) -> bytes:
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png")
     return buffer.getvalue()
-
-
-def _numbers(values: object) -> list[float]:
-    if not isinstance(values, list):
-        return []
-    return [
-        float(value) for value in values if isinstance(value, int | float) and not isinstance(value, bool)
-    ]
-
-
-def _keyed(values: object) -> dict[int, float]:
-    if not isinstance(values, dict):
-        return {}
-    return {int(key): float(value) for key, value in values.items() if isinstance(value, int | float)}
-
-
-def plot_blackjack(result: ProblemResult, config: AssignmentConfig) -> tuple[str, str, PlotFigure] | None:
-    """The exact win probability of every threshold n, and the student's win rates with their bands."""
-    settings = config.problem("blackjack")
-    exact, student = _keyed(result.measurements.get("exact_curve")), _keyed(result.measurements.get("curve"))
-    if not exact or not isinstance(settings, BlackjackConfig):
-        return None
-    figure, axes = _new_plot()
-    xs = sorted(exact)
-    axes.plot(xs, [exact[n] for n in xs], color=EXACT_COLOUR, label="exact win probability")
-    for index, (n, rate) in enumerate(sorted(student.items())):
-        band = binomial_acceptance(settings.games_per_call, exact.get(n, 0.0), settings.win_rate_alpha)
-        low, high = band.low / band.trials, band.high / band.trials
-        axes.plot([n, n], [low, high], color=STUDENT_COLOUR, linewidth=6, alpha=0.25,
-                  label="accepted band" if index == 0 else None)  # fmt: skip
-        axes.plot([n], [rate], "o", color=STUDENT_COLOUR, label="your win rate" if index == 0 else None)
-    axes.set(
-        xlabel="n (draw while the hand is at most n)", ylabel="win rate", xlim=(min(xs) - 0.5, max(xs) + 0.5)
-    )
-    axes.legend(loc="lower left", fontsize=8)
-    caption = (
-        "blackjack(n): the line is the exact probability of winning when drawing on hands up to n; "
-        f"each dot is what your function returned, and its shaded band the win rates {settings.games_per_call:,} games of a correct policy land in with probability 1 - {settings.win_rate_alpha:g}."  # noqa: E501
-    )
-    return "Blackjack win rate against n", caption, figure
-
-
-@functools.cache
-def reference_lengths(problem: str, episodes: int = REFERENCE_EPISODES) -> tuple[int, ...]:
-    """Episode lengths of the reference solution (seeds 0..episodes-1), computed once per process."""
-    from reference import solutions
-
-    play: Callable[..., int] = solutions.cartpole if problem == "cartpole" else solutions.car
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return tuple(play(seed=seed) for seed in range(episodes))
-
-
-def plot_lengths(result: ProblemResult, config: AssignmentConfig) -> tuple[str, str, PlotFigure] | None:
-    """Histogram of the student's episode lengths against the lab's bars and the reference solution's."""
-    lengths = _numbers(result.measurements.get("lengths"))
-    settings = config.problem("cartpole" if result.id == "cartpole" else "car")
-    if not lengths:
-        return None
-    reference = reference_lengths(result.id)
-    figure, axes = _new_plot()
-    bins = np.linspace(0, max(200, *lengths, *reference) + 1, 41)
-    axes.hist(reference, bins=bins, color=REFERENCE_COLOUR, alpha=0.5, label="reference solution")
-    axes.hist(lengths, bins=bins, color=STUDENT_COLOUR, alpha=0.7, label="your episodes")
-    mean = float(np.mean(lengths))
-    axes.axvline(mean, color=STUDENT_COLOUR, linestyle="--", label=f"your mean {mean:.1f}")
-    if isinstance(settings, CartpoleConfig):
-        axes.axvline(settings.min_steps, color=BAR_COLOUR, label=f"every episode >= {settings.min_steps}")
-        axes.axvline(settings.min_mean_steps, color=BAR_COLOUR, linestyle=":",
-                     label=f"mean >= {settings.min_mean_steps:g}")  # fmt: skip
-        game, rule = "CartPole", "the pole must stay up: longer is better"
-    elif isinstance(settings, CarConfig):
-        axes.axvline(settings.max_mean_steps, color=BAR_COLOUR, linestyle=":",
-                     label=f"mean < {settings.max_mean_steps:g}")  # fmt: skip
-        game, rule = "MountainCar", "the car must reach the flag: shorter is better"
-    else:
-        return None
-    axes.set(xlabel="steps in the episode", ylabel="episodes")
-    axes.legend(loc="upper left", fontsize=8)
-    caption = f"{game} episode lengths ({rule}): your {len(lengths)} replayed episodes, the lab's bars in red, and {len(reference)} episodes of the reference solution in grey."  # noqa: E501
-    return f"{game} episode lengths", caption, figure
-
-
-def plot_taxi(result: ProblemResult, config: AssignmentConfig) -> tuple[str, str, PlotFigure] | None:
-    """The two averages taxi() returned against the exact expectations and their tolerances."""
-    measured = result.measurements
-    pairs = [
-        ("random actions", "returned_random_mean", "exact_random_mean", "random_tolerance"),
-        ("Q-table", "returned_q_mean", "exact_q_mean", "q_tolerance"),
-    ]
-    rows: list[tuple[str, float, float, float]] = []
-    for label, *keys in pairs:
-        values = [measured.get(key) for key in keys]
-        numbers = [float(value) for value in values if isinstance(value, int | float)]
-        if len(numbers) == len(keys):
-            rows.append((label, numbers[0], numbers[1], numbers[2]))
-    if not rows:
-        return None
-    figure = PlotFigure(figsize=PLOT_SIZE, dpi=PLOT_DPI, layout="constrained")
-    FigureCanvasAgg(figure)
-    for index, (label, returned, exact, tolerance) in enumerate(rows):
-        axes = figure.add_subplot(1, len(rows), index + 1)
-        axes.axhspan(exact - tolerance, exact + tolerance, color=EXACT_COLOUR, alpha=0.2, label="accepted")
-        axes.axhline(exact, color=EXACT_COLOUR, label="exact expectation")
-        axes.plot([0], [returned], "o", color=STUDENT_COLOUR, label="your average")
-        spread = max(abs(returned - exact), tolerance) * 1.6
-        axes.set(title=label, xticks=[], ylim=(exact - spread, exact + spread), ylabel="mean total reward")
-        axes.legend(loc="lower right", fontsize=7)
-    caption = "taxi(): the average total rewards your function returned, against the exact expected return of random play and of the Q-table's greedy policy, with the band a correct answer lands in."  # noqa: E501
-    return "Taxi average returns", caption, figure
-
-
-def plot_guess_counts(result: ProblemResult, config: AssignmentConfig) -> tuple[str, str, PlotFigure] | None:
-    """The student's guesses per game against the exact distribution of the midpoint search's."""
-    from reference.oracles.guessing_game import midpoint_guess_counts
-
-    counts = [int(count) for count in _numbers(result.measurements.get("lengths"))]
-    if not counts:
-        return None
-    oracle = midpoint_guess_counts()
-    most = max(oracle.most, *counts)
-    guesses = np.arange(1, most + 1)
-    figure, axes = _new_plot()
-    axes.bar(guesses, [counts.count(int(k)) for k in guesses], color=STUDENT_COLOUR, alpha=0.7,
-             label="your games")  # fmt: skip
-    axes.plot(guesses, [len(counts) * oracle.probability(int(k)) for k in guesses], "o", color=EXACT_COLOUR,
-              label="midpoint search (exact expectation)")  # fmt: skip
-    axes.set(xlabel="guesses in the game", ylabel="games")
-    axes.legend(loc="upper left", fontsize=8)
-    caption = f"guessing_game(): how many guesses each of your {len(counts)} replayed games took (bars), against the number of games the midpoint search is expected to finish in each count (exact, {oracle.mean:.3f} guesses on average)."  # noqa: E501
-    return "GuessingGame guesses per game", caption, figure
-
-
-PLOTTERS: dict[str, Callable[[ProblemResult, AssignmentConfig], tuple[str, str, PlotFigure] | None]] = {
-    "blackjack": plot_blackjack,
-    "cartpole": plot_lengths,
-    "car": plot_lengths,
-    "taxi": plot_taxi,
-    "guessing_game": plot_guess_counts,
-}
-"""The problems with a plot, and how each is drawn (the replays are chosen in grader.showcase)."""
 
 
 def replay_gif(replay: EpisodeReplay) -> tuple[bytes, int]:

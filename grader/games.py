@@ -1,10 +1,11 @@
-"""The environments each problem may be played in: the one place that declares accepted ids and arguments.
+"""The environments problems may be played in: each game's accepted ids and rule arguments, declared once.
 
-The lab was taught in two versions. The classic one names `Blackjack-v0` and `CartPole-v0`; the gym 0.26
-one names `Blackjack-v1` (registered with `sab=True`, Sutton and Barto's rules, the only Blackjack of
-gym 0.22+) and `CartPole-v1` (500-step limit). Both are the lab's games: each problem accepts every game
-listed in `ACCEPTED_GAMES` unless the assignment configuration restricts it (`games = [...]` in the
-problem's table, `accepted_envs = [...]`); checks grade each game against its own exact expectations.
+The lab was taught in several versions. The classic one names `Blackjack-v0` and `CartPole-v0`; later ones
+name `Blackjack-v1` (registered with `sab=True`, Sutton and Barto's rules, the only Blackjack of gym 0.22+)
+and `CartPole-v1` (500-step limit). Which games a problem accepts is a field of its declaration
+(`grader.problem_registry.Problem.games`, the `*_GAMES` tuples below are the lab's); the assignment
+configuration may restrict them (`accepted_envs = [...]` in the problem's table); checks grade each game
+against its own exact expectations.
 """
 
 from __future__ import annotations
@@ -19,7 +20,6 @@ import gymnasium
 from gymnasium.envs.registration import load_env_creator
 
 from grader.compat import register_envs
-from grader.problem_registry import ProblemId
 
 if TYPE_CHECKING:
     from grader.sandbox.episode_log import EpisodeLog
@@ -96,20 +96,17 @@ TAXI = Game(
 )
 GUESSING_GAME = Game("GuessingGame-v0", ("GuessingGame-v0",), description="GuessingGame-v0")
 
-ACCEPTED_GAMES: Mapping[ProblemId, tuple[Game, ...]] = {
-    "random_blackjack": (BLACKJACK_V0, BLACKJACK_V1),
-    "blackjack": (BLACKJACK_V0, BLACKJACK_V1),
-    "cartpole": (CARTPOLE_V0, CARTPOLE_V1),
-    "car": (MOUNTAIN_CAR,),
-    "taxi": (TAXI,),
-    "guessing_game": (GUESSING_GAME,),
-}
-"""Every game each problem that plays episodes accepts by default; the first is the classic lab's."""
+BLACKJACK_GAMES = (BLACKJACK_V0, BLACKJACK_V1)
+CARTPOLE_GAMES = (CARTPOLE_V0, CARTPOLE_V1)
+MOUNTAIN_CAR_GAMES = (MOUNTAIN_CAR,)
+TAXI_GAMES = (TAXI,)
+GUESSING_GAMES = (GUESSING_GAME,)
+"""The games the lab's problems accept by default, the classic lab's first (problem declarations use them)."""
 
 
-def accepted_game_names(problem: ProblemId) -> tuple[str, ...]:
-    """The names a configuration may list in the problem's `accepted_envs`."""
-    return tuple(game.name for game in ACCEPTED_GAMES[problem])
+def game_names(accepted: Sequence[Game]) -> tuple[str, ...]:
+    """The names a configuration may list in a problem's `accepted_envs`."""
+    return tuple(game.name for game in accepted)
 
 
 @dataclass(frozen=True)
@@ -169,25 +166,29 @@ class GameRules:
         return next(iter(played.values()), self.games[0])
 
 
-def allowed_games(problem: ProblemId, names: Sequence[str] | None = None) -> GameRules:
+def allowed_games(
+    accepted: Sequence[Game], names: Sequence[str] | None = None, *, problem: str = "this problem"
+) -> GameRules:
     """The games a problem's episodes may be played in.
 
     Args:
-        problem: The problem id.
-        names: The configuration's `accepted_envs` for the problem (a subset of `accepted_game_names`),
+        accepted: The games the problem's declaration accepts, its lab's first.
+        names: The configuration's `accepted_envs` for the problem (a subset of `game_names(accepted)`),
             or None for every accepted game.
+        problem: The problem's id, for the error message.
 
     Raises:
-        ValueError: A name is not one of the problem's accepted games.
+        ValueError: The problem accepts no games, or a name is not one of its accepted games.
     """
-    accepted = ACCEPTED_GAMES[problem]
+    accepted = tuple(accepted)
+    if not accepted:
+        raise ValueError(f"{problem} declares no games: its calls play no episodes")
     if names is None:
         return GameRules(accepted[0].name, accepted)
-    unknown = [name for name in names if name not in accepted_game_names(problem)]
+    unknown = [name for name in names if name not in game_names(accepted)]
     if unknown or not names:
-        raise ValueError(
-            f"{problem} accepts the games {', '.join(accepted_game_names(problem))}; found {list(names)}"
-        )
+        accepted_names = ", ".join(game_names(accepted))
+        raise ValueError(f"{problem} accepts the games {accepted_names}; found {list(names)}")
     chosen = tuple(game for game in accepted if game.name in names)
     return GameRules(chosen[0].name, chosen)
 

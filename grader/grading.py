@@ -18,7 +18,7 @@ from grader.execution import problem_seed
 from grader.notebook import NotebookModule, build_module, is_notebook
 from grader.plugin import CaseOutcome, GraderFailure, ProblemCase, SessionPlan
 from grader.problems import ProblemId
-from grader.report import GradingTimings, ProblemResult, ProblemRun, Report, Visibility
+from grader.report import FIRST_EDITION, GradingTimings, ProblemResult, ProblemRun, Report, Visibility
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import IsolationUnavailable
 from grader.sandbox.isolation.scope import sandbox_scope
@@ -39,6 +39,8 @@ class GradingPlan:
     """SHA-256 of the effective assignment configuration (its validated JSON form); "" for a plan made by
     hand. A report records it, so a resumed batch knows which configuration graded a file."""
     visibility: dict[ProblemId, Visibility] = field(default_factory=dict)
+    edition: str = FIRST_EDITION
+    """The edition the configuration grades (its `edition`, the first when it names none)."""
 
     @classmethod
     def load(cls, config: Path | None, only: Sequence[str] | None) -> GradingPlan:
@@ -65,6 +67,7 @@ class GradingPlan:
             config=config,
             config_sha256=hashlib.sha256(assignment.model_dump_json().encode()).hexdigest(),
             visibility={problem: assignment.problem(problem).visibility for problem in problems},
+            edition=assignment.edition,
         )
 
 
@@ -256,6 +259,7 @@ def build_report(
         sha256=hashlib.sha256(data).hexdigest(),
         seed=seed,
         config_sha256=plan.config_sha256,
+        edition=plan.edition,
         gymnasium_version=version("gymnasium"),
         grader_version=grader.__version__,
         isolation=isolation,
@@ -309,6 +313,7 @@ def _rejected_report(path: Path, data: bytes, plan: GradingPlan, seed: int, verd
         sha256=hashlib.sha256(data).hexdigest(),
         seed=seed,
         config_sha256=plan.config_sha256,
+        edition=plan.edition,
         gymnasium_version=version("gymnasium"),
         grader_version=grader.__version__,
         score=0.0,

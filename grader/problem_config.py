@@ -7,8 +7,8 @@ from typing import Annotated, Self
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr
 
 from grader.errors import PlanError
-from grader.games import GameRules, accepted_game_names, allowed_games
-from grader.problem_registry import ProblemId
+from grader.games import Game, GameRules, allowed_games, game_names
+from grader.problem_id import ProblemId
 from grader.report import Visibility
 
 Probability = Annotated[float, Field(gt=0.0, lt=1.0)]
@@ -44,6 +44,7 @@ class ProblemConfig(StrictModel):
         "'visible' (at once), 'after_due_date' (once GYMGRADE_DUE_DATE has passed) or 'hidden' (instructors only).",  # noqa: E501
     )
     _problem: ProblemId | None = PrivateAttr(default=None)
+    _games: tuple[Game, ...] = PrivateAttr(default=())
 
     @property
     def problem_id(self) -> ProblemId:
@@ -59,14 +60,19 @@ class ProblemConfig(StrictModel):
             )
         return self._problem
 
-    def for_problem(self, problem_id: ProblemId) -> Self:
+    def for_problem(self, problem_id: ProblemId, games: tuple[Game, ...] = ()) -> Self:
         """These settings bound to the problem they configure (what the loader does with every table).
+
+        Args:
+            problem_id: The problem's id.
+            games: The games the problem's declaration accepts (`Problem.games`); empty when it plays none.
 
         Raises:
             ValueError: A setting does not suit the problem (the loader reports it under the table).
         """
         bound = self.model_copy()
         bound._problem = problem_id
+        bound._games = tuple(games)
         return bound
 
     def game_rules(self) -> GameRules | None:
@@ -79,7 +85,7 @@ class PlayedProblemConfig(ProblemConfig):
 
     accepted_envs: list[str] | None = Field(
         default=None,
-        description="The games the episodes may be played in, by id (grader/games.py lists each problem's: Blackjack-v0/Blackjack-v1, CartPole-v0/CartPole-v1, MountainCar-v0, Taxi-v3); "  # noqa: E501
+        description="The games the episodes may be played in, by id (the problem's declaration lists them, e.g. Blackjack-v0/Blackjack-v1, CartPole-v0/CartPole-v1, MountainCar-v0, Taxi-v3); "  # noqa: E501
         "absent = all of them.",
     )
 
@@ -91,19 +97,28 @@ class PlayedProblemConfig(ProblemConfig):
         "0 = a note in the feedback only.",
     )
 
-    def for_problem(self, problem_id: ProblemId) -> Self:
-        """These settings bound to their problem, once `accepted_envs` names only games it accepts."""
-        accepted = accepted_game_names(problem_id)
+    def for_problem(self, problem_id: ProblemId, games: tuple[Game, ...] = ()) -> Self:
+        """These settings bound to their problem, once `accepted_envs` names only games it accepts.
+
+        Raises:
+            ValueError: The problem's declaration names no games, or `accepted_envs` names another game.
+        """
+        if not games:
+            raise ValueError(
+                f"{problem_id} plays episodes, so its declaration must list the games it accepts (Problem(games=...)); "  # noqa: E501
+                "found none"
+            )
+        accepted = game_names(games)
         chosen = self.accepted_envs
         if chosen is not None and (not chosen or not set(chosen) <= set(accepted)):
             raise ValueError(
                 f"accepted_envs must be a non-empty list of {', '.join(accepted)}; found {chosen}"
             )
-        return super().for_problem(problem_id)
+        return super().for_problem(problem_id, games)
 
     def game_rules(self) -> GameRules:
         """The games the problem's episodes must be played in (`accepted_envs`, else all it accepts)."""
-        return allowed_games(self.problem_id, self.accepted_envs)
+        return allowed_games(self._games, self.accepted_envs, problem=self.problem_id)
 
 
 class CountedStepsConfig(PlayedProblemConfig):

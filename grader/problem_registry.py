@@ -1,33 +1,40 @@
 """What a problem of an assignment is (`Problem`) and the ordered `Registry` all problem lists derive from.
 
-The lab's own registry is `grader.problems.PROBLEMS`; this module only defines the shapes, so the settings
-and checks it refers to can be imported below it without a cycle.
+A problem's declaration holds everything about it: its settings model, its check, the games it may be
+played in, how the report chooses the episode it replays and how it plots its measurements. The lab's own
+registry is `grader.problems.PROBLEMS`; the edition packs (`grader.editions`) build theirs from these
+declarations. This module sits above the checks, the settings models, the games, the showcase rules and
+the plots it refers to, and below the configuration loader (`grader.config`), which it never imports: a
+problem reads its settings from anything with a `problem(id)` method (`SettingsSource`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Generic, TypeAlias, TypeVar
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar
 
 from grader.errors import PlanError, UnknownProblem
+from grader.problem_id import ProblemId, acceptance_module_name
 
 if TYPE_CHECKING:
     from grader.checks.base import ProblemCheck
-    from grader.config import AssignmentConfig
+    from grader.games import Game
     from grader.problem_config import ProblemConfig
+    from grader.problem_plots import Plotter
+    from grader.showcase import ShowcaseRule
 
-ProblemId: TypeAlias = str
-"""A registered problem's id: a Python identifier that names the student's function, the `[problems.<id>]`
-table and the acceptance module `grader/acceptance/test_<id>.py`. Checked where it enters
-(`Registry.problem`, `Registry.select`, the configuration loader)."""
+__all__ = ["Problem", "ProblemId", "Registry", "SettingsSource", "acceptance_module_name"]
 
 ConfigT = TypeVar("ConfigT", bound="ProblemConfig")
 
 
-def acceptance_module_name(problem_id: ProblemId) -> str:
-    """The name of a problem's acceptance module in `grader/acceptance/` (one test per submission)."""
-    return f"test_{problem_id}"
+class SettingsSource(Protocol):
+    """What holds an assignment's settings by problem id (`grader.config.AssignmentConfig` does)."""
+
+    def problem(self, problem_id: ProblemId) -> ProblemConfig:
+        """The settings of one problem."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -42,6 +49,10 @@ class Problem(Generic[ConfigT]):
         check: Plans its calls and judges their outcomes, typed by `config`.
         enabled: Whether it is graded unless the configuration says otherwise. A problem disabled by default
             is optional: a configuration may omit its table (every field of `config` then needs a default).
+        games: The games its episodes may be played in, the edition's own first (a configuration's
+            `accepted_envs` chooses among them); empty for a problem whose calls play none.
+        showcase: How the report chooses the episode it replays as an animation; None: no replay.
+        plot: How the report plots its measurements; None: no plot.
     """
 
     id: ProblemId
@@ -50,6 +61,9 @@ class Problem(Generic[ConfigT]):
     config: type[ConfigT]
     check: ProblemCheck[ConfigT]
     enabled: bool = True
+    games: tuple[Game, ...] = field(default=(), hash=False)
+    showcase: ShowcaseRule | None = None
+    plot: Plotter | None = None
 
     @property
     def acceptance_module(self) -> str:
@@ -60,7 +74,7 @@ class Problem(Generic[ConfigT]):
         """The fields its configuration table takes from this declaration when the table leaves them out."""
         return {"title": self.title, "points": self.points, "enabled": self.enabled}
 
-    def settings(self, assignment: AssignmentConfig) -> ConfigT:
+    def settings(self, assignment: SettingsSource) -> ConfigT:
         """This problem's settings in an assignment, typed: the one place a configuration is narrowed.
 
         Raises:

@@ -2,7 +2,8 @@
 
 Everything that lists problems derives from `PROBLEMS`: the assignment configuration's tables
 (`grader.config`), `--only`, the acceptance modules (`grader/acceptance/test_<id>.py`), the report's titles
-and points. Adding a problem is one entry here, its module in `grader/checks/` (settings model + check), its
+and points, the games each problem accepts, the episode its report replays and its plot. Adding a problem
+is one entry here (or in an edition pack), its module in `grader/checks/` (settings model + check), its
 acceptance module and its `[problems.<id>]` table (ARCHITECTURE.md, "Adding an edition or a lab").
 This registry is the first edition's (`grader.editions.classic`); later editions reuse its declarations.
 """
@@ -14,7 +15,10 @@ from grader.checks.find_qvalues import FindQvaluesCheck, FindQvaluesConfig
 from grader.checks.guessing_game import GuessingGameCheck, GuessingGameConfig
 from grader.checks.random_blackjack import RandomBlackjackCheck, RandomBlackjackConfig
 from grader.checks.taxi import TaxiCheck, TaxiConfig
+from grader.games import BLACKJACK_GAMES, CARTPOLE_GAMES, GUESSING_GAMES, MOUNTAIN_CAR_GAMES, TAXI_GAMES
+from grader.problem_plots import plot_blackjack, plot_guess_counts, plot_lengths, plot_taxi
 from grader.problem_registry import Problem, ProblemId, Registry
+from grader.showcase import LAST_TAXI_OF_FIRST_CALL, LONGEST_MOUNTAIN_CAR, SHORTEST_CARTPOLE
 
 __all__ = ["PROBLEMS", "PROBLEM_IDS", "ProblemId", "problem"]
 
@@ -26,6 +30,7 @@ PROBLEMS = Registry(
             points=1.0,
             config=RandomBlackjackConfig,
             check=RandomBlackjackCheck(),
+            games=BLACKJACK_GAMES,
         ),
         Problem(
             id="blackjack",
@@ -33,6 +38,8 @@ PROBLEMS = Registry(
             points=1.0,
             config=BlackjackConfig,
             check=BlackjackCheck(),
+            games=BLACKJACK_GAMES,
+            plot=plot_blackjack,
         ),
         Problem(
             id="cartpole",
@@ -40,6 +47,9 @@ PROBLEMS = Registry(
             points=1.0,
             config=CartpoleConfig,
             check=CartpoleCheck(),
+            games=CARTPOLE_GAMES,
+            showcase=SHORTEST_CARTPOLE,
+            plot=plot_lengths,
         ),
         Problem(
             id="car",
@@ -47,6 +57,9 @@ PROBLEMS = Registry(
             points=1.0,
             config=CarConfig,
             check=CarCheck(),
+            games=MOUNTAIN_CAR_GAMES,
+            showcase=LONGEST_MOUNTAIN_CAR,
+            plot=plot_lengths,
         ),
         Problem(
             id="taxi",
@@ -54,6 +67,9 @@ PROBLEMS = Registry(
             points=1.0,
             config=TaxiConfig,
             check=TaxiCheck(),
+            games=TAXI_GAMES,
+            showcase=LAST_TAXI_OF_FIRST_CALL,
+            plot=plot_taxi,
         ),
         Problem(
             id="find_qvalues",
@@ -68,6 +84,8 @@ PROBLEMS = Registry(
             points=1.0,
             config=GuessingGameConfig,
             check=GuessingGameCheck(),
+            games=GUESSING_GAMES,
+            plot=plot_guess_counts,
             enabled=False,
         ),
     )

@@ -19,6 +19,8 @@ Visibility = Literal["visible", "after_due_date", "hidden"]
 only the instructor. The report always holds everything; the service's student views honour it."""
 
 REPORT_FORMAT = 1
+FIRST_EDITION = "classic"
+"""The edition a report that names none was graded in: every report written before editions existed."""
 OUTPUT_CAP_CHARS = 8_000
 """Student output kept per problem in the report; the rest is replaced by a note saying how much was cut."""
 
@@ -207,6 +209,11 @@ class Report(BaseModel):
     seed: int = Field(description="The grading seed; the same bytes and seed give the same verdicts.")
     config_sha256: str = Field(
         default="", description="SHA-256 of the assignment configuration that graded the file (its JSON)."
+    )
+    edition: str = Field(
+        default=FIRST_EDITION,
+        description="The edition of the lab graded (grader/editions/). "
+        "Absent in reports older than editions, all graded in the first, 'classic'.",
     )
     gymnasium_version: str = Field(description="Gymnasium version the episodes were replayed with.")
     grader_version: str = Field(description="gymgrade version.")

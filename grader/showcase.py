@@ -1,8 +1,9 @@
 """Which of a student's episodes the report replays as an animation: the one they would most like to see.
 
-CartPole: the shortest episode (where the pole fell first); MountainCar: the longest (where the car took
-longest to reach the flag, or never did); Taxi: the last episode of the first call that returned (with the
-lab's order, an episode of the Q-table policy). Only episodes the trusted replay reproduced exactly, of the
+Each problem with a replay names its rule in its declaration (`Problem.showcase`). CartPole: the shortest
+episode (where the pole fell first); MountainCar: the longest (where the car took longest to reach the
+flag, or never did); Taxi: the last episode of the first call that returned (with the lab's order, an
+episode of the Q-table policy). Only episodes the trusted replay reproduced exactly, of the
 problem's own games made without extra arguments, are kept: the animation is re-rendered from the reset
 seed and the actions, so it shows what the grader judged.
 """
@@ -25,10 +26,21 @@ IGNORED_KWARGS = frozenset({"render_mode"})
 
 
 @dataclass(frozen=True)
-class _Rule:
+class ShowcaseRule:
+    """How a problem chooses the episode its report replays.
+
+    Attributes:
+        env_ids: The gymnasium ids an episode may have been played in.
+        choose: Picks one of the clean episodes (each with its trusted replay).
+        label: How the report names the chosen episode, given how many were clean.
+        first_call_only: Only the first call that returned counts (its episodes are the ones the lab
+            meant, e.g. Taxi's Q-table episodes last).
+    """
+
     env_ids: frozenset[str]
     choose: Callable[[list[tuple[EpisodeLog, Replay]]], tuple[EpisodeLog, Replay]]
     label: Callable[[int], str]
+    first_call_only: bool = False
 
 
 def _shortest(episodes: list[tuple[EpisodeLog, Replay]]) -> tuple[EpisodeLog, Replay]:
@@ -43,42 +55,40 @@ def _last(episodes: list[tuple[EpisodeLog, Replay]]) -> tuple[EpisodeLog, Replay
     return episodes[-1]
 
 
-RULES: dict[str, _Rule] = {
-    "cartpole": _Rule(
-        frozenset({"CartPole-v0", "CartPole-v1"}),
-        _shortest,
-        lambda count: f"your shortest of {count} CartPole episodes",
+SHORTEST_CARTPOLE = ShowcaseRule(
+    frozenset({"CartPole-v0", "CartPole-v1"}),
+    _shortest,
+    lambda count: f"your shortest of {count} CartPole episodes",
+)
+LONGEST_MOUNTAIN_CAR = ShowcaseRule(
+    frozenset({"MountainCar-v0"}),
+    _longest,
+    lambda count: f"your longest of {count} MountainCar episodes",
+)
+LAST_TAXI_OF_FIRST_CALL = ShowcaseRule(
+    frozenset({"Taxi-v3", "Taxi-v4"}),
+    _last,
+    lambda count: (
+        f"the last of the {count} Taxi episodes of your first call (the lab plays the Q-table's episodes last)"  # noqa: E501
     ),
-    "car": _Rule(
-        frozenset({"MountainCar-v0"}),
-        _longest,
-        lambda count: f"your longest of {count} MountainCar episodes",
-    ),
-    "taxi": _Rule(
-        frozenset({"Taxi-v3", "Taxi-v4"}),
-        _last,
-        lambda count: (
-            f"the last of the {count} Taxi episodes of your first call (the lab plays the Q-table's episodes last)"  # noqa: E501
-        ),
-    ),
-}
-"""The problems whose report shows a replay, and how each chooses its episode."""
+    first_call_only=True,
+)
+"""The lab's replay rules (the problem declarations name them)."""
 
 
-def showcase_episode(problem: str, records: Sequence[CallRecord]) -> EpisodeReplay | None:
-    """The episode of ``problem`` the report animates, or None (no such problem, no clean episode).
+def showcase_episode(rule: ShowcaseRule | None, records: Sequence[CallRecord]) -> EpisodeReplay | None:
+    """The episode the report animates under a problem's rule, or None (no rule, no clean episode).
 
     Args:
-        problem: The problem id.
+        rule: The problem's rule (`Problem.showcase`); None for a problem without a replay.
         records: The problem's calls with their trusted replays.
 
     Returns:
         The chosen episode, with its actions up to the replayed end.
     """
-    rule = RULES.get(problem)
     if rule is None:
         return None
-    if problem == "taxi":
+    if rule.first_call_only:
         records = [record for record in records if record.outcome.status == OutcomeStatus.OK][:1]
     episodes = [
         (log, replay)
@@ -99,7 +109,7 @@ def showcase_episode(problem: str, records: Sequence[CallRecord]) -> EpisodeRepl
     )
 
 
-def _clean(rule: _Rule, log: EpisodeLog, replay: Replay) -> bool:
+def _clean(rule: ShowcaseRule, log: EpisodeLog, replay: Replay) -> bool:
     return (
         log.env_id in rule.env_ids
         and not (set(log.env_kwargs) - IGNORED_KWARGS)

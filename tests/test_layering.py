@@ -36,6 +36,8 @@ GRADER_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "problems",
             "problem_registry",
             "problem_config",
+            "problem_id",
+            "problem_plots",
             "config",
             "games",
             "showcase",

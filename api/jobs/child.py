@@ -65,12 +65,16 @@ def main() -> int:
         allow_weak_isolation=request["allow_weak_isolation"],
     )
     try:
+        path = Path(request["path"])
+        config = Path(request["config"]) if request.get("config") else None
+        if config is None:
+            config = _edition_config(path, request.get("edition"))
         report = grader(
-            Path(request["path"]),
+            path,
             seed=int(request["seed"]),
             on_progress=lambda problem: _send(channel, {"kind": "progress", "problem": problem}),
             only=request.get("only"),
-            config=Path(request["config"]) if request.get("config") else None,
+            config=config,
         )
     except ServiceError as error:
         _send(channel, {"kind": "error", "message": str(error)})
@@ -80,6 +84,17 @@ def main() -> int:
         return 1
     _send(channel, {"kind": "report", "report": report})
     return 0
+
+
+def _edition_config(submission: Path, edition: str | None) -> Path | None:
+    """The configuration of the edition an upload is graded as: the service's `GYMGRADE_EDITION`, else the
+    one detected from the upload (read statically, never run); None: the bundled (first edition's) one.
+    Which edition and why goes to the job's stderr log."""
+    from grader.editions.choice import choose_edition  # the grader is heavy: import it only here
+
+    choice = choose_edition(edition, None, submission)
+    print(choice.line, file=sys.stderr, flush=True)
+    return choice.config
 
 
 if __name__ == "__main__":

@@ -88,6 +88,7 @@ def _send_request(
         "seed": job.seed,
         "only": list(job.only) if job.only is not None else None,
         "config": str(config) if config is not None else None,
+        "edition": settings.edition,
         "workers": settings.grading_workers,
         "allow_weak_isolation": settings.allow_weak_isolation,
         "nice": settings.nice,

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, ParamSpec, Protocol, TypeVar
 
 from grader.problem_config import ProblemConfig
-from grader.problem_registry import ProblemId
+from grader.problem_id import ProblemId
 from grader.report import Status
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, PlainValue
 

@@ -12,9 +12,17 @@ from grader.editions.gym026 import GYM026
 from grader.editions.pack import Edition, ExpectedFunction
 from grader.editions.rl1 import RL1
 from grader.editions.volume2 import VOLUME2
-from grader.problem_registry import ProblemId
+from grader.problem_id import ProblemId
 
-__all__ = ["DEFAULT_EDITION", "EDITIONS", "Edition", "ExpectedFunction", "all_problem_ids", "edition_of"]
+__all__ = [
+    "DEFAULT_EDITION",
+    "EDITIONS",
+    "Edition",
+    "ExpectedFunction",
+    "all_problem_ids",
+    "edition_label",
+    "edition_of",
+]
 
 EDITIONS: dict[str, Edition] = {edition.name: edition for edition in (CLASSIC, GYM026, VOLUME2, RL1)}
 """Every edition pack, oldest first."""
@@ -39,3 +47,12 @@ def all_problem_ids() -> tuple[ProblemId, ...]:
     """Every problem id some edition grades, each once, oldest edition's first (what `--only` accepts)."""
     ids = (problem for edition in EDITIONS.values() for problem in edition.registry.ids)
     return tuple(dict.fromkeys(ids))
+
+
+def edition_label(name: str) -> str:
+    """How a report names its edition to a person: `rl1 (Reinforcement Learning 1: Gymnasium)`.
+
+    A name no pack has (a report from a newer gymgrade) is shown as it is.
+    """
+    found = EDITIONS.get(name)
+    return name if found is None else f"{found.name} ({found.title})"

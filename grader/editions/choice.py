@@ -70,7 +70,7 @@ def choose_edition(flag: str | None, config: Path | None, submission: Path | Non
     if flag is not None:
         chosen = edition_of(flag, where="--edition")
         if config is None:
-            return EditionChoice(chosen, _default_config(chosen), "chosen with --edition")
+            return EditionChoice(chosen, default_config(chosen), "chosen with --edition")
         named = edition_of(configured_edition(config))
         if named.registry is not chosen.registry:
             graded, configured = ", ".join(chosen.registry.ids), ", ".join(named.registry.ids)
@@ -89,10 +89,18 @@ def choose_edition(flag: str | None, config: Path | None, submission: Path | Non
     detected = detect_edition(submission)
     return EditionChoice(
         detected.edition,
-        _default_config(detected.edition),
+        default_config(detected.edition),
         f"detected from {submission.name}: {detected.reason}",
     )
 
 
-def _default_config(edition: Edition) -> Path | None:
+def default_config(edition: Edition) -> Path | None:
+    """The configuration an edition is graded with when none is given (None: the bundled one)."""
     return None if edition.default_config == BUNDLED_CONFIG else edition.default_config
+
+
+def edition_config(name: str) -> Path | None:
+    """The default configuration of the edition a report names (None: the bundled one), to draw its
+    figures with; a name no pack has (a report from a newer gymgrade) gets the first edition's."""
+    found = EDITIONS.get(name)
+    return None if found is None else default_config(found)

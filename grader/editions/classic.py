@@ -2,6 +2,7 @@
 
 from grader.editions.pack import BUNDLED_CONFIG, REPOSITORY, Edition, ExpectedFunction
 from grader.problems import PROBLEMS
+from grader.report import FIRST_EDITION
 
 FUNCTIONS = (
     ExpectedFunction("random_blackjack", ("n",), env_ids=("Blackjack-v0",)),
@@ -15,7 +16,7 @@ FUNCTIONS = (
 )
 
 CLASSIC = Edition(
-    name="classic",
+    name=FIRST_EDITION,
     number=1,
     title="OpenGym AI (classic gym)",
     api="classic",

@@ -10,8 +10,10 @@ from grader.checks.epsilon_decay import EpsilonDecayCheck, EpsilonDecayConfig
 from grader.checks.sarsa import SarsaCheck, SarsaConfig
 from grader.checks.taxi_tables import TaxiTablesCheck, TaxiTablesConfig
 from grader.editions.pack import PACKAGE, REPOSITORY, Edition, ExpectedFunction
+from grader.games import TAXI_GAMES
 from grader.problem_registry import Problem, Registry
 from grader.problems import PROBLEMS
+from grader.showcase import LAST_TAXI_OF_FIRST_CALL
 
 _LEARNER = ("env", "alpha=0.1", "gamma=0.6", "epsilon=0.1", "N=70_000", "decay=False")
 
@@ -51,6 +53,8 @@ RL1 = Edition(
                 points=1.0,
                 config=TaxiTablesConfig,
                 check=TaxiTablesCheck(),
+                games=TAXI_GAMES,
+                showcase=LAST_TAXI_OF_FIRST_CALL,
             ),
             Problem(
                 id="sarsa0",

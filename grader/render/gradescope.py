@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from grader.gradescope_upload import UploadSeed
-from grader.render.text import isolation_lines, notebook_lines
+from grader.render.text import edition_name, isolation_lines, notebook_lines
 from grader.report import SHOWN_AT_ONCE, Report, errors_shown, withheld_ids
 
 if TYPE_CHECKING:
@@ -110,7 +110,10 @@ def results(
             tests.append(
                 _instructor_note(f"{problem.title}: what the code printed", f"{index}.1", problem.output)
             )
-    lines = [f"gymgrade {report.grader_version}, gymnasium {report.gymnasium_version}."]
+    lines = [
+        f"gymgrade {report.grader_version}, gymnasium {report.gymnasium_version}.",
+        f"Edition: {edition_name(report.edition)}.",
+    ]
     if report.notebook is not None:
         lines += notebook_lines(report.notebook)
     if report.submission_error is not None:

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 from grader.render.csp import content_security_policy
 from grader.render.page import page_environment
-from grader.render.text import isolation_lines
+from grader.render.text import edition_name, isolation_lines
 from grader.report import Report
 
 if TYPE_CHECKING:
@@ -53,5 +53,10 @@ def render_html(
     drawn = figures if figures is not None else all_figures(report.problems, config)
     isolation = " ".join(isolation_lines(report.isolation))
     return _environment.get_template("report.html").render(
-        report=report, figures=drawn, csp=CSP, style=STYLE, isolation=isolation
+        report=report,
+        figures=drawn,
+        csp=CSP,
+        style=STYLE,
+        isolation=isolation,
+        edition=edition_name(report.edition),
     )

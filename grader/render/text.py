@@ -33,12 +33,20 @@ def summary(report: Report) -> str:
     lines.append(
         f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
     )
+    lines.append(f"Edition: {edition_name(report.edition)}")
     lines.append(
         f"Practice seed {report.seed}: your instructor grades on different, unseen starts (a held-out seed), so code that only does well from these starts will fail there."  # noqa: E501
     )
     lines += isolation_lines(report.isolation)
     lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
     return "\n".join(lines)
+
+
+def edition_name(name: str) -> str:
+    """How a report names its edition to a person: `rl1 (Reinforcement Learning 1: Gymnasium)`."""
+    from grader.editions import edition_label  # the packs import the checks: only when a report is shown
+
+    return edition_label(name)
 
 
 def notebook_lines(notebook: NotebookSummary) -> list[str]:

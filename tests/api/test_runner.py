@@ -154,3 +154,41 @@ def test_a_submission_named_like_a_module_cannot_shadow_the_grading_process(
         row = _grade(sessions, settings, hostile, filename=name)
         assert row.status == "done", (name, row.error)
         assert row.report is not None and row.report["submission"] == name
+
+
+RL1_EPSILON_ONLY = b'''"""An rl1 (Reinforcement Learning 1) submission with only epsilon_decay written."""
+
+
+def epsilon_decay(episode, N, epsilon_start=1.0, epsilon_end=1e-6):
+    delta = (epsilon_start - epsilon_end) / N
+    return epsilon_start - (episode - 1) * delta
+
+
+def taxi(q_table, q_table_decay):
+    raise NotImplementedError
+'''
+
+
+@pytest.mark.parametrize(
+    ("edition", "graded", "expected"),
+    [
+        (None, "rl1", {"epsilon_decay": "passed", "taxi": "missing", "cartpole": "missing"}),
+        ("classic", "classic", {"taxi": "missing", "cartpole": "missing"}),
+    ],
+    ids=["detected-per-upload", "named-by-the-service"],
+)
+def test_the_real_grader_grades_the_uploads_edition(
+    sessions: sessionmaker[Session],
+    make_settings: SettingsFactory,
+    edition: str | None,
+    graded: str,
+    expected: dict[str, str],
+) -> None:
+    real = {"grader": "grader.grading:grade_submission", "allow_weak_isolation": True, "grading_workers": 1}
+    settings = make_settings(**real, edition=edition)
+    row = _grade(sessions, settings, RL1_EPSILON_ONLY, filename="gymnasium.py")
+    assert row.status == "done", row.error
+    assert row.report is not None and row.report["edition"] == graded
+    statuses = {problem["id"]: problem["status"] for problem in row.report["problems"]}
+    assert {problem: statuses.get(problem) for problem in expected} == expected
+    assert ("epsilon_decay" in statuses) == (graded == "rl1")

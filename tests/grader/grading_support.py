@@ -20,9 +20,10 @@ FAST_OVERRIDES: dict[str, dict[str, Any]] = {
 }
 
 
-def write_config(path: Path, overrides: dict[str, dict[str, Any]]) -> Path:
-    """Write the bundled assignment configuration with some problem fields replaced; return the path."""
-    config = tomllib.loads(DEFAULT_CONFIG.read_text(encoding="utf-8"))
+def write_config(path: Path, overrides: dict[str, dict[str, Any]], base: Path = DEFAULT_CONFIG) -> Path:
+    """Write an assignment configuration (the bundled one unless `base` names an edition's) with some problem
+    fields replaced; return the path."""
+    config = tomllib.loads(base.read_text(encoding="utf-8"))
     for problem, fields in overrides.items():
         config["problems"][problem].update(fields)
     path.write_text(_toml(config), encoding="utf-8")
@@ -30,7 +31,7 @@ def write_config(path: Path, overrides: dict[str, dict[str, Any]]) -> Path:
 
 
 def _toml(config: dict[str, Any]) -> str:
-    lines: list[str] = []
+    lines: list[str] = [f"edition = {_value(config['edition'])}"] if "edition" in config else []
     for problem, fields in config["problems"].items():
         lines.append(f"[problems.{problem}]")
         lines += [f"{name} = {_value(value)}" for name, value in fields.items()]

@@ -1,10 +1,11 @@
-"""The games each problem accepts (grader/games.py): ids, rule arguments, restriction by the configuration."""
+"""The games each problem accepts (its declaration's `games`): ids, rule arguments, restriction."""
 
 from __future__ import annotations
 
 import pytest
 
-from grader.games import BLACKJACK_V1, CARTPOLE_V0, accepted_game_names, allowed_games
+from grader.games import BLACKJACK_V1, CARTPOLE_V0, allowed_games, game_names
+from grader.problems import problem as declared
 from grader.sandbox.episode_log import EpisodeLog
 
 
@@ -80,21 +81,30 @@ CASES = [
 def test_accepted_games(
     problem: str, restrict: list[str] | None, log: EpisodeLog, expected: str | None
 ) -> None:
-    assert allowed_games(problem, restrict).problem_with(log) == expected  # type: ignore[arg-type]
+    assert allowed_games(declared(problem).games, restrict, problem=problem).problem_with(log) == expected  # type: ignore[arg-type]
 
 
 def test_the_game_played_is_identified_and_mixing_games_is_named() -> None:
-    rules = allowed_games("blackjack")
+    rules = allowed_games(declared("blackjack").games)
     assert rules.played_game([_log("Blackjack-v1", "Blackjack-v1")]) is BLACKJACK_V1
     assert rules.played_game([]).name == "Blackjack-v0"
     mixed = rules.played_game(
         [_log("Blackjack-v1", "Blackjack-v1"), _log("Blackjack-v1", "Blackjack-v0", sab=False)]
     )
     assert isinstance(mixed, str) and mixed.startswith("your episodes were played in Blackjack-v1 (Sutton")
-    assert allowed_games("cartpole").played_game([_log("CartPole-v0", "CartPole-v0")]) is CARTPOLE_V0
+    assert (
+        allowed_games(declared("cartpole").games).played_game([_log("CartPole-v0", "CartPole-v0")])
+        is CARTPOLE_V0
+    )
 
 
 def test_a_restriction_names_only_accepted_games() -> None:
-    assert accepted_game_names("cartpole") == ("CartPole-v0", "CartPole-v1")
+    assert game_names(declared("cartpole").games) == ("CartPole-v0", "CartPole-v1")
     with pytest.raises(ValueError, match="cartpole accepts the games CartPole-v0, CartPole-v1; found"):
-        allowed_games("cartpole", ["CartPole-v2"])
+        allowed_games(declared("cartpole").games, ["CartPole-v2"], problem="cartpole")
+
+
+def test_a_problem_that_declares_no_games_has_no_rules() -> None:
+    assert declared("find_qvalues").games == ()
+    with pytest.raises(ValueError, match="find_qvalues declares no games"):
+        allowed_games(declared("find_qvalues").games, problem="find_qvalues")

@@ -22,6 +22,7 @@ from gradescope_support import SECRET, metadata
 from grading_support import ROOT, SUBMISSIONS, write_config
 
 from grader.cli import main
+from grader.editions import EDITIONS
 from grader.errors import GradescopeError
 from grader.gradescope import SECRET_FILE, bundle, bundle_secret, pick_submission
 from grader.gradescope_upload import METADATA_FILE, UploadSeed, read_metadata
@@ -333,3 +334,18 @@ def test_two_uploads_get_different_starts_and_a_recorded_one_regrades_identicall
     # Where the seed repeats (one seed per bundle, as before), the same tapes get full marks.
     assert main([*arguments, "--submission", str(attack), "--out", str(tmp_path / "same-seed.json")]) == 0
     assert _cartpole(json.loads((tmp_path / "same-seed.json").read_text()))["status"] == "passed"
+
+
+@pytest.mark.slow
+def test_a_current_edition_upload_is_graded_by_its_editions_bundle(tmp_path: Path) -> None:
+    rl1 = EDITIONS["rl1"]
+    overrides: dict[str, dict[str, Any]] = {problem: {"enabled": False} for problem in rl1.registry.ids}
+    overrides["epsilon_decay"] = {"enabled": True}
+    config = write_config(tmp_path / "assignment.toml", overrides, base=rl1.default_config)
+    archive = bundle(tmp_path / "autograder.zip", config=config, secret=SECRET)
+    meta = metadata(2001, "2026-11-25T11:00:00.000000-08:00", 7)
+    data = _upload(archive, tmp_path / "root", rl1.reference, meta)
+    graded = [test for test in data["tests"] if test["name"] == "Problem 5: epsilon_decay"]
+    assert [(test["status"], test["score"]) for test in graded] == [("passed", 1.0)], data["tests"]
+    assert data["score"] == 1.0
+    assert "Edition: rl1 (Reinforcement Learning 1: Gymnasium)." in data["output"]

@@ -7,6 +7,7 @@ from typing import Any
 import pytest
 
 from grader.checks.base import CallRecord
+from grader.problems import problem
 from grader.sandbox import Call, CallOutcome, EpisodeLog, OutcomeStatus
 from grader.sandbox.replay import Replay
 from grader.showcase import showcase_episode
@@ -43,7 +44,7 @@ def _records(
 
 def test_cartpole_shows_the_shortest_episode() -> None:
     chosen = showcase_episode(
-        "cartpole", _records(_episode(150, seed=1), _episode(90, seed=2), _episode(200))
+        problem("cartpole").showcase, _records(_episode(150, seed=1), _episode(90, seed=2), _episode(200))
     )
     assert chosen is not None
     assert (chosen.reset_seed, chosen.length, chosen.label) == (2, 90, "your shortest of 3 CartPole episodes")
@@ -54,7 +55,7 @@ def test_mountain_car_shows_the_longest_episode() -> None:
         _episode(120, env_id="MountainCar-v0", seed=1),
         _episode(140, env_id="MountainCar-v0", seed=2),
     ]
-    chosen = showcase_episode("car", _records(*episodes))
+    chosen = showcase_episode(problem("car").showcase, _records(*episodes))
     assert chosen is not None and (chosen.reset_seed, chosen.length) == (2, 140)
 
 
@@ -65,8 +66,10 @@ def test_mountain_car_shows_the_longest_episode() -> None:
     ids=["replay-disagrees", "student-kwargs", "reset-options", "another-game"],
 )  # fmt: skip
 def test_only_episodes_the_grader_can_vouch_for_are_shown(changes: dict[str, Any]) -> None:
-    assert showcase_episode("cartpole", _records(_episode(10, **changes))) is None
+    assert showcase_episode(problem("cartpole").showcase, _records(_episode(10, **changes))) is None
 
 
 def test_problems_without_a_game_to_show_have_no_replay() -> None:
-    assert showcase_episode("blackjack", _records(_episode(3, env_id="Blackjack-v1"))) is None
+    assert (
+        showcase_episode(problem("blackjack").showcase, _records(_episode(3, env_id="Blackjack-v1"))) is None
+    )

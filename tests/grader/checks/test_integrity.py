@@ -15,6 +15,8 @@ from grader.testing.behaviours import cartpole, velocity_policy
 
 from .support import grade, simulate, small_config
 
+CARTPOLE_RULES = allowed_games(PROBLEMS.problem("cartpole").games)
+
 
 def _tampered(records: list[CallRecord], **changes: object) -> list[CallRecord]:
     first = records[0]
@@ -27,7 +29,7 @@ def _tampered(records: list[CallRecord], **changes: object) -> list[CallRecord]:
 def test_a_forged_reward_does_not_replay(seed: int) -> None:
     records = simulate("cartpole", {"cartpole": cartpole}, seed)
     forged = _tampered(records, rewards=[2.0] * len(records[0].outcome.episodes[0].rewards))
-    problem = integrity_problem(forged, played_episodes(forged), allowed_games("cartpole"))
+    problem = integrity_problem(forged, played_episodes(forged), CARTPOLE_RULES)
     assert problem is not None and problem.startswith(
         "episode 1 of call 1 did not replay: step 1 of the episode"
     )
@@ -36,7 +38,7 @@ def test_a_forged_reward_does_not_replay(seed: int) -> None:
 def test_a_chosen_reset_seed_is_caught(seed: int) -> None:
     records = simulate("cartpole", {"cartpole": cartpole}, seed)
     forged = _tampered(records, reset_seed=12345)
-    problem = integrity_problem(forged, played_episodes(forged), allowed_games("cartpole"))
+    problem = integrity_problem(forged, played_episodes(forged), CARTPOLE_RULES)
     assert problem is not None and "the episode log was altered" in problem
 
 
@@ -212,13 +214,13 @@ def test_an_episode_of_another_game_is_not_replayed(seed: int) -> None:
     acrobot = dataclasses.replace(
         outcome.episodes[0], env_id="Acrobot-v1", requested_id="Acrobot-v1", actions=[0] * 100_000
     )
-    record = replay_call(dataclasses.replace(outcome, episodes=[acrobot]), allowed_games("cartpole"))
+    record = replay_call(dataclasses.replace(outcome, episodes=[acrobot]), CARTPOLE_RULES)
     assert record.replays[0].mismatch is not None
     assert record.replays[0].mismatch.startswith(
         "not replayed: the episodes must be played in CartPole-v0 or CartPole-v1"
     )
     assert record.replays[0].length == 0
-    assert settled_by(record, allowed_games("cartpole")) is not None
+    assert settled_by(record, CARTPOLE_RULES) is not None
 
 
 def test_a_call_with_episodes_where_none_are_planned_is_not_replayed(seed: int) -> None:
@@ -229,10 +231,7 @@ def test_a_call_with_episodes_where_none_are_planned_is_not_replayed(seed: int) 
 
 def test_an_honest_call_does_not_settle_the_verdict(seed: int) -> None:
     records = simulate("cartpole", {"cartpole": cartpole}, seed, replay=False)
-    assert (
-        settled_by(replay_call(records[0].outcome, allowed_games("cartpole")), allowed_games("cartpole"))
-        is None
-    )
+    assert settled_by(replay_call(records[0].outcome, CARTPOLE_RULES), CARTPOLE_RULES) is None
 
 
 def test_budgets_leave_room_for_diagnoses() -> None:

@@ -8,6 +8,7 @@ import pytest
 
 from grader import cli
 from grader.editions import EDITIONS
+from grader.report import Report
 
 RL1 = EDITIONS["rl1"]
 CLASSIC_COMPLETE = EDITIONS["classic"].reference
@@ -54,13 +55,38 @@ def test_the_edition_flag_lists_every_edition(capsys: pytest.CaptureFixture[str]
     assert "choose from classic, gym026, volume2, rl1" in capsys.readouterr().err.replace("'", "")
 
 
-def test_grade_without_edition_or_configuration_grades_the_first_edition(
+def test_grade_without_edition_or_configuration_detects_it_per_submission(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    args = cli.build_parser().parse_args(["grade", str(tmp_path), "--out", str(tmp_path / "out")])
+    inputs = tmp_path / "inputs"
+    for student, source in (("alice", RL1.reference), ("bob", RL1.template), ("carol", CLASSIC_COMPLETE)):
+        (inputs / student).mkdir(parents=True)
+        (inputs / student / "opengym.py").write_bytes(source.read_bytes())
+    out = tmp_path / "out"
+    argv = ["grade", str(inputs), "--out", str(out), "--only", "epsilon_decay", "--workers", "1"]
+    assert cli.main(argv) == 0
+    err = capsys.readouterr().err
+    assert "Edition: rl1 (Reinforcement Learning 1: Gymnasium): detected per submission" in err
+    assert "  alice: rl1: it defines epsilon_decay(" in err
+    assert "  carol: classic: " in err and "graded as rl1 with the class" in err
+    reports = {path.stem: Report.model_validate_json(path.read_text()) for path in out.glob("*.json")}
+    assert {student: report.edition for student, report in reports.items()} == {
+        "alice": "rl1", "bob": "rl1", "carol": "rl1"
+    }  # fmt: skip
+    statuses = {student: report.problems[0].status for student, report in reports.items()}
+    assert statuses == {"alice": "passed", "bob": "missing", "carol": "missing"}
+
+
+def test_grade_with_a_configuration_says_its_edition_and_detects_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["grade", str(tmp_path), "--out", str(tmp_path / "out"), "--config", str(RL1.default_config)]
+    args = cli.build_parser().parse_args(argv)
     cli._choose_edition(args)
-    assert args.config is None
-    assert "Edition: classic" in capsys.readouterr().err
+    assert args.config == RL1.default_config and not getattr(args, "detect_editions", False)
+    assert f"Edition: rl1 (Reinforcement Learning 1: Gymnasium): named by {RL1.default_config}" in (
+        capsys.readouterr().err
+    )
 
 
 def test_the_gradescope_bundle_carries_the_editions_configuration(
