@@ -21,11 +21,6 @@ def epsilon_decay(lab: Lab, episode: int, n: int, start: float = 1.0, end: float
     return start - (episode - 1) * (start - end) / n
 
 
-def epsilon_decay_zero_based(lab: Lab, episode: int, n: int, start: float = 1.0, end: float = 1e-6) -> float:
-    """A wrong decay (0-based episodes), graded in problem 5 and not again in sarsa0."""
-    return start - episode * (start - end) / n
-
-
 def _env(lab: Lab, env: EnvArgument) -> Any:
     return lab.make(env.env_id, max_episode_steps=env.max_episode_steps)
 
@@ -39,7 +34,7 @@ def _random_argmax(row: Any, lab: Lab) -> int:
     return int(best[lab.random.randrange(len(best))])
 
 
-def _learner(
+def learner(
     *,
     target: str = "sarsa",
     alpha_used: bool = True,
@@ -110,31 +105,26 @@ def _learner(
     return sarsa0
 
 
-def learner_with_decay(schedule: Callable[..., float]) -> Callable[..., Any]:
-    """The lab's learner calling another epsilon_decay (a student's own, right or wrong)."""
-    return _learner(schedule=schedule)
-
-
 HONEST: dict[str, Callable[..., Any]] = {
-    "lab_loop": _learner(),
-    "table_only": _learner(returns="table"),
-    "random_ties": _learner(argmax=_random_argmax),
-    "stops_on_truncated": _learner(stop_on_truncated=True),
+    "lab_loop": learner(),
+    "table_only": learner(returns="table"),
+    "random_ties": learner(argmax=_random_argmax),
+    "stops_on_truncated": learner(stop_on_truncated=True),
 }
 """Honest learners: the lab's loop, the table alone returned, ties broken at random, a stop on truncated."""
 
 MISTAKES: dict[str, tuple[Callable[..., Any], str]] = {
-    "q_learning": (_learner(target="max"), "which is Q-learning"),
-    "next_action_after_update": (_learner(target="taken"), "the next action was chosen after the update"),
-    "next_action_from_state": (_learner(choose_from="state"), "choose the next action from next_state"),
-    "missing_alpha": (_learner(alpha_used=False), "instead of moving it by alpha"),
-    "missing_gamma": (_learner(gamma_used=False), "did not discount"),
-    "no_end_update": (_learner(end_update=False), "skips the update of the last step"),
-    "default_parameters": (_learner(fixed=(0.1, 0.6)), "alpha=0.1 and gamma=0.6"),
-    "trains_twice": (_learner(runs=2), "episode(s); N="),
-    "table_of_another_run": (_learner(keeps_first_table=True), "nor any typical variant"),
-    "never_explores": (_learner(explore=False), "you explored less than epsilon asks"),
-    "ignores_decay": (_learner(decays=False), "less than the decayed schedule"),
-    "wrong_penalties": (_learner(penalty_offset=1), "penalties"),
+    "q_learning": (learner(target="max"), "which is Q-learning"),
+    "next_action_after_update": (learner(target="taken"), "the next action was chosen after the update"),
+    "next_action_from_state": (learner(choose_from="state"), "choose the next action from next_state"),
+    "missing_alpha": (learner(alpha_used=False), "instead of moving it by alpha"),
+    "missing_gamma": (learner(gamma_used=False), "did not discount"),
+    "no_end_update": (learner(end_update=False), "skips the update of the last step"),
+    "default_parameters": (learner(fixed=(0.1, 0.6)), "alpha=0.1 and gamma=0.6"),
+    "trains_twice": (learner(runs=2), "episode(s); N="),
+    "table_of_another_run": (learner(keeps_first_table=True), "nor any typical variant"),
+    "never_explores": (learner(explore=False), "you explored less than epsilon asks"),
+    "ignores_decay": (learner(decays=False), "less than the decayed schedule"),
+    "wrong_penalties": (learner(penalty_offset=1), "penalties"),
 }
 """Typical sarsa0 mistakes: (the learner, words its feedback must contain)."""

@@ -14,7 +14,7 @@ from grader.checks.sarsa import SarsaConfig, returned_table
 from grader.config import load_config
 from grader.editions.rl1 import RL1
 from grader.testing import sarsa as students
-from grader.testing.simulation import simulate_calls
+from grader.testing.simulation import Lab, simulate_calls
 
 PROBLEM = RL1.registry.problem("sarsa0")
 
@@ -54,10 +54,15 @@ def test_a_q_learning_update_names_the_first_wrong_cell(seed: int) -> None:
     assert "SARSA(0) from the transitions you played gives" in verdict.feedback
 
 
+def epsilon_decay_zero_based(lab: Lab, episode: int, n: int, start: float = 1.0, end: float = 1e-6) -> float:
+    """A wrong decay (0-based episodes), graded in problem 5 and not again in sarsa0."""
+    return start - episode * (start - end) / n
+
+
 def test_a_wrong_epsilon_decay_is_not_counted_again(seed: int) -> None:
     """The decay call is judged against the student's own schedule: problem 5 counts the mistake."""
-    learner = students.learner_with_decay(students.epsilon_decay_zero_based)
-    verdict = _judge(learner, seed, decay=students.epsilon_decay_zero_based)
+    learner = students.learner(schedule=epsilon_decay_zero_based)
+    verdict = _judge(learner, seed, decay=epsilon_decay_zero_based)
     assert verdict.status == "passed", verdict.feedback
 
 
