@@ -1,10 +1,12 @@
 """Edition 4, "Reinforcement Learning 1: Gymnasium" (2024 onwards), the one taught today.
 
 Problems 1-4 are the shared declarations of `grader.problems`; `epsilon_decay` and the two-table
-`taxi(q_table, q_table_decay)` are this edition's own. `sarsa0` and `compare()` are declared as expected
-functions (the template defines them, detection reads them) but not graded yet (`not_graded`).
+`taxi(q_table, q_table_decay)` are this edition's own. `compare()` is graded when the configuration
+runs the notebook's cells (`run_cells`, else it is skipped, worth 0: `grader.checks.compare`). `sarsa0`
+is declared as an expected function (the template defines it, detection reads it) but not graded yet.
 """
 
+from grader.checks.compare import CompareCheck, CompareConfig
 from grader.checks.epsilon_decay import EpsilonDecayCheck, EpsilonDecayConfig
 from grader.checks.taxi_tables import TaxiTablesCheck, TaxiTablesConfig
 from grader.editions.pack import PACKAGE, REPOSITORY, Edition, ExpectedFunction
@@ -50,6 +52,13 @@ RL1 = Edition(
                 config=TaxiTablesConfig,
                 check=TaxiTablesCheck(),
             ),
+            Problem(
+                id="compare",
+                title="Problem 7: compare()",
+                points=1.0,
+                config=CompareConfig,
+                check=CompareCheck(),
+            ),
         )
     ),
     functions=FUNCTIONS,
@@ -58,9 +67,12 @@ RL1 = Edition(
     default_config=PACKAGE / "rl1.toml",
     notebook_name="gymnasium.ipynb",
     not_graded=(
-        ("qlearn", "provided by the template; taxi gets the grader's own tables, so no verdict needs it"),
+        (
+            "qlearn",
+            "provided by the template; taxi gets the grader's own tables, so no verdict needs it; "
+            "it runs only inside the notebook's cells when compare() is graded with run_cells",
+        ),
         ("sarsa0", "SARSA(0) verified by replaying its updates is not graded yet"),
-        ("compare", "compare() needs the notebook's own training cells; not graded yet"),
     ),
 )
-"""The current edition: problems 1-6 graded; qlearn, sarsa0 and compare() listed in `not_graded`."""
+"""The current edition: problems 1-6 and compare() graded; qlearn and sarsa0 listed in `not_graded`."""

@@ -69,6 +69,8 @@ class Call:
         record_episodes: Whether the child logs every episode played (False for long training runs).
         budget: The most the call may record; None keeps the sandbox-wide limits: the step limit
             (`grader.sandbox.child.recorder.DEFAULT_MAX_RECORDED_STEPS`) and `Limits.frame_bytes`.
+        seconds: Wall-clock limit of this call; None keeps `Limits.call_seconds` (a problem's calls share
+            one limit; running a notebook's cells before them has its own).
     """
 
     function: str
@@ -76,6 +78,7 @@ class Call:
     kwargs: Mapping[str, PlainValue] = field(default_factory=dict)
     record_episodes: bool = True
     budget: CallBudget | None = None
+    seconds: float | None = None
 
 
 @dataclass(frozen=True)
