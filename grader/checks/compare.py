@@ -167,6 +167,14 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
     measurements["compare_seconds"] = round(compare.wall_time, 3)
     preface += f" ({compare.wall_time:.1f} s)"
     early = outcome_verdict(records[1:])
+    if early is not None and compare.status is OutcomeStatus.EPISODE_LIMIT:
+        hint = (
+            " compare() plays the tables your notebook's cells already trained; training inside compare() "
+            f"plays thousands of games (the cells left {_listed(tables)})."
+        )
+        return Verdict(
+            "failed", 0.0, f"{preface}: {early.feedback}.{hint}", {**early.measurements, **measurements}
+        )
     if early is not None:
         return Verdict(
             early.status, 0.0, f"{preface}: {early.feedback}", {**early.measurements, **measurements}
@@ -220,7 +228,7 @@ def _judge_compare(
             else:
                 why = (
                     "its actions are greedy on no table your notebook's cells made (compare() must not train or load tables of its own: "  # noqa: E501
-                    f"read the globals the cells set; the cells left {', '.join(t.label for t in tables)})"
+                    f"read the globals the cells set; the cells left {_listed(tables)})"
                 )
             return _fail(f"{preface}: in the {which} {per_table} episodes {why}.", measurements)
         played.append(table)
@@ -351,6 +359,10 @@ def _not_decayed(played: Sequence[NotebookTable], tables: Sequence[NotebookTable
                 f"a decaying epsilon: your notebook has {decayed[0].label}."
             )
     return None
+
+
+def _listed(tables: Sequence[NotebookTable]) -> str:
+    return ", ".join(table.label for table in tables) or "no Taxi Q-table"
 
 
 def _close(returned: tuple[float, float], expected: tuple[float, float]) -> bool:
