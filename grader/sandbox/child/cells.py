@@ -84,7 +84,7 @@ def _described(number: int, script: bool, filename: str, error: BaseException) -
     line = _line_in(error.__traceback__, filename)
     if isinstance(error, SyntaxError) and error.filename == filename:
         line = error.lineno
-    where = "your file, run as a script," if script else f"cell {number}"
+    where = "your file run as a script" if script else f"cell {number}"
     at = f" (line {line})" if line is not None else ""
     text = str(error)
     return f"{where}{at} raised {type(error).__name__}{': ' + text if text else ''}"
