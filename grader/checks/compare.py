@@ -43,10 +43,8 @@ RETURN_TOLERANCE = 1e-6
 RANDOM_SHARE = 0.25
 """More non-greedy actions than this share of a half's steps reads as random play."""
 NOT_GRADABLE = (
-    "Not graded: compare() takes no arguments and reads the tables your notebook's own training cells made, "
-    "so it cannot be graded in isolation; it is worth 0 points in this assignment. "
-    "Instructors: set run_cells = true in [problems.compare] to run the notebook's cells in the sandbox "
-    "(bounded by cells_seconds) before calling compare() (docs/editions.md)."
+    "Not graded: compare() takes no arguments and reads the tables your notebook's own training cells made, so it cannot be graded in isolation; it is worth 0 points in this assignment. "  # noqa: E501
+    "Instructors: set run_cells = true in [problems.compare] to run the notebook's cells in the sandbox (bounded by cells_seconds) before calling compare() (docs/editions.md)."  # noqa: E501
 )
 
 
@@ -151,8 +149,7 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
     ran, tables = _cells_value(cells.value)
     seconds = sum(seconds for _, seconds in ran)
     preface = (
-        f"Ran your notebook's {len(ran)} code cell{'' if len(ran) == 1 else 's'} in the sandbox in {seconds:.1f} s "  # noqa: E501
-        f"(limit {settings.cells_seconds:g} s), then called compare()"
+        f"Ran your notebook's {len(ran)} code cell{'' if len(ran) == 1 else 's'} in the sandbox in {seconds:.1f} s (limit {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
         if ran and ran[0][0] != 0
         else f"Ran your file as a script in the sandbox in {seconds:.1f} s (limit {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
     )
@@ -168,10 +165,7 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
     preface += f" ({compare.wall_time:.1f} s)"
     early = outcome_verdict(records[1:])
     if early is not None and compare.status is OutcomeStatus.EPISODE_LIMIT:
-        hint = (
-            " compare() plays the tables your notebook's cells already trained; training inside compare() "
-            f"plays thousands of games (the cells left {_listed(tables)})."
-        )
+        hint = f" compare() plays the tables your notebook's cells already trained; training inside compare() plays thousands of games (the cells left {_listed(tables)})."  # noqa: E501
         return Verdict(
             "failed", 0.0, f"{preface}: {early.feedback}.{hint}", {**early.measurements, **measurements}
         )
@@ -215,8 +209,8 @@ def _judge_compare(
     halves = (episodes[:per_table], episodes[per_table : 2 * per_table])
     if not tables:
         return _fail(
-            f"{preface}: your cells left no Taxi Q-table (a 500 x 6 array) in the notebook's globals and none came from qlearn() or sarsa0(), "  # noqa: E501
-            "so compare() cannot have played the notebook's tables. Train them in cells (as the template's last cell does) and have compare() read those globals.",  # noqa: E501
+            f"{preface}: your cells left no Taxi Q-table (a 500 x 6 array) in the notebook's globals and none came from qlearn() or sarsa0(), so compare() cannot have played the notebook's tables. "  # noqa: E501
+            "Train them in cells (as the template's last cell does) and have compare() read those globals.",
             measurements,
         )
     played: list[NotebookTable] = []
@@ -378,8 +372,7 @@ def _cells_failed(settings: CompareConfig, status: OutcomeStatus, message: str) 
         return Verdict(
             "timeout",
             0.0,
-            f"Ran your notebook's code cells in the sandbox, in order: together they did not finish within "
-            f"{settings.cells_seconds:g} seconds (this assignment's limit for running them), so compare() was not called. "  # noqa: E501
+            f"Ran your notebook's code cells in the sandbox, in order: together they did not finish within {settings.cells_seconds:g} seconds (this assignment's limit for running them), so compare() was not called. "  # noqa: E501
             "Keep the training cells to what compare() needs (the lab's N), and move long demos out of the notebook.",  # noqa: E501
             measurements,
         )
