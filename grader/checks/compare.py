@@ -126,7 +126,13 @@ class CompareCheck:
             return []
         budget = games_budget(2 * settings.episodes_per_table, EPISODE_STEPS)
         return [
-            Call(RUN_CELLS, record_episodes=False, budget=NO_EPISODES, seconds=settings.cells_seconds),
+            Call(
+                RUN_CELLS,
+                kwargs={"then": "compare"},
+                record_episodes=False,
+                budget=NO_EPISODES,
+                seconds=settings.cells_seconds,
+            ),
             Call("compare", budget=budget),
         ]
 
@@ -374,6 +380,14 @@ def _cells_failed(settings: CompareConfig, status: OutcomeStatus, message: str) 
             0.0,
             f"Ran your notebook's code cells in the sandbox, in order: together they did not finish within {settings.cells_seconds:g} seconds (this assignment's limit for running them), so compare() was not called. "  # noqa: E501
             "Keep the training cells to what compare() needs (the lab's N), and move long demos out of the notebook.",  # noqa: E501
+            measurements,
+        )
+    not_attempted = message.partition("NotAttemptedError: ")[2]
+    if not_attempted:
+        return Verdict(
+            "missing",
+            0.0,
+            f"{not_attempted}: not attempted yet. Write compare() (it plays the tables your training cells make).",  # noqa: E501
             measurements,
         )
     what = message.partition("NotebookCellError: ")[2] or message

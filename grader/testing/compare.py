@@ -30,7 +30,7 @@ def notebook_tables() -> dict[str, npt.NDArray[np.float64]]:
     return {"q_table_decay": detour, "sarsa_table_decay": optimal, "q_table": constant}
 
 
-def cells(_lab: Lab, *_args: Any) -> dict[str, Any]:
+def cells(_lab: Lab, *_args: Any, **_kwargs: Any) -> dict[str, Any]:
     """What the cells call returns after a notebook trained its three tables."""
     tables = notebook_tables()
     labels = {

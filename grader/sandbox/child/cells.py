@@ -22,6 +22,8 @@ from collections.abc import Callable
 from types import ModuleType, TracebackType
 from typing import Any
 
+from grader.sandbox.child.stubs import stub_body
+
 RUN_CELLS = "notebook cells"
 """The function name of a cells call (not an identifier, so no student function can be meant)."""
 LEARNERS = ("qlearn", "sarsa0")
@@ -39,22 +41,31 @@ class NotebookCellError(Exception):
     """Raised when a notebook cell raises: the message names the cell, the line and the error."""
 
 
-def run_cells(module: ModuleType, cells: list[dict[str, Any]]) -> dict[str, Any]:
+class NotAttemptedError(Exception):
+    """Raised before any cell runs when the function called after the cells is missing or a template stub."""
+
+
+def run_cells(module: ModuleType, cells: list[dict[str, Any]], then: str | None = None) -> dict[str, Any]:
     """Run `cells` in order in `module`'s namespace and describe what they left behind.
 
     Args:
         module: The imported submission (its globals are the notebook's namespace).
         cells: ``{"cell": number, "source": python, "script": bool}`` each; a script runs with
             ``__name__ == "__main__"``.
+        then: The function the problem calls after the cells: when the submission lacks it or it is still
+            the template's stub, no cell runs (a template's training cells would cost minutes for nothing).
 
     Returns:
         ``{"cells": [{"cell", "seconds"}], "tables": [{"names", "learner", "decay", "N", "table"}]}``.
 
     Raises:
         NotebookCellError: A cell raised (the run stops there, as "Run All" does).
+        NotAttemptedError: `then` is missing or a stub.
         MemoryError: A cell ran out of memory (the harness reports the memory limit).
     """
     namespace = vars(module)
+    if then is not None:
+        _check_attempted(namespace, then)
     learned: dict[int, dict[str, Any]] = {}
     kept: list[Any] = []  # the learners' tables stay alive, so their ids stay theirs
     ran: list[dict[str, Any]] = []
@@ -78,6 +89,17 @@ def run_cells(module: ModuleType, cells: list[dict[str, Any]]) -> dict[str, Any]
         ran.append({"cell": number, "seconds": time.perf_counter() - started})
         _label_learners(namespace, learned, kept)
     return {"cells": ran, "tables": _tables(namespace, learned, kept)}
+
+
+def _check_attempted(namespace: dict[str, Any], name: str) -> None:
+    function = namespace.get(name)
+    if not callable(function):
+        raise NotAttemptedError(f"your notebook defines no function `{name}`, so its cells were not run")
+    stub = stub_body(function)
+    if stub is not None:
+        raise NotAttemptedError(
+            f"`{name}` is still the template's stub (its body {stub}), so the cells were not run"
+        )
 
 
 def _described(number: int, script: bool, filename: str, error: BaseException) -> str:

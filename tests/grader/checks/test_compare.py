@@ -9,7 +9,7 @@ from grader.checks.compare import NOT_GRADABLE, CompareConfig
 from grader.config import load_config
 from grader.editions.rl1 import RL1
 from grader.notebook.cells import RAN_CELLS
-from grader.sandbox.child.cells import RUN_CELLS, NotebookCellError
+from grader.sandbox.child.cells import RUN_CELLS, NotAttemptedError, NotebookCellError
 from grader.sandbox.outcome import OutcomeStatus
 from grader.testing import compare as students
 from grader.testing.simulation import simulate_calls
@@ -33,6 +33,7 @@ def _judge(function: Any, seed: int, cells: Any = students.cells) -> Verdict:
 def test_the_plan_runs_the_cells_with_their_own_limit_then_records_compare() -> None:
     cells, compare = PROBLEM.check.plan(_settings(cells_seconds=123.0), {})
     assert (cells.function, cells.seconds, cells.record_episodes) == (RUN_CELLS, 123.0, False)
+    assert cells.kwargs == {"then": "compare"}  # a missing or stub compare() runs no cell
     assert (compare.function, compare.seconds, compare.record_episodes) == ("compare", None, True)
 
 
@@ -74,7 +75,7 @@ def test_each_mistake_fails_and_is_named(name: str, mistake: tuple[Any, str], se
 
 
 def _raising(error: BaseException) -> Any:
-    def cells(_lab: Any, *_args: Any) -> None:
+    def cells(_lab: Any, *_args: Any, **_kwargs: Any) -> None:
         raise error
 
     return cells
@@ -87,8 +88,10 @@ def _raising(error: BaseException) -> Any:
          "as Restart & Run All does: cell 8 (line 5) raised NameError: name 'sarsa' is not defined, so the run stopped there"),  # noqa: E501
         (NotebookCellError("cell 9 (line 2) raised NotImplementedError: Problem 7 incomplete"), "missing",
          "cell 9 (line 2) raised NotImplementedError: Problem 7 incomplete, so compare() was not called: not attempted yet"),  # noqa: E501
+        (NotAttemptedError("`compare` is still the template's stub (its body only raises NotImplementedError), so the cells were not run"), "missing",  # noqa: E501
+         "so the cells were not run: not attempted yet"),
     ],
-    ids=["cell_error", "stub_in_a_cell"],
+    ids=["cell_error", "stub_in_a_cell", "compare_a_stub"],
 )  # fmt: skip
 def test_a_failing_cell_is_the_result(error: BaseException, status: str, words: str, seed: int) -> None:
     verdict = _judge(students.honest, seed, cells=_raising(error))
@@ -110,7 +113,7 @@ def test_cells_out_of_time_are_a_timeout() -> None:
 
 
 def test_a_notebook_without_tables_fails_with_what_to_do(seed: int) -> None:
-    def no_tables(_lab: Any, *_args: Any) -> dict[str, Any]:
+    def no_tables(_lab: Any, *_args: Any, **_kwargs: Any) -> dict[str, Any]:
         return {"cells": [{"cell": 2, "seconds": 0.1}], "tables": []}
 
     verdict = _judge(students.honest, seed, cells=no_tables)
@@ -119,7 +122,7 @@ def test_a_notebook_without_tables_fails_with_what_to_do(seed: int) -> None:
 
 
 def test_a_forged_cells_value_is_read_defensively(seed: int) -> None:
-    def forged(_lab: Any, *_args: Any) -> Any:
+    def forged(_lab: Any, *_args: Any, **_kwargs: Any) -> Any:
         return {"cells": "many", "tables": [{"table": [[1, 2]]}, 5, {"table": "x" * 10}]}
 
     verdict = _judge(students.honest, seed, cells=forged)

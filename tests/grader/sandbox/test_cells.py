@@ -1,12 +1,14 @@
 """The child's cells runner: cells run in order in the module's globals, a failing cell is named, learners'
 tables are labelled (`grader.sandbox.child.cells`, run here in-process on a fresh module)."""
 
+import importlib.util
+from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 import pytest
 
-from grader.sandbox.child.cells import MAX_TABLES, NotebookCellError, run_cells
+from grader.sandbox.child.cells import MAX_TABLES, NotAttemptedError, NotebookCellError, run_cells
 
 
 def _module() -> ModuleType:
@@ -107,3 +109,28 @@ def test_a_failing_script_names_the_file_and_line() -> None:
 def test_non_finite_tables_are_left_out() -> None:
     value = run_cells(_module(), _cells("import numpy as np\nbad = np.full((500, 6), np.nan)"))
     assert value["tables"] == []
+
+
+@pytest.mark.parametrize(
+    ("source", "message"),
+    [
+        ("x = 1", "your notebook defines no function `compare`, so its cells were not run"),
+        (
+            "def compare():\n    raise NotImplementedError('Problem 7')",
+            "`compare` is still the template's stub",
+        ),
+    ],
+    ids=["missing", "stub"],
+)
+def test_no_cell_runs_when_the_function_called_after_them_is_not_attempted(
+    source: str, message: str, tmp_path: Path
+) -> None:
+    path = tmp_path / "gymnasium.ipynb.py"
+    path.write_text(source + "\n", encoding="utf-8")
+    spec = importlib.util.spec_from_file_location("submission_under_test", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)  # the stub's source is read from its file, as in the child
+    with pytest.raises(NotAttemptedError, match=message):
+        run_cells(module, _cells("ran = True"), then="compare")
+    assert not hasattr(module, "ran")
