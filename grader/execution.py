@@ -131,7 +131,8 @@ def run_problem(
         isolation = isolation_summary(sandbox.isolation)
     outcomes = [record.outcome for record in records]
     verdict = check.judge(settings, records)
-    if stopped is not None and len(records) < len(calls):
+    cells_failed = bool(records) and records[-1].outcome.call.function == RUN_CELLS  # the check says so
+    if stopped is not None and len(records) < len(calls) and not cells_failed:
         verdict = _stopped_early(verdict, stopped, len(records), len(calls))
     wall_seconds = time.perf_counter() - started
     student_seconds = sum(outcome.wall_time for outcome in outcomes)

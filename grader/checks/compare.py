@@ -382,7 +382,8 @@ def _cells_failed(settings: CompareConfig, status: OutcomeStatus, message: str) 
             "Keep the training cells to what compare() needs (the lab's N), and move long demos out of the notebook.",  # noqa: E501
             measurements,
         )
-    not_attempted = message.partition("NotAttemptedError: ")[2]
+    first_line = message.split("\n", 1)[0]  # the rest is the runner's own traceback, not the student's
+    not_attempted = first_line.partition("NotAttemptedError: ")[2]
     if not_attempted:
         return Verdict(
             "missing",
@@ -390,7 +391,7 @@ def _cells_failed(settings: CompareConfig, status: OutcomeStatus, message: str) 
             f"{not_attempted}: not attempted yet. Write compare() (it plays the tables your training cells make).",  # noqa: E501
             measurements,
         )
-    what = message.partition("NotebookCellError: ")[2] or message
+    what = first_line.partition("NotebookCellError: ")[2] or first_line
     if "raised NotImplementedError" in what:
         return Verdict(
             "missing",
