@@ -29,7 +29,7 @@ from grader.checks.integrity import NO_EPISODES, games_budget, integrity_problem
 from grader.checks.taxi import EPISODE_STEPS
 from grader.checks.values import as_number, describe
 from grader.games import GameRules, accepted_game_names, allowed_games
-from grader.notebook.cells import RAN_CELLS
+from grader.notebook.cells import RAN_CELLS, SCRIPT_CELL
 from grader.problem_config import PlayedProblemConfig, Probability, ProblemConfig
 from grader.sandbox.child.cells import RUN_CELLS
 from grader.sandbox.outcome import Call, FunctionInfo, OutcomeStatus, PlainValue
@@ -156,7 +156,7 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
     seconds = sum(seconds for _, seconds in ran)
     preface = (
         f"Ran your notebook's {len(ran)} code cell{'' if len(ran) == 1 else 's'} in the sandbox in {seconds:.1f} s (limit {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
-        if ran and ran[0][0] != 0
+        if not (ran and ran[0][0] == SCRIPT_CELL)
         else f"Ran your file as a script in the sandbox in {seconds:.1f} s (limit {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
     )
     measurements: dict[str, PlainValue] = {
