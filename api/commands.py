@@ -46,7 +46,7 @@ def add_worker_command(subparsers: argparse._SubParsersAction[argparse.ArgumentP
         "--workers",
         type=int,
         default=None,
-        help="gradings run at once (default GYMGRADE_WORKERS, at least 1)",
+        help="gradings run at once (default: one per core with GYMGRADE_BROKER_URL, else GYMGRADE_WORKERS; at least 1)",  # noqa: E501
     )
     parser.set_defaults(handler=work)
 

@@ -102,7 +102,7 @@ def _names(node: ast.stmt) -> set[str]:
 def handle(mode: str, payload: bytes, budget: tuple[int, int]) -> int:
     """Handle one result frame as the runner does; returns the number of episodes decoded."""
     from grader.sandbox.child.frames import parse_payload
-    from grader.sandbox.outcome import CallBudget
+    from grader.sandbox.limits import CallBudget
 
     call_budget = CallBudget(*budget)
     frame = parse_payload(payload)

@@ -44,7 +44,7 @@ from grader.sandbox.child.budget import WireBudget, frame_limits
 from grader.sandbox.child.errors import ProtocolError
 from grader.sandbox.child.frames import parse_payload
 from grader.sandbox.episode_log import episodes_from_plain
-from grader.sandbox.outcome import CallBudget
+from grader.sandbox.limits import CallBudget
 
 mode, path, budget, trace = sys.argv[1], sys.argv[2], json.loads(sys.argv[3]), sys.argv[4] == "trace"
 payload = open(path, "rb").read()

@@ -14,9 +14,9 @@ from typing import TYPE_CHECKING
 
 from grader.editions import EDITIONS, all_problem_ids
 from grader.errors import BatchInterrupted, ExecutorUnavailable, GraderError
-from grader.notebook import NotebookSummary
 from grader.progress import ProgressBar, result_line
-from grader.report import IsolationSummary, ProblemResult, Report
+from grader.render.registry import FORMATS, format_help
+from grader.report import ProblemResult
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import SandboxError
 from grader.seeds import PRACTICE_SEED, held_out_seed
@@ -160,13 +160,7 @@ def build_parser() -> argparse.ArgumentParser:
         check,
         f"seed of the starts (default: the practice seed {PRACTICE_SEED}; instructors grade on another)",
     )
-    check.add_argument(
-        "--format",
-        choices=("text", "json", "gradescope"),
-        default="text",
-        help="text (default): live progress and a summary; json: exactly the report JSON on stdout; "
-        "gradescope: exactly Gradescope's results.json on stdout",
-    )
+    check.add_argument("--format", choices=tuple(FORMATS), default=next(iter(FORMATS)), help=format_help())
     check.add_argument("--json", action="store_true", help="same as --format json")
     check.add_argument(
         "--output", type=Path, default=None, metavar="PATH", help="also write the report JSON here"
@@ -364,6 +358,7 @@ def run_doctor(args: argparse.Namespace) -> int:
 
 def run_check(args: argparse.Namespace) -> int:
     """`gymgrade check`: grade one file with live progress, summarise, exit 0 only at full marks."""
+    from grader.config import load_config
     from grader.grading import grade_submission
 
     if not args.file.is_file():
@@ -372,14 +367,14 @@ def run_check(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_ERROR
-    output_format = "json" if args.json else args.format
-    progress = sys.stdout if output_format == "text" else sys.stderr
+    output = FORMATS["json" if args.json else args.format]
+    progress = sys.stdout if output.live_progress else sys.stderr
     seed = PRACTICE_SEED if args.seed is None else args.seed
 
     def show(result: ProblemResult) -> None:
         print(result_line(result), file=progress, flush=True)
 
-    if output_format == "text":
+    if output.live_progress:
         print(f"Checking {args.file.name} (practice seed {seed})...", flush=True)
     report = grade_submission(
         args.file,
@@ -390,77 +385,15 @@ def run_check(args: argparse.Namespace) -> int:
         on_progress=show,
         config=args.config,
     )
+    config = load_config(args.config)
     if args.output is not None:
-        args.output.write_text(report.to_json() + "\n", encoding="utf-8")
+        args.output.write_text(FORMATS["json"].render(report, config), encoding="utf-8")
     if args.html is not None:
-        from grader.config import load_config
-        from grader.html_report import render_html
-
-        args.html.write_text(render_html(report, load_config(args.config)), encoding="utf-8")
-    if output_format == "json":
-        sys.stdout.write(report.to_json() + "\n")
-    elif output_format == "gradescope":
-        from grader.gradescope import results
-
-        sys.stdout.write(results(report).to_json())
-    else:
-        print(summary(report))
+        args.html.write_text(FORMATS["html"].render(report, config), encoding="utf-8")
+    sys.stdout.write(output.render(report, config))
     if report.grader_errors:
         return EXIT_ERROR
     return EXIT_FULL_MARKS if report.full_marks else EXIT_NOT_FULL
-
-
-def summary(report: Report) -> str:
-    """The readable end of `gymgrade check`: every verdict's feedback, the total, the isolation."""
-    lines = [""]
-    if report.notebook is not None:
-        lines += notebook_lines(report.notebook)
-    if report.submission_error is not None:
-        lines.append(report.submission_error)
-    else:
-        for result in report.problems:
-            lines += [f"{result.title}: {result.status}", f"  {result.feedback}"]
-    lines.append(
-        f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
-    )
-    lines.append(
-        f"Practice seed {report.seed}: your instructor grades on different, unseen starts (a held-out seed), so code that only does well from these starts will fail there."  # noqa: E501
-    )
-    lines += isolation_lines(report.isolation)
-    lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
-    return "\n".join(lines)
-
-
-def notebook_lines(notebook: NotebookSummary) -> list[str]:
-    """What of a notebook ran at import, and every statement that did not, cell by cell."""
-    lines = [
-        f"Notebook: {notebook.kept_statements} imports, definitions and constants from {notebook.code_cells} code cells ran at import; "  # noqa: E501
-        f"{len(notebook.skipped)} statements did not:"
-    ]
-    for entry in notebook.skipped:
-        label = f"In [{entry.execution_count}]" if entry.execution_count is not None else "no run"
-        lines.append(f"  cell {entry.cell} ({label}), line {entry.line}: {entry.code}  <- {entry.reason}")
-    lines += [f"  ignored: {note}" for note in notebook.ignored]
-    return [*lines, ""]
-
-
-def isolation_lines(isolation: IsolationSummary | None) -> list[str]:
-    """How the student's code was isolated: one line when fully, else each missing layer and its remedy."""
-    if isolation is None:
-        return []
-    if isolation.full:
-        names = ", ".join(layer.name for layer in isolation.layers if layer.active)
-        return [f"Sandbox: full isolation ({names})."]
-    lines = [
-        "Sandbox: weaker isolation on this machine (fine for checking your own code; instructors grade with full isolation). "  # noqa: E501
-        "Missing:"
-    ]
-    lines += [
-        f"  - {layer.name}: {layer.detail}" + (f" (to fix: {layer.remedy})" if layer.remedy else "")
-        for layer in isolation.layers
-        if layer.required and not layer.active
-    ]
-    return lines
 
 
 def choose_seed(given: int | None, out_dir: Path) -> int:

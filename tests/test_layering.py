@@ -4,6 +4,10 @@
                    \\->  grader.compat        (stdlib, numpy, gymnasium)
                    \\->  grader.sandbox.child (stdlib, numpy, gymnasium, grader.compat)
 
+Inside grader/, the parts are stacked in `GRADER_LAYERS` (shown in ARCHITECTURE.md, "Layers inside
+grader/"): a part imports its own layer or those below. Across grader, api and reference there is no import
+circle at all.
+
 Read from the source with `ast`: every `import`, also inside functions and under `if TYPE_CHECKING:`.
 """
 
@@ -11,12 +15,40 @@ from __future__ import annotations
 
 import ast
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 THIRD_PARTY_OF_THE_CHILD = ("numpy", "gymnasium")
+PACKAGES = ("grader", "api", "reference")
+"""The project's packages: the import graph whose circles are counted."""
+GRADER_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("commands", ("cli", "acceptance")),
+    ("outputs and classes", ("render", "gradescope", "class_report", "similarity", "classroom", "doctor")),
+    ("grading", ("batch", "grading", "session", "plugin", "execution", "scheduling", "progress")),
+    (
+        "the lab's problems",
+        (
+            "checks",
+            "editions",
+            "problems",
+            "problem_registry",
+            "problem_config",
+            "config",
+            "games",
+            "showcase",
+            "figures",
+            "testing",
+        ),
+    ),
+    ("plain data", ("report", "notebook", "stats", "seeds", "gradescope_upload", "validation", "errors")),
+    ("untrusted execution", ("sandbox",)),
+    ("the lab's dialects", ("compat",)),
+)
+"""The parts of grader/ (its modules and subpackages), top layer first: each imports only its own layer or
+those below it (a part of the same layer too, as long as no circle forms)."""
 
 
 def imported_modules(path: Path) -> set[str]:
@@ -94,3 +126,139 @@ def test_the_grader_package_root_is_import_light() -> None:
     assert [
         module for module in imported_modules(init) if module.split(".")[0] not in sys.stdlib_module_names
     ] == []
+
+
+def _module_files() -> dict[str, Path]:
+    """Every module of the project's packages by dotted name (a package by its ``__init__.py``)."""
+    modules: dict[str, Path] = {}
+    for package in PACKAGES:
+        for path in _sources(package):
+            parts = path.relative_to(ROOT).with_suffix("").parts
+            modules[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return modules
+
+
+def import_graph() -> dict[str, set[str]]:
+    """Which project modules each project module imports (``from package import name`` counts as the
+    module ``package.name`` when there is one, else as ``package``; a module's own packages are left out,
+    as Python imports them whatever the module says)."""
+    modules = _module_files()
+
+    def resolved(name: str) -> str | None:
+        while name and name not in modules:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    graph: dict[str, set[str]] = {module: set() for module in modules}
+    for module, path in modules.items():
+        for name in imported_modules(path):
+            target = resolved(name)
+            if target is not None and target != module and not module.startswith(f"{target}."):
+                graph[module].add(target)
+    return graph
+
+
+def import_circles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The graph's circles: its strongly connected components of more than one module, each sorted."""
+    index: dict[str, int] = {}
+    lowest: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    circles: list[list[str]] = []
+
+    def visit(start: str) -> None:
+        # Tarjan's algorithm with an explicit stack of iterators (the graph is deeper than the recursion limit
+        # allows in the worst case).
+        index[start] = lowest[start] = len(index)
+        stack.append(start)
+        on_stack.add(start)
+        pending: list[tuple[str, Iterator[str]]] = [(start, iter(sorted(graph[start])))]
+        while pending:
+            module, targets = pending[-1]
+            target = next(targets, None)
+            if target is not None:
+                if target not in index:
+                    index[target] = lowest[target] = len(index)
+                    stack.append(target)
+                    on_stack.add(target)
+                    pending.append((target, iter(sorted(graph[target]))))
+                elif target in on_stack:
+                    lowest[module] = min(lowest[module], index[target])
+                continue
+            pending.pop()
+            if pending:
+                lowest[pending[-1][0]] = min(lowest[pending[-1][0]], lowest[module])
+            if lowest[module] == index[module]:
+                component = []
+                while True:
+                    member = stack.pop()
+                    on_stack.discard(member)
+                    component.append(member)
+                    if member == module:
+                        break
+                if len(component) > 1:
+                    circles.append(sorted(component))
+
+    for module in sorted(graph):
+        if module not in index:
+            visit(module)
+    return sorted(circles)
+
+
+def test_the_circle_finder_sees_type_only_imports_and_circles() -> None:
+    assert "grader.config" in imported_modules(ROOT / "grader/render/text.py")  # under TYPE_CHECKING
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": {"e", "f"}, "f": set()}
+    assert import_circles(graph) == [["a", "b", "c"]]
+
+
+def test_there_is_no_import_circle() -> None:
+    """Two modules that need each other move their shared contract down into a third."""
+    circles = import_circles(import_graph())
+    assert circles == [], "import circles (type-only imports included):\n" + "\n".join(
+        f"  {len(circle)} modules: {', '.join(circle)}" for circle in circles
+    )
+
+
+def _grader_part(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[1] if parts[0] == "grader" and len(parts) > 1 else None
+
+
+def _layer_of() -> dict[str, int]:
+    return {part: level for level, (_, parts) in enumerate(GRADER_LAYERS) for part in parts}
+
+
+def test_every_part_of_grader_has_a_layer() -> None:
+    parts = {part for module in _module_files() if (part := _grader_part(module)) is not None}
+    unplaced = sorted(parts - set(_layer_of()))
+    gone = sorted(set(_layer_of()) - parts)
+    assert (unplaced, gone) == ([], []), (
+        f"grader parts without a layer: {unplaced}; layers naming no part: {gone}. "
+        "Place each new module or subpackage in GRADER_LAYERS (and ARCHITECTURE.md)"
+    )
+
+
+def test_no_part_of_grader_imports_a_layer_above_its_own() -> None:
+    layer_of = _layer_of()
+    modules = _module_files()
+    upward = sorted(
+        f"{modules[module].relative_to(ROOT)} ({GRADER_LAYERS[layer_of[part]][0]}) imports {target} "
+        f"({GRADER_LAYERS[layer_of[target_part]][0]})"
+        for module, targets in import_graph().items()
+        if (part := _grader_part(module)) in layer_of
+        for target in targets
+        if (target_part := _grader_part(target)) in layer_of and layer_of[target_part] < layer_of[part]
+    )
+    assert upward == []
+
+
+def layers_diagram() -> str:
+    """The layers inside grader/ as ARCHITECTURE.md shows them, top first."""
+    return "\n".join(f"{name}: {', '.join(parts)}" for name, parts in GRADER_LAYERS)
+
+
+def test_architecture_shows_the_layers_held_here() -> None:
+    architecture = (ROOT / "ARCHITECTURE.md").read_text(encoding="utf-8")
+    assert f"```text\n{layers_diagram()}\n```" in architecture, (
+        "ARCHITECTURE.md, section 'Layers inside grader/', must show exactly:\n" + layers_diagram()
+    )

@@ -12,7 +12,9 @@ import json
 import logging
 import os
 import socket
+import sys
 import threading
+import time
 import uuid
 from dataclasses import dataclass, field
 from typing import Any
@@ -39,6 +41,36 @@ from api.models import JobStatus
 from api.settings import Settings
 
 logger = logging.getLogger(__name__)
+
+RESTARTS_VARIABLE = "GYMGRADE_WORKER_RESTARTS"
+"""Where a worker that restarted itself in place keeps the times of its restarts (comma-separated)."""
+RESTART_LIMIT = 5
+RESTART_WINDOW_SECONDS = 300.0
+
+
+def restart_history(variable: str | None, now: float) -> tuple[float, ...]:
+    """The restart times of ``variable`` still inside the window before ``now`` (garbage ignored)."""
+    times = []
+    for item in (variable or "").split(","):
+        try:
+            moment = float(item)
+        except ValueError:
+            continue
+        if now - RESTART_WINDOW_SECONDS <= moment <= now:
+            times.append(moment)
+    return tuple(times)
+
+
+def should_restart(exitcode: int | None, stop_requested: bool, history: tuple[float, ...]) -> bool:
+    """Whether a worker whose Celery loop returned should start again in place.
+
+    Celery ends its worker on an error it does not know how to recover from, such as kombu failing inside
+    its own reconnection after a broker restart (``Unrecoverable error: AttributeError(...)``). The rows
+    are safe in the database either way, but a worker that simply exits stops the cluster's grading until
+    someone restarts it; so unless a stop was asked for (SIGTERM, Ctrl-C) the worker starts again, at most
+    :data:`RESTART_LIMIT` times in :data:`RESTART_WINDOW_SECONDS` (then it exits and says so).
+    """
+    return not stop_requested and bool(exitcode) and len(history) < RESTART_LIMIT
 
 
 def cores() -> int:
@@ -236,7 +268,7 @@ def run_worker(settings: Settings, concurrency: int | None) -> int:
 
     Args:
         settings: Service settings with a broker URL.
-        concurrency: Gradings at once (None: GYMGRADE_WORKERS).
+        concurrency: Gradings at once (None: one per core, see :func:`split_cores`).
 
     Returns:
         The worker's exit code.
@@ -266,4 +298,35 @@ def run_worker(settings: Settings, concurrency: int | None) -> int:
         worker.start()
     finally:
         runtime.close()
-    return int(worker.exitcode or 0)
+    exitcode = int(worker.exitcode or 0)
+    now = time.time()
+    history = restart_history(os.environ.get(RESTARTS_VARIABLE), now)
+    if should_restart(exitcode, runtime.stop.is_set(), history):
+        logger.critical(
+            "the Celery worker stopped on an error it could not recover from (exit code %d); "
+            "starting it again in place (restart %d of at most %d in %.0f s)",
+            exitcode,
+            len(history) + 1,
+            RESTART_LIMIT,
+            RESTART_WINDOW_SECONDS,
+        )
+        _restart_in_place([*history, now])
+    if exitcode and not runtime.stop.is_set():
+        logger.critical(
+            "the Celery worker stopped on errors %d times in %.0f s; exiting. "
+            "Check the broker (`gymgrade doctor`), then start `gymgrade worker` again: queued submissions are kept",  # noqa: E501
+            len(history),
+            RESTART_WINDOW_SECONDS,
+        )
+    return exitcode
+
+
+def _restart_in_place(history: list[float]) -> None:
+    """Replace this process with a fresh run of the same command (same pid, so leases stay readable)."""
+    for handler in logging.getLogger().handlers:
+        handler.flush()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    time.sleep(min(2.0 ** (len(history) - 1), 30.0))  # 1, 2, 4, 8, 16 s: a broken broker is not hammered
+    environment = {**os.environ, RESTARTS_VARIABLE: ",".join(f"{moment:.3f}" for moment in history)}
+    os.execve(sys.executable, list(sys.orig_argv), environment)

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 from grader.checks.base import RESET_SLACK, CallRecord, Verdict
 from grader.checks.episodes import Episode, all_resets, episodes_per_call, played_episodes
 from grader.checks.starts import selection_problem
-from grader.sandbox.outcome import CallBudget
+from grader.sandbox.limits import CallBudget
 from grader.sandbox.replay import not_replayed, replay_episodes, verify_reset_seeds
 
 if TYPE_CHECKING:

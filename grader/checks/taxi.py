@@ -24,7 +24,8 @@ from grader.checks.integrity import (
 from grader.checks.truncation import ignored_truncation
 from grader.checks.values import as_number, describe, same_number
 from grader.problem_config import PlayedProblemConfig, Probability
-from grader.sandbox.outcome import Call, CallBudget, FunctionInfo
+from grader.sandbox.limits import CallBudget
+from grader.sandbox.outcome import Call, FunctionInfo
 from grader.stats import goodness_of_fit, mean_tolerance
 from reference.oracles import greedy_policy_return, optimal_q_table, optimal_return, random_policy_return
 

@@ -1,27 +1,23 @@
 """The class page: one self-contained HTML file under the student report's Content-Security-Policy.
 
 No script, no network: images are ``data:`` URIs and the only style is the page's own, pinned by hash,
-exactly as in ``grader.html_report``. Every string from a student or a roster is escaped by the template
-and shown through ``display_text`` (bounded, no controls or bidi overrides, inside ``<bdi>``); links to
-the students' reports are relative paths checked by ``safe_href``.
+under the one policy of ``grader.render.csp``. Every string from a student or a roster is escaped by
+the template and shown through ``display_text`` (bounded, no controls or bidi overrides, inside
+``<bdi>``); links to the students' reports are relative paths checked by ``safe_href``.
 """
 
 from __future__ import annotations
 
-import base64
-import hashlib
 from collections.abc import Sequence
-from pathlib import Path
-
-from jinja2 import Environment, FileSystemLoader, select_autoescape
 
 from grader.class_report.entries import ClassEntry
 from grader.class_report.figures import class_figures
 from grader.class_report.summary import ClassSummary, summarise
 from grader.class_report.text import MAX_NAME_CHARS, MAX_NOTE_CHARS, display_identity, display_text
 from grader.figures import Figure
+from grader.render.csp import content_security_policy
+from grader.render.page import page_environment
 
-TEMPLATES = Path(__file__).resolve().parents[1] / "templates"
 TEMPLATE = "class_report.html"
 DIAGNOSES_SHOWN = 20
 """Diagnosis groups on the page (most common first); class.json lists more."""
@@ -38,20 +34,9 @@ STYLE = (
 )
 
 
-def content_security_policy(style: str) -> str:
-    """The report pages' policy for a page whose only stylesheet is ``style``: nothing loads or runs but
-    its ``data:`` images and that stylesheet (the same policy as ``grader.html_report.CSP``)."""
-    digest = base64.b64encode(hashlib.sha256(style.encode()).digest()).decode()
-    return (
-        f"default-src 'none'; img-src data:; style-src 'sha256-{digest}'; base-uri 'none'; form-action 'none'"
-    )
-
-
 CSP = content_security_policy(STYLE)
 
-_environment = Environment(
-    loader=FileSystemLoader(TEMPLATES), autoescape=select_autoescape(["html"]), keep_trailing_newline=True
-)
+_environment = page_environment()
 _environment.filters["identity"] = lambda text: display_identity(text, IDENTITY_SHOWN_CHARS)
 _environment.filters["name"] = lambda text: display_text(text, MAX_NAME_CHARS)
 _environment.filters["note"] = lambda text: display_text(text, MAX_NOTE_CHARS)

@@ -1,13 +1,14 @@
 """Edition 4, "Reinforcement Learning 1: Gymnasium" (2024 onwards), the one taught today.
 
 Problems 1-4 are the shared declarations of `grader.problems`; `epsilon_decay` and the two-table
-`taxi(q_table, q_table_decay)` are this edition's own. `compare()` is graded when the configuration
-runs the notebook's cells (`run_cells`, else it is skipped, worth 0: `grader.checks.compare`). `sarsa0`
-is declared as an expected function (the template defines it, detection reads it) but not graded yet.
+`taxi(q_table, q_table_decay)` are this edition's own, and `sarsa0`, verified by replaying its updates
+(`grader.checks.sarsa`). `compare()` is graded when the configuration runs the notebook's cells
+(`run_cells`, else it is skipped, worth 0: `grader.checks.compare`).
 """
 
 from grader.checks.compare import CompareCheck, CompareConfig
 from grader.checks.epsilon_decay import EpsilonDecayCheck, EpsilonDecayConfig
+from grader.checks.sarsa import SarsaCheck, SarsaConfig
 from grader.checks.taxi_tables import TaxiTablesCheck, TaxiTablesConfig
 from grader.editions.pack import PACKAGE, REPOSITORY, Edition, ExpectedFunction
 from grader.problem_registry import Problem, Registry
@@ -53,6 +54,13 @@ RL1 = Edition(
                 check=TaxiTablesCheck(),
             ),
             Problem(
+                id="sarsa0",
+                title="Problem 7: SARSA(0)",
+                points=1.0,
+                config=SarsaConfig,
+                check=SarsaCheck(),
+            ),
+            Problem(
                 id="compare",
                 title="Problem 7: compare()",
                 points=1.0,
@@ -72,7 +80,6 @@ RL1 = Edition(
             "provided by the template; taxi gets the grader's own tables, so no verdict needs it; "
             "it runs only inside the notebook's cells when compare() is graded with run_cells",
         ),
-        ("sarsa0", "SARSA(0) verified by replaying its updates is not graded yet"),
     ),
 )
-"""The current edition: problems 1-6 and compare() graded; qlearn and sarsa0 listed in `not_graded`."""
+"""The current edition: problems 1-7 graded (sarsa0, and compare() with `run_cells`); qlearn in `not_graded`."""

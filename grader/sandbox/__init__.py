@@ -4,10 +4,9 @@ from grader.sandbox.episode_log import EpisodeLog
 from grader.sandbox.errors import IsolationUnavailable, SandboxClosedError, SandboxError
 from grader.sandbox.isolation import probe_isolation
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
-from grader.sandbox.limits import IsolationPolicy, Limits
+from grader.sandbox.limits import CallBudget, IsolationPolicy, Limits
 from grader.sandbox.outcome import (
     Call,
-    CallBudget,
     CallOutcome,
     CompatEventRecord,
     FunctionInfo,

@@ -21,7 +21,7 @@ from grader.sandbox.boundary import STRICT, describe, one_of, problem
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
 from grader.sandbox.child.frames import MAX_DEPTH, MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
 from grader.sandbox.child.recorder import EPISODE_COLUMNS
-from grader.sandbox.outcome import CallBudget
+from grader.sandbox.limits import CallBudget
 from grader.sandbox.text import clean_plain, clean_text
 
 MAX_ID_LENGTH = 200

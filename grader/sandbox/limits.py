@@ -1,4 +1,5 @@
-"""Resource limits for sandboxed calls and the policy deciding whether weaker isolation is acceptable."""
+"""Resource limits (the sandbox's `Limits`, one call's `CallBudget`) and the policy deciding whether weaker
+isolation is acceptable."""
 
 from __future__ import annotations
 
@@ -66,3 +67,26 @@ class Limits:
         ):
             if getattr(self, name) <= 0:
                 raise ValueError(f"{name} must be positive; found {getattr(self, name)}")
+
+
+@dataclass(frozen=True)
+class CallBudget:
+    """What one call may record: resets (played or not) and steps summed over its episodes.
+
+    The child stops recording once either is exceeded and the call ends with
+    `OutcomeStatus.EPISODE_LIMIT`; the parent also derives from it the largest result frame it parses
+    (`grader.sandbox.child.budget.frame_limits`).
+
+    Attributes:
+        max_episodes: Resets the call may make (every `reset`, whether or not a step follows).
+        max_steps: Steps the call may take, summed over all its episodes.
+    """
+
+    max_episodes: int
+    max_steps: int
+
+    def __post_init__(self) -> None:
+        for name in ("max_episodes", "max_steps"):
+            value = getattr(self, name)
+            if type(value) is not int or value < 0:
+                raise ValueError(f"CallBudget.{name} must be a non-negative int; found {value!r}")

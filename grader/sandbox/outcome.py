@@ -1,4 +1,4 @@
-"""What a sandboxed call asks for and what it produced: `Call`, its `CallBudget`, `CallOutcome`."""
+"""What a sandboxed call asks for and what it produced: `Call` (with its `CallBudget`), `CallOutcome`."""
 
 from __future__ import annotations
 
@@ -8,6 +8,8 @@ from enum import StrEnum
 from typing import TYPE_CHECKING, Any, TypeAlias
 
 from pydantic import BaseModel, ConfigDict, Field
+
+from grader.sandbox.limits import CallBudget
 
 if TYPE_CHECKING:
     from grader.sandbox.episode_log import EpisodeLog
@@ -36,29 +38,6 @@ class OutcomeStatus(StrEnum):
 
 
 @dataclass(frozen=True)
-class CallBudget:
-    """What one call may record: resets (played or not) and steps summed over its episodes.
-
-    The child stops recording once either is exceeded and the call ends with
-    `OutcomeStatus.EPISODE_LIMIT`; the parent also derives from it the largest result frame it parses
-    (`grader.sandbox.child.budget.frame_limits`).
-
-    Attributes:
-        max_episodes: Resets the call may make (every `reset`, whether or not a step follows).
-        max_steps: Steps the call may take, summed over all its episodes.
-    """
-
-    max_episodes: int
-    max_steps: int
-
-    def __post_init__(self) -> None:
-        for name in ("max_episodes", "max_steps"):
-            value = getattr(self, name)
-            if type(value) is not int or value < 0:
-                raise ValueError(f"CallBudget.{name} must be a non-negative int; found {value!r}")
-
-
-@dataclass(frozen=True)
 class Call:
     """One call of a student function.
 
@@ -71,6 +50,9 @@ class Call:
             (`grader.sandbox.child.recorder.DEFAULT_MAX_RECORDED_STEPS`) and `Limits.frame_bytes`.
         seconds: Wall-clock limit of this call; None keeps `Limits.call_seconds` (a problem's calls share
             one limit; running a notebook's cells before them has its own).
+        provided: Names of the submission's globals the child binds, for this call only, to the grader's
+            own definitions (`grader.sandbox.child.provided.PROVIDED`), e.g. sarsa0 run with the
+            grader's `epsilon_decay`.
     """
 
     function: str
@@ -79,6 +61,7 @@ class Call:
     record_episodes: bool = True
     budget: CallBudget | None = None
     seconds: float | None = None
+    provided: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

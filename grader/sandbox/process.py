@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 from grader.sandbox.child.frames import HEADER
-from grader.sandbox.isolation.launch import Launch
+from grader.sandbox.isolation.layer import Launch
 from grader.sandbox.text import clean_text
 
 _READ_CHUNK = 1 << 16

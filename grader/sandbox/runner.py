@@ -159,6 +159,7 @@ class Sandbox:
             "seed": seed,
             "record": call.record_episodes,
             "budget": None if budget is None else budget.to_plain(),
+            "provided": list(call.provided),
         }
         child.reset_oom_baseline()
         started = time.perf_counter()

@@ -6,14 +6,12 @@ and only its own stylesheet (pinned by hash), like the grading report's.
 
 from __future__ import annotations
 
-import base64
-import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from jinja2 import Environment, FileSystemLoader, select_autoescape
-
+from grader.render.csp import content_security_policy
+from grader.render.page import page_environment
 from grader.similarity.report import Fragment, Pair, SimilarityReport
 
 MAX_LINES_SHOWN = 60
@@ -27,17 +25,9 @@ STYLE = (
     "pre{white-space:pre;overflow-x:auto;background:#f6f6f6;padding:.5rem;font-size:.8rem;margin:.2rem 0}"
     ".ln{color:#999;user-select:none}.side h4{margin:.3rem 0;font-size:.85rem}.reason{color:#a00}"
 )
-CSP = (
-    "default-src 'none'; style-src 'sha256-"
-    + base64.b64encode(hashlib.sha256(STYLE.encode()).digest()).decode()
-    + "'; base-uri 'none'; form-action 'none'"
-)
+CSP = content_security_policy(STYLE, images=False)
 
-_environment = Environment(
-    loader=FileSystemLoader(Path(__file__).with_name("templates")),
-    autoescape=select_autoescape(["html"]),
-    keep_trailing_newline=True,
-)
+_environment = page_environment(Path(__file__).with_name("templates"))
 
 
 @dataclass(frozen=True)

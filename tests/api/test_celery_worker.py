@@ -61,3 +61,30 @@ def test_a_worker_refuses_a_machine_that_cannot_isolate(
     assert (
         startup_problem(make_settings(broker_url="redis://127.0.0.1:1/0", allow_weak_isolation=True)) is None
     )
+
+
+@pytest.mark.parametrize(
+    ("exitcode", "stop_requested", "restarts", "expected"),
+    [
+        (1, False, 0, True),
+        (1, False, 4, True),
+        (1, False, 5, False),
+        (1, True, 0, False),
+        (0, False, 0, False),
+        (None, False, 0, False),
+    ],
+    ids=["crashed", "crashed-fifth-time", "crashed-too-often", "asked-to-stop", "clean-exit", "no-exit-code"],
+)
+def test_a_worker_restarts_in_place_only_after_a_crash_it_was_not_asked_for(
+    exitcode: int | None, stop_requested: bool, restarts: int, expected: bool
+) -> None:
+    history = tuple(float(moment) for moment in range(restarts))
+    assert celery_worker.should_restart(exitcode, stop_requested, history) is expected
+
+
+def test_the_restart_history_keeps_the_window_and_ignores_garbage() -> None:
+    now = 10_000.0
+    window = celery_worker.RESTART_WINDOW_SECONDS
+    variable = f"{now - window - 1},{now - 10},x,,{now + 5},{now}"
+    assert celery_worker.restart_history(variable, now) == (now - 10, now)
+    assert celery_worker.restart_history(None, now) == ()

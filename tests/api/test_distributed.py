@@ -14,11 +14,12 @@ from typing import Any
 
 import httpx
 import pytest
+import redis
 from api_testing import FAKE_GRADER, PostgresServer, RedisServer, free_port, instructor_headers
 from live_server import LiveProcess, create_student, service_environment, upload, wait_for
 from sqlalchemy import create_engine, select
 
-from api.jobs.distributed import CeleryDispatcher
+from api.jobs.distributed import QUEUE, CeleryDispatcher
 from api.models import Submission
 from api.settings import BrokerSettings
 
@@ -155,6 +156,25 @@ def test_a_broker_restart_and_duplicated_tasks_lose_and_repeat_nothing(
     assert [view["attempts"] for view in views] == [1] * 4
     listed = httpx.get(cluster.server.url + "/submissions", headers=instructor_headers()).json()
     assert sorted(item["id"] for item in listed) == sorted([*before, *during])
+
+
+def test_a_worker_whose_celery_loop_dies_starts_again_in_place_and_grades(cluster: Cluster) -> None:
+    worker = cluster.start_worker()
+    broker = redis.Redis.from_url(cluster.env["GYMGRADE_BROKER_URL"])
+    try:
+        broker.set(QUEUE, "not a list")  # the consumer's BRPOP gets WRONGTYPE: Celery cannot recover
+        deadline = time.monotonic() + WAIT_SECONDS
+        while "starting it again in place" not in worker.log():
+            assert time.monotonic() < deadline, f"the worker did not restart itself:\n{worker.log()}"
+            time.sleep(0.1)
+        broker.delete(QUEUE)
+    finally:
+        broker.close()
+    token = create_student(cluster.server.url, "hedy")
+    graded = upload(cluster.server.url, token, fake_submission(0, sleep=0.02))
+    _wait_all(cluster, token, [graded])
+    assert worker.process is not None and worker.process.poll() is None, "the same process still runs"
+    assert len(re.findall(rf"gymgrade-{worker.process.pid}@\S+ ready", worker.log())) >= 2
 
 
 @pytest.mark.parametrize(

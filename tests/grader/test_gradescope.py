@@ -23,9 +23,10 @@ from grading_support import ROOT, SUBMISSIONS, write_config
 
 from grader.cli import main
 from grader.errors import GradescopeError
-from grader.gradescope import SECRET_FILE, GradescopeResults, bundle, bundle_secret, pick_submission, results
+from grader.gradescope import SECRET_FILE, bundle, bundle_secret, pick_submission
 from grader.gradescope_upload import METADATA_FILE, UploadSeed, read_metadata
 from grader.problems import PROBLEM_IDS
+from grader.render.gradescope import GradescopeResults, results
 from grader.report import GradingTimings, ProblemResult, Report, Timings
 from grader.seeds import upload_seed
 

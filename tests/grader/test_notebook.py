@@ -210,7 +210,7 @@ def test_the_report_carries_the_summary_and_the_notes() -> None:
 
 
 def test_the_check_summary_lists_what_was_skipped_cell_by_cell() -> None:
-    from grader.cli import summary
+    from grader.render.text import summary
 
     module = built("!pip install gym\nimport gym", DEFINITION + "\nprint(cartpole())")
     report = Report(

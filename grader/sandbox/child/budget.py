@@ -35,7 +35,7 @@ UNBUDGETED_NODES = 4 * MAX_NODES
 
 @dataclass(frozen=True)
 class WireBudget:
-    """`grader.sandbox.outcome.CallBudget` as the child receives it in a call frame."""
+    """`grader.sandbox.limits.CallBudget` as the child receives it in a call frame."""
 
     max_episodes: int
     max_steps: int

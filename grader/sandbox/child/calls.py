@@ -11,12 +11,16 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+import gymnasium
+
 from grader.compat import events as compat_events
+from grader.compat import register_envs, resolve_env_id
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.cells import RUN_CELLS, run_cells
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
-from grader.sandbox.child.frames import decode_value, encode_value
+from grader.sandbox.child.frames import EnvArgument, decode_value, encode_value
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
+from grader.sandbox.child.provided import PROVIDED
 from grader.sandbox.child.recorder import Recorder
 from grader.sandbox.child.stubs import RAISING_STUB, stub_body
 
@@ -24,6 +28,7 @@ MAX_COMPAT_EVENTS = 100
 MAX_EVENT_DETAIL = 1000
 """Characters kept of a compat event's detail (100 events stay far below the frame's allowance)."""
 _CALL_FIELDS = {"type", "id", "nonce", "function", "args", "kwargs", "seed", "record", "budget"}
+_OPTIONAL_CALL_FIELDS = {"provided"}
 
 
 @dataclass(frozen=True)
@@ -38,6 +43,7 @@ class CallRequest:
     seed: int
     record: bool
     budget: WireBudget | None = None
+    provided: tuple[str, ...] = ()
 
 
 def parse_call(frame: dict[str, Any]) -> CallRequest:
@@ -46,7 +52,7 @@ def parse_call(frame: dict[str, Any]) -> CallRequest:
     Raises:
         ProtocolError: a field is missing, extra or of the wrong type.
     """
-    if frame.keys() != _CALL_FIELDS or frame["type"] != "call":
+    if not _CALL_FIELDS <= frame.keys() <= _CALL_FIELDS | _OPTIONAL_CALL_FIELDS or frame["type"] != "call":
         raise ProtocolError(
             f"expected a call frame with fields {sorted(_CALL_FIELDS)}, found {sorted(frame)}"
         )
@@ -58,20 +64,30 @@ def parse_call(frame: dict[str, Any]) -> CallRequest:
         "kwargs": type(frame["kwargs"]) is dict,
         "seed": type(frame["seed"]) is int and frame["seed"] >= 0,
         "record": type(frame["record"]) is bool,
+        "provided": type(frame.get("provided", [])) is list
+        and all(type(name) is str and name in PROVIDED for name in frame.get("provided", [])),
     }
     wrong = [name for name, ok in checks.items() if not ok]
     if wrong:
         raise ProtocolError(f"call frame fields of the wrong type: {', '.join(wrong)}")
     try:
-        args = decode_value(frame["args"], "the call's arguments")
-        kwargs = decode_value(frame["kwargs"], "the call's keyword arguments")
+        args = decode_value(frame["args"], "the call's arguments", allow_envs=True)
+        kwargs = decode_value(frame["kwargs"], "the call's keyword arguments", allow_envs=True)
         budget = WireBudget.from_plain(frame["budget"])
     except InvalidValueError as error:
         raise ProtocolError(error.message) from None
     except ValueError as error:
         raise ProtocolError(str(error)) from None
     return CallRequest(
-        frame["id"], frame["nonce"], frame["function"], args, kwargs, frame["seed"], frame["record"], budget
+        frame["id"],
+        frame["nonce"],
+        frame["function"],
+        args,
+        kwargs,
+        frame["seed"],
+        frame["record"],
+        budget,
+        tuple(frame.get("provided", [])),
     )
 
 
@@ -173,9 +189,19 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
         )
     if mismatch:
         return _status("bad_signature", mismatch)
+    try:
+        args = [_made(arg) for arg in request.args]
+        kwargs = {key: _made(arg) for key, arg in request.kwargs.items()}
+    except Exception as error:  # the grader's own env could not be made: not the student's doing
+        return _status(
+            "sandbox_error", f"the grader could not make the environment it passes to {name}(): {error}"
+        )
+    namespace = vars(module)
+    replaced = {provided: namespace[provided] for provided in request.provided if provided in namespace}
+    namespace.update({provided: PROVIDED[provided] for provided in request.provided})
     started = time.perf_counter()
     try:
-        value = function(*request.args, **request.kwargs)
+        value = function(*args, **kwargs)
     except MemoryError:
         return _status(
             "memory_limit",
@@ -191,6 +217,12 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
             traceback=student_traceback(error, submission),
             wall_time=time.perf_counter() - started,
         )
+    finally:
+        for provided in request.provided:
+            if provided in replaced:
+                namespace[provided] = replaced[provided]
+            else:
+                namespace.pop(provided, None)
     wall_time = time.perf_counter() - started
     try:
         encoded = encode_value(value, f"the value returned by {name}()", max_bytes=max_frame)
@@ -208,6 +240,20 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
             "memory_limit", f"{name}() returned more data than fits in memory", wall_time=wall_time
         )
     return {**_status("ok", ""), "value": encoded, "wall_time": wall_time}
+
+
+def _made(argument: Any) -> Any:
+    """An `EnvArgument` made into an env (through the recorder, like any env of the call), else itself.
+
+    A lab id gymnasium no longer registers is resolved quietly: the student did not name it.
+    """
+    if type(argument) is not EnvArgument:
+        return argument
+    register_envs()
+    target = resolve_env_id(argument.env_id)
+    return gymnasium.make(
+        target.gymnasium_id, max_episode_steps=argument.max_episode_steps, **target.merged_kwargs({})
+    )
 
 
 def _signature_mismatch(name: str, function: Any, request: CallRequest) -> str:

@@ -4,7 +4,9 @@ A frame is a 4-byte big-endian length followed by that many bytes of UTF-8 JSON 
 Values travel as JSON with two tagged forms: ``{"$float": "nan" | "inf" | "-inf"}`` for non-finite
 floats and ``{"$ndarray": {"dtype": "<f8", "shape": [...], "data": base64}}`` for numeric numpy
 arrays (raw bytes read back with `numpy.frombuffer`, never pickle). Only exact built-in types are
-accepted: a subclass of `float` with rigged comparisons is refused, not converted.
+accepted: a subclass of `float` with rigged comparisons is refused, not converted. A call's arguments may
+also hold ``{"$env": {"id": ..., "max_episode_steps": ...}}`` (`EnvArgument`): an environment the child
+makes for the call (the learners of edition rl1 take `env`); no return value or episode log may.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import math
 import os
 import struct
 from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from typing import Any, BinaryIO
 
 import numpy as np
@@ -31,6 +34,8 @@ MAX_NODES = 2_000_000
 MAX_INT_BITS = 256
 FLOAT_TAG = "$float"
 NDARRAY_TAG = "$ndarray"
+ENV_TAG = "$env"
+MAX_ENV_ID = 100
 
 PLAIN_TYPES_HINT = "only plain data can be returned: None, bool, int, float, str, list, tuple, dict with str keys, numpy numbers and numpy arrays of bool/int/float"  # noqa: E501
 _NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
@@ -47,6 +52,22 @@ _ALLOWED_DTYPES = frozenset(
     for code in ("?", "i1", "i2", "i4", "i8", "u1", "u2", "u4", "u8", "f2", "f4", "f8")
     for order in ("<", ">")
 )
+
+
+@dataclass(frozen=True)
+class EnvArgument:
+    """An argument the child replaces by an environment it makes and records like the student's own.
+
+    Attributes:
+        env_id: The id to make (a lab id such as ``"Taxi-v3"`` is resolved as the compat layer does).
+        max_episode_steps: The time limit of the env made; None keeps the registered one.
+    """
+
+    env_id: str
+    max_episode_steps: int | None = None
+
+    def __repr__(self) -> str:
+        return f"gym.make({self.env_id!r})"
 
 
 @contextlib.contextmanager
@@ -141,14 +162,19 @@ def encode_value(value: Any, what: str = "the value", max_bytes: int | None = No
         return _Encoder(what, max_bytes).encode(value, "", 0)
 
 
-def decode_value(data: Any, what: str = "the value") -> Any:
+def decode_value(data: Any, what: str = "the value", *, allow_envs: bool = False) -> Any:
     """Decode data produced by `encode_value` (after JSON parsing), validating every node.
+
+    Args:
+        data: The parsed JSON.
+        what: How to name the value in error messages.
+        allow_envs: Accept `EnvArgument` tags (a call's arguments only, never a returned value).
 
     Raises:
         InvalidValueError: the data does not have the layout `encode_value` produces.
     """
     with paused_gc():
-        return _Decoder(what).decode(data, "", 0)
+        return _Decoder(what, allow_envs).decode(data, "", 0)
 
 
 class _Encoder:
@@ -188,6 +214,8 @@ class _Encoder:
             return _encode_array(value, self.what, where)
         if kind in _NUMPY_SCALARS:
             return self.encode(_NUMPY_SCALARS[kind](value), where, depth)
+        if kind is EnvArgument:
+            return {ENV_TAG: {"id": value.env_id, "max_episode_steps": value.max_episode_steps}}
         raise _invalid(self.what, where, _found(value) + "; " + PLAIN_TYPES_HINT + _conversion_hint(value))
 
     def _encode_dict(self, value: dict[Any, Any], where: str, depth: int) -> dict[str, Any]:
@@ -204,9 +232,10 @@ class _Encoder:
 
 
 class _Decoder:
-    def __init__(self, what: str) -> None:
+    def __init__(self, what: str, allow_envs: bool = False) -> None:
         self.what = what
         self.nodes = 0
+        self.allow_envs = allow_envs
 
     def decode(self, data: Any, where: str, depth: int) -> Any:
         self.nodes += 1
@@ -234,7 +263,20 @@ class _Decoder:
             return _NON_FINITE[data[FLOAT_TAG]]
         if data.keys() == {NDARRAY_TAG} and type(data[NDARRAY_TAG]) is dict:
             return _decode_array(data[NDARRAY_TAG], self.what, where)
+        if self.allow_envs and data.keys() == {ENV_TAG}:
+            return _decode_env(data[ENV_TAG], self.what, where)
         raise _invalid(self.what, where, f"unknown tagged object with keys {sorted(data)}")
+
+
+def _decode_env(spec: Any, what: str, where: str) -> EnvArgument:
+    if type(spec) is not dict or spec.keys() != {"id", "max_episode_steps"}:
+        raise _invalid(what, where, "an env argument needs exactly id and max_episode_steps")
+    env_id, limit = spec["id"], spec["max_episode_steps"]
+    if type(env_id) is not str or not 0 < len(env_id) <= MAX_ENV_ID:
+        raise _invalid(what, where, f"an env id must be a string of 1 to {MAX_ENV_ID} characters")
+    if limit is not None and (type(limit) is not int or not 0 < limit < 2**62):
+        raise _invalid(what, where, f"max_episode_steps {limit!r} is not a positive int or null")
+    return EnvArgument(env_id, limit)
 
 
 def _encode_array(array: np.ndarray, what: str, where: str) -> dict[str, Any]:

@@ -31,7 +31,7 @@ from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 from grader.sandbox.isolation.privileges import running_as_root
 
 if TYPE_CHECKING:
-    from grader.sandbox.isolation.launch import LaunchSpec
+    from grader.sandbox.isolation.layer import LaunchSpec
 
 HARNESS_DIR = "/gymgrade"
 SUBMISSION_DIR = "/submission"

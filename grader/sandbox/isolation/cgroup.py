@@ -12,11 +12,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from grader.sandbox.isolation import scope
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
-from grader.sandbox.isolation.scope import forget_cgroup, record_cgroup
 
 if TYPE_CHECKING:
-    from grader.sandbox.isolation.launch import LaunchSpec
+    from grader.sandbox.isolation.layer import LaunchSpec
 
 CGROUP_ROOT = Path("/sys/fs/cgroup")
 CONTROLLERS = ("memory", "pids", "cpu")
@@ -28,6 +28,9 @@ _REMEDY = (
 _JOIN_CGROUPS = 'for f do [ "$f" = -- ] && break; echo $$ > "$f" || exit 125; shift; done; shift; exec "$@"'
 JOIN_FAILED_EXIT = 125
 """Exit status of the start-up wrapper when the child could not join its cgroups."""
+CGROUP_RECORDS = "cgroups"
+"""The kind of resource job cgroups are recorded under in a grading's scope: one record per job cgroup, a
+`<version> <path>` line per hierarchy."""
 
 
 @dataclass
@@ -140,7 +143,7 @@ class JobCgroup:
             else:
                 removed = False
         if removed and self.groups:
-            forget_cgroup(self.groups[0].path.name)
+            scope.forget(CGROUP_RECORDS, self.groups[0].path.name)
         return emptied and removed
 
 
@@ -152,6 +155,15 @@ def remove_job_directories(directories: list[tuple[int, Path]]) -> bool:
     """
     groups = [_Group(path, version, ()) for version, path in directories if path.name.startswith(JOB_PREFIX)]
     return JobCgroup(groups).remove()
+
+
+def _remove_recorded(lines: list[str]) -> None:
+    """The scope's cleanup of one recorded job cgroup (its `<version> <path>` lines)."""
+    directories = [line.split(" ", 1) for line in lines]
+    remove_job_directories([(int(version), Path(path)) for version, path in directories])
+
+
+scope.register_cleanup(CGROUP_RECORDS, _remove_recorded)
 
 
 def _remove_stale(parent: Path, version: int) -> None:
@@ -169,7 +181,9 @@ def _remove_stale(parent: Path, version: int) -> None:
 def _make_group(parent: Path, name: str, version: int, controllers: tuple[str, ...]) -> _Group:
     _remove_stale(parent, version)
     path = parent / name
-    record_cgroup(name, version, path)  # before it exists: a kill right after mkdir leaves nothing
+    scope.record(
+        CGROUP_RECORDS, name, f"{version} {path}"
+    )  # before it exists: a kill right after mkdir leaves nothing
     path.mkdir()
     return _Group(path, version, controllers)
 

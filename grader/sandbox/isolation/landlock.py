@@ -15,7 +15,7 @@ from grader.sandbox.isolation.filesystem import SYSTEM_CONFIG_DIRS, SYSTEM_DIRS
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 
 if TYPE_CHECKING:
-    from grader.sandbox.isolation.launch import LaunchSpec
+    from grader.sandbox.isolation.layer import LaunchSpec
 
 READABLE_FILES = ("/dev/null", "/dev/urandom", "/proc/self", "/etc/ld.so.cache", "/etc/localtime")
 """Files outside the interpreter's directories the child reads."""

@@ -12,7 +12,7 @@ from grader.sandbox.isolation.filesystem import python_paths
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 
 if TYPE_CHECKING:
-    from grader.sandbox.isolation.launch import LaunchSpec
+    from grader.sandbox.isolation.layer import LaunchSpec
 
 SANDBOX_UID = 65534
 """`nobody` on Debian and most distributions."""

@@ -10,7 +10,7 @@ from grader.sandbox.isolation.privileges import running_as_root
 from grader.sandbox.limits import Limits
 
 if TYPE_CHECKING:
-    from grader.sandbox.isolation.launch import LaunchSpec
+    from grader.sandbox.isolation.layer import LaunchSpec
 
 CPU_GRACE_SECONDS = 5
 """Between the soft CPU limit (SIGXCPU) and the hard one (SIGKILL)."""

@@ -3,9 +3,12 @@
 A grading's pytest run is SIGKILLed when its results are in or when it is abandoned, so its workers'
 exit handlers never run. Instead, the grading's top-level process opens a `sandbox_scope`: every
 harness tree and scratch directory of its workers is created inside the scope's directory (named by
-the `SCOPE_VARIABLE` environment variable the workers inherit), and every job cgroup is recorded
-there before it is created. Closing the scope kills what is left in those cgroups, removes them and
-deletes the directory.
+the `SCOPE_VARIABLE` environment variable the workers inherit), and every resource outside it (a job
+cgroup) is recorded there before it is created, under the kind of resource it is. Closing the scope
+runs each kind's cleanup on what is still recorded, then deletes the directory.
+
+The scope knows no layer: a layer that records a kind registers its cleanup (`register_cleanup`) when
+its module is imported, which importing this package does (`grader.sandbox.isolation` lists every layer).
 """
 
 from __future__ import annotations
@@ -14,14 +17,16 @@ import contextlib
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 SCOPE_VARIABLE = "GYMGRADE_SANDBOX_SCOPE"
 """Environment variable naming the directory of the grading this process works for."""
 SCOPE_PREFIX = "gymgrade-scope-"
-CGROUP_RECORDS = "cgroups"
-"""Subdirectory of the scope: one file per job cgroup, a `<version> <path>` line per hierarchy."""
+Cleanup = Callable[[list[str]], None]
+"""Releases (best effort) what one record lists: the lines recorded for one resource."""
+CLEANUPS: dict[str, Cleanup] = {}
+"""Every kind of resource a scope releases, with its cleanup; filled by the layers' modules on import."""
 
 
 def scope_directory() -> Path | None:
@@ -35,46 +40,50 @@ def temp_root() -> Path:
     return scope_directory() or Path(tempfile.gettempdir())
 
 
-def record_cgroup(name: str, version: int, path: Path) -> None:
-    """Notes, before it is created, a job cgroup directory the scope must remove (no-op outside one)."""
+def register_cleanup(kind: str, cleanup: Cleanup) -> None:
+    """Makes closing a scope run `cleanup` on every resource of `kind` still recorded in it."""
+    CLEANUPS[kind] = cleanup
+
+
+def record(kind: str, name: str, line: str) -> None:
+    """Notes, before it is created, a resource of `kind` the scope must release (no-op outside one)."""
     scope = scope_directory()
     if scope is None:
         return
-    records = scope / CGROUP_RECORDS
+    records = scope / kind
     records.mkdir(exist_ok=True)
-    with (records / name).open("a") as record:
-        record.write(f"{version} {path}\n")
+    with (records / name).open("a") as recorded:
+        recorded.write(f"{line}\n")
 
 
-def forget_cgroup(name: str) -> None:
-    """Drops the record of a job cgroup its owner removed."""
+def forget(kind: str, name: str) -> None:
+    """Drops the record of a resource its owner released."""
     scope = scope_directory()
     if scope is not None:
         with contextlib.suppress(OSError):
-            (scope / CGROUP_RECORDS / name).unlink()
+            (scope / kind / name).unlink()
 
 
 @contextlib.contextmanager
 def sandbox_scope() -> Iterator[dict[str, str]]:
     """Opens a scope for one grading; yields the environment variables its processes must inherit.
 
-    On exit (also after an exception), every recorded job cgroup still present is emptied (SIGKILL) and
-    removed, then the directory with every harness tree and scratch directory in it.
+    On exit (also after an exception), every resource still recorded is released by its kind's cleanup
+    (a job cgroup is emptied with SIGKILL and removed), then the directory with every harness tree and
+    scratch directory in it is deleted.
     """
     root = Path(tempfile.mkdtemp(prefix=SCOPE_PREFIX))
     os.chmod(root, 0o711)  # a child whose uid was dropped must reach its scratch inside
     try:
         yield {SCOPE_VARIABLE: str(root)}
     finally:
-        remove_recorded_cgroups(root)
+        release_recorded(root)
         shutil.rmtree(root, ignore_errors=True)
 
 
-def remove_recorded_cgroups(root: Path) -> None:
-    """Kills the processes of, and removes, every job cgroup recorded in the scope `root`."""
-    from grader.sandbox.isolation.cgroup import remove_job_directories  # the cgroup layer records here
-
-    for record in sorted((root / CGROUP_RECORDS).glob("*")):
-        with contextlib.suppress(OSError, ValueError):
-            lines = [line.split(" ", 1) for line in record.read_text().splitlines() if line]
-            remove_job_directories([(int(version), Path(path)) for version, path in lines])
+def release_recorded(root: Path) -> None:
+    """Runs each kind's cleanup on every resource still recorded in the scope `root`."""
+    for kind, cleanup in sorted(CLEANUPS.items()):
+        for recorded in sorted((root / kind).glob("*")):
+            with contextlib.suppress(OSError, ValueError):
+                cleanup([line for line in recorded.read_text().splitlines() if line])

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 
 if TYPE_CHECKING:
-    from grader.sandbox.isolation.launch import LaunchSpec
+    from grader.sandbox.isolation.layer import LaunchSpec
 
 DEBIAN_BINDINGS = "/usr/lib/python3/dist-packages"
 _REMEDY = (

@@ -9,7 +9,7 @@ from grader.checks.base import CallRecord
 from grader.checks.integrity import games_budget, integrity_problem, played_episodes, replay_call, settled_by
 from grader.games import allowed_games
 from grader.problems import PROBLEMS
-from grader.sandbox.outcome import CallBudget
+from grader.sandbox.limits import CallBudget
 from grader.sandbox.replay import replay_episode
 from grader.testing.behaviours import cartpole, velocity_policy
 

@@ -8,43 +8,7 @@ from pathlib import Path
 import pytest
 
 from grader import cli
-from grader.class_report.from_batch import entries_from_batch, page_clash_of_reports
-
-from .support import report, result
-
-
-@pytest.mark.parametrize(
-    ("page", "href"),
-    [
-        ("class.html", "out/alice.json"),
-        ("out/class.html", "alice.json"),
-        ("pages/x/class.html", "../../out/alice.json"),
-    ],
-    ids=["beside-the-out-dir", "inside-it", "elsewhere"],
-)  # fmt: skip
-def test_batch_entries_link_each_report_relative_to_the_page(tmp_path: Path, page: str, href: str) -> None:
-    [entry] = entries_from_batch(
-        [tmp_path / "in" / "alice.py"], [report()], tmp_path / "out", tmp_path / page
-    )
-    assert (entry.identity, entry.status, entry.report_href, entry.note) == (
-        "alice",
-        "graded",
-        href,
-        "graded alice.py",
-    )
-
-
-def test_batch_entries_take_the_batchs_report_names_and_mark_submission_errors(tmp_path: Path) -> None:
-    paths = [tmp_path / "a" / "opengym.py", tmp_path / "b" / "opengym.py"]
-    reports = [
-        report(result("taxi", "passed")),
-        report(result("taxi", "error", "x"), submission_error="empty"),
-    ]
-    entries = entries_from_batch(paths, reports, tmp_path, tmp_path / "class.html")
-    assert [(entry.identity, entry.status, entry.note, entry.report_href) for entry in entries] == [
-        ("opengym", "graded", "graded opengym.py", "opengym.json"),
-        ("opengym-2", "submission_error", "empty", "opengym-2.json"),
-    ]
+from grader.class_report.from_batch import page_clash_of_reports
 
 
 def test_grade_with_html_writes_the_class_page_and_its_summary(

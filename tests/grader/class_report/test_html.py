@@ -8,10 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from grader import html_report
 from grader.class_report import CSP, ClassEntry, render_class_html, summary_path, write_class_report
-from grader.class_report.html import DIAGNOSES_SHOWN, IDENTITIES_SHOWN, STYLE, content_security_policy
+from grader.class_report.html import DIAGNOSES_SHOWN, IDENTITIES_SHOWN, STYLE
 from grader.class_report.text import HIDDEN, MAX_DIAGNOSIS_CHARS
+from grader.render import html as html_report
+from grader.render.csp import content_security_policy
 
 from .support import SHORT_POLE, STOOD_ON_N, all_passed, graded, report, result
 

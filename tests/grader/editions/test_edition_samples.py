@@ -97,6 +97,12 @@ def test_at_least_five_epsilon_decay_mistakes_are_pinned() -> None:
     assert all(sample.feedback.get("epsilon_decay") for sample in failing)
 
 
+def test_at_least_five_sarsa0_mistakes_are_pinned() -> None:
+    failing = [sample for sample in SAMPLES if sample.status.get("sarsa0") == "failed"]
+    assert len(failing) >= 5
+    assert all(sample.feedback.get("sarsa0") for sample in failing)
+
+
 @pytest.mark.parametrize("sample", SAMPLES, ids=[sample.file for sample in SAMPLES])
 def test_sample_gets_its_verdicts(sample: Sample, reports: dict[str, Report]) -> None:
     report = reports[sample.file]

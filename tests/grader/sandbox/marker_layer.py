@@ -7,8 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from grader.sandbox.isolation.launch import LaunchSpec
-from grader.sandbox.isolation.layer import IsolationReport, LayerReport
+from grader.sandbox.isolation.layer import IsolationReport, LaunchSpec, LayerReport
 
 MARKER_VARIABLE = "GYMGRADE_MARKER"
 

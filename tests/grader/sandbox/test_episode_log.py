@@ -12,7 +12,7 @@ from grader.sandbox.child.errors import InvalidEpisodeLogError
 from grader.sandbox.child.frames import encode_frame, encode_value, parse_payload
 from grader.sandbox.child.recorder import EPISODE_COLUMNS, EPISODE_HEADER, SHORT_EPISODE_STEPS, EpisodeRecord
 from grader.sandbox.episode_log import EpisodeLog, WireEpisode, episodes_from_plain
-from grader.sandbox.outcome import CallBudget
+from grader.sandbox.limits import CallBudget
 
 STEPS = [(1, -1.0), (4, -10.0), (5, 20.0)]
 LONG = SHORT_EPISODE_STEPS + 1

@@ -15,8 +15,8 @@ from grader.sandbox import Call, IsolationPolicy, Limits, OutcomeStatus, Sandbox
 from grader.sandbox.isolation import bubblewrap, cgroup, landlock, privileges, registry, rlimits, seccomp
 from grader.sandbox.isolation.cgroup import JOIN_FAILED_EXIT, JobCgroup, join_argv
 from grader.sandbox.isolation.filesystem import SYSTEM_DIRS, ChildView, harness_tree, python_paths
-from grader.sandbox.isolation.launch import LaunchSpec, build_launch
-from grader.sandbox.isolation.layer import IsolationReport, LayerReport
+from grader.sandbox.isolation.launch import build_launch
+from grader.sandbox.isolation.layer import IsolationReport, LaunchSpec, LayerReport
 
 LAYER_ORDER = ["cgroup", "bubblewrap", "seccomp", "privileges", "rlimits", "landlock"]
 LIMITS = Limits(call_seconds=5, import_seconds=20)

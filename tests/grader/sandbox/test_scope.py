@@ -13,7 +13,8 @@ import pytest
 
 from grader.grading import GradingPlan, grade_files
 from grader.sandbox import IsolationPolicy, probe_isolation
-from grader.sandbox.isolation.scope import CGROUP_RECORDS, SCOPE_PREFIX, sandbox_scope
+from grader.sandbox.isolation.cgroup import CGROUP_RECORDS
+from grader.sandbox.isolation.scope import SCOPE_PREFIX, sandbox_scope
 
 SUBMISSION = textwrap.dedent("""
     import time

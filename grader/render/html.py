@@ -1,4 +1,4 @@
-"""The self-contained HTML report: verdicts, feedback, plots and replays in one file that needs nothing else.
+"""The HTML report of one grading: verdicts, feedback, plots and replays in one file that needs nothing else.
 
 Every image is a ``data:`` URI; the page carries its own Content-Security-Policy (no scripts, no network,
 images only from ``data:``, and only its own stylesheet, pinned by hash), so it can be mailed, uploaded to
@@ -7,18 +7,17 @@ a learning platform or opened from disk.
 
 from __future__ import annotations
 
-import base64
-import hashlib
-from pathlib import Path
+from typing import TYPE_CHECKING
 
-from jinja2 import Environment, FileSystemLoader, select_autoescape
-
-from grader.cli import isolation_lines
-from grader.config import AssignmentConfig
-from grader.figures import Figure, all_figures
+from grader.render.csp import content_security_policy
+from grader.render.page import page_environment
+from grader.render.text import isolation_lines
 from grader.report import Report
 
-TEMPLATES = Path(__file__).with_name("templates")
+if TYPE_CHECKING:
+    from grader.config import AssignmentConfig
+    from grader.figures import Figure
+
 STYLE = (
     "body{font-family:system-ui,sans-serif;max-width:52rem;margin:2rem auto;padding:0 1rem;color:#222}"
     ".meta{color:#555;font-size:.9rem}.badge{font-size:.8rem;padding:.1rem .4rem;border-radius:.3rem;"
@@ -29,16 +28,10 @@ STYLE = (
     "td,th{border:1px solid #ddd;padding:.2rem .4rem;text-align:left;vertical-align:top}"
     ".feedback{white-space:pre-wrap}"
 )
-CSP = (
-    "default-src 'none'; img-src data:; style-src 'sha256-"
-    + base64.b64encode(hashlib.sha256(STYLE.encode()).digest()).decode()
-    + "'; base-uri 'none'; form-action 'none'"
-)
+CSP = content_security_policy(STYLE)
 """The page's policy: nothing loads or runs except its images (data: URIs) and its own style."""
 
-_environment = Environment(
-    loader=FileSystemLoader(TEMPLATES), autoescape=select_autoescape(["html"]), keep_trailing_newline=True
-)
+_environment = page_environment()
 
 
 def render_html(
@@ -54,6 +47,9 @@ def render_html(
     Returns:
         The page.
     """
+    # Drawing needs matplotlib: imported only when a page is drawn, not whenever a format is chosen.
+    from grader.figures import all_figures
+
     drawn = figures if figures is not None else all_figures(report.problems, config)
     isolation = " ".join(isolation_lines(report.isolation))
     return _environment.get_template("report.html").render(

@@ -16,7 +16,7 @@ from PIL import Image
 
 from grader.config import load_config
 from grader.figures import MAX_GIF_FRAMES, MAX_GIF_WIDTH, all_figures, replay_gif
-from grader.html_report import CSP, render_html
+from grader.render.html import CSP, render_html
 from grader.report import EpisodeReplay, ProblemResult, Report
 from reference.oracles.taxi import optimal_q_table
 from reference.solutions import cartpole_policy, mountain_car_policy

@@ -1,0 +1,24 @@
+"""The frame of every self-contained page gymgrade writes (`templates/page.html`) and its Jinja environment.
+
+A page template extends ``page.html``, filling its ``title`` and ``body`` blocks; the frame adds the page's
+Content-Security-Policy (`grader.render.csp`) and its one stylesheet, passed as ``csp`` and ``style``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from jinja2 import Environment, FileSystemLoader, select_autoescape
+
+TEMPLATES = Path(__file__).resolve().parents[1] / "templates"
+"""The report pages' templates and the frame."""
+
+
+def page_environment(*templates: Path) -> Environment:
+    """An environment drawing pages from ``templates`` (then `TEMPLATES`, where the frame is): every value
+    escaped as HTML, the template's last newline kept."""
+    return Environment(
+        loader=FileSystemLoader([*templates, TEMPLATES]),
+        autoescape=select_autoescape(["html"]),
+        keep_trailing_newline=True,
+    )

@@ -1,0 +1,73 @@
+"""The text summary `gymgrade check` prints: every verdict's feedback, the total, the isolation.
+
+Its pieces (`notebook_lines`, `isolation_lines`) are also what the Gradescope output and the HTML report
+say of the notebook and the sandbox.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from grader.notebook import NotebookSummary
+from grader.report import IsolationSummary, Report
+
+if TYPE_CHECKING:
+    from grader.config import AssignmentConfig
+
+
+def render_text(report: Report, config: AssignmentConfig | None = None) -> str:
+    """`summary` as printed: one line each, ending with a newline (``config`` is not needed)."""
+    return summary(report) + "\n"
+
+
+def summary(report: Report) -> str:
+    """The readable end of `gymgrade check`: every verdict's feedback, the total, the isolation."""
+    lines = [""]
+    if report.notebook is not None:
+        lines += notebook_lines(report.notebook)
+    if report.submission_error is not None:
+        lines.append(report.submission_error)
+    else:
+        for result in report.problems:
+            lines += [f"{result.title}: {result.status}", f"  {result.feedback}"]
+    lines.append(
+        f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
+    )
+    lines.append(
+        f"Practice seed {report.seed}: your instructor grades on different, unseen starts (a held-out seed), so code that only does well from these starts will fail there."  # noqa: E501
+    )
+    lines += isolation_lines(report.isolation)
+    lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
+    return "\n".join(lines)
+
+
+def notebook_lines(notebook: NotebookSummary) -> list[str]:
+    """What of a notebook ran at import, and every statement that did not, cell by cell."""
+    lines = [
+        f"Notebook: {notebook.kept_statements} imports, definitions and constants from {notebook.code_cells} code cells ran at import; "  # noqa: E501
+        f"{len(notebook.skipped)} statements did not:"
+    ]
+    for entry in notebook.skipped:
+        label = f"In [{entry.execution_count}]" if entry.execution_count is not None else "no run"
+        lines.append(f"  cell {entry.cell} ({label}), line {entry.line}: {entry.code}  <- {entry.reason}")
+    lines += [f"  ignored: {note}" for note in notebook.ignored]
+    return [*lines, ""]
+
+
+def isolation_lines(isolation: IsolationSummary | None) -> list[str]:
+    """How the student's code was isolated: one line when fully, else each missing layer and its remedy."""
+    if isolation is None:
+        return []
+    if isolation.full:
+        names = ", ".join(layer.name for layer in isolation.layers if layer.active)
+        return [f"Sandbox: full isolation ({names})."]
+    lines = [
+        "Sandbox: weaker isolation on this machine (fine for checking your own code; instructors grade with full isolation). "  # noqa: E501
+        "Missing:"
+    ]
+    lines += [
+        f"  - {layer.name}: {layer.detail}" + (f" (to fix: {layer.remedy})" if layer.remedy else "")
+        for layer in isolation.layers
+        if layer.required and not layer.active
+    ]
+    return lines

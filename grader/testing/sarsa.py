@@ -1,0 +1,140 @@
+"""Simulated `sarsa0(env, alpha, gamma, epsilon, N, decay)` students (edition rl1): honest ones and mistakes.
+
+Each is called as ``function(lab, env_argument, alpha, gamma, epsilon, N, decay)`` by
+`grader.testing.simulation`; it makes the env the grader passes with `lab.make` (logged like the sandbox's
+recorder) and draws its randomness from `lab.random` and the env's action space.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from grader.sandbox.child.frames import EnvArgument
+from grader.testing.simulation import Lab
+
+
+def epsilon_decay(lab: Lab, episode: int, n: int, start: float = 1.0, end: float = 1e-6) -> float:
+    """The lab's linear decay."""
+    return start - (episode - 1) * (start - end) / n
+
+
+def epsilon_decay_zero_based(lab: Lab, episode: int, n: int, start: float = 1.0, end: float = 1e-6) -> float:
+    """A wrong decay (0-based episodes), graded in problem 5 and not again in sarsa0."""
+    return start - episode * (start - end) / n
+
+
+def _env(lab: Lab, env: EnvArgument) -> Any:
+    return lab.make(env.env_id, max_episode_steps=env.max_episode_steps)
+
+
+def _first_argmax(row: Any, lab: Lab) -> int:
+    return int(np.argmax(row))
+
+
+def _random_argmax(row: Any, lab: Lab) -> int:
+    best = np.flatnonzero(row == row.max())
+    return int(best[lab.random.randrange(len(best))])
+
+
+def _learner(
+    *,
+    target: str = "sarsa",
+    alpha_used: bool = True,
+    gamma_used: bool = True,
+    end_update: bool = True,
+    choose_from: str = "next",
+    explore: bool = True,
+    decays: bool = True,
+    argmax: Callable[[Any, Lab], int] = _first_argmax,
+    stop_on_truncated: bool = False,
+    returns: str = "pair",
+    fixed: tuple[float, float] | None = None,
+    penalty_offset: int = 0,
+    runs: int = 1,
+    keeps_first_table: bool = False,
+    schedule: Callable[..., float] = epsilon_decay,
+) -> Callable[..., Any]:
+    """A SARSA(0) learner on the lab's skeleton, with one of the typical departures switched on."""
+    kept: list[Any] = []
+
+    def sarsa0(
+        lab: Lab, env_argument: EnvArgument, alpha: float, gamma: float, epsilon: float, n: int, decay: bool
+    ) -> Any:
+        if fixed is not None:
+            alpha, gamma = fixed
+        env = _env(lab, env_argument)
+        for _ in range(runs):
+            q_table = np.zeros((env.observation_space.n, env.action_space.n))
+            penalties = 0
+
+            def choose(state: int, rate: float, table: Any = q_table) -> int:
+                if explore and lab.random.uniform(0, 1) < rate:
+                    return int(env.action_space.sample())
+                return argmax(table[state], lab)
+
+            for episode in range(1, n + 1):
+                rate = schedule(lab, episode, n) if decay and decays else epsilon
+                state, _ = env.reset()
+                action = choose(state, rate)
+                done = False
+                while not done:
+                    next_state, reward, terminated, truncated, _ = env.step(action)
+                    if target == "taken":
+                        q_table[state, action] += alpha * (
+                            reward + gamma * q_table[next_state, action] - q_table[state, action]
+                        )
+                    next_action = choose(next_state if choose_from == "next" else state, rate)
+                    if target == "max":
+                        bootstrap = np.max(q_table[next_state])
+                    else:
+                        bootstrap = q_table[next_state, next_action]
+                    value = reward + (gamma if gamma_used else 1.0) * bootstrap
+                    done = terminated or (stop_on_truncated and truncated)
+                    if target != "taken" and (end_update or not terminated):
+                        if alpha_used:
+                            q_table[state, action] = (1 - alpha) * q_table[state, action] + alpha * value
+                        else:
+                            q_table[state, action] = value
+                    penalties += reward == -10
+                    state, action = next_state, next_action
+        if keeps_first_table:
+            kept.append(q_table)
+            q_table = kept[0]
+        if returns == "table":
+            return q_table
+        return q_table, penalties + penalty_offset
+
+    return sarsa0
+
+
+def learner_with_decay(schedule: Callable[..., float]) -> Callable[..., Any]:
+    """The lab's learner calling another epsilon_decay (a student's own, right or wrong)."""
+    return _learner(schedule=schedule)
+
+
+HONEST: dict[str, Callable[..., Any]] = {
+    "lab_loop": _learner(),
+    "table_only": _learner(returns="table"),
+    "random_ties": _learner(argmax=_random_argmax),
+    "stops_on_truncated": _learner(stop_on_truncated=True),
+}
+"""Honest learners: the lab's loop, the table alone returned, ties broken at random, a stop on truncated."""
+
+MISTAKES: dict[str, tuple[Callable[..., Any], str]] = {
+    "q_learning": (_learner(target="max"), "which is Q-learning"),
+    "next_action_after_update": (_learner(target="taken"), "the next action was chosen after the update"),
+    "next_action_from_state": (_learner(choose_from="state"), "choose the next action from next_state"),
+    "missing_alpha": (_learner(alpha_used=False), "instead of moving it by alpha"),
+    "missing_gamma": (_learner(gamma_used=False), "did not discount"),
+    "no_end_update": (_learner(end_update=False), "skips the update of the last step"),
+    "default_parameters": (_learner(fixed=(0.1, 0.6)), "alpha=0.1 and gamma=0.6"),
+    "trains_twice": (_learner(runs=2), "episode(s); N="),
+    "table_of_another_run": (_learner(keeps_first_table=True), "nor any typical variant"),
+    "never_explores": (_learner(explore=False), "you explored less than epsilon asks"),
+    "ignores_decay": (_learner(decays=False), "less than the decayed schedule"),
+    "wrong_penalties": (_learner(penalty_offset=1), "penalties"),
+}
+"""Typical sarsa0 mistakes: (the learner, words its feedback must contain)."""
