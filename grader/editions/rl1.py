@@ -82,4 +82,4 @@ RL1 = Edition(
         ),
     ),
 )
-"""The current edition: problems 1-7 graded (sarsa0, and compare() with `run_cells`); qlearn in `not_graded`."""
+"""The current edition: problems 1-7 graded (sarsa0; compare() with `run_cells`); qlearn in `not_graded`."""
