@@ -5,11 +5,13 @@ from __future__ import annotations
 import hashlib
 import time
 from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 
 from grader.checks.base import CallRecord, Verdict
 from grader.checks.integrity import replay_call, settled_by
 from grader.config import AssignmentConfig
+from grader.notebook.cells import runnable_cells
 from grader.problem_registry import ProblemId
 from grader.report import (
     IsolationSummary,
@@ -28,6 +30,7 @@ from grader.sandbox import (
     IsolationReport,
     Sandbox,
 )
+from grader.sandbox.child.cells import RUN_CELLS
 from grader.showcase import showcase_episode
 
 MAX_COMPAT_EVENTS = 20
@@ -119,6 +122,8 @@ def run_problem(
     with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:
         calls = check.plan(settings, FunctionsOnDemand(sandbox))
         for call in calls:
+            if call.function == RUN_CELLS:  # the cells are the submission's, known here, not to the plan
+                call = replace(call, args=(runnable_cells(submission),))
             records.append(replay_call(sandbox.call(call), games))
             stopped = settled_by(records[-1], games)
             if stopped is not None:
@@ -126,7 +131,8 @@ def run_problem(
         isolation = isolation_summary(sandbox.isolation)
     outcomes = [record.outcome for record in records]
     verdict = check.judge(settings, records)
-    if stopped is not None and len(records) < len(calls):
+    cells_failed = bool(records) and records[-1].outcome.call.function == RUN_CELLS  # the check says so
+    if stopped is not None and len(records) < len(calls) and not cells_failed:
         verdict = _stopped_early(verdict, stopped, len(records), len(calls))
     wall_seconds = time.perf_counter() - started
     student_seconds = sum(outcome.wall_time for outcome in outcomes)

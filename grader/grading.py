@@ -16,6 +16,7 @@ from grader.config import load_config
 from grader.errors import UnknownProblem
 from grader.execution import problem_seed
 from grader.notebook import NotebookModule, build_module, is_notebook
+from grader.notebook.cells import RAN_CELLS, write_cells
 from grader.plugin import CaseOutcome, GraderFailure, ProblemCase, SessionPlan
 from grader.problems import ProblemId
 from grader.report import FIRST_EDITION, GradingTimings, ProblemResult, ProblemRun, Report, Visibility
@@ -206,6 +207,7 @@ def _prepare(
     module = modules_dir / f"{len(list(modules_dir.iterdir()))}" / f"{path.name}.py"
     module.parent.mkdir()
     module.write_text(built.source, encoding="utf-8")
+    write_cells(module, built.cells)
     return module, built
 
 
@@ -219,7 +221,7 @@ def with_notebook(report: Report, notebook: NotebookModule | None) -> Report:
         result.model_copy(
             update={
                 "feedback": notebook.cited(
-                    " ".join([*notebook.summary.notes_for(result.id), result.feedback]), module_name
+                    " ".join([*_global_notes(notebook, result), result.feedback]), module_name
                 ),
                 "output": notebook.cited(result.output, module_name),
             }
@@ -227,6 +229,14 @@ def with_notebook(report: Report, notebook: NotebookModule | None) -> Report:
         for result in report.problems
     ]
     return report.model_copy(update={"notebook": notebook.summary, "problems": problems})
+
+
+def _global_notes(notebook: NotebookModule, result: ProblemResult) -> list[str]:
+    """The notes on globals only skipped statements set: none for a problem not run, or run after the
+    notebook's cells (which set them)."""
+    if result.status == "skipped" or result.measurements.get(RAN_CELLS):
+        return []
+    return notebook.summary.notes_for(result.id)
 
 
 def build_report(

@@ -2,10 +2,11 @@
 
 Problems 1-4 are the shared declarations of `grader.problems`; `epsilon_decay` and the two-table
 `taxi(q_table, q_table_decay)` are this edition's own, and `sarsa0`, verified by replaying its updates
-(`grader.checks.sarsa`). `compare()` is declared as an expected function (the template defines it,
-detection reads it) but not graded yet (`not_graded`).
+(`grader.checks.sarsa`). `compare()` is graded when the configuration runs the notebook's cells
+(`run_cells`, else it is skipped, worth 0: `grader.checks.compare`).
 """
 
+from grader.checks.compare import CompareCheck, CompareConfig
 from grader.checks.epsilon_decay import EpsilonDecayCheck, EpsilonDecayConfig
 from grader.checks.sarsa import SarsaCheck, SarsaConfig
 from grader.checks.taxi_tables import TaxiTablesCheck, TaxiTablesConfig
@@ -63,6 +64,13 @@ RL1 = Edition(
                 config=SarsaConfig,
                 check=SarsaCheck(),
             ),
+            Problem(
+                id="compare",
+                title="Problem 7: compare()",
+                points=1.0,
+                config=CompareConfig,
+                check=CompareCheck(),
+            ),
         )
     ),
     functions=FUNCTIONS,
@@ -71,8 +79,11 @@ RL1 = Edition(
     default_config=PACKAGE / "rl1.toml",
     notebook_name="gymnasium.ipynb",
     not_graded=(
-        ("qlearn", "provided by the template; taxi gets the grader's own tables, so no verdict needs it"),
-        ("compare", "compare() needs the notebook's own training cells; not graded yet"),
+        (
+            "qlearn",
+            "provided by the template; taxi gets the grader's own tables, so no verdict needs it; "
+            "it runs only inside the notebook's cells when compare() is graded with run_cells",
+        ),
     ),
 )
-"""The current edition: problems 1-7 graded (sarsa0 included); qlearn and compare() listed in `not_graded`."""
+"""The current edition: problems 1-7 graded (sarsa0; compare() with `run_cells`); qlearn in `not_graded`."""

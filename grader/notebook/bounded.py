@@ -50,6 +50,7 @@ class _Reply(BaseModel):
     source: str = ""
     summary: NotebookSummary | None = None
     origins: list[tuple[int, int] | None] = []
+    cells: list[tuple[int, str]] = []
 
 
 def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) -> NotebookModule | FileVerdict:
@@ -95,7 +96,9 @@ def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) ->
         return _unreadable(name, "the reader's reply was not understood")
     if reply.status != "module" or reply.summary is None:
         return FileVerdict("missing" if reply.status == "missing" else "error", reply.message)
-    return NotebookModule(source=reply.source, summary=reply.summary, origins=tuple(reply.origins))
+    return NotebookModule(
+        source=reply.source, summary=reply.summary, origins=tuple(reply.origins), cells=tuple(reply.cells)
+    )
 
 
 def _unreadable(name: str, what: str) -> FileVerdict:
@@ -144,7 +147,11 @@ def _main() -> None:
         reply = _Reply(status=built.status, message=built.message)
     else:
         reply = _Reply(
-            status="module", source=built.source, summary=built.summary, origins=list(built.origins)
+            status="module",
+            source=built.source,
+            summary=built.summary,
+            origins=list(built.origins),
+            cells=list(built.cells),
         )
     sys.stdout.write(reply.model_dump_json())
 

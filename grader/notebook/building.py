@@ -73,6 +73,7 @@ class _Builder:
     broken: list[str] = field(default_factory=list)
     postponed_annotations: bool = False
     graded: Collection[str] | None = None
+    runnable: list[tuple[int, str]] = field(default_factory=list)
 
     @property
     def bound(self) -> set[str]:
@@ -126,7 +127,9 @@ def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) ->
         ignored=read.ignored,
     )
     origins = [None] * len(builder.future) + builder.origins
-    return NotebookModule(source=source, summary=summary, origins=tuple(origins))
+    return NotebookModule(
+        source=source, summary=summary, origins=tuple(origins), cells=tuple(builder.runnable)
+    )
 
 
 def _skip(builder: _Builder, cell: Cell, line: int, reason: str, code: str) -> SkippedCode:
@@ -169,6 +172,7 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
     if magic is not None and magic not in PYTHON_CELL_MAGICS:
         _skip(builder, cell, 1, f"cell magic {magic}: the whole cell is left out", cell.source.strip())
         return
+    builder.runnable.append((cell.number, transformed.source))
     if magic is not None:
         _skip(
             builder, cell, 1, f"cell magic {magic} (the cell's statements are judged like any other's)", magic

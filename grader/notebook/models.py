@@ -79,11 +79,15 @@ class NotebookModule:
         source: The module's Python source.
         summary: What ran and what was skipped (goes into the report).
         origins: For each line of ``source`` (0-based), the (cell, line in cell) it came from, if any.
+        cells: Every code cell Jupyter's "Run All" would run, in order, as (cell number, its Python source
+            after IPython's transformations): what a problem that runs the notebook's cells executes
+            (`grader.notebook.cells`). Cells of a non-Python cell magic are left out.
     """
 
     source: str
     summary: NotebookSummary
     origins: tuple[tuple[int, int] | None, ...] = ()
+    cells: tuple[tuple[int, str], ...] = ()
 
     def cited(self, text: str, module_name: str) -> str:
         """``text`` with ``File ".../<module_name>", line N`` rewritten to the notebook's cell and line."""

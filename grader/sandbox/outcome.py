@@ -48,6 +48,8 @@ class Call:
         record_episodes: Whether the child logs every episode played (False for long training runs).
         budget: The most the call may record; None keeps the sandbox-wide limits: the step limit
             (`grader.sandbox.child.recorder.DEFAULT_MAX_RECORDED_STEPS`) and `Limits.frame_bytes`.
+        seconds: Wall-clock limit of this call; None keeps `Limits.call_seconds` (a problem's calls share
+            one limit; running a notebook's cells before them has its own).
         provided: Names of the submission's globals the child binds, for this call only, to the grader's
             own definitions (`grader.sandbox.child.provided.PROVIDED`), e.g. sarsa0 run with the
             grader's `epsilon_decay`.
@@ -58,6 +60,7 @@ class Call:
     kwargs: Mapping[str, PlainValue] = field(default_factory=dict)
     record_episodes: bool = True
     budget: CallBudget | None = None
+    seconds: float | None = None
     provided: tuple[str, ...] = ()
 
 

@@ -163,9 +163,10 @@ class Sandbox:
         }
         child.reset_oom_baseline()
         started = time.perf_counter()
-        sent = child.send(encode_frame(request, self.limits.frame_bytes), self.limits.call_seconds)
+        seconds = self.limits.call_seconds if call.seconds is None else call.seconds
+        sent = child.send(encode_frame(request, self.limits.frame_bytes), seconds)
         if sent is FrameEnd.FRAME:
-            remaining = self.limits.call_seconds - (time.perf_counter() - started)
+            remaining = seconds - (time.perf_counter() - started)
             wait = child.wait_frame(remaining, frame_limit.max_bytes)
         else:
             wait = FrameWait(sent)
@@ -182,7 +183,7 @@ class Sandbox:
             child.kill_tree()
             ending = Ending(
                 OutcomeStatus.TIMEOUT,
-                f"{call.function}() did not return within {self.limits.call_seconds:g} seconds",
+                f"{call.function}() did not return within {seconds:g} seconds",
             )
         elif wait.end is FrameEnd.TOO_LARGE:  # the harness reports oversized results in a small frame
             child.kill_tree()

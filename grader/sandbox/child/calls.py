@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import inspect
 import json
 import time
@@ -15,6 +16,7 @@ import gymnasium
 from grader.compat import events as compat_events
 from grader.compat import register_envs, resolve_env_id
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
+from grader.sandbox.child.cells import RUN_CELLS, run_cells
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
 from grader.sandbox.child.frames import EnvArgument, decode_value, encode_value
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
@@ -163,7 +165,7 @@ def _budget_message(function: str, recorder: Recorder) -> str:
 
 def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_frame: int) -> dict[str, Any]:
     name = request.function
-    function = vars(module).get(name)
+    function = functools.partial(run_cells, module) if name == RUN_CELLS else vars(module).get(name)
     if function is None:
         return _status(
             "missing_function",

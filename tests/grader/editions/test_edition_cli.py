@@ -44,7 +44,7 @@ def test_a_flag_against_the_configuration_is_a_usage_error(capsys: pytest.Captur
     argv = ["check", str(RL1.template), "--edition", "rl1", "--config", str(config)]
     assert cli.main(argv) == cli.EXIT_ERROR
     assert (
-        f"--edition rl1 grades random_blackjack, blackjack, cartpole, car, epsilon_decay, taxi, but {config}"
+        f"--edition rl1 grades {', '.join(RL1.registry.ids)}, but {config}"
         in capsys.readouterr().err
     )
 

@@ -23,6 +23,7 @@ from grader.sandbox import (
     probe_isolation,
     run_calls,
 )
+from grader.sandbox.child.cells import RUN_CELLS
 from grader.sandbox.child.seeding import derive_call_seed
 from grader.sandbox.process import CappedOutput
 
@@ -119,6 +120,7 @@ CLASSIFIED = [
         "but your function is defined as add(a, b=1)",
     ),
     ("timeout", Call("spin"), OutcomeStatus.TIMEOUT, "spin() did not return within 2 seconds"),
+    ("own limit", Call("spin", seconds=1.0), OutcomeStatus.TIMEOUT, "spin() did not return within 1 seconds"),
     ("segfault", Call("segfault"), OutcomeStatus.KILLED, "segfault() was killed by SIGSEGV"),
     ("abort", Call("abort"), OutcomeStatus.KILLED, "abort() was killed by SIGABRT"),
     (
@@ -264,3 +266,25 @@ def test_arguments_larger_than_a_pipe_buffer_reach_the_child(submission: Path) -
         outcome = sandbox.call(Call("add", (table, 1.0)))
     assert outcome.status is OutcomeStatus.OK, outcome.message
     assert np.array_equal(outcome.value, table + 1.0)
+
+
+def test_a_cells_call_runs_in_the_module_globals_with_its_own_limit(tmp_path: Path) -> None:
+    path = tmp_path / "gymnasium.ipynb.py"
+    path.write_text("def read():\n    return table\n")
+
+    def cells(source: str) -> tuple[list[dict[str, object]]]:
+        return ([{"cell": 2, "source": source, "script": False}],)
+
+    with Sandbox(path, seed=1, limits=LIMITS) as sandbox:
+        ran = sandbox.call(Call(RUN_CELLS, cells("table = 41 + 1"), record_episodes=False))
+        read = sandbox.call(Call("read"))
+        failed = sandbox.call(Call(RUN_CELLS, cells("x = 1\nraise ValueError('no')"), record_episodes=False))
+        slow = sandbox.call(
+            Call(RUN_CELLS, cells("while True:\n    pass"), record_episodes=False, seconds=1.0)
+        )
+    assert (ran.status, [cell["cell"] for cell in ran.value["cells"]]) == (OutcomeStatus.OK, [2])
+    assert (read.status, read.value) == (OutcomeStatus.OK, 42)
+    assert failed.status is OutcomeStatus.EXCEPTION
+    assert "NotebookCellError: cell 2 (line 2) raised ValueError: no" in failed.message
+    assert slow.status is OutcomeStatus.TIMEOUT
+    assert "did not return within 1 seconds" in slow.message
