@@ -1,0 +1,138 @@
+"""Per-step cost of recording in the sandbox child: the lab's Taxi loop with and without the recorder.
+
+    python bench/recorder_cost.py [--steps 400000] [--rounds 5] [--api classic|gymnasium]
+
+Each variant runs in a fresh interpreter, alternated A/B, B/A, ... for `--rounds` rounds:
+
+- plain: `grader.compat.activate()`, then the lab's random Taxi play (`gym.make("Taxi-v3")`, reset, random
+  actions until done, `--steps` steps in all), as the plain run of `bench/speed.py` does;
+- recorded: the same after the child's set-up (`Recorder`, `install`, `begin_call(record=True)` with a
+  budget, as `grader.sandbox.child.calls.run_call` does), then `finish_call` and `to_plain` of every
+  episode (the log as sent, before JSON encoding).
+
+Prints the median CPU per step of each and their difference: what the recorder costs per step.
+`--api gymnasium` plays through `gymnasium.make` directly (no compat wrapper).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def play(steps: int, api: str) -> int:
+    """Random Taxi play as the lab writes it; returns the steps taken (at least `steps`)."""
+    return play_classic(steps) if api == "classic" else play_gymnasium(steps)
+
+
+def play_classic(steps: int) -> int:
+    """The lab's loop on the classic API (one function per API: the compat layer reads the call site)."""
+    import random
+
+    import gym
+
+    env = gym.make("Taxi-v3")
+    taken = 0
+    while taken < steps:
+        env.reset()
+        done = False
+        while not done:
+            _, _, done, _ = env.step(random.randrange(6))
+            taken += 1
+    return taken
+
+
+def play_gymnasium(steps: int) -> int:
+    """The same loop on gymnasium's API, through `gymnasium.make`."""
+    import random
+
+    import gymnasium
+
+    env = gymnasium.make("Taxi-v4")
+    taken = 0
+    while taken < steps:
+        env.reset()
+        terminated = truncated = False
+        while not (terminated or truncated):
+            _, _, terminated, truncated, _ = env.step(random.randrange(6))
+            taken += 1
+    return taken
+
+
+def child(variant: str, steps: int, api: str) -> None:
+    """One measurement in this process; prints `{"cpu": seconds, "steps": n}`."""
+    os.environ.update({"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
+    import grader.compat
+
+    grader.compat.activate()
+    recorder = None
+    if variant == "recorded":
+        from grader.sandbox.child.budget import WireBudget
+        from grader.sandbox.child.recorder import Recorder, install
+
+        recorder = Recorder(0)
+        install(recorder)
+        recorder.begin_call(1, record=True, budget=WireBudget(max_episodes=10**6, max_steps=10**8))
+    import random
+
+    random.seed(0)
+    started = time.process_time()
+    taken = play(steps, api)
+    if recorder is not None:
+        episodes = recorder.finish_call()
+        plain = [episode.to_plain() for episode in episodes]
+        assert sum(len(episode.actions) for episode in episodes) == taken, "every step logged"
+        del plain
+    print(json.dumps({"cpu": time.process_time() - started, "steps": taken}))
+
+
+def run(variant: str, steps: int, api: str) -> dict[str, float]:
+    """One measurement in a fresh interpreter."""
+    environment = dict(
+        os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
+    )
+    command = [sys.executable, __file__, "--child", variant, "--steps", str(steps), "--api", api]
+    done = subprocess.run(command, capture_output=True, text=True, env=environment, check=True)
+    return json.loads(done.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--steps", type=int, default=400_000)
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--api", choices=("classic", "gymnasium"), default="classic")
+    parser.add_argument("--child", choices=("plain", "recorded"), help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        child(args.child, args.steps, args.api)
+        return 0
+    per_step: dict[str, list[float]] = {"plain": [], "recorded": []}
+    load = [os.getloadavg()[0]]
+    for index in range(args.rounds):
+        for variant in ("plain", "recorded") if index % 2 == 0 else ("recorded", "plain"):
+            figures = run(variant, args.steps, args.api)
+            per_step[variant].append(figures["cpu"] / figures["steps"] * 1e6)
+    load.append(os.getloadavg()[0])
+    plain, recorded = (statistics.median(per_step[name]) for name in ("plain", "recorded"))
+    print(
+        f"Taxi random play, {args.api} API, {args.steps:,} steps per run, "
+        f"{args.rounds} rounds A/B alternated;"
+    )
+    print(f"load average {load[0]:.1f} before, {load[1]:.1f} after (CPU time, so load stretches it little)")
+    for name in ("plain", "recorded"):
+        values = ", ".join(f"{value:.2f}" for value in per_step[name])
+        print(f"  {name:9s} {statistics.median(per_step[name]):6.2f} us/step CPU (median; each: {values})")
+    print(f"  recorder  {recorded - plain:6.2f} us/step ({recorded / plain - 1:.0%} of the plain step)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
