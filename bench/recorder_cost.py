@@ -1,6 +1,7 @@
 """Per-step cost of recording in the sandbox child: the lab's Taxi loop with and without the recorder.
 
     python bench/recorder_cost.py [--steps 400000] [--rounds 5] [--api classic|gymnasium]
+                                  [--game taxi|blackjack]
 
 Each variant runs in a fresh interpreter, alternated A/B, B/A, ... for `--rounds` rounds:
 
@@ -11,7 +12,8 @@ Each variant runs in a fresh interpreter, alternated A/B, B/A, ... for `--rounds
   episode (the log as sent, before JSON encoding).
 
 Prints the median CPU per step of each and their difference: what the recorder costs per step.
-`--api gymnasium` plays through `gymnasium.make` directly (no compat wrapper).
+`--api gymnasium` plays through `gymnasium.make` directly (no compat wrapper); `--game blackjack` plays the
+lab's Blackjack (one or two steps a game, so the cost of a reset dominates).
 """
 
 from __future__ import annotations
@@ -28,46 +30,50 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def play(steps: int, api: str) -> int:
-    """Random Taxi play as the lab writes it; returns the steps taken (at least `steps`)."""
-    return play_classic(steps) if api == "classic" else play_gymnasium(steps)
+def play(steps: int, api: str, game: str) -> int:
+    """Random play as the lab writes it; returns the steps taken (at least `steps`)."""
+    if api == "classic":
+        return play_classic(steps, "Taxi-v3" if game == "taxi" else "Blackjack-v0")
+    return play_gymnasium(steps, "Taxi-v4" if game == "taxi" else "Blackjack-v1")
 
 
-def play_classic(steps: int) -> int:
+def play_classic(steps: int, env_id: str) -> int:
     """The lab's loop on the classic API (one function per API: the compat layer reads the call site)."""
     import random
 
     import gym
 
-    env = gym.make("Taxi-v3")
+    env = gym.make(env_id)
+    actions = env.action_space.n
     taken = 0
     while taken < steps:
         env.reset()
         done = False
         while not done:
-            _, _, done, _ = env.step(random.randrange(6))
+            _, _, done, _ = env.step(random.randrange(actions))
             taken += 1
     return taken
 
 
-def play_gymnasium(steps: int) -> int:
+def play_gymnasium(steps: int, env_id: str) -> int:
     """The same loop on gymnasium's API, through `gymnasium.make`."""
     import random
 
     import gymnasium
 
-    env = gymnasium.make("Taxi-v4")
+    env = gymnasium.make(env_id)
+    actions = int(env.action_space.n)
     taken = 0
     while taken < steps:
         env.reset()
         terminated = truncated = False
         while not (terminated or truncated):
-            _, _, terminated, truncated, _ = env.step(random.randrange(6))
+            _, _, terminated, truncated, _ = env.step(random.randrange(actions))
             taken += 1
     return taken
 
 
-def child(variant: str, steps: int, api: str) -> None:
+def child(variant: str, steps: int, api: str, game: str) -> None:
     """One measurement in this process; prints `{"cpu": seconds, "steps": n}`."""
     os.environ.update({"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
     import grader.compat
@@ -85,7 +91,7 @@ def child(variant: str, steps: int, api: str) -> None:
 
     random.seed(0)
     started = time.process_time()
-    taken = play(steps, api)
+    taken = play(steps, api, game)
     if recorder is not None:
         episodes = recorder.finish_call()
         plain = [episode.to_plain() for episode in episodes]
@@ -94,12 +100,23 @@ def child(variant: str, steps: int, api: str) -> None:
     print(json.dumps({"cpu": time.process_time() - started, "steps": taken}))
 
 
-def run(variant: str, steps: int, api: str) -> dict[str, float]:
+def run(variant: str, steps: int, api: str, game: str) -> dict[str, float]:
     """One measurement in a fresh interpreter."""
     environment = dict(
         os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
     )
-    command = [sys.executable, __file__, "--child", variant, "--steps", str(steps), "--api", api]
+    command = [
+        sys.executable,
+        __file__,
+        "--child",
+        variant,
+        "--steps",
+        str(steps),
+        "--api",
+        api,
+        "--game",
+        game,
+    ]
     done = subprocess.run(command, capture_output=True, text=True, env=environment, check=True)
     return json.loads(done.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
 
@@ -109,21 +126,22 @@ def main() -> int:
     parser.add_argument("--steps", type=int, default=400_000)
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--api", choices=("classic", "gymnasium"), default="classic")
+    parser.add_argument("--game", choices=("taxi", "blackjack"), default="taxi")
     parser.add_argument("--child", choices=("plain", "recorded"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        child(args.child, args.steps, args.api)
+        child(args.child, args.steps, args.api, args.game)
         return 0
     per_step: dict[str, list[float]] = {"plain": [], "recorded": []}
     load = [os.getloadavg()[0]]
     for index in range(args.rounds):
         for variant in ("plain", "recorded") if index % 2 == 0 else ("recorded", "plain"):
-            figures = run(variant, args.steps, args.api)
+            figures = run(variant, args.steps, args.api, args.game)
             per_step[variant].append(figures["cpu"] / figures["steps"] * 1e6)
     load.append(os.getloadavg()[0])
     plain, recorded = (statistics.median(per_step[name]) for name in ("plain", "recorded"))
     print(
-        f"Taxi random play, {args.api} API, {args.steps:,} steps per run, "
+        f"{args.game} random play, {args.api} API, {args.steps:,} steps per run, "
         f"{args.rounds} rounds A/B alternated;"
     )
     print(f"load average {load[0]:.1f} before, {load[1]:.1f} after (CPU time, so load stretches it little)")
