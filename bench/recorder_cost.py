@@ -11,7 +11,9 @@ Each variant runs in a fresh interpreter, alternated A/B, B/A, ... for `--rounds
   budget, as `grader.sandbox.child.calls.run_call` does), then `finish_call` and `to_plain` of every
   episode (the log as sent, before JSON encoding).
 
-Prints the median CPU per step of each and their difference: what the recorder costs per step.
+Prints the median CPU per step of each and the median of the rounds' differences: what the recorder costs
+per step. `--baseline TREE` adds a third variant, the recorder of another tree (a worktree of `main`), in
+the same rounds: a before/after on the same load.
 `--api gymnasium` plays through `gymnasium.make` directly (no compat wrapper); `--game blackjack` plays the
 lab's Blackjack (one or two steps a game, so the cost of a reset dominates).
 """
@@ -100,10 +102,10 @@ def child(variant: str, steps: int, api: str, game: str) -> None:
     print(json.dumps({"cpu": time.process_time() - started, "steps": taken}))
 
 
-def run(variant: str, steps: int, api: str, game: str) -> dict[str, float]:
-    """One measurement in a fresh interpreter."""
+def run(variant: str, steps: int, api: str, game: str, tree: Path) -> dict[str, float]:
+    """One measurement in a fresh interpreter, with the grader of `tree`."""
     environment = dict(
-        os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
+        os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(tree), os.environ.get("PYTHONPATH")]))
     )
     command = [
         sys.executable,
@@ -127,28 +129,45 @@ def main() -> int:
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--api", choices=("classic", "gymnasium"), default="classic")
     parser.add_argument("--game", choices=("taxi", "blackjack"), default="taxi")
+    parser.add_argument(
+        "--baseline",
+        type=Path,
+        default=None,
+        help="also measure the recorder of this tree (a worktree of main, say), in the same rounds",
+    )
     parser.add_argument("--child", choices=("plain", "recorded"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         child(args.child, args.steps, args.api, args.game)
         return 0
-    per_step: dict[str, list[float]] = {"plain": [], "recorded": []}
+    trees = {"this tree": ROOT} | ({} if args.baseline is None else {"baseline": args.baseline.resolve()})
+    variants = [("plain", "plain", ROOT)] + [
+        (f"recorded, {label}", "recorded", tree) for label, tree in trees.items()
+    ]
+    per_step: dict[str, list[float]] = {label: [] for label, _, _ in variants}
     load = [os.getloadavg()[0]]
     for index in range(args.rounds):
-        for variant in ("plain", "recorded") if index % 2 == 0 else ("recorded", "plain"):
-            figures = run(variant, args.steps, args.api, args.game)
-            per_step[variant].append(figures["cpu"] / figures["steps"] * 1e6)
+        for label, variant, tree in variants if index % 2 == 0 else variants[::-1]:
+            figures = run(variant, args.steps, args.api, args.game, tree)
+            per_step[label].append(figures["cpu"] / figures["steps"] * 1e6)
     load.append(os.getloadavg()[0])
-    plain, recorded = (statistics.median(per_step[name]) for name in ("plain", "recorded"))
     print(
-        f"{args.game} random play, {args.api} API, {args.steps:,} steps per run, "
-        f"{args.rounds} rounds A/B alternated;"
+        f"{args.game} random play, {args.api} API, {args.steps:,} steps per run, {args.rounds} rounds, "
+        f"variants alternated; load average {load[0]:.1f} before, {load[1]:.1f} after"
     )
-    print(f"load average {load[0]:.1f} before, {load[1]:.1f} after (CPU time, so load stretches it little)")
-    for name in ("plain", "recorded"):
-        values = ", ".join(f"{value:.2f}" for value in per_step[name])
-        print(f"  {name:9s} {statistics.median(per_step[name]):6.2f} us/step CPU (median; each: {values})")
-    print(f"  recorder  {recorded - plain:6.2f} us/step ({recorded / plain - 1:.0%} of the plain step)")
+    for label, values in per_step.items():
+        each = ", ".join(f"{value:.2f}" for value in values)
+        print(f"  {label:22s} {statistics.median(values):7.2f} us/step CPU (median; each: {each})")
+    for label, tree in trees.items():
+        paired = [
+            recorded - plain
+            for recorded, plain in zip(per_step[f"recorded, {label}"], per_step["plain"], strict=True)
+        ]
+        share = statistics.median(paired) / statistics.median(per_step["plain"])
+        print(
+            f"  recorder of {label} ({tree}): {statistics.median(paired):.2f} us/step "
+            f"(median of the rounds' differences; {share:.0%} of the plain step)"
+        )
     return 0
 
 
