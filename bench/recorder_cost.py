@@ -28,6 +28,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -73,6 +74,62 @@ def play_gymnasium(steps: int, env_id: str) -> int:
             _, _, terminated, truncated, _ = env.step(random.randrange(actions))
             taken += 1
     return taken
+
+
+def play_block(env: Any, steps: int, actions: int) -> int:
+    """`steps` steps or more of the lab's classic loop on `env` (whole episodes)."""
+    import random
+
+    taken = 0
+    while taken < steps:
+        env.reset()
+        done = False
+        while not done:
+            _, _, done, _ = env.step(random.randrange(actions))
+            taken += 1
+    return taken
+
+
+def interleaved(steps: int, game: str, blocks: int) -> dict[str, float]:
+    """Median CPU per step of three variants in this one process, block by block in turn.
+
+    - bare: the compat `ClassicEnv` straight on gymnasium's env, as the plain run has it;
+    - wrapped: through the recorder's wrapper while the call does not record;
+    - recording: through the wrapper while the call records (then `finish_call` and `to_plain`).
+    Interleaving the blocks in one process cancels most of the load's drift between variants.
+    """
+    import random
+
+    import grader.compat
+
+    grader.compat.activate()
+    import gym
+
+    from grader.compat.adapter import ClassicEnv
+    from grader.sandbox.child.budget import WireBudget
+    from grader.sandbox.child.recorder import Recorder, install
+
+    recorder = Recorder(0)
+    install(recorder)
+    env_id = "Taxi-v3" if game == "taxi" else "Blackjack-v0"
+    wrapped = gym.make(env_id)
+    bare = ClassicEnv(wrapped.env.env, env_id)
+    actions = int(wrapped.action_space.n)
+    random.seed(0)
+    times: dict[str, list[float]] = {"bare": [], "wrapped": [], "recording": []}
+    budget = WireBudget(max_episodes=10**6, max_steps=10**8)
+    for block in range(blocks):
+        for name in ("bare", "wrapped", "recording") if block % 2 == 0 else ("recording", "wrapped", "bare"):
+            recorder.begin_call(block, record=name == "recording", budget=budget)
+            started = time.process_time()
+            taken = play_block(bare if name == "bare" else wrapped, steps, actions)
+            if name == "recording":
+                episodes = recorder.finish_call()
+                [episode.to_plain() for episode in episodes]
+            else:
+                recorder.finish_call()
+            times[name].append((time.process_time() - started) / taken * 1e6)
+    return {name: statistics.median(values) for name, values in times.items()}
 
 
 def child(variant: str, steps: int, api: str, game: str) -> None:
@@ -123,6 +180,33 @@ def run(variant: str, steps: int, api: str, game: str, tree: Path) -> dict[str, 
     return json.loads(done.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
 
 
+def interleaved_main(args: argparse.Namespace) -> int:
+    """`--interleaved BLOCKS`: one process per tree (this one, then `--baseline`), variants block by block."""
+    trees = {"this tree": ROOT} | ({} if args.baseline is None else {"baseline": args.baseline.resolve()})
+    load = os.getloadavg()[0]
+    print(
+        f"{args.game}, classic API, {args.interleaved} blocks of {args.steps:,} steps per variant, "
+        f"interleaved in one process per tree; load average {load:.1f} before"
+    )
+    for label, tree in trees.items():
+        environment = dict(
+            os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(tree), os.environ.get("PYTHONPATH")]))
+        )
+        command = [sys.executable, __file__, "--child", "interleaved", "--steps", str(args.steps)]
+        command += ["--game", args.game, "--blocks", str(args.interleaved)]
+        done = subprocess.run(command, capture_output=True, text=True, env=environment, check=True)
+        figures = json.loads(done.stdout.strip().splitlines()[-1])
+        bare = figures["bare"]
+        print(
+            f"  {label} ({tree}): bare {bare:.2f}, wrapped {figures['wrapped']:.2f}, recording "
+            f"{figures['recording']:.2f} us/step (medians); the wrapper's frame "
+            f"{figures['wrapped'] - bare:+.2f}, recording {figures['recording'] - bare:+.2f} us/step "
+            f"({(figures['recording'] - bare) / bare:+.0%} of the bare step)"
+        )
+    print(f"load average {os.getloadavg()[0]:.1f} after")
+    return 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=400_000)
@@ -135,11 +219,24 @@ def main() -> int:
         default=None,
         help="also measure the recorder of this tree (a worktree of main, say), in the same rounds",
     )
-    parser.add_argument("--child", choices=("plain", "recorded"), help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--interleaved",
+        type=int,
+        default=0,
+        metavar="BLOCKS",
+        help="measure in one process per tree instead: BLOCKS blocks of --steps steps per variant, in turn",
+    )
+    parser.add_argument("--blocks", type=int, default=0, help=argparse.SUPPRESS)
+    parser.add_argument("--child", choices=("plain", "recorded", "interleaved"), help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.child == "interleaved":
+        print(json.dumps(interleaved(args.steps, args.game, args.blocks)))
+        return 0
     if args.child:
         child(args.child, args.steps, args.api, args.game)
         return 0
+    if args.interleaved:
+        return interleaved_main(args)
     trees = {"this tree": ROOT} | ({} if args.baseline is None else {"baseline": args.baseline.resolve()})
     variants = [("plain", "plain", ROOT)] + [
         (f"recorded, {label}", "recorded", tree) for label, tree in trees.items()
