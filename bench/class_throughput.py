@@ -51,7 +51,6 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(BENCH))
 
 from class_calls import LOG_VARIABLE, read_calls  # noqa: E402
-from speed import plain_run  # noqa: E402
 
 RESULTS = BENCH / "RESULTS.md"
 HEADING = "## Class throughput"
@@ -212,6 +211,23 @@ def grade_edition(
             report = json.loads(report_path.read_text(encoding="utf-8"))
             statuses.update(problem["status"] for problem in report["problems"])
     return wall, cpu, statuses
+
+
+def plain_cpu(submission: Path, calls_file: Path) -> tuple[float, float]:
+    """CPU (import + calls) and wall of the logged calls run plainly in a fresh interpreter
+    (`bench/speed.py --plain-child`)."""
+    environment = dict(os.environ)
+    environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), environment.get("PYTHONPATH")]))
+    command = [sys.executable, str(BENCH / "speed.py"), "--plain-child", str(calls_file), str(submission)]
+    started = time.perf_counter()
+    done = subprocess.run(command, capture_output=True, text=True, env=environment, check=False)
+    wall = time.perf_counter() - started
+    if done.returncode != 0:
+        raise SystemExit(
+            f"the plain run of {submission.name} failed (exit {done.returncode}): {done.stderr[-3000:]}"
+        )
+    summary = json.loads(done.stdout.strip().splitlines()[-1])
+    return summary["import_cpu"] + summary["calls_cpu"], wall
 
 
 def row(*cells: object) -> str:
@@ -376,10 +392,8 @@ def main() -> int:
             assert run.log is not None
             calls_file = run.log / "plain.calls"
             calls_file.write_bytes(pickle.dumps(read_calls(run.log)[run.logged_file]))
-            plain, summary = plain_run(EDITIONS[run.edition], calls_file)
-            run.plain_cpu = summary["import_cpu"] + summary["calls_cpu"]
-            run.plain_wall = plain.wall
-            print(f"plain {run.edition}: {run.plain_cpu:.1f} s CPU ({plain.wall:.1f} s wall)", flush=True)
+            run.plain_cpu, run.plain_wall = plain_cpu(EDITIONS[run.edition], calls_file)
+            print(f"plain {run.edition}: {run.plain_cpu:.1f} s CPU ({run.plain_wall:.1f} s wall)", flush=True)
     command = " ".join(["python", "bench/class_throughput.py", *sys.argv[1:]])
     text = section(runs, cores, args.workers, load, command)
     print(text)

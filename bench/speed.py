@@ -69,6 +69,7 @@ def plain_child(calls_file: Path, submission: Path) -> None:
 
     started, cpu = time.perf_counter(), time.process_time()
     grader.compat.activate()
+    _route_lab_ids()
     spec = importlib.util.spec_from_file_location("opengym", submission)
     if spec is None or spec.loader is None:
         raise SystemExit(f"cannot import {submission}")
@@ -97,6 +98,30 @@ def plain_child(calls_file: Path, submission: Path) -> None:
         "per_function": per_function,
     }
     print(json.dumps(summary))
+
+
+def _route_lab_ids() -> None:
+    """Let plain `gymnasium.make("Taxi-v3")` make the env the lab means, as the sandbox's recorder does.
+
+    Gymnasium-API submissions of the later editions keep the lab's ids, which today's gymnasium no longer
+    registers; the grader resolves them (`grader.compat.resolve_env_id`), so the plain run does too (once
+    per `make`, nothing per step).
+    """
+    import gymnasium
+    import gymnasium.envs.registration
+
+    from grader.compat import register_envs, resolve_env_id
+
+    original = gymnasium.envs.registration.make
+
+    def make(id: Any, *args: Any, **kwargs: Any) -> Any:
+        if isinstance(id, str) and ":" not in id and id not in gymnasium.envs.registration.registry:
+            target = resolve_env_id(id)
+            register_envs()
+            return original(target.gymnasium_id, *args, **target.merged_kwargs(kwargs))
+        return original(id, *args, **kwargs)
+
+    gymnasium.make = gymnasium.envs.make = gymnasium.envs.registration.make = make
 
 
 @dataclass
