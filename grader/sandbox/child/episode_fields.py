@@ -34,7 +34,5 @@ def check_declaration(declared: tuple[str, ...], where: str) -> None:
     """
     if declared != EPISODE_FIELDS:
         raise TypeError(
-            f"{where} declares the episode fields {declared}, expected {EPISODE_FIELDS} "
-            "(grader/sandbox/child/episode_fields.py is the one declaration: change it there and in the "
-            "models)"
+            f"{where} declares the episode fields {declared}, expected {EPISODE_FIELDS} (grader/sandbox/child/episode_fields.py is the one declaration: change it there and in the models)"  # noqa: E501
         )
