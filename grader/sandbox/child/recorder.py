@@ -94,7 +94,7 @@ class EpisodeRecord:
             plain["truncated"] = list(map(bool, self.truncated))
             return plain
         actions = self.actions
-        if type(actions) is array:
+        if isinstance(actions, array):
             plain["actions"] = _smallest_int_array(np.frombuffer(actions, dtype=np.int64).copy())
         else:
             plain["actions"] = _compact_actions(actions)
@@ -356,7 +356,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
                     episode.add_action(action)
                 reward, terminated, truncated = result[1], result[2], result[3]
                 try:
-                    episode.rewards.append(reward)
+                    episode.rewards.append(reward)  # type: ignore[arg-type]  # converted by array, or refused
                 except _FLOAT_ERRORS:
                     episode.rewards.append(_float_or_nan(reward))
                 episode.terminated.append(terminated if type(terminated) is bool else bool(terminated))
