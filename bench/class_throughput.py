@@ -19,8 +19,12 @@
    (goal <= 1.1), the grading CPU per submission against the plain one, the machine's load average
    sampled during the run, and the projection for 300 submissions on 2 cores and on 4 cores with Celery.
 
-`--write` replaces the `## Class throughput` section of bench/RESULTS.md. With the default K = 4 (one
-file per edition) the grading takes about 3-4 minutes on an idle 2-core machine, the plain runs 2 more.
+The 300-submission projection: the drain time of a busy machine is K x (grading CPU per submission) /
+cores, so 300 x the measured CPU per submission (this mix of editions) / 2 for one 2-core machine, and / 4
+plus one grading's skew for two such machines running `gymgrade worker` (one grading per core); the
+section states the assumptions. `--write` replaces the `## Class throughput` section of bench/RESULTS.md.
+With the default K = 4 (one file per edition) the grading takes about 5 minutes on an idle 2-core machine
+(about 370 s of CPU, and each edition's run waits for its Taxi check), the plain runs about 3 more.
 """
 
 from __future__ import annotations
@@ -322,7 +326,7 @@ def section(runs: list[EditionRun], cores: int, workers: int, load: LoadSampler,
         row("machine", "projected drain (min)", "bound: plain CPU / cores (min)", "ratio"),
         row("---", "---:", "---:", "---:"),
         row(
-            f"1 x {cores} cores, `gymgrade grade`" if cores == 2 else "1 x 2 cores, `gymgrade grade`",
+            "1 x 2 cores, `gymgrade grade`",
             f"{two_core / 60:.1f}",
             f"{two_core_bound / 60:.1f}",
             f"{two_core / two_core_bound:.2f}",
