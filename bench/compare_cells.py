@@ -50,7 +50,7 @@ def _statuses(function: Any, regrades: int) -> Counter[str]:
     settings = load_config(RL1.default_config).problems["compare"]
     assert isinstance(settings, CompareConfig)
     settings = CompareConfig.model_validate({**settings.model_dump(), "run_cells": True}).for_problem(
-        "compare"
+        "compare", problem.games
     )
     calls = problem.check.plan(settings, {})
     found: Counter[str] = Counter()

@@ -21,7 +21,9 @@
    graded in both orders, which shows that a shared child makes a problem's report depend on which
    problems ran before it in that child (on xdist scheduling).
 
-`--write` replaces the `## Speed (issue 11)` section at the end of bench/RESULTS.md.
+`--write` replaces the `## Speed (issue 11)` section at the end of bench/RESULTS.md. `--ab BASELINE_ROOT` runs
+only step 2, with the grader of another tree (a worktree of `main`, say) alternated with this one's: an
+A/B of a change, e.g. `--ab /work/main --only taxi --rounds 2`.
 """
 
 from __future__ import annotations
@@ -67,6 +69,7 @@ def plain_child(calls_file: Path, submission: Path) -> None:
 
     started, cpu = time.perf_counter(), time.process_time()
     grader.compat.activate()
+    _route_lab_ids()
     spec = importlib.util.spec_from_file_location("opengym", submission)
     if spec is None or spec.loader is None:
         raise SystemExit(f"cannot import {submission}")
@@ -97,6 +100,30 @@ def plain_child(calls_file: Path, submission: Path) -> None:
     print(json.dumps(summary))
 
 
+def _route_lab_ids() -> None:
+    """Let plain `gymnasium.make("Taxi-v3")` make the env the lab means, as the sandbox's recorder does.
+
+    Gymnasium-API submissions of the later editions keep the lab's ids, which today's gymnasium no longer
+    registers; the grader resolves them (`grader.compat.resolve_env_id`), so the plain run does too (once
+    per `make`, nothing per step).
+    """
+    import gymnasium
+    import gymnasium.envs.registration
+
+    from grader.compat import register_envs, resolve_env_id
+
+    original = gymnasium.envs.registration.make
+
+    def make(id: Any, *args: Any, **kwargs: Any) -> Any:
+        if isinstance(id, str) and ":" not in id and id not in gymnasium.envs.registration.registry:
+            target = resolve_env_id(id)
+            register_envs()
+            return original(target.gymnasium_id, *args, **target.merged_kwargs(kwargs))
+        return original(id, *args, **kwargs)
+
+    gymnasium.make = gymnasium.envs.make = gymnasium.envs.registration.make = make
+
+
 @dataclass
 class Run:
     """One timed subprocess: its wall time and what it printed."""
@@ -106,10 +133,10 @@ class Run:
     returncode: int
 
 
-def timed_run(command: Sequence[str], **extra: str) -> Run:
-    """Run a command with this tree's sources first on PYTHONPATH; time it and its descendants."""
+def timed_run(command: Sequence[str], root: Path = ROOT, **extra: str) -> Run:
+    """Run a command with a tree's sources (default: this one) first on PYTHONPATH; time it."""
     environment = dict(os.environ, **extra)
-    environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), environment.get("PYTHONPATH")]))
+    environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(root), environment.get("PYTHONPATH")]))
     started = time.perf_counter()
     done = subprocess.run(list(command), capture_output=True, text=True, env=environment, check=False)
     wall = time.perf_counter() - started
@@ -127,14 +154,14 @@ def plain_run(submission: Path, calls_file: Path) -> tuple[Run, dict[str, Any]]:
 
 
 def gymgrade_run(
-    submission: Path, workers: int, seed: int, config: Path | None, only: Sequence[str]
+    submission: Path, workers: int, seed: int, config: Path | None, only: Sequence[str], root: Path = ROOT
 ) -> tuple[Run, Any]:
-    """`gymgrade check --json` of the submission in a fresh interpreter, and its report."""
+    """`gymgrade check --json` of the submission in a fresh interpreter (the grader of tree `root`)."""
     from grader.report import Report
 
     command = [sys.executable, "-c", _CLI, "check", str(submission), "--json", "--workers", str(workers)]
     command += ["--seed", str(seed), "--only", ",".join(only), *(["--config", str(config)] if config else [])]
-    run = timed_run(command)
+    run = timed_run(command, root)
     report = Report.model_validate_json(run.stdout)
     if run.returncode != 0 or report.grader_errors:
         raise SystemExit(
@@ -454,6 +481,74 @@ def shared_lines(figures: Figures) -> list[str]:
     return lines
 
 
+# -------------------------------------------------------------------------------------------------- A/B
+
+
+def ab_lines(
+    baseline: Path,
+    grades: dict[str, list[tuple[Run, Any]]],
+    plain: list[tuple[Run, dict[str, Any]]],
+    load: str,
+) -> list[str]:
+    """The A/B table: the same check graded by a baseline tree's grader and this tree's, and plainly."""
+    median = statistics.median
+    lines = [
+        f"A/B against `{baseline}` ({load}); alternated baseline, this tree, plain, then reversed:",
+        "",
+        row("run", "wall (s), each", "median wall (s)", "student (s)", "grader overhead (s)"),
+        row("---", "---", "---:", "---:", "---:"),
+    ]
+    for label, runs in grades.items():
+        reports = [report for _, report in runs]
+        lines.append(
+            row(
+                label,
+                seconds([run.wall for run, _ in runs]),
+                f"{median([run.wall for run, _ in runs]):.1f}",
+                f"{median([report.timings.student_seconds for report in reports]):.1f}",
+                f"{median([report.timings.overhead_seconds for report in reports]):.1f}",
+            )
+        )
+    lines.append(
+        row(
+            "plain, 1 process",
+            seconds([run.wall for run, _ in plain]),
+            f"{median([run.wall for run, _ in plain]):.1f}",
+            f"{median([summary['calls_seconds'] for _, summary in plain]):.1f}",
+            "",
+        )
+    )
+    return lines
+
+
+def ab_main(args: argparse.Namespace, submission: Path, problems: Sequence[str], config: Any) -> int:
+    """`--ab BASELINE`: only the comparison of step 2, with a second grader (another worktree) alternated."""
+    load_before = os.getloadavg()[0]
+    print("1. recording the calls (one serial grading) ...", flush=True)
+    _, _, calls = grade_serially(submission, problems, config, args.seed)
+    labels = {"baseline": args.ab.resolve(), "this tree": ROOT}
+    grades: dict[str, list[tuple[Run, Any]]] = {label: [] for label in labels}
+    plain: list[tuple[Run, dict[str, Any]]] = []
+    with tempfile.TemporaryDirectory(prefix="gymgrade-speed-") as scratch:
+        calls_file = Path(scratch) / "calls.pickle"
+        calls_file.write_bytes(pickle.dumps(calls))
+        for round_index in range(args.rounds):
+            order = ["baseline", "this tree", "plain"]
+            for kind in order if round_index % 2 == 0 else order[::-1]:
+                if kind == "plain":
+                    plain.append(plain_run(submission, calls_file))
+                    run = plain[-1][0]
+                else:
+                    grades[kind].append(
+                        gymgrade_run(submission, args.workers, args.seed, args.config, problems, labels[kind])
+                    )
+                    run = grades[kind][-1][0]
+                print(f"2. {kind}: {run.wall:.1f} s wall", flush=True)
+    load = f"load average {load_before:.1f} before, {os.getloadavg()[0]:.1f} after"
+    print("\n".join(ab_lines(labels["baseline"], grades, plain, load)))
+    return 0
+
+
 # -------------------------------------------------------------------------------------------------- main
 
 
@@ -466,6 +561,13 @@ def main() -> int:
     parser.add_argument("--config", type=Path, default=None)
     parser.add_argument("--only", default=None, metavar="ID[,ID...]", help="grade only these problems")
     parser.add_argument("--write", action="store_true")
+    parser.add_argument(
+        "--ab",
+        type=Path,
+        default=None,
+        metavar="BASELINE_ROOT",
+        help="only compare this tree's grader with another tree's (a worktree of main) and the plain run",
+    )
     parser.add_argument(
         "--plain-child", nargs=2, type=Path, metavar=("CALLS", "SUBMISSION"), help=argparse.SUPPRESS
     )
@@ -481,6 +583,8 @@ def main() -> int:
     config = load_config(args.config)
     only = [name for name in args.only.split(",") if name] if args.only else None
     plan = GradingPlan.load(args.config, only)
+    if args.ab is not None:
+        return ab_main(args, submission, plan.problems, config)
     load_before = os.getloadavg()[0]
 
     print("1. grading serially, instrumented: one child per problem, then one child for all ...", flush=True)

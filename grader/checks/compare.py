@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Self
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -28,16 +28,13 @@ from grader.checks.episodes import Episode, played_episodes
 from grader.checks.integrity import NO_EPISODES, games_budget, integrity_problem
 from grader.checks.taxi import EPISODE_STEPS
 from grader.checks.values import as_number, describe
-from grader.games import GameRules, accepted_game_names, allowed_games
 from grader.notebook.cells import RAN_CELLS, SCRIPT_CELL
-from grader.problem_config import PlayedProblemConfig, Probability, ProblemConfig
+from grader.problem_config import PlayedProblemConfig, Probability
 from grader.sandbox.child.cells import RUN_CELLS
 from grader.sandbox.outcome import Call, FunctionInfo, OutcomeStatus, PlainValue
 from grader.stats import mean_tolerance
 from reference.oracles import greedy_policy_return
 
-GAME = "taxi"
-"""compare() plays Taxi, as taxi() does (its accepted games are taxi's)."""
 RETURN_TOLERANCE = 1e-6
 """How far a returned mean may be from its replayed episodes' mean (float rounding of a sum of 1 000)."""
 RANDOM_SHARE = 0.25
@@ -77,20 +74,6 @@ class CompareConfig(PlayedProblemConfig):
         if isinstance(data, dict) and not data.get("run_cells", False):
             return {**data, "points": 0.0}
         return data
-
-    def for_problem(self, problem_id: str) -> Self:
-        """These settings bound to their problem, once `accepted_envs` names only games taxi accepts."""
-        accepted = accepted_game_names(GAME)
-        chosen = self.accepted_envs
-        if chosen is not None and (not chosen or not set(chosen) <= set(accepted)):
-            raise ValueError(
-                f"accepted_envs must be a non-empty list of {', '.join(accepted)}; found {chosen}"
-            )
-        return ProblemConfig.for_problem(self, problem_id)
-
-    def game_rules(self) -> GameRules:
-        """Taxi's games (`accepted_envs`, else all taxi accepts)."""
-        return allowed_games(GAME, self.accepted_envs)
 
 
 @dataclass(frozen=True)

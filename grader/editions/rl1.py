@@ -70,6 +70,7 @@ RL1 = Edition(
                 points=1.0,
                 config=CompareConfig,
                 check=CompareCheck(),
+                games=TAXI_GAMES,
             ),
         )
     ),

@@ -1,10 +1,11 @@
 """`EpisodeLog`: one episode as the student's code played it, decoded by a declared model from the child.
 
-The child sends each episode in the layout `grader.sandbox.child.recorder` declares (`EPISODE_HEADER` and
-`EPISODE_COLUMNS`: per-step columns as numpy arrays, or plain lists for short episodes). `WireEpisode` is
-that layout on the parent's side (pydantic, strict, no other fields; a test holds it to the child's
-declaration). `episodes_from_plain` validates it, checks the call's budget from list lengths and array
-shapes, and only then decodes arrays. Nothing in a log is trusted: `grader.sandbox.replay` replays it.
+The child sends each episode in the layout `grader.sandbox.child.episode_fields` declares (`EPISODE_HEADER`
+and `EPISODE_COLUMNS`: per-step columns as numpy arrays, or plain lists for short episodes), a stdlib-only
+module the child's recorder imports too. `WireEpisode` is that layout on the parent's side (pydantic,
+strict, no other fields); it and `EpisodeLog` are checked against the declaration at import.
+`episodes_from_plain` validates it, checks the call's budget from list lengths and array shapes, and only
+then decodes arrays. Nothing in a log is trusted: `grader.sandbox.replay` replays it.
 """
 
 from __future__ import annotations
@@ -18,9 +19,9 @@ from pydantic import AfterValidator, Field, TypeAdapter, ValidationError, with_c
 from typing_extensions import TypedDict
 
 from grader.sandbox.boundary import STRICT, describe, one_of, problem
+from grader.sandbox.child.episode_fields import EPISODE_COLUMNS, EPISODE_FIELDS, check_declaration
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
 from grader.sandbox.child.frames import MAX_DEPTH, MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
-from grader.sandbox.child.recorder import EPISODE_COLUMNS
 from grader.sandbox.limits import CallBudget
 from grader.sandbox.text import clean_plain, clean_text
 
@@ -171,6 +172,11 @@ class WireEpisode(TypedDict):
     terminated: Flags
     truncated: Flags
 
+
+check_declaration(tuple(WireEpisode.__annotations__), "episode_log.WireEpisode")
+check_declaration(
+    tuple(sorted(EpisodeLog.__dataclass_fields__, key=EPISODE_FIELDS.index)), "episode_log.EpisodeLog"
+)
 
 WIRE_EPISODES: TypeAdapter[list[WireEpisode]] = TypeAdapter(
     Annotated[list[WireEpisode], Field(fail_fast=True)]

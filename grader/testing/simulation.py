@@ -12,6 +12,7 @@ code is gymnasium's, only the random stream differs, so such episodes are judged
 
 from __future__ import annotations
 
+import copy
 import inspect
 import operator
 import random
@@ -26,6 +27,7 @@ import numpy as np
 
 from grader.checks.base import CallRecord
 from grader.compat import resolve_env_id
+from grader.sandbox.child.episode_fields import EPISODE_FIELDS
 from grader.sandbox.child.seeding import SeedStream, Stream, space_seed
 from grader.sandbox.episode_log import EpisodeLog
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
@@ -62,19 +64,8 @@ class _Episode:
     reset_options: dict[str, Any] | None = None
 
     def log(self) -> EpisodeLog:
-        return EpisodeLog(
-            env_index=self.env_index,
-            requested_id=self.requested_id,
-            env_id=self.env_id,
-            env_kwargs=dict(self.env_kwargs),
-            reset_seed=self.reset_seed,
-            student_seed=self.student_seed,
-            actions=list(self.actions),
-            rewards=list(self.rewards),
-            terminated=list(self.terminated),
-            truncated=list(self.truncated),
-            reset_options=self.reset_options,
-        )
+        """The episode as the parent decodes it: every wire field (`EPISODE_FIELDS`), containers copied."""
+        return EpisodeLog(**{name: copy.copy(getattr(self, name)) for name in EPISODE_FIELDS})
 
     def replay_as_played(self) -> Replay:
         ends = [step for step, end in enumerate(map(operator.or_, self.terminated, self.truncated)) if end]

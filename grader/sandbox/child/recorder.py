@@ -14,7 +14,7 @@ import sys
 import weakref
 from array import array
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from types import FrameType
 from typing import Any
 
@@ -29,12 +29,16 @@ from grader.compat import events as compat_events
 from grader.compat import make as compat_make
 from grader.compat import register_envs, resolve_env_id
 from grader.sandbox.child.budget import WireBudget
+from grader.sandbox.child.episode_fields import (
+    EPISODE_FIELDS,
+    EPISODE_HEADER,
+    SHORT_EPISODE_STEPS,
+    check_declaration,
+)
 from grader.sandbox.child.frames import MAX_NODES
 from grader.sandbox.child.seeding import CallSeeds, kept_generator_seed
 
 DEFAULT_MAX_RECORDED_STEPS = 5_000_000
-SHORT_EPISODE_STEPS = 16
-"""Episodes up to this many steps send their columns as lists, longer ones as numpy arrays."""
 LIST_NODE_BUDGET = MAX_NODES // 2
 """Most elements a call's episode log may take with list columns; beyond it all columns are arrays."""
 EPISODE_NODES = 16
@@ -44,26 +48,19 @@ MAX_KEPT_GENERATORS = 10_000
 _DROPPED_KWARGS = ("render_mode", "disable_env_checker")
 _COMPAT_MAKE_CODE = compat_make.__code__
 _EXACT_INTS = 2**53
-EPISODE_HEADER = (
-    "env_index",
-    "requested_id",
-    "env_id",
-    "env_kwargs",
-    "reset_seed",
-    "student_seed",
-    "reset_options",
-)
-"""The fields of an episode on the wire besides its per-step columns, in the order `to_plain` sends them.
-
-The one declaration of the wire layout: the parent's model (`grader.sandbox.episode_log.WireEpisode`) is
-checked against it and `EPISODE_COLUMNS` by a test (the child cannot import the parent's modules)."""
-EPISODE_COLUMNS = ("actions", "rewards", "terminated", "truncated")
-"""The per-step columns: one entry per step, as a list for short episodes and a numpy array otherwise."""
+_NO_STEP_LIMIT = sys.maxsize
+_FLOAT_ERRORS = (TypeError, ValueError, OverflowError)
 
 
 @dataclass
 class EpisodeRecord:
-    """One episode as the student played it (child-side, mutable while the episode runs)."""
+    """One episode as the student played it (child-side, mutable while the episode runs).
+
+    Its first fields are the wire's (`episode_fields.EPISODE_FIELDS`, checked at import). The columns are
+    compact typed arrays, appended to without creating a Python object per step: actions as 64-bit ints
+    (a list from the first action that is not a plain int, a `Box` env's arrays say), rewards as doubles,
+    the flags as bytes.
+    """
 
     env_index: int
     requested_id: str
@@ -72,7 +69,7 @@ class EpisodeRecord:
     reset_seed: int
     student_seed: int | None
     reset_options: dict[str, Any] | None
-    actions: list[Any] = field(default_factory=list)
+    actions: array[int] | list[Any] = field(default_factory=lambda: array("q"))
     rewards: array[float] = field(default_factory=lambda: array("d"))
     terminated: bytearray = field(default_factory=bytearray)
     truncated: bytearray = field(default_factory=bytearray)
@@ -96,11 +93,36 @@ class EpisodeRecord:
             plain["terminated"] = list(map(bool, self.terminated))
             plain["truncated"] = list(map(bool, self.truncated))
             return plain
-        plain["actions"] = _compact_actions(self.actions)
+        actions = self.actions
+        if isinstance(actions, array):
+            plain["actions"] = _smallest_int_array(np.frombuffer(actions, dtype=np.int64).copy())
+        else:
+            plain["actions"] = _compact_actions(actions)
         plain["rewards"] = _compact_numbers(np.frombuffer(self.rewards, dtype=np.float64))
         plain["terminated"] = np.frombuffer(self.terminated, dtype=np.bool_)
         plain["truncated"] = np.frombuffer(self.truncated, dtype=np.bool_)
         return plain
+
+    def add_action(self, action: Any) -> None:
+        """Log one action (a copy: the student may mutate an array they passed), the general case.
+
+        `RecordingEnv.step` appends a plain int itself; anything else comes here, and the column becomes
+        a list the first time an action is not an int that fits 64 bits.
+        """
+        copied = _copy_action(action)
+        actions = self.actions
+        if type(actions) is array:
+            if type(copied) is int:
+                with contextlib.suppress(OverflowError):
+                    actions.append(copied)
+                    return
+            actions = self.actions = list(actions)
+        actions.append(copied)
+
+
+check_declaration(
+    tuple(item.name for item in fields(EpisodeRecord))[: len(EPISODE_FIELDS)], "recorder.EpisodeRecord"
+)
 
 
 @dataclass(frozen=True)
@@ -127,6 +149,8 @@ class Recorder:
         self.overflowed = False
         self.record_call = False
         self.budget: WireBudget | None = None
+        self.step_limit = _NO_STEP_LIMIT
+        """The call's `max_steps` (read on every step), unlimited without a budget."""
         self.resets = 0
         self.steps = 0
         self.played = 0
@@ -162,6 +186,7 @@ class Recorder:
         self.recording = record
         self.record_call = record
         self.budget = budget
+        self.step_limit = _NO_STEP_LIMIT if budget is None else budget.max_steps
         self.resets = 0
         self.steps = 0
         self.played = 0
@@ -230,7 +255,7 @@ class Recorder:
             return
         self.resets += 1
         if self.budget is not None and self.resets > self.budget.max_episodes:
-            self._exceed("episodes")
+            self.exceed("episodes")
 
     def start_episode(
         self, env: RecordingEnv, reset_seed: int, student_seed: int | None, options: dict[str, Any] | None
@@ -247,37 +272,8 @@ class Recorder:
         self.episodes.append(episode)
         return episode
 
-    def record_step(
-        self,
-        episode: EpisodeRecord | None,
-        action: Any,
-        reward: Any,
-        terminated: Any,
-        truncated: Any,
-        *,
-        first: bool = False,
-    ) -> None:
-        """Count one step against the call's budget and append it to `episode` while recording.
-
-        `first`: the step is the first since its env's last reset (the game counts as played).
-        """
-        if not self.record_call:
-            return
-        self.steps += 1
-        self.played += first
-        if self.budget is not None and self.steps > self.budget.max_steps:
-            self._exceed("steps")
-        if episode is None or not self.recording or not self._spend_step():
-            return
-        episode.actions.append(_copy_action(action))
-        try:
-            episode.rewards.append(float(reward))
-        except (TypeError, ValueError):
-            episode.rewards.append(float("nan"))
-        episode.terminated.append(bool(terminated))
-        episode.truncated.append(bool(truncated))
-
-    def _exceed(self, what: str) -> None:
+    def exceed(self, what: str) -> None:
+        """The call went beyond its budget (`what`: "episodes" or "steps"): log nothing more, send nothing."""
         if self.exceeded is None:
             self.exceeded = what
         self.recording = False
@@ -327,12 +323,46 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         return result
 
     def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
-        """Step the env and log the action and what the student sees."""
+        """Step the env, count the step against the call's budget and log the action and what the student saw.
+
+        The recorder's per-step work, in this one frame (it runs millions of times a call: Taxi plays 2
+        million steps): every step of a recording call counts (`steps`, and `played` for the first step
+        after a reset); while the call records, the step is appended to the open episode's typed columns
+        until `max_recorded_steps` (then `overflowed`). A reward that is not a number is logged as NaN
+        (the replay then reports the mismatch).
+        """
         result = self.env.step(action)
-        if self.recorder.record_call:
-            _, reward, terminated, truncated, _ = result
-            self.recorder.record_step(self._episode, action, reward, terminated, truncated, first=self._fresh)
-        self._fresh = False
+        recorder = self.recorder
+        if recorder.record_call:
+            if self._fresh:
+                self._fresh = False
+                recorder.played += 1
+            steps = recorder.steps = recorder.steps + 1
+            if steps > recorder.step_limit:
+                recorder.exceed("steps")
+            episode = self._episode
+            if episode is not None and recorder.recording:
+                if recorder._recorded_steps >= recorder.max_recorded_steps:
+                    recorder.overflowed = True
+                    recorder.recording = False
+                    return result
+                recorder._recorded_steps += 1
+                if type(action) is int and type(episode.actions) is array:
+                    try:
+                        episode.actions.append(action)
+                    except OverflowError:
+                        episode.add_action(action)
+                else:
+                    episode.add_action(action)
+                reward, terminated, truncated = result[1], result[2], result[3]
+                try:
+                    episode.rewards.append(reward)  # type: ignore[arg-type]  # converted by array, or refused
+                except _FLOAT_ERRORS:
+                    episode.rewards.append(_float_or_nan(reward))
+                episode.terminated.append(terminated if type(terminated) is bool else bool(terminated))
+                episode.truncated.append(truncated if type(truncated) is bool else bool(truncated))
+        elif self._fresh:
+            self._fresh = False
         return result
 
 
@@ -457,6 +487,14 @@ def _plain_seed(seed: Any) -> int | None:
     if isinstance(seed, int | np.integer) and not isinstance(seed, bool | np.bool_) and 0 <= seed < 2**64:
         return int(seed)
     return None
+
+
+def _float_or_nan(reward: Any) -> float:
+    """`float(reward)`, or NaN for what is not a number (a string `float` parses is a number here too)."""
+    try:
+        return float(reward)
+    except _FLOAT_ERRORS:
+        return float("nan")
 
 
 def _copy_action(action: Any) -> Any:

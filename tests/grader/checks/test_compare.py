@@ -21,7 +21,7 @@ def _settings(**fields: Any) -> CompareConfig:
     settings = load_config(RL1.default_config).problems["compare"]
     assert isinstance(settings, CompareConfig)
     data = {**settings.model_dump(), "points": 1.0, "run_cells": True, **fields}
-    return CompareConfig.model_validate(data).for_problem("compare")
+    return CompareConfig.model_validate(data).for_problem("compare", PROBLEM.games)
 
 
 def _judge(function: Any, seed: int, cells: Any = students.cells) -> Verdict:

@@ -8,9 +8,10 @@ from typing import Any
 import numpy as np
 import pytest
 
+from grader.sandbox.child.episode_fields import EPISODE_COLUMNS, EPISODE_HEADER, SHORT_EPISODE_STEPS
 from grader.sandbox.child.errors import InvalidEpisodeLogError
 from grader.sandbox.child.frames import encode_frame, encode_value, parse_payload
-from grader.sandbox.child.recorder import EPISODE_COLUMNS, EPISODE_HEADER, SHORT_EPISODE_STEPS, EpisodeRecord
+from grader.sandbox.child.recorder import EpisodeRecord
 from grader.sandbox.episode_log import EpisodeLog, WireEpisode, episodes_from_plain
 from grader.sandbox.limits import CallBudget
 

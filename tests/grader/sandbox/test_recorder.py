@@ -2,17 +2,20 @@
 
 from __future__ import annotations
 
+import math
 import textwrap
+from array import array
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import gymnasium
 import numpy as np
 import pytest
 from child_client import ChildClient, write_submission
 
 from grader.sandbox.child.frames import MAX_NODES, decode_value, encode_value
-from grader.sandbox.child.recorder import SHORT_EPISODE_STEPS, EpisodeRecord, Recorder
+from grader.sandbox.child.recorder import SHORT_EPISODE_STEPS, EpisodeRecord, MadeEnv, Recorder, RecordingEnv
 from grader.sandbox.child.seeding import derive_call_seed, reset_seeds
 from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
 from grader.sandbox.replay import verify_reset_seeds
@@ -457,3 +460,50 @@ def test_every_reset_within_the_budget_is_recorded(child: ChildClient) -> None:
 
 def test_an_unlimited_call_keeps_the_global_limit(child: ChildClient) -> None:
     assert len(episodes_of(child.call("scouting", 3000))) == 3001
+
+
+def test_int_actions_stay_one_int64_column_until_an_action_that_is_not_such_an_int() -> None:
+    record = EpisodeRecord(0, "Taxi-v3", "Taxi-v4", {}, 1, None, None)
+    for action in (1, np.int64(2), 3):
+        record.add_action(action)
+    assert isinstance(record.actions, array) and record.actions.tolist() == [1, 2, 3]
+
+    record.add_action(2**70)  # beyond int64: the column becomes a list, nothing lost
+    record.add_action(True)
+    assert record.actions == [1, 2, 3, 2**70, True] and type(record.actions[-1]) is bool
+
+
+class _OddRewards(gymnasium.Env[int, int]):
+    """An env whose rewards and flags are not the plain floats and bools gymnasium's own envs return."""
+
+    observation_space = gymnasium.spaces.Discrete(2)
+    action_space = gymnasium.spaces.Discrete(2)
+
+    def __init__(self, rewards: list[Any]) -> None:
+        self._rewards = iter(rewards)
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[int, dict[str, Any]]:
+        super().reset(seed=seed)
+        return 0, {}
+
+    def step(self, action: int) -> tuple[int, Any, Any, bool, dict[str, Any]]:
+        return 0, next(self._rewards), np.bool_(False), False, {}
+
+
+def test_recorded_steps_log_any_reward_as_a_float_and_nan_when_it_is_not_a_number() -> None:
+    recorder = Recorder(seed=1)
+    recorder.begin_call(2, record=True)
+    env = RecordingEnv(
+        _OddRewards(["1.5", 3, np.float32(0.5), object(), 2**2000]), recorder, MadeEnv("Odd", "Odd", {})
+    )
+    env.reset()
+    for action in (0, 1, 1, 0, 1):
+        env.step(action)
+    (episode,) = recorder.finish_call()
+
+    rewards = episode.rewards.tolist()
+    assert rewards[:3] == [1.5, 3.0, 0.5] and math.isnan(rewards[3]) and math.isnan(rewards[4])
+    assert list(episode.terminated) == [0] * 5 and episode.actions.tolist() == [0, 1, 1, 0, 1]
+    assert (recorder.steps, recorder.played, recorder.resets) == (5, 1, 1)

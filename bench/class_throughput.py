@@ -1,0 +1,417 @@
+"""Figures of issue 25: a class of K submissions graded by `gymgrade grade` against the machine's limit.
+
+    python bench/class_throughput.py [--submissions K] [--editions classic,gym026,volume2,rl1]
+                                     [--workers N] [--seed 0] [--write]
+
+1. Builds a class of K submissions: the lab-literal solution of each edition (`EDITIONS` below), handed
+   out round-robin, every copy with different bytes (a header comment naming the student, blank lines
+   doubled or not, trailing blank lines), so no two files hash alike and no report is reused.
+2. Grades the class with `gymgrade grade` (full isolation, `--workers N`, one run per edition since a
+   batch grades one edition), timing the wall and the CPU of every process of the run (the grader, its
+   xdist workers, the sandbox children: a cgroup v1 `cpuacct` group the run starts in, else
+   `RUSAGE_CHILDREN` with this process as their subreaper, which misses children killed with their
+   parents). `bench/class_calls.py`, loaded in every process of the run through a `sitecustomize` module on
+   its PYTHONPATH, logs every call the grader makes.
+3. Runs one file's logged calls of each edition plainly and serially in a fresh process (as
+   `bench/speed.py` does: `grader.compat.activate()`, import, the same calls with the same arguments; no
+   sandbox, no recording, no replay): the plain serial CPU per submission of that edition.
+4. Prints the ratio of the class's wall time to the bound K x (plain serial CPU per submission) / cores
+   (goal <= 1.1), the grading CPU per submission against the plain one, the machine's load average
+   sampled during the run, and the projection for 300 submissions on 2 cores and on 4 cores with Celery.
+
+The 300-submission projection: the drain time of a busy machine is K x (grading CPU per submission) /
+cores, so 300 x the measured CPU per submission (this mix of editions) / 2 for one 2-core machine, and / 4
+plus one grading's skew for two such machines running `gymgrade worker` (one grading per core); the
+section states the assumptions. `--write` replaces the `## Class throughput` section of bench/RESULTS.md.
+With the default K = 4 (one file per edition) the grading takes about 5 minutes on an idle 2-core machine
+(about 370 s of CPU, and each edition's run waits for its Taxi check), the plain runs about 3 more.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import ctypes
+import json
+import os
+import pickle
+import platform
+import re
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections import Counter
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCH = Path(__file__).resolve().parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(BENCH))
+
+from class_calls import LOG_VARIABLE, read_calls  # noqa: E402
+
+RESULTS = BENCH / "RESULTS.md"
+HEADING = "## Class throughput"
+EDITIONS = {
+    "classic": ROOT / "submissions" / "classic_complete.py",
+    "gym026": ROOT / "submissions" / "gym026_complete.py",
+    "volume2": ROOT / "submissions" / "gymnasium_complete.py",
+    "rl1": ROOT / "submissions" / "editions" / "rl1_complete.py",
+}
+"""Each edition's lab-literal solution (every problem passes with the edition's default configuration)."""
+PROJECTED_CLASS = 300
+CHUNK_SUBMISSIONS = 24  # grader.batch.CHUNK_SUBMISSIONS, repeated to keep this module importable alone
+_PR_SET_CHILD_SUBREAPER = 36
+_CLI = "import sys; from grader.cli import main; sys.exit(main(sys.argv[1:]))"
+
+
+def varied(source: str, index: int) -> str:
+    """The same program with different bytes: a header comment, blank lines doubled or not, a tail."""
+    body = source.replace("\n\n\ndef ", "\n\n\n\ndef ") if index % 2 else source
+    return f"# student {index:04d} (class throughput bench)\n" + body + "\n" * (index % 3)
+
+
+@dataclass
+class EditionRun:
+    """One `gymgrade grade` run of the class's files of one edition."""
+
+    edition: str
+    files: int
+    wall: float
+    cpu: float
+    statuses: Counter[str]
+    plain_cpu: float = 0.0
+    plain_wall: float = 0.0
+    calls: int = 0
+    log: Path | None = None
+    logged_file: str = ""
+
+
+@dataclass
+class LoadSampler:
+    """The 1-minute load average, sampled every few seconds on a thread while a run lasts."""
+
+    period: float = 5.0
+    samples: list[float] = field(default_factory=list)
+    _stop: threading.Event = field(default_factory=threading.Event)
+
+    def __enter__(self) -> LoadSampler:
+        self.samples.append(os.getloadavg()[0])
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        self._stop.set()
+        self._thread.join()
+        self.samples.append(os.getloadavg()[0])
+
+    def _run(self) -> None:
+        while not self._stop.wait(self.period):
+            self.samples.append(os.getloadavg()[0])
+
+    def summary(self) -> str:
+        """Min, median and max of the samples."""
+        values = self.samples
+        return (
+            f"1-minute load average {min(values):.1f} / {statistics.median(values):.1f} / {max(values):.1f} "
+            f"(min / median / max of {len(values)} samples)"
+        )
+
+
+class CpuGroup:
+    """A cgroup v1 `cpuacct` group the run starts in: its usage is every descendant's CPU, killed ones too.
+
+    `RUSAGE_CHILDREN` misses processes whose parent died without waiting for them (the sandbox kills a
+    child's whole cgroup at once); the grader makes no groups in the `cpuacct` hierarchy, so every
+    process of the run stays in this one. None of this is available without cgroup v1 `cpuacct` as root:
+    then `RUSAGE_CHILDREN` is used and the section says so.
+    """
+
+    ROOT = Path("/sys/fs/cgroup/cpuacct")
+
+    def __init__(self, name: str) -> None:
+        self.path: Path | None = self.ROOT / f"gymgrade-bench-{os.getpid()}-{name}"
+        try:
+            self.path.mkdir()
+        except OSError:
+            self.path = None
+
+    def join(self) -> None:
+        """Move the calling process into the group (a `preexec_fn`: runs in the child before exec)."""
+        if self.path is not None:
+            (self.path / "cgroup.procs").write_text(str(os.getpid()))
+
+    def seconds(self) -> float | None:
+        """CPU used by the group's processes so far, None without a group."""
+        if self.path is None:
+            return None
+        return int((self.path / "cpuacct.usage").read_text()) / 1e9
+
+    def remove(self) -> None:
+        """Remove the group once its processes are gone (waits a few seconds for stragglers)."""
+        if self.path is None:
+            return
+        for _ in range(50):
+            with contextlib.suppress(OSError):
+                self.path.rmdir()
+                return
+            time.sleep(0.1)
+
+
+def children_cpu() -> float:
+    """User + system CPU of every waited-for descendant so far."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def reap_orphans() -> None:
+    """Wait for the descendants this subreaper adopted (xdist workers the grader killed, their children), so
+    their CPU enters `RUSAGE_CHILDREN`; a live one is waited for (the run is over, it is ending)."""
+    while True:
+        try:
+            pid, _ = os.waitpid(-1, 0)
+        except ChildProcessError:
+            return
+        if pid == 0:
+            return
+
+
+def grade_edition(
+    edition: str, folder: Path, out: Path, log: Path, workers: int, seed: int
+) -> tuple[float, float, Counter[str]]:
+    """`gymgrade grade` of one edition's files: wall, CPU of all its processes, statuses of the problems."""
+    environment = dict(os.environ)
+    hook = log / "site"  # the session drops PYTEST_PLUGINS; every process imports sitecustomize
+    hook.mkdir()
+    (hook / "sitecustomize.py").write_text("import class_calls  # noqa: F401\n", encoding="utf-8")
+    environment["PYTHONPATH"] = os.pathsep.join(
+        filter(None, [str(hook), str(ROOT), str(BENCH), environment.get("PYTHONPATH")])
+    )
+    environment[LOG_VARIABLE] = str(log)
+    command = [sys.executable, "-c", _CLI, "grade", str(folder), "--out", str(out)]
+    command += ["--edition", edition, "--seed", str(seed), "--workers", str(workers)]
+    group = CpuGroup(edition)
+    cpu_before, started = children_cpu(), time.perf_counter()
+    done = subprocess.run(
+        command, capture_output=True, text=True, env=environment, check=False, preexec_fn=group.join
+    )
+    wall = time.perf_counter() - started
+    reap_orphans()
+    grouped = group.seconds()
+    cpu = grouped if grouped is not None else children_cpu() - cpu_before
+    group.remove()
+    if done.returncode not in (0, 1):
+        raise SystemExit(f"gymgrade grade failed (exit {done.returncode}): {done.stderr[-3000:]}")
+    statuses: Counter[str] = Counter()
+    for report_path in sorted(out.glob("*.json")):
+        with contextlib.suppress(ValueError, KeyError):
+            report = json.loads(report_path.read_text(encoding="utf-8"))
+            statuses.update(problem["status"] for problem in report["problems"])
+    return wall, cpu, statuses
+
+
+def plain_cpu(submission: Path, calls_file: Path) -> tuple[float, float]:
+    """CPU (import + calls) and wall of the logged calls run plainly in a fresh interpreter
+    (`bench/speed.py --plain-child`)."""
+    environment = dict(os.environ)
+    environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), environment.get("PYTHONPATH")]))
+    command = [sys.executable, str(BENCH / "speed.py"), "--plain-child", str(calls_file), str(submission)]
+    started = time.perf_counter()
+    done = subprocess.run(command, capture_output=True, text=True, env=environment, check=False)
+    wall = time.perf_counter() - started
+    if done.returncode != 0:
+        raise SystemExit(
+            f"the plain run of {submission.name} failed (exit {done.returncode}): {done.stderr[-3000:]}"
+        )
+    summary = json.loads(done.stdout.strip().splitlines()[-1])
+    return summary["import_cpu"] + summary["calls_cpu"], wall
+
+
+def row(*cells: object) -> str:
+    """A markdown table row."""
+    return "| " + " | ".join(str(cell) for cell in cells) + " |"
+
+
+def section(runs: list[EditionRun], cores: int, workers: int, load: LoadSampler, command: str) -> str:
+    """The `## Class throughput` section."""
+    total_files = sum(run.files for run in runs)
+    wall = sum(run.wall for run in runs)
+    grade_cpu = sum(run.cpu for run in runs)
+    plain_cpu = sum(run.plain_cpu * run.files for run in runs)
+    bound = plain_cpu / cores
+    per_plain = plain_cpu / total_files
+    per_grade = grade_cpu / total_files
+    cpu_ratio = per_grade / per_plain
+    chunks = -(-PROJECTED_CLASS // CHUNK_SUBMISSIONS)
+    longest = max(run.cpu / run.files for run in runs)
+    two_core = PROJECTED_CLASS * per_grade / 2
+    two_core_bound = PROJECTED_CLASS * per_plain / 2
+    four_core = PROJECTED_CLASS * per_grade / 4 + longest
+    four_core_bound = PROJECTED_CLASS * per_plain / 4
+    busy = statistics.median(load.samples) > cores
+    stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
+    lines = [
+        HEADING,
+        "",
+        f"`{command}`, {stamp}, {platform.machine()}, {cores} cores, full isolation, `--workers {workers}`. "
+        f"Machine load during the run: {load.summary()}."
+        + (
+            f" **The machine was shared with other engineers' jobs (median load above {cores} cores)**: "
+            "the wall times and the wall ratio are stretched by them; the CPU figures are not."
+            if busy
+            else ""
+        ),
+        "",
+        f"A class of {total_files} submissions: the lab-literal solution of each edition, every copy with "
+        "different bytes (header comment, blank lines), graded with `gymgrade grade --edition E` (one run "
+        "per edition, as a batch grades one edition). Plain: one file's calls of each edition, exactly as "
+        "the grader made them (logged by `bench/class_calls.py`), run serially in one fresh process "
+        "(`grader.compat.activate()`, import, call; no sandbox, no recording, no replay).",
+        "",
+        row(
+            "edition",
+            "files",
+            "calls per file",
+            "problem statuses",
+            "grade wall (s)",
+            "grade CPU per file (s)",
+            "plain CPU per file (s)",
+            "CPU ratio",
+        ),
+        row("---", "---:", "---:", "---", "---:", "---:", "---:", "---:"),
+    ]
+    for run in runs:
+        statuses = ", ".join(f"{count} {status}" for status, count in sorted(run.statuses.items()))
+        lines.append(
+            row(
+                run.edition,
+                run.files,
+                run.calls,
+                statuses,
+                f"{run.wall:.1f}",
+                f"{run.cpu / run.files:.1f}",
+                f"{run.plain_cpu:.1f}",
+                f"{run.cpu / run.files / run.plain_cpu:.2f}",
+            )
+        )
+    lines += [
+        row(
+            "class",
+            total_files,
+            "",
+            "",
+            f"{wall:.1f}",
+            f"{per_grade:.1f}",
+            f"{per_plain:.1f}",
+            f"{cpu_ratio:.2f}",
+        ),
+        "",
+        f"- **Wall / bound: {wall / bound:.2f}** (goal <= 1.1): the class took {wall:.1f} s; the bound "
+        f"K x plain CPU per submission / cores = {plain_cpu:.1f} s / {cores} = {bound:.1f} s.",
+        f"- **Grading CPU / plain CPU per submission: {cpu_ratio:.2f}** ({per_grade:.1f} s against "
+        f"{per_plain:.1f} s): what the grader spends besides the student's own work (sandbox start, "
+        "recording, transfer, replay, judging, pytest and xdist), the figure load cannot stretch.",
+        f"- Cores busy on average: {grade_cpu / wall:.2f} of {cores} (grading CPU / wall).",
+        "",
+        f"Projection for {PROJECTED_CLASS} submissions (this mix of editions), from the CPU per submission "
+        "measured here:",
+        "",
+        row("machine", "projected drain (min)", "bound: plain CPU / cores (min)", "ratio"),
+        row("---", "---:", "---:", "---:"),
+        row(
+            "1 x 2 cores, `gymgrade grade`",
+            f"{two_core / 60:.1f}",
+            f"{two_core_bound / 60:.1f}",
+            f"{two_core / two_core_bound:.2f}",
+        ),
+        row(
+            "2 x 2 cores, Celery workers (one grading per core)",
+            f"{four_core / 60:.1f}",
+            f"{four_core_bound / 60:.1f}",
+            f"{four_core / four_core_bound:.2f}",
+        ),
+        "",
+        "Assumptions: every submission costs what its edition's lab-literal file costs here (the class mix "
+        "is the same); gradings are CPU-bound and independent, so N cores drain N core-seconds per second "
+        f"(2 cores: {PROJECTED_CLASS} x {per_grade:.1f} s / 2; the {chunks} pytest runs of "
+        f"{CHUNK_SUBMISSIONS} submissions each sort their problems longest first across the chunk, so a "
+        "chunk's tail is its shortest problems, a few seconds each, not counted); with Celery, "
+        "`gymgrade worker` runs one grading per core without xdist (`## Scale-out (issue 9)`), each costing "
+        "the CPU per submission measured here, plus the last grading's skew (at most one submission, "
+        f"{longest:.1f} s of CPU); Redis and PostgreSQL carry a few messages per grading and are not "
+        "binding; cores are real cores. The projected ratio equals the CPU ratio: on a machine kept busy, "
+        "only the grader's CPU per submission stands between the drain time and the bound.",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--submissions", type=int, default=4, help="K, the class size (default 4)")
+    parser.add_argument("--editions", default=",".join(EDITIONS))
+    parser.add_argument("--workers", type=int, default=len(os.sched_getaffinity(0)))
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--write", action="store_true")
+    args = parser.parse_args()
+    editions = [name for name in args.editions.split(",") if name]
+    unknown = set(editions) - set(EDITIONS)
+    if unknown:
+        raise SystemExit(f"unknown editions {sorted(unknown)}; expected some of {', '.join(EDITIONS)}")
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
+    cores = len(os.sched_getaffinity(0))
+    runs: list[EditionRun] = []
+    with tempfile.TemporaryDirectory(prefix="gymgrade-class-") as scratch:
+        root = Path(scratch)
+        counts = Counter(editions[index % len(editions)] for index in range(args.submissions))
+        with LoadSampler() as load:
+            for edition in editions:
+                if not counts[edition]:
+                    continue
+                folder, out, log = root / edition, root / f"{edition}-out", root / f"{edition}-calls"
+                for directory in (folder, out, log):
+                    directory.mkdir()
+                source = EDITIONS[edition].read_text(encoding="utf-8")
+                for index in range(counts[edition]):
+                    name = f"student{index:04d}_{edition}.py"
+                    (folder / name).write_text(varied(source, index), encoding="utf-8")
+                print(f"grading {counts[edition]} {edition} file(s) ...", flush=True)
+                wall, cpu, statuses = grade_edition(edition, folder, out, log, args.workers, args.seed)
+                print(f"   {wall:.1f} s wall, {cpu:.1f} s CPU, {dict(statuses)}", flush=True)
+                calls = read_calls(log)
+                if not calls:
+                    raise SystemExit(f"no call was logged for {edition}: is bench/class_calls.py loaded?")
+                first = min(calls)
+                runs.append(EditionRun(edition, counts[edition], wall, cpu, statuses))
+                runs[-1].calls, runs[-1].log, runs[-1].logged_file = len(calls[first]), log, first
+        for run in runs:
+            assert run.log is not None
+            calls_file = run.log / "plain.calls"
+            calls_file.write_bytes(pickle.dumps(read_calls(run.log)[run.logged_file]))
+            run.plain_cpu, run.plain_wall = plain_cpu(EDITIONS[run.edition], calls_file)
+            print(f"plain {run.edition}: {run.plain_cpu:.1f} s CPU ({run.plain_wall:.1f} s wall)", flush=True)
+    command = " ".join(["python", "bench/class_throughput.py", *sys.argv[1:]])
+    text = section(runs, cores, args.workers, load, command)
+    print(text)
+    if args.write:
+        current = RESULTS.read_text(encoding="utf-8")
+        pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.MULTILINE | re.DOTALL)
+        updated = (
+            pattern.sub(lambda _: text, current)
+            if pattern.search(current)
+            else current.rstrip() + "\n\n" + text
+        )
+        RESULTS.write_text(updated, encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
