@@ -30,8 +30,7 @@ from grader.checks.taxi import EPISODE_STEPS
 from grader.checks.values import as_number, describe
 from grader.notebook.cells import RAN_CELLS, SCRIPT_CELL
 from grader.problem_config import PlayedProblemConfig, Probability
-from grader.sandbox.child.cells import RUN_CELLS
-from grader.sandbox.outcome import Call, FunctionInfo, OutcomeStatus, PlainValue
+from grader.sandbox.outcome import RUN_CELLS, Call, FunctionInfo, OutcomeStatus, PlainValue
 from grader.stats import mean_tolerance
 from reference.oracles import greedy_policy_return
 

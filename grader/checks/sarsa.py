@@ -39,10 +39,8 @@ from grader.checks.sarsa_updates import (
 from grader.checks.values import as_number, describe
 from grader.games import TAXI, Game, GameRules
 from grader.problem_config import Probability, ProblemConfig
-from grader.sandbox.child.frames import EnvArgument
-from grader.sandbox.child.provided import epsilon_decay
 from grader.sandbox.limits import CallBudget
-from grader.sandbox.outcome import Call, FunctionInfo, OutcomeStatus, PlainValue
+from grader.sandbox.outcome import PROVIDED, Call, EnvArgument, FunctionInfo, OutcomeStatus, PlainValue
 
 TAXI_SHAPE = (500, 6)
 PENALTY_REWARD = -10.0
@@ -221,7 +219,8 @@ def _schedule(settings: SarsaConfig, decay_records: Sequence[CallRecord], run: R
     The grader's formula when it provided its own; else the student's values, read by calling it.
     """
     if settings.decay_schedule == "grader":
-        return [epsilon_decay(episode, run.episodes) for episode in range(1, run.episodes + 1)]
+        lab_decay = PROVIDED["epsilon_decay"]
+        return [lab_decay(episode, run.episodes) for episode in range(1, run.episodes + 1)]
     values = [returned_number(record.outcome.value) for record in decay_records]
     if len(values) != run.episodes or any(value is None for value in values):
         return None

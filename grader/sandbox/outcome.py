@@ -9,7 +9,25 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from grader.sandbox.child.cells import RUN_CELLS
+from grader.sandbox.child.frames import EnvArgument
+from grader.sandbox.child.provided import PROVIDED
 from grader.sandbox.limits import CallBudget
+
+__all__ = [
+    "PROVIDED",
+    "RUN_CELLS",
+    "Call",
+    "CallOutcome",
+    "EnvArgument",
+    "FunctionInfo",
+    "OutcomeStatus",
+    "ParameterInfo",
+    "PlainValue",
+]
+"""`RUN_CELLS` (the call that runs a notebook's cells), `EnvArgument` (an env the child makes for a call) and
+`PROVIDED` (the grader's definitions a call may bind) are declared by the child, which imports nothing of
+the parent; the plans use them from here."""
 
 if TYPE_CHECKING:
     from grader.sandbox.episode_log import EpisodeLog
