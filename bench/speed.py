@@ -63,6 +63,17 @@ _CLI = "import sys; from grader.cli import main; sys.exit(main(sys.argv[1:]))"
 # ---------------------------------------------------------------------------------------------- plain side
 
 
+def _plain_argument(value: Any) -> Any:
+    """A logged argument as the plain run passes it: an `EnvArgument` (made by the sandbox) made here."""
+    from grader.sandbox.outcome import EnvArgument
+
+    if isinstance(value, EnvArgument):
+        import gymnasium  # its make resolves lab ids here (`_route_lab_ids`)
+
+        return gymnasium.make(value.env_id, max_episode_steps=value.max_episode_steps)
+    return value
+
+
 def plain_child(calls_file: Path, submission: Path) -> None:
     """Run the recorded calls plainly in this process; print the times as one JSON line on stdout."""
     import grader.compat
@@ -82,7 +93,8 @@ def plain_child(calls_file: Path, submission: Path) -> None:
     calls: list[tuple[str, tuple[Any, ...], dict[str, Any]]] = pickle.loads(calls_file.read_bytes())
     per_function: dict[str, float] = {}
     calls_started, calls_cpu = time.perf_counter(), time.process_time()
-    for function, args, kwargs in calls:
+    for function, logged_args, kwargs in calls:
+        args = tuple(_plain_argument(value) for value in logged_args)
         began = time.perf_counter()
         with contextlib.redirect_stdout(quiet):
             getattr(module, function)(*args, **kwargs)
