@@ -71,18 +71,7 @@ class EpisodeLog:
         """Field by field; array actions (Box envs) compare by dtype, shape and values."""
         if not isinstance(other, EpisodeLog):
             return NotImplemented
-        fields = (
-            "env_index",
-            "requested_id",
-            "env_id",
-            "env_kwargs",
-            "reset_seed",
-            "student_seed",
-            "rewards",
-            "terminated",
-            "truncated",
-            "reset_options",
-        )
+        fields = tuple(name for name in EPISODE_FIELDS if name != "actions")  # actions: below, by type
         return (
             all(getattr(self, name) == getattr(other, name) for name in fields)
             and len(self.actions) == len(other.actions)
