@@ -36,7 +36,6 @@ import json
 import os
 import pickle
 import platform
-import re
 import resource
 import statistics
 import subprocess
@@ -55,8 +54,8 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(BENCH))
 
 from class_calls import LOG_VARIABLE, read_calls  # noqa: E402
+from results_section import replace_section  # noqa: E402
 
-RESULTS = BENCH / "RESULTS.md"
 HEADING = "## Class throughput"
 EDITIONS = {
     "classic": ROOT / "submissions" / "classic_complete.py",
@@ -402,14 +401,7 @@ def main() -> int:
     text = section(runs, cores, args.workers, load, command)
     print(text)
     if args.write:
-        current = RESULTS.read_text(encoding="utf-8")
-        pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.MULTILINE | re.DOTALL)
-        updated = (
-            pattern.sub(lambda _: text, current)
-            if pattern.search(current)
-            else current.rstrip() + "\n\n" + text
-        )
-        RESULTS.write_text(updated, encoding="utf-8")
+        replace_section(HEADING, text)
     return 0
 
 

@@ -36,7 +36,6 @@ import json
 import os
 import pickle
 import platform
-import re
 import statistics
 import subprocess
 import sys
@@ -52,8 +51,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from grading_probe import ProblemCost, SharedChild, grade_serially, graded, leaky_orders  # noqa: E402
+from results_section import replace_section  # noqa: E402
 
-RESULTS = ROOT / "bench" / "RESULTS.md"
 HEADING = "## Speed (issue 11)"
 DEFAULT_SUBMISSION = ROOT / "submissions" / "classic_complete.py"
 ACCEPTANCE_DIR = ROOT / "grader" / "acceptance"
@@ -670,14 +669,7 @@ def main() -> int:
     text = section(figures)
     print(text)
     if args.write:
-        current = RESULTS.read_text(encoding="utf-8")
-        pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.MULTILINE | re.DOTALL)
-        updated = (
-            pattern.sub(lambda _: text, current)
-            if pattern.search(current)
-            else current.rstrip() + "\n\n" + text
-        )
-        RESULTS.write_text(updated, encoding="utf-8")
+        replace_section(HEADING, text)
     return 0
 
 
