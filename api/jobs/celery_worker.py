@@ -315,7 +315,7 @@ def run_worker(settings: Settings, concurrency: int | None) -> int:
         logger.critical(
             "the Celery worker stopped on errors %d times in %.0f s; exiting. "
             "Check the broker (`gymgrade doctor`), then start `gymgrade worker` again: queued submissions are kept",  # noqa: E501
-            len(history),
+            len(history) + 1,  # this stop too
             RESTART_WINDOW_SECONDS,
         )
     return exitcode
