@@ -22,7 +22,7 @@ from typing import Any
 from pydantic import JsonValue
 
 import grader
-from grader.grading import GradingPlan
+from grader.plan import GradingPlan
 from grader.report import ProblemResult, Report
 
 PROBLEMS = (
