@@ -17,7 +17,8 @@ import grader.sandbox.runner
 from grader.batch import grade_many
 from grader.collector import OnResult
 from grader.errors import BatchInterrupted
-from grader.grading import GradingPlan, grade_files, grade_submission
+from grader.grading import grade_files, grade_submission
+from grader.plan import GradingPlan
 from grader.plugin import GraderFailure, SessionPlan
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
