@@ -45,9 +45,10 @@ def page_figures(problems: Sequence[Mapping[str, Any]], edition: str | None) -> 
         if problem.get("status") == "withheld":
             continue
         try:
-            figures[str(problem["id"])] = list(_figures(json.dumps(_figure_input(problem), sort_keys=True), config))
+            drawn = _figures(json.dumps(_figure_input(problem), sort_keys=True), config)
         except (ValueError, TypeError, KeyError):  # not a grader's result: the page shows it without figures
             continue
+        figures[str(problem["id"])] = list(drawn)
     return figures
 
 

@@ -1,4 +1,4 @@
-"""The figures gymgrade shows: plots of a problem's measurements against the exact answers, and episode replays.
+"""The figures gymgrade shows: plots of a problem's measurements against the exact answers, and replays.
 
 One stack draws them for the HTML report, the class report (`grader.class_report.figures`) and the service's
 page (`api.web.page_figures`). Plots are PNGs drawn by `grader.problem_plots` (matplotlib's Agg canvas: no
