@@ -17,7 +17,7 @@ import os
 import time
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from matplotlib.figure import Figure as PlotFigure
@@ -44,7 +44,7 @@ class Figure:
         caption: What it shows and how to read it.
         mime: ``image/png`` or ``image/gif``.
         data: The encoded image.
-        seconds: Time it took to draw.
+        seconds: Time it took to draw (not part of what the figure is: equal figures may differ in it).
     """
 
     problem: str
@@ -52,7 +52,7 @@ class Figure:
     caption: str
     mime: str
     data: bytes
-    seconds: float
+    seconds: float = field(compare=False)
 
     def data_uri(self) -> str:
         """The image as a ``data:`` URI, to embed in a self-contained page."""
