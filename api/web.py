@@ -33,8 +33,9 @@ def page_figures(problems: Sequence[Mapping[str, Any]], edition: str | None) -> 
     Args:
         problems: The report's problems, or while the grading runs (no report yet) the finished ones.
         edition: The report's edition; None while the grading runs, when the first edition's
-            configuration draws them (every edition plots blackjack, cartpole and car as the first does, with
-            its settings; a plotter draws nothing for another edition's measurements).
+            configuration draws them (every edition plots its problems with the first edition's plotters
+            and settings, as `tests/api/test_web.py` holds it; a plotter draws nothing for another
+            edition's measurements).
 
     Returns:
         The figures; none for a withheld problem or an entry that is not a grader's problem result.

@@ -2,10 +2,10 @@
 
 One stack draws them for the HTML report, the class report (`grader.class_report.figures`) and the service's
 page (`api.web.page_figures`). Plots are PNGs drawn by `grader.problem_plots` (matplotlib's Agg canvas: no
-pyplot, no display, safe in threads); replays are
-animated GIFs re-rendered headless (``rgb_array``) in the grader's own gymnasium from the episode's reset
-seed and actions. Both are small: a plot is 480x256 pixels; a GIF keeps at most ``MAX_GIF_FRAMES`` frames
-(every k-th step, and always the last) at most ``MAX_GIF_WIDTH`` pixels wide, on one 64-colour palette.
+pyplot, no display, safe in threads); replays are animated GIFs re-rendered headless (``rgb_array``) in the
+grader's own gymnasium from the episode's reset seed and actions. Both are small: a plot is 480x256 pixels;
+a GIF keeps at most ``MAX_GIF_FRAMES`` frames (every k-th step, and always the last) at most
+``MAX_GIF_WIDTH`` pixels wide, on one 64-colour palette.
 """
 
 from __future__ import annotations
