@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 from pydantic import Field
 
-from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, count_games, hits_by_sum
 from grader.checks.integrity import (
     all_resets,
@@ -52,11 +52,9 @@ class RandomBlackjackCheck:
 
     @noting_post_terminal_steps
     @paused_gc
+    @judged_when_all_returned
     def judge(self, settings: RandomBlackjackConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the call against its replayed games and the exact random-policy win probability."""
-        early = outcome_verdict(records)
-        if early is not None:
-            return early
         call = f"random_blackjack({settings.games})"
         returned = as_number(records[0].outcome.value)
         if returned is None:

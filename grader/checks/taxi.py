@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from pydantic import Field
 
-from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, paused_gc
 from grader.checks.integrity import (
     Episode,
     all_resets,
@@ -144,11 +144,9 @@ class TaxiCheck:
 
     @noting_post_terminal_steps
     @paused_gc
+    @judged_when_all_returned
     def judge(self, settings: TaxiConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned means against the replayed scenarios and the exact expectations."""
-        early = outcome_verdict(records)
-        if early is not None:
-            return early
         outcome = records[0].outcome
         value = outcome.value
         means = [as_number(item) for item in value] if isinstance(value, list) and len(value) == 2 else [None]
