@@ -13,8 +13,8 @@ import numpy as np
 from pydantic import Field
 
 from grader.checks.base import CallRecord, Verdict, paused_gc
-from grader.checks.integrity import Episode, games_budget, played_episodes
-from grader.checks.lengths import LengthRuns, judge_lengths
+from grader.checks.integrity import Episode, played_episodes
+from grader.checks.lengths import LengthRuns, judge_lengths, one_game_calls
 from grader.checks.values import chance_text
 from grader.compat.envs.guessing_game import GUESS_EQUAL, GUESS_TOO_HIGH, GUESS_TOO_LOW
 from grader.problem_config import PlayedProblemConfig, Probability
@@ -268,8 +268,7 @@ class GuessingGameCheck:
 
     def plan(self, settings: GuessingGameConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of guessing_game() calls."""
-        budget = games_budget(1, EPISODE_STEPS)
-        return [Call("guessing_game", budget=budget) for _ in range(settings.calls)]
+        return one_game_calls("guessing_game", settings.calls, EPISODE_STEPS)
 
     @paused_gc
     def judge(self, settings: GuessingGameConfig, records: Sequence[CallRecord]) -> Verdict:
