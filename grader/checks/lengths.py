@@ -9,12 +9,10 @@ from typing import TYPE_CHECKING
 from grader.checks.base import CallRecord, Verdict, outcome_verdict
 from grader.checks.integrity import (
     Episode,
-    all_resets,
     episodes_per_call,
     games_budget,
-    integrity_problem,
     played_episodes,
-    repeated_seed_problem,
+    played_games_problem,
 )
 from grader.checks.values import as_number, describe, same_number, step_count_mismatch_cause
 from grader.games import Game, GameRules
@@ -110,9 +108,7 @@ def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]
     if early is not None:
         return early
     episodes = played_episodes(records)
-    problem = integrity_problem(records, episodes, rules) or repeated_seed_problem(
-        all_resets(records), across_calls=True
-    )
+    problem = played_games_problem(records, episodes, rules, across_calls=True)
     if problem:
         return Verdict("failed", 0.0, f"{function}(): {problem}.", {})
     game = rules.played_game(episode.log for episode in episodes)

@@ -11,12 +11,10 @@ from pydantic import Field
 from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, count_games, hits_by_sum
 from grader.checks.integrity import (
-    all_resets,
     games_budget,
-    integrity_problem,
     noting_post_terminal_steps,
     played_episodes,
-    repeated_seed_problem,
+    played_games_problem,
 )
 from grader.checks.values import as_number, chance_text, describe, rate_mismatch_cause, read_rate
 from grader.problem_config import PlayedProblemConfig, Probability
@@ -63,9 +61,7 @@ class RandomBlackjackCheck:
             )
         episodes = played_episodes(records)
         rules = settings.game_rules()
-        problem = integrity_problem(records, episodes, rules) or repeated_seed_problem(
-            all_resets(records), across_calls=False
-        )
+        problem = played_games_problem(records, episodes, rules, across_calls=False)
         if problem:
             return _fail(f"{call}: {problem}.")
         game = rules.played_game(episode.log for episode in episodes)

@@ -13,12 +13,10 @@ from pydantic import Field
 from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, paused_gc
 from grader.checks.integrity import (
     Episode,
-    all_resets,
     games_budget,
-    integrity_problem,
     noting_post_terminal_steps,
     played_episodes,
-    repeated_seed_problem,
+    played_games_problem,
     seed_problem,
 )
 from grader.checks.truncation import ignored_truncation
@@ -156,9 +154,7 @@ class TaxiCheck:
             )
         random_mean, greedy_mean = float(means[0]), float(means[1])  # type: ignore[arg-type]
         episodes = played_episodes(records)
-        problem = integrity_problem(records, episodes, settings.game_rules()) or repeated_seed_problem(
-            all_resets(records), across_calls=False
-        )
+        problem = played_games_problem(records, episodes, settings.game_rules(), across_calls=False)
         if problem:
             # An altered log is named as such; otherwise a loop that ignored `truncated` is named as that.
             diagnosis = None if seed_problem(records) else ignored_truncation(episodes)
