@@ -100,14 +100,9 @@ def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
 
 def _add_class_options(grade: argparse.ArgumentParser) -> None:
     from grader.classroom.gradebooks import GRADEBOOKS
-    from grader.classroom.layouts import LAYOUTS
+    from grader.classroom.layouts import add_layout_option
 
-    grade.add_argument(
-        "--layout",
-        choices=tuple(LAYOUTS),
-        default=None,
-        help="the download's layout (default: recognised from its names; see docs/instructors.md)",
-    )
+    add_layout_option(grade)
     grade.add_argument(
         "--roster",
         type=Path,

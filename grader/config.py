@@ -172,6 +172,27 @@ def _describe(error: ValidationError, where: str) -> str:
     return "\n".join(lines)
 
 
+def read_config_file(source: Path) -> dict[str, Any]:
+    """The TOML table of an assignment configuration file, not yet validated.
+
+    Raises:
+        ConfigError: The file is missing, cannot be read, or is not UTF-8 TOML.
+    """
+    try:
+        return tomllib.loads(source.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(
+            f"assignment configuration {source} not found: pass an existing TOML file"
+        ) from None
+    except OSError as error:
+        raise ConfigError(
+            f"cannot read the assignment configuration {source} ({error.strerror or error}): "
+            "pass a readable TOML file"
+        ) from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise ConfigError(f"{source} is not valid UTF-8 TOML ({error}): fix the syntax") from None
+
+
 def load_config(path: Path | None = None, registry: Registry | None = None) -> AssignmentConfig:
     """Load and validate the assignment configuration.
 
@@ -188,15 +209,7 @@ def load_config(path: Path | None = None, registry: Registry | None = None) -> A
             what was expected and what was found).
     """
     source = path or DEFAULT_CONFIG_PATH
-    try:
-        raw = tomllib.loads(source.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ConfigError(
-            f"assignment configuration {source} not found: pass an existing TOML file"
-        ) from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise ConfigError(f"{source} is not valid UTF-8 TOML ({error}): fix the syntax") from None
-    return config_from_data(raw, where=str(source), registry=registry)
+    return config_from_data(read_config_file(source), where=str(source), registry=registry)
 
 
 def config_from_data(
