@@ -186,7 +186,7 @@ def test_every_check_reports_its_timings_apart_from_the_verdict(reports: dict[st
 
 @contextlib.contextmanager
 def _deleted_when_the_session_starts(path: Path) -> Iterator[None]:
-    """Delete ``path`` once it is validated, as its session starts: its check then fails in the grader."""
+    """Delete ``path`` once the plan is made and the files validated, as the session starts."""
     import grader.grading
 
     start = grader.grading.run_session
@@ -221,3 +221,16 @@ def test_a_grader_failure_keeps_the_problems_visibility(tmp_path: Path) -> None:
     config = write_config(tmp_path / "assignment.toml", {"car": {"visibility": "hidden"}})
     [result] = _vanished_report(GradingPlan.load(config, ["car"]), tmp_path).problems
     assert (result.status, result.visibility) == ("error", "hidden")
+
+
+def test_the_workers_grade_with_the_plans_configuration_even_if_its_file_is_gone(tmp_path: Path) -> None:
+    config = write_config(tmp_path / "assignment.toml", {"car": {"points": 3.0, "visibility": "hidden"}})
+    plan = GradingPlan.load(config, ["car"])
+    with _deleted_when_the_session_starts(config):  # no process of the session may read it again
+        [report] = grade_files(
+            [CLASSIC_COMPLETE], plan, seed=0, workers=1, policy=IsolationPolicy.ALLOW_FALLBACK
+        )
+    assert not config.exists() and report.grader_errors == []
+    [result] = report.problems
+    assert (result.status, result.max_score, result.visibility) == ("passed", 3.0, "hidden")
+    assert report.config_sha256 == plan.config_sha256
