@@ -8,7 +8,7 @@ from pathlib import Path
 import nbformat
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 
-from grader.grading import with_notebook
+from grader.collector import with_notebook
 from grader.notebook import NotebookModule, build_module
 from grader.notebook.cells import RAN_CELLS, cells_path, runnable_cells, write_cells
 from grader.report import ProblemResult, Report
