@@ -198,7 +198,11 @@ def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[Epi
         if budget is not None:
             _check_steps(episodes, budget)
         arrays = _decoded_arrays(episodes)
-        return [_episode(episode, f"episode {number}", arrays) for number, episode in enumerate(episodes)]
+        mappings: dict[tuple[Any, ...], dict[str, Any]] = {}
+        return [
+            _episode(episode, f"episode {number}", arrays, mappings)
+            for number, episode in enumerate(episodes)
+        ]
 
 
 def _problem(error: ValidationError) -> str:
@@ -249,7 +253,12 @@ def _decoded_arrays(episodes: list[WireEpisode]) -> Iterator[np.ndarray]:
         yield from arrays
 
 
-def _episode(episode: WireEpisode, where: str, arrays: Iterator[np.ndarray]) -> EpisodeLog:
+def _episode(
+    episode: WireEpisode,
+    where: str,
+    arrays: Iterator[np.ndarray],
+    mappings: dict[tuple[Any, ...], dict[str, Any]],
+) -> EpisodeLog:
     actions = _actions(episode["actions"], arrays, f"{where}: actions")
     rewards = _rewards(episode["rewards"], arrays, f"{where}: rewards")
     terminated = _flags(episode["terminated"], arrays, f"{where}: terminated")
@@ -263,7 +272,7 @@ def _episode(episode: WireEpisode, where: str, arrays: Iterator[np.ndarray]) -> 
         env_index=episode["env_index"],
         requested_id=episode["requested_id"],
         env_id=episode["env_id"],
-        env_kwargs=_mapping(episode["env_kwargs"], f"{where}: env_kwargs"),
+        env_kwargs=_env_kwargs(episode["env_kwargs"], f"{where}: env_kwargs", mappings),
         reset_seed=episode["reset_seed"],
         student_seed=episode["student_seed"],
         actions=actions,
@@ -302,6 +311,26 @@ def _array(array: np.ndarray, kinds: str, where: str) -> np.ndarray:
             f"{where} should be a 1-D array of kind {kinds!r} or a list, found {describe(array)}"
         )
     return array
+
+
+def _env_kwargs(
+    value: dict[str, Any], where: str, decoded: dict[tuple[Any, ...], dict[str, Any]]
+) -> dict[str, Any]:
+    """`_mapping` of an episode's env arguments, decoded once per call for arguments of plain scalars.
+
+    Every episode of one env repeats the same arguments (Blackjack's `natural` and `sab`, 10 000 games a
+    call); the key holds each value's type, so `True` and `1` stay apart. Each episode gets its own copy.
+    """
+    if not value:
+        return value
+    try:
+        key = tuple((name, type(item), item) for name, item in value.items())
+        known = decoded.get(key)
+    except TypeError:  # a list or dict among the values: decoded every time
+        return _mapping(value, where)
+    if known is None:
+        known = decoded[key] = _mapping(value, where)
+    return dict(known)
 
 
 def _mapping(value: dict[str, Any], where: str) -> dict[str, Any]:
