@@ -18,7 +18,7 @@ from typing import Any, SupportsFloat
 import gymnasium
 from gymnasium.envs.toy_text.blackjack import BlackjackEnv
 
-from grader.sandbox.batched.draws import SeededDraws
+from grader.sandbox.batched.draws import SeededDraws, seeded_draws
 from grader.sandbox.batched.replayer import BatchedEpisode
 from grader.sandbox.episode_log import EpisodeLog
 
@@ -53,13 +53,14 @@ class BlackjackReplayer:
             wrapped.close()
             raise TypeError(f"{logs[0].env_id} is not gymnasium's BlackjackEnv without a time limit")
         try:
-            return [_play(blackjack, log) for log in logs]
+            draws = seeded_draws([log.reset_seed for log in logs])
+            return [_play(blackjack, log, cards) for log, cards in zip(logs, draws, strict=True)]
         finally:
             wrapped.close()
 
 
-def _play(blackjack: BlackjackEnv, log: EpisodeLog) -> BatchedEpisode:
-    blackjack._np_random = SeededDraws(log.reset_seed)  # type: ignore[assignment]  # duck-typed Generator
+def _play(blackjack: BlackjackEnv, log: EpisodeLog, cards: SeededDraws) -> BatchedEpisode:
+    blackjack._np_random = cards  # type: ignore[assignment]  # duck-typed Generator
     observations: list[Any] = [blackjack.reset()[0]]
     rewards: list[float] = []
     terminated: list[bool] = []

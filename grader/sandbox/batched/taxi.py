@@ -4,7 +4,7 @@
 terminated)`; with default arguments (no rain, no fickle passenger) every list holds one transition
 of probability 1.0, so the random draw `step` makes cannot change the outcome and an episode is
 a chain of table lookups. Here the parent's own env provides the table (checked to be deterministic)
-and the initial-state distribution, sampled as its `reset(seed)` does (`SeededDraws`); all episodes
+and the initial-state distribution, sampled as its `reset(seed)` does (`seeded_draws`); all episodes
 advance in lockstep, one array lookup per step. `grader.sandbox.replay` checks every batch against
 the scalar env, which stays the authority for every mismatch.
 """
@@ -18,7 +18,7 @@ import gymnasium
 import numpy as np
 from gymnasium.envs.toy_text.taxi import TaxiEnv
 
-from grader.sandbox.batched.draws import SeededDraws
+from grader.sandbox.batched.draws import seeded_draws
 from grader.sandbox.batched.replayer import BatchedEpisode, int_actions, lockstep, plain_arguments
 from grader.sandbox.episode_log import EpisodeLog
 
@@ -64,7 +64,7 @@ def _initial_states(taxi: TaxiEnv, logs: Sequence[EpisodeLog]) -> np.ndarray:
     That is `argmax(cumsum(distribution) > np_random.random())`, the first draw of each seed's generator.
     """
     cumulative = np.cumsum(np.asarray(taxi.initial_state_distrib))
-    uniforms = np.array([SeededDraws(log.reset_seed).random() for log in logs])
+    uniforms = np.array([draws.random() for draws in seeded_draws([log.reset_seed for log in logs])])
     states: np.ndarray = np.argmax(cumulative[None, :] > uniforms[:, None], axis=1).astype(np.int64)
     return states
 
