@@ -19,7 +19,12 @@ from pydantic import AfterValidator, Field, TypeAdapter, ValidationError, with_c
 from typing_extensions import TypedDict
 
 from grader.sandbox.boundary import STRICT, describe, one_of, problem
-from grader.sandbox.child.episode_fields import EPISODE_COLUMNS, EPISODE_FIELDS, check_declaration
+from grader.sandbox.child.episode_fields import (
+    EPISODE_COLUMNS,
+    EPISODE_FIELDS,
+    EpisodeHeader,
+    check_declaration,
+)
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
 from grader.sandbox.child.frames import MAX_DEPTH, MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
 from grader.sandbox.limits import CallBudget
@@ -32,17 +37,10 @@ ARRAY_BATCH = 256
 
 
 @dataclass(frozen=True, eq=False)
-class EpisodeLog:
-    """One episode: which env, how it was reset, and every step the student took.
+class EpisodeLog(EpisodeHeader):
+    """One episode: which env, how it was reset (`EpisodeHeader`), and every step the student took.
 
     Attributes:
-        env_index: which env instance, numbered in the order of its first reset within the call.
-        requested_id: the id the student asked for (`"Blackjack-v0"`).
-        env_id: the gymnasium id actually made (`"Blackjack-v1"`).
-        env_kwargs: the other `gymnasium.make` arguments (`max_episode_steps` included when given);
-            `gymnasium.make(env_id, **env_kwargs)` rebuilds the env.
-        reset_seed: the seed the episode was actually reset with (grader-chosen or mapped).
-        student_seed: the seed the student passed to reset, if any.
         actions: one per step: int for `Discrete`, a numpy array for `Box` (dtype as the student sent it).
         rewards: what the student saw, one per step.
         terminated: the flags the student saw, one per step.
@@ -50,12 +48,6 @@ class EpisodeLog:
         reset_options: the `options` passed to reset, if any.
     """
 
-    env_index: int
-    requested_id: str
-    env_id: str
-    env_kwargs: dict[str, Any]
-    reset_seed: int
-    student_seed: int | None
     actions: list[Any]
     rewards: list[float]
     terminated: list[bool]
