@@ -337,10 +337,22 @@ def test_seeded_draws_interleave_doubles_and_bounded_draws_as_numpy_does() -> No
         assert [draws.random() if op == "random" else draws.bounded(op) for op in operations] == expected
 
 
-def test_batched_blackjack_matches_gymnasiums_env_over_many_seeds() -> None:
-    # Deterministic: 3000 grader-stream seeds, random hit/stick sequences (long ones run past the end).
+BLACKJACK_RULES = [
+    {},
+    {"natural": False, "sab": False},
+    {"natural": True},
+    {"sab": True},
+    {"natural": True, "sab": True},
+]
+
+
+@pytest.mark.parametrize(
+    "kwargs", BLACKJACK_RULES, ids=["defaults", "plain", "natural", "sab", "natural-sab"]
+)
+def test_batched_blackjack_matches_gymnasiums_env_over_many_seeds(kwargs: dict[str, bool]) -> None:
+    # Deterministic: 3000 grader-stream seeds, random hit/stick sequences (long ones run past the end);
+    # about 1 in 20 deals is a natural, so each rule's payout is met about 150 times.
     rng = np.random.default_rng(4096)
-    kwargs = {"natural": False, "sab": False}
     seeds = reset_seeds(77, 3000)
     logs = [played("Blackjack-v1", seed, rng.integers(0, 2, 1 + seed % 7).tolist(), kwargs) for seed in seeds]
     env = gymnasium.make("Blackjack-v1", **kwargs)
