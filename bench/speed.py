@@ -32,6 +32,7 @@ import argparse
 import contextlib
 import importlib.util
 import io
+import itertools
 import json
 import os
 import pickle
@@ -50,6 +51,7 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from cpu_group import CpuGroup  # noqa: E402
 from grading_probe import ProblemCost, SharedChild, grade_serially, graded, leaky_orders  # noqa: E402
 from results_section import replace_section  # noqa: E402
 
@@ -137,21 +139,34 @@ def _route_lab_ids() -> None:
 
 @dataclass
 class Run:
-    """One timed subprocess: its wall time and what it printed."""
+    """One timed subprocess: its wall time, the CPU of all its processes (None without a cgroup), output."""
 
     wall: float
     stdout: str
     returncode: int
+    cpu: float | None = None
+
+
+_run_numbers = itertools.count()
 
 
 def timed_run(command: Sequence[str], root: Path = ROOT, **extra: str) -> Run:
-    """Run a command with a tree's sources (default: this one) first on PYTHONPATH; time it."""
+    """Run a command with a tree's sources (default: this one) first on PYTHONPATH; time it.
+
+    Its CPU is every process's of the run (the grader, its xdist workers, the sandbox children), counted in
+    a cgroup v1 `cpuacct` group (`bench/cpu_group.py`; None where that is not available).
+    """
     environment = dict(os.environ, **extra)
     environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(root), environment.get("PYTHONPATH")]))
+    group = CpuGroup(f"speed-{next(_run_numbers)}")
     started = time.perf_counter()
-    done = subprocess.run(list(command), capture_output=True, text=True, env=environment, check=False)
+    done = subprocess.run(
+        list(command), capture_output=True, text=True, env=environment, check=False, preexec_fn=group.join
+    )
     wall = time.perf_counter() - started
-    return Run(wall, done.stdout, done.returncode)
+    cpu = group.seconds()
+    group.remove()
+    return Run(wall, done.stdout, done.returncode, cpu)
 
 
 def plain_run(submission: Path, calls_file: Path) -> tuple[Run, dict[str, Any]]:
@@ -506,9 +521,18 @@ def ab_lines(
     lines = [
         f"A/B against `{baseline}` ({load}); alternated baseline, this tree, plain, then reversed:",
         "",
-        row("run", "wall (s), each", "median wall (s)", "student (s)", "grader overhead (s)"),
-        row("---", "---", "---:", "---:", "---:"),
+        row(
+            "run",
+            "wall (s), each",
+            "median wall (s)",
+            "CPU (s), each",
+            "median CPU (s)",
+            "student (s)",
+            "grader overhead (s)",
+        ),
+        row("---", "---", "---:", "---", "---:", "---:", "---:"),
     ]
+    plain_cpu = _median_cpu([run for run, _ in plain])
     for label, runs in grades.items():
         reports = [report for _, report in runs]
         lines.append(
@@ -516,6 +540,8 @@ def ab_lines(
                 label,
                 seconds([run.wall for run, _ in runs]),
                 f"{median([run.wall for run, _ in runs]):.1f}",
+                seconds([run.cpu for run, _ in runs if run.cpu is not None]),
+                _cpu_text(_median_cpu([run for run, _ in runs])),
                 f"{median([report.timings.student_seconds for report in reports]):.1f}",
                 f"{median([report.timings.overhead_seconds for report in reports]):.1f}",
             )
@@ -525,11 +551,28 @@ def ab_lines(
             "plain, 1 process",
             seconds([run.wall for run, _ in plain]),
             f"{median([run.wall for run, _ in plain]):.1f}",
+            seconds([run.cpu for run, _ in plain if run.cpu is not None]),
+            _cpu_text(plain_cpu),
             f"{median([summary['calls_seconds'] for _, summary in plain]):.1f}",
             "",
         )
     )
+    lines.append("")
+    for label, runs in grades.items():
+        cpu = _median_cpu([run for run, _ in runs])
+        wall_ratio = median([run.wall for run, _ in runs]) / median([run.wall for run, _ in plain])
+        cpu_ratio = f"{cpu / plain_cpu:.2f}" if cpu is not None and plain_cpu else "n/a (no cgroup)"
+        lines.append(f"- {label}: wall / plain {wall_ratio:.2f}, CPU / plain CPU {cpu_ratio} (goal <= 1.0).")
     return lines
+
+
+def _median_cpu(runs: Sequence[Run]) -> float | None:
+    values = [run.cpu for run in runs if run.cpu is not None]
+    return statistics.median(values) if values else None
+
+
+def _cpu_text(cpu: float | None) -> str:
+    return "n/a" if cpu is None else f"{cpu:.1f}"
 
 
 def ab_main(args: argparse.Namespace, submission: Path, problems: Sequence[str], config: Any) -> int:
