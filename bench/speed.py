@@ -23,7 +23,9 @@
 
 `--write` replaces the `## Speed (issue 11)` section at the end of bench/RESULTS.md. `--ab BASELINE_ROOT` runs
 only step 2, with the grader of another tree (a worktree of `main`, say) alternated with this one's: an
-A/B of a change, e.g. `--ab /work/main --only taxi --rounds 2`.
+A/B of a change, e.g. `--ab /work/main --only taxi --rounds 2`, wall and CPU (every process of a run, in a
+cgroup v1 `cpuacct` group where available). `--breakdown` runs only step 1 and prints its per-problem table
+and the grader process's own CPU.
 """
 
 from __future__ import annotations
@@ -426,23 +428,35 @@ def fixed_lines(figures: Figures) -> list[str]:
         "Per problem, graded serially in one process (`run_problem`, timers around the sandbox, the replay "
         "and the teardown; seconds):",
         "",
-        row(
-            "problem",
-            "status",
-            "calls",
-            "wall",
-            "child start + import",
-            "student",
-            "transfer",
-            "replay",
-            "judge + rest",
-            "teardown",
-        ),
-        row("---", "---", *["---:"] * 8),
     ]
-    lines += [cost_row(cost.problem, cost.status, [cost]) for cost in figures.costs]
-    lines.append(cost_row("all", "", figures.costs))
+    return lines + cost_table(figures.costs)
+
+
+def cost_table(costs: Sequence[ProblemCost]) -> list[str]:
+    """The per-problem table: where each problem's serial grading time went, and the sum."""
+    header = ["problem", "status", "calls", "wall", "child start + import", "student", "transfer", "replay"]
+    lines = [row(*header, "judge + rest", "teardown"), row("---", "---", *["---:"] * 8)]
+    lines += [cost_row(cost.problem, cost.status, [cost]) for cost in costs]
+    lines.append(cost_row("all", "", costs))
     return lines
+
+
+def breakdown_main(args: argparse.Namespace, submission: Path, problems: Sequence[str], config: Any) -> int:
+    """`--breakdown`: only step 1's per-problem table, and the CPU of this (the grader's) process."""
+    load_before = os.getloadavg()[0]
+    cpu_before = time.process_time()
+    costs, _, _ = grade_serially(submission, problems, config, args.seed)
+    cpu = time.process_time() - cpu_before
+    print(
+        f"`{submission.name}`, load average {load_before:.1f} before, {os.getloadavg()[0]:.1f} after",
+        flush=True,
+    )
+    print("\n".join(cost_table(costs)))
+    print(
+        f"\nThe grader's own process: {cpu:.2f} s of CPU (frames decoded, replay, judging; the children's "
+        "start, the student's calls and the recording are not in it)."
+    )
+    return 0
 
 
 def shared_lines(figures: Figures) -> list[str]:
@@ -623,6 +637,9 @@ def main() -> int:
         help="only compare this tree's grader with another tree's (a worktree of main) and the plain run",
     )
     parser.add_argument(
+        "--breakdown", action="store_true", help="only the per-problem table of one serial grading (step 1)"
+    )
+    parser.add_argument(
         "--plain-child", nargs=2, type=Path, metavar=("CALLS", "SUBMISSION"), help=argparse.SUPPRESS
     )
     args = parser.parse_args()
@@ -639,6 +656,8 @@ def main() -> int:
     plan = GradingPlan.load(args.config, only)
     if args.ab is not None:
         return ab_main(args, submission, plan.problems, config)
+    if args.breakdown:
+        return breakdown_main(args, submission, plan.problems, config)
     load_before = os.getloadavg()[0]
 
     print("1. grading serially, instrumented: one child per problem, then one child for all ...", flush=True)
