@@ -1,4 +1,4 @@
-"""The service's view of the grader: a small protocol and the adapter that calls the configured grader."""
+"""The service's view of the grader: the adapter that calls the configured grader (``GYMGRADE_GRADER``)."""
 
 from __future__ import annotations
 
@@ -7,32 +7,12 @@ import importlib.util
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 from api.errors import GraderFailed, GraderUnavailable
 
 JsonObject = dict[str, Any]
 ProgressCallback = Callable[[JsonObject], None]
-
-
-class Grader(Protocol):
-    """Grades one file and returns the report as JSON data, reporting each problem as it finishes."""
-
-    def __call__(
-        self,
-        path: Path,
-        *,
-        seed: int,
-        on_progress: ProgressCallback,
-        only: Sequence[str] | None = None,
-        config: Path | None = None,
-    ) -> JsonObject:
-        """Grade the file at ``path`` with ``seed``; call ``on_progress`` with each finished problem.
-
-        ``only`` and ``config`` (a distributed batch's --only and --config) default to every enabled
-        problem of the bundled configuration.
-        """
-        ...
 
 
 @dataclass(frozen=True)
@@ -58,7 +38,11 @@ class ImportedGrader:
         only: Sequence[str] | None = None,
         config: Path | None = None,
     ) -> JsonObject:
-        """Grade the file at ``path``; see :class:`Grader`."""
+        """Grade the file at ``path`` with ``seed``; call ``on_progress`` with each finished problem (JSON).
+
+        ``only`` and ``config`` (a distributed batch's --only and --config) default to every enabled
+        problem of the bundled configuration. Returns the report as JSON data.
+        """
         grade_submission = load_function(self.target)
         from grader.sandbox import IsolationPolicy  # the grader is heavy: import it only where grading runs
 

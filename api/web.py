@@ -4,66 +4,72 @@ from __future__ import annotations
 
 import functools
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from fastapi.templating import Jinja2Templates
 
-from api.plots import problem_plots
-from grader.config import load_config
+from grader.config import AssignmentConfig, load_config
 from grader.editions.choice import edition_config
-from grader.figures import Figure, all_figures
-from grader.report import Report
+from grader.figures import Figure, problem_figures
+from grader.report import ProblemResult
 
 TEMPLATES_DIR = Path(__file__).with_name("templates")
 STATIC_DIR = Path(__file__).with_name("static")
+FIGURES_CACHED = 64
+"""Problems whose figures stay drawn (a report has up to eight; the page is refreshed every second)."""
 
 templates = Jinja2Templates(directory=TEMPLATES_DIR)
 templates.env.autoescape = True
-templates.env.globals["problem_plots"] = problem_plots
 
 
-def report_figures(report: Mapping[str, Any] | None) -> dict[str, list[Figure]]:
-    """The plots and replays of a finished report, by problem id (drawn once per report, then cached).
+def page_figures(problems: Sequence[Mapping[str, Any]], edition: str | None) -> dict[str, list[Figure]]:
+    """The plots and replays of the problems a page shows, by problem id, as the HTML report draws them.
+
+    Each problem is drawn once, then cached: while the grading runs, a problem's figures appear as soon as
+    it has finished, and the finished report reuses them.
 
     Args:
-        report: The stored report, or None while the grading runs.
+        problems: The report's problems, or while the grading runs (no report yet) the finished ones.
+        edition: The report's edition; None while the grading runs, when the first edition's
+            configuration draws them (every edition plots its problems with the first edition's plotters
+            and settings, as `tests/api/test_web.py` holds it; a plotter draws nothing for another
+            edition's measurements).
 
     Returns:
-        The figures; empty for no report or one that is not a grader report.
+        The figures; none for a withheld problem or an entry that is not a grader's problem result.
     """
-    if not report:
-        return {}
-    try:
-        return _figures(json.dumps(_figure_inputs(report), sort_keys=True))
-    except (ValueError, TypeError, KeyError):  # a report of another layout: the page shows it without figures
-        return {}
+    config = edition_config(edition) if edition else None
+    figures = {}
+    for problem in problems:
+        if problem.get("status") == "withheld":
+            continue
+        try:
+            drawn = _figures(json.dumps(_figure_input(problem), sort_keys=True), config)
+        except (ValueError, TypeError, KeyError):  # not a grader's result: the page shows it without figures
+            continue
+        figures[str(problem["id"])] = list(drawn)
+    return figures
 
 
-def _figure_inputs(report: Mapping[str, Any]) -> dict[str, Any]:
-    """The report as the figures read it: a student's view has its seeds (and a withheld total) nulled,
-    which the figures never draw, so stand-ins keep it a valid `Report`; withheld problems are left out."""
-    problems = [
-        {**problem, "seed": problem.get("seed") or 0, "score": problem.get("score") or 0.0}
-        for problem in report.get("problems", [])
-        if problem.get("status") != "withheld"
-    ]
-    return {
-        **report,
-        "seed": report.get("seed") or 0,
-        "score": report.get("score") or 0.0,
-        "problems": problems,
-    }
+def _figure_input(problem: Mapping[str, Any]) -> dict[str, Any]:
+    """The problem as the figures read it: a student's view has its seed nulled, which the figures never
+    draw, so a stand-in keeps it a valid `ProblemResult`."""
+    return {**problem, "seed": problem.get("seed") or 0, "score": problem.get("score") or 0.0}
 
 
-@functools.lru_cache(maxsize=32)
-def _figures(report_json: str) -> dict[str, list[Figure]]:
-    report = Report.model_validate_json(report_json)
-    return all_figures(report.problems, load_config(edition_config(report.edition)))
+@functools.lru_cache(maxsize=FIGURES_CACHED)
+def _figures(problem_json: str, config: Path | None) -> tuple[Figure, ...]:
+    return tuple(problem_figures(ProblemResult.model_validate_json(problem_json), _config(config)))
 
 
-templates.env.globals["report_figures"] = report_figures
+@functools.lru_cache(maxsize=8)
+def _config(path: Path | None) -> AssignmentConfig:
+    return load_config(path)
+
+
+templates.env.globals["page_figures"] = page_figures
 
 PAGE_HEADERS = {
     "Content-Security-Policy": (

@@ -35,7 +35,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from grader.checks.compare import CompareConfig
 from grader.config import load_config
 from grader.editions.rl1 import RL1
-from grader.grading import GradingPlan, grade_files
+from grader.grading import grade_files
+from grader.plan import GradingPlan
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.child.cells import RUN_CELLS

@@ -30,7 +30,8 @@ from grader.config import load_config
 from grader.editions import EDITIONS
 from grader.editions.detection import detect_edition
 from grader.editions.rl1 import RL1
-from grader.grading import GradingPlan, grade_files
+from grader.grading import grade_files
+from grader.plan import GradingPlan
 from grader.sandbox import IsolationPolicy
 from grader.testing import epsilon_decay as students
 from grader.testing import taxi_tables

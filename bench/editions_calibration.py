@@ -11,6 +11,7 @@ Another problem's calibration is one more `Calibration` in `CALIBRATIONS`.
 
     python bench/editions_calibration.py                      # every problem, 200 honest / 50 per mistake
     python bench/editions_calibration.py --only taxi --budget-minutes 10
+    python bench/editions_calibration.py --only sarsa0 --student float32_table --regrades 50
 
 With `--budget-minutes`, each problem's mistakes run first (50 of each), then the honest regrades until
 the budget of that problem is spent; the counts printed are the ones actually run.
@@ -115,22 +116,28 @@ def calibrate(
     caps: Mapping[str, int] | None = None,
     parts: tuple[str, ...] = ("mistakes", "honest"),
     first_seed: int = SEED_BASE,
+    students: frozenset[str] = frozenset(),
 ) -> bool:
     """Run one calibration and print it; True when no honest regrade failed and every mistake was named.
 
-    `caps` lowers the regrades of named mistakes (a slow one under a loaded machine); the printed counts
-    say what ran.
+    `caps` lowers the regrades of named mistakes (a slow one under a loaded machine); `students`, when not
+    empty, keeps only the honest students and mistakes it names; the printed counts say what ran.
     """
     calibration = CALIBRATIONS[name]
+    chosen = students or frozenset(calibration.mistakes) | frozenset(calibration.honest)
     started, cpu = time.perf_counter(), time.process_time()
     ok = True
     print(f"## {calibration.edition} {calibration.problem}")
     for student, (function, words) in calibration.mistakes.items() if "mistakes" in parts else ():
+        if student not in chosen:
+            continue
         count = min(mistake_regrades, (caps or {}).get(student, mistake_regrades))
         tally = regrade(calibration, function, range(first_seed, first_seed + count), words)
         ok &= tally.named == tally.runs == count
         print(f"  mistake {student:<22} {tally.line()}")
     for student, function in calibration.honest.items() if "honest" in parts else ():
+        if student not in chosen:
+            continue
         done = Tally(statuses=Counter())
         seed = first_seed
         while done.runs < regrades:
@@ -167,12 +174,24 @@ def main() -> int:
     parser.add_argument(
         "--first-seed", type=int, default=SEED_BASE, help="continue a run: the seed of the first regrade"
     )
+    parser.add_argument(
+        "--student", action="append", default=[], metavar="NAME", help="only this honest student or mistake"
+    )
     args = parser.parse_args()
     parts = ("mistakes", "honest") if args.part is None else (args.part,)
     budget = None if args.budget_minutes is None else 60 * args.budget_minutes
     caps = {name: int(count) for name, _, count in (cap.partition("=") for cap in args.cap)}
     results = [
-        calibrate(name, args.regrades, args.mistake_regrades, budget, caps, parts, args.first_seed)
+        calibrate(
+            name,
+            args.regrades,
+            args.mistake_regrades,
+            budget,
+            caps,
+            parts,
+            args.first_seed,
+            frozenset(args.student),
+        )
         for name in args.only or CALIBRATIONS
     ]
     print("all calibrations held" if all(results) else "SOME CALIBRATION FAILED")

@@ -19,7 +19,7 @@ import statistics
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -33,7 +33,8 @@ from grader.batch import grade_many  # noqa: E402
 from grader.classroom import GradedFileRule, discover  # noqa: E402
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment  # noqa: E402
 from grader.classroom.output import ClassGradebook  # noqa: E402
-from grader.grading import GradingPlan  # noqa: E402
+from grader.collector import GradingListener  # noqa: E402
+from grader.plan import GradingPlan  # noqa: E402
 from grader.report import ProblemResult, Report  # noqa: E402
 
 RULE = GradedFileRule(functions=("random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues"))
@@ -43,13 +44,7 @@ class InstantExecutor:
     """Grades every file at once into a report of its bytes: what is left is the batch's own cost."""
 
     def grade(
-        self,
-        paths: Sequence[Path],
-        plan: GradingPlan,
-        *,
-        seed: int,
-        on_report: Callable[[Path, Report], None],
-        on_result: Callable[[Path, ProblemResult], None] | None,
+        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
     ) -> None:
         for path in paths:
             data = path.read_bytes()
@@ -57,7 +52,7 @@ class InstantExecutor:
                 ProblemResult(id=p, title=p, status="passed", score=1.0, max_score=1.0, feedback="ok")
                 for p in plan.problems
             ]
-            on_report(
+            listener.report(
                 path,
                 Report(
                     submission=path.name,

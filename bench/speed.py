@@ -648,7 +648,7 @@ def main() -> int:
         return 0
 
     from grader.config import load_config
-    from grader.grading import GradingPlan
+    from grader.plan import GradingPlan
 
     submission = args.submission.resolve()
     config = load_config(args.config)

@@ -24,9 +24,11 @@ from typing import Protocol
 from pydantic import ValidationError
 
 import grader
+from grader.collector import GradingListener
 from grader.errors import BatchInterrupted
-from grader.grading import GradingPlan, grade_files
+from grader.grading import grade_files
 from grader.notebook import NOTEBOOK_SUFFIX
+from grader.plan import GradingPlan
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
 
@@ -40,7 +42,6 @@ GRADEBOOK_INTERVAL = 1.0
 every report costs O(n^2)); the gradebooks are always rewritten when the batch ends or is interrupted."""
 SUBMISSION_SUFFIXES = (".py", NOTEBOOK_SUFFIX)
 
-ReportCallback = Callable[[Path, Report], None]
 ResultCallback = Callable[[Path, ProblemResult], None]
 GradebookWriter = Callable[[Path, Mapping[Path, Report]], None]
 """Writes the batch's gradebook(s) into the output directory from the reports finished so far (by file);
@@ -51,15 +52,10 @@ class BatchExecutor(Protocol):
     """Grades files and hands over each report as soon as that file is done (in any order)."""
 
     def grade(
-        self,
-        paths: Sequence[Path],
-        plan: GradingPlan,
-        *,
-        seed: int,
-        on_report: ReportCallback,
-        on_result: ResultCallback | None,
+        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
     ) -> None:
-        """Grade ``paths`` with ``seed`` under ``plan``; call ``on_report`` once per file as it finishes.
+        """Grade ``paths`` with ``seed`` under ``plan``; tell ``listener`` each result (progress) and each
+        file's report once, as it finishes.
 
         Raises:
             KeyboardInterrupt: The batch was interrupted; reports already handed over are kept.
@@ -80,25 +76,12 @@ class LocalExecutor:
     policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL
 
     def grade(
-        self,
-        paths: Sequence[Path],
-        plan: GradingPlan,
-        *,
-        seed: int,
-        on_report: ReportCallback,
-        on_result: ResultCallback | None,
+        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
     ) -> None:
         """Grade ``paths`` locally; see :class:`BatchExecutor`."""
         for start in range(0, len(paths), CHUNK_SUBMISSIONS):
-            grade_files(
-                paths[start : start + CHUNK_SUBMISSIONS],
-                plan,
-                seed=seed,
-                workers=self.workers,
-                policy=self.policy,
-                on_result=on_result,
-                on_report=on_report,
-            )
+            chunk = paths[start : start + CHUNK_SUBMISSIONS]
+            grade_files(chunk, plan, seed=seed, workers=self.workers, policy=self.policy, listener=listener)
 
 
 def report_names(paths: Sequence[Path]) -> dict[Path, str]:
@@ -169,12 +152,16 @@ class BatchOutcome:
 class OutputDirectory:
     """The batch's output directory: one ``<name>.json`` per file and ``grades.csv``, each written whole.
 
+    It is the batch's `GradingListener`: a file's report is written the moment it arrives, and each result
+    goes on to ``progress``.
+
     Args:
         out_dir: The directory (created).
         paths: Every file of the batch, in gradebook order.
         plan: The problems graded (the gradebook's columns).
         names: Each file's identity (its report is ``<identity>.json``); file stems when None.
         gradebook: Writes the gradebook; ``grades.csv`` of :func:`write_grades` when None.
+        progress: Called with (file, result) as each check finishes.
     """
 
     def __init__(
@@ -184,6 +171,7 @@ class OutputDirectory:
         plan: GradingPlan,
         names: Mapping[Path, str] | None = None,
         gradebook: GradebookWriter | None = None,
+        progress: ResultCallback | None = None,
     ) -> None:
         out_dir.mkdir(parents=True, exist_ok=True)
         self.out_dir = out_dir
@@ -191,6 +179,7 @@ class OutputDirectory:
         self.plan = plan
         self.names = dict(names) if names is not None else report_names(paths)
         self.gradebook = gradebook
+        self.progress = progress
         self.reports: dict[Path, Report] = {}
         self.pending = False
         self.written_at = -GRADEBOOK_INTERVAL
@@ -210,7 +199,12 @@ class OutputDirectory:
         """Count an earlier run's report of ``path`` as this run's (``grades.csv`` is written later)."""
         self.reports[path] = report
 
-    def keep(self, path: Path, report: Report) -> None:
+    def result(self, path: Path, result: ProblemResult) -> None:
+        """A check of ``path`` finished: pass it on to ``progress``."""
+        if self.progress is not None:
+            self.progress(path, result)
+
+    def report(self, path: Path, report: Report) -> None:
         """Write a finished file's report and rewrite ``grades.csv`` with every file finished so far (a
         class's gradebooks at most every ``GRADEBOOK_INTERVAL`` seconds, the rest at :meth:`flush`)."""
         self.reports[path] = report
@@ -281,7 +275,7 @@ def grade_many(
         grader.errors.BatchInterrupted: Interrupted; the reports finished so far are in ``out_dir``.
     """
     plan = GradingPlan.load(config, only)
-    output = OutputDirectory(out_dir, paths, plan, names, gradebook)
+    output = OutputDirectory(out_dir, paths, plan, names, gradebook, on_result)
     outcome = BatchOutcome(reports=[], reused=[], graded=[])
     for path in paths:
         report_text = output.existing_text(path)
@@ -299,7 +293,7 @@ def grade_many(
     if outcome.graded:
         try:
             (executor or LocalExecutor(workers, policy)).grade(
-                outcome.graded, plan, seed=seed, on_report=output.keep, on_result=on_result
+                outcome.graded, plan, seed=seed, listener=output
             )
         except KeyboardInterrupt as interruption:
             raise BatchInterrupted(len(output.reports), len(paths)) from interruption

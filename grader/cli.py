@@ -100,14 +100,9 @@ def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
 
 def _add_class_options(grade: argparse.ArgumentParser) -> None:
     from grader.classroom.gradebooks import GRADEBOOKS
-    from grader.classroom.layouts import LAYOUTS
+    from grader.classroom.layouts import add_layout_option
 
-    grade.add_argument(
-        "--layout",
-        choices=tuple(LAYOUTS),
-        default=None,
-        help="the download's layout (default: recognised from its names; see docs/instructors.md)",
-    )
+    add_layout_option(grade)
     grade.add_argument(
         "--roster",
         type=Path,
@@ -361,8 +356,8 @@ def run_doctor(args: argparse.Namespace) -> int:
 
 def run_check(args: argparse.Namespace) -> int:
     """`gymgrade check`: grade one file with live progress, summarise, exit 0 only at full marks."""
-    from grader.config import load_config
     from grader.grading import grade_submission
+    from grader.plan import GradingPlan
 
     if not args.file.is_file():
         print(
@@ -370,6 +365,7 @@ def run_check(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_ERROR
+    plan = GradingPlan.load(args.config, args.only)
     output = FORMATS["json" if args.json else args.format]
     progress = sys.stdout if output.live_progress else sys.stderr
     seed = PRACTICE_SEED if args.seed is None else args.seed
@@ -383,17 +379,15 @@ def run_check(args: argparse.Namespace) -> int:
         args.file,
         seed=seed,
         workers=args.workers,
-        only=args.only,
         policy=IsolationPolicy.ALLOW_FALLBACK,
         on_progress=show,
-        config=args.config,
+        plan=plan,
     )
-    config = load_config(args.config)
     if args.output is not None:
-        args.output.write_text(FORMATS["json"].render(report, config), encoding="utf-8")
+        args.output.write_text(FORMATS["json"].render(report, plan.assignment), encoding="utf-8")
     if args.html is not None:
-        args.html.write_text(FORMATS["html"].render(report, config), encoding="utf-8")
-    sys.stdout.write(output.render(report, config))
+        args.html.write_text(FORMATS["html"].render(report, plan.assignment), encoding="utf-8")
+    sys.stdout.write(output.render(report, plan.assignment))
     if report.grader_errors:
         return EXIT_ERROR
     return EXIT_FULL_MARKS if report.full_marks else EXIT_NOT_FULL
@@ -476,7 +470,7 @@ def run_grade(args: argparse.Namespace) -> int:
     from grader.classroom.gradebooks import Assignment
     from grader.classroom.output import ClassGradebook
     from grader.classroom.roster import read_roster
-    from grader.grading import GradingPlan
+    from grader.plan import GradingPlan
 
     roster = read_roster(args.roster) if args.roster is not None else None
     assignment = Assignment(title=args.assignment_title, lms_id=args.assignment_id)
@@ -542,7 +536,7 @@ def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> 
     """Detect each submission's edition, grade the class as the edition most were written for (into
     ``args.config``), print which and why; return the functions of its enabled problems."""
     from grader.editions.per_submission import class_editions
-    from grader.grading import GradingPlan
+    from grader.plan import GradingPlan
 
     files = {
         submission.identity: submission.graded_file.path
@@ -718,7 +712,7 @@ def write_class_page(page: Path, gradebook: ClassGradebook, out_dir: Path) -> No
 
 def problems_of(args: argparse.Namespace) -> tuple[str, ...]:
     """The problems a `gymgrade grade` run covers."""
-    from grader.grading import GradingPlan
+    from grader.plan import GradingPlan
 
     return GradingPlan.load(args.config, args.only).problems
 

@@ -9,6 +9,7 @@ be left out.
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Mapping
 from functools import cache, partial
 from pathlib import Path
 from typing import Annotated, Any
@@ -159,8 +160,8 @@ def assignment_file_model(registry: Registry) -> type[BaseModel]:
     )
 
 
-def _describe(error: ValidationError, path: Path) -> str:
-    lines = [f"{path}: invalid assignment configuration:"]
+def _describe(error: ValidationError, where: str) -> str:
+    lines = [f"{where}: invalid assignment configuration:"]
     for item in error.errors():
         location = ".".join(str(part) for part in item["loc"])
         if item["type"] == "missing":
@@ -169,6 +170,27 @@ def _describe(error: ValidationError, path: Path) -> str:
             lines.append(f"  {location}: {item['msg']} (found {item.get('input')!r})")
     lines.append("Fix these fields (every field is described in grader/assignment.toml).")
     return "\n".join(lines)
+
+
+def read_config_file(source: Path) -> dict[str, Any]:
+    """The TOML table of an assignment configuration file, not yet validated.
+
+    Raises:
+        ConfigError: The file is missing, cannot be read, or is not UTF-8 TOML.
+    """
+    try:
+        return tomllib.loads(source.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(
+            f"assignment configuration {source} not found: pass an existing TOML file"
+        ) from None
+    except OSError as error:
+        raise ConfigError(
+            f"cannot read the assignment configuration {source} ({error.strerror or error}): "
+            "pass a readable TOML file"
+        ) from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise ConfigError(f"{source} is not valid UTF-8 TOML ({error}): fix the syntax") from None
 
 
 def load_config(path: Path | None = None, registry: Registry | None = None) -> AssignmentConfig:
@@ -187,22 +209,40 @@ def load_config(path: Path | None = None, registry: Registry | None = None) -> A
             what was expected and what was found).
     """
     source = path or DEFAULT_CONFIG_PATH
-    try:
-        raw = tomllib.loads(source.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ConfigError(
-            f"assignment configuration {source} not found: pass an existing TOML file"
-        ) from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise ConfigError(f"{source} is not valid UTF-8 TOML ({error}): fix the syntax") from None
-    edition_name = raw.get("edition", DEFAULT_EDITION)
+    return config_from_data(read_config_file(source), where=str(source), registry=registry)
+
+
+def config_from_data(
+    data: Mapping[str, Any], *, where: str, registry: Registry | None = None
+) -> AssignmentConfig:
+    """The configuration that the data of an assignment file describes (a parsed TOML file, or
+    `config_data` of a configuration: the same configuration again).
+
+    Args:
+        data: The file's tables: `edition`, `problems`, `sandbox`.
+        where: Where the data comes from, for the error message (a file's path).
+        registry: The problems it configures; by default those of the edition it names.
+
+    Raises:
+        ConfigError: A field is invalid (the message names the field, what was expected and what was found).
+    """
+    edition_name = data.get("edition", DEFAULT_EDITION)
     if registry is None:
-        registry = edition_of(edition_name, where=f"{source}: edition").registry
+        registry = edition_of(edition_name, where=f"{where}: edition").registry
     try:
-        parsed = dict(assignment_file_model(registry).model_validate(raw))
+        parsed = dict(assignment_file_model(registry).model_validate(data))
         config = AssignmentConfig(problems=dict(parsed["problems"]), sandbox=parsed["sandbox"])
     except ValidationError as error:
-        raise ConfigError(_describe(error, source)) from None
+        raise ConfigError(_describe(error, where)) from None
     config._registry = registry
     config._edition = parsed["edition"]
     return config
+
+
+def config_data(config: AssignmentConfig) -> dict[str, Any]:
+    """A configuration as the plain (JSON) data of its file: `config_from_data` of it gives it back.
+
+    This is how a grading's plan carries its configuration to the processes that check: as data read and
+    validated once, not as a path each process reads again.
+    """
+    return {"edition": config.edition, **config.model_dump(mode="json")}

@@ -1,9 +1,11 @@
-"""The report's figures: plots of a problem's measurements against the exact answers, and episode replays.
+"""The figures gymgrade shows: plots of a problem's measurements against the exact answers, and replays.
 
-Plots are PNGs drawn with matplotlib's Agg canvas (no pyplot, no display, safe in threads); replays are
-animated GIFs re-rendered headless (``rgb_array``) in the grader's own gymnasium from the episode's reset
-seed and actions. Both are small: a plot is 480x256 pixels; a GIF keeps at most ``MAX_GIF_FRAMES`` frames
-(every k-th step, and always the last) at most ``MAX_GIF_WIDTH`` pixels wide, on one 64-colour palette.
+One stack draws them for the HTML report, the class report (`grader.class_report.figures`) and the service's
+page (`api.web.page_figures`). Plots are PNGs drawn by `grader.problem_plots` (matplotlib's Agg canvas: no
+pyplot, no display, safe in threads); replays are animated GIFs re-rendered headless (``rgb_array``) in the
+grader's own gymnasium from the episode's reset seed and actions. Both are small: a plot is 480x256 pixels;
+a GIF keeps at most ``MAX_GIF_FRAMES`` frames (every k-th step, and always the last) at most
+``MAX_GIF_WIDTH`` pixels wide, on one 64-colour palette.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import os
 import time
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from matplotlib.figure import Figure as PlotFigure
@@ -23,12 +25,6 @@ from PIL import Image
 
 from grader.config import AssignmentConfig
 from grader.errors import UnknownProblem
-from grader.problem_plots import BAR_COLOUR as BAR_COLOUR  # the class report draws with the same look
-from grader.problem_plots import EXACT_COLOUR as EXACT_COLOUR
-from grader.problem_plots import PLOT_DPI as PLOT_DPI
-from grader.problem_plots import PLOT_SIZE as PLOT_SIZE
-from grader.problem_plots import REFERENCE_COLOUR as REFERENCE_COLOUR
-from grader.problem_plots import STUDENT_COLOUR as STUDENT_COLOUR
 from grader.report import EpisodeReplay, ProblemResult
 
 MAX_GIF_FRAMES = 60
@@ -48,7 +44,7 @@ class Figure:
         caption: What it shows and how to read it.
         mime: ``image/png`` or ``image/gif``.
         data: The encoded image.
-        seconds: Time it took to draw.
+        seconds: Time it took to draw (not part of what the figure is: equal figures may differ in it).
     """
 
     problem: str
@@ -56,7 +52,7 @@ class Figure:
     caption: str
     mime: str
     data: bytes
-    seconds: float
+    seconds: float = field(compare=False)
 
     def data_uri(self) -> str:
         """The image as a ``data:`` URI, to embed in a self-contained page."""
@@ -82,8 +78,7 @@ def problem_figures(result: ProblemResult, config: AssignmentConfig) -> list[Fig
         started = time.perf_counter()
         drawn = plotter(result, config.problem(result.id))
         if drawn is not None:
-            title, caption, plot = drawn
-            figures.append(Figure(result.id, title, caption, "image/png", _png(plot), _since(started)))
+            figures.append(png_figure(result.id, *drawn, started=started))
     if result.replay is not None:
         started = time.perf_counter()
         gif, shown = replay_gif(result.replay)
@@ -98,10 +93,19 @@ def _since(started: float) -> float:
     return time.perf_counter() - started
 
 
-def _png(figure: PlotFigure) -> bytes:
+def png_figure(problem: str, title: str, caption: str, plot: PlotFigure, *, started: float) -> Figure:
+    """A drawn plot encoded as a PNG `Figure`.
+
+    Args:
+        problem: What it belongs to (a problem id, or the class report's ``class``).
+        title: Its title.
+        caption: Its caption.
+        plot: The matplotlib figure.
+        started: `time.perf_counter()` when its drawing began (for `Figure.seconds`).
+    """
     buffer = io.BytesIO()
-    figure.savefig(buffer, format="png")
-    return buffer.getvalue()
+    plot.savefig(buffer, format="png")
+    return Figure(problem, title, caption, "image/png", buffer.getvalue(), _since(started))
 
 
 def replay_gif(replay: EpisodeReplay) -> tuple[bytes, int]:

@@ -23,7 +23,8 @@ import pytest
 from pydantic import BaseModel, ConfigDict, TypeAdapter, ValidationError
 from xdist.workermanage import parse_tx_spec_config
 
-from grader.config import AssignmentConfig, load_config
+from grader.config import AssignmentConfig
+from grader.plan import GradingPlan
 from grader.problem_registry import ProblemId, acceptance_module_name
 from grader.report import ProblemResult, ProblemRun
 from grader.sandbox import IsolationPolicy
@@ -57,16 +58,23 @@ class ProblemCase:
         return f"{module}.py::{module}[{self.test_id}]"
 
 
-class SessionPlan(BaseModel):
-    """What one acceptance session grades; the caller validates it, every process of the session reads it."""
+@dataclass(frozen=True)
+class SessionPlan:
+    """What one acceptance session grades: a grading's plan, the files, the seed and the isolation policy.
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    The caller makes it; every process of the session reads the same one from ``--gymgrade-plan``, where
+    it travels as JSON data (the configuration included), so no worker reads or validates a file again.
+    """
 
+    grading: GradingPlan
     submissions: tuple[Path, ...]
-    problems: tuple[ProblemId, ...]
     seed: int
     policy: IsolationPolicy
-    config: Path | None = None
+
+    @property
+    def problems(self) -> tuple[ProblemId, ...]:
+        """The problems graded, in the registry's order."""
+        return self.grading.problems
 
     def cases(self) -> list[ProblemCase]:
         """Every (submission, problem) case of the session, problems in the plan's order."""
@@ -78,14 +86,25 @@ class SessionPlan(BaseModel):
 
     def option(self) -> str:
         """This plan as the ``--gymgrade-plan`` argument of the session and its workers."""
-        # json.dumps escapes the lone surrogates a file name that is not UTF-8 decodes to; pydantic's own
-        # JSON refuses them.
-        return f"{PLAN_OPTION}={json.dumps(self.model_dump(mode='json'))}"
+        data = {
+            "grading": self.grading.to_data(),
+            "submissions": [str(path) for path in self.submissions],
+            "seed": self.seed,
+            "policy": self.policy.value,
+        }
+        # json.dumps escapes the lone surrogates a file name that is not UTF-8 decodes to.
+        return f"{PLAN_OPTION}={json.dumps(data)}"
 
     @classmethod
     def from_option(cls, text: str) -> SessionPlan:
         """The plan a ``--gymgrade-plan`` value holds."""
-        return cls.model_validate(json.loads(text))
+        data = json.loads(text)
+        return cls(
+            grading=GradingPlan.from_data(data["grading"]),
+            submissions=tuple(Path(path) for path in data["submissions"]),
+            seed=int(data["seed"]),
+            policy=IsolationPolicy(data["policy"]),
+        )
 
 
 class GraderFailure(BaseModel):
@@ -139,11 +158,11 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 class GradingSession:
-    """Per-process state: the plan and the assignment configuration it names."""
+    """Per-process state: the session's plan (its configuration decoded, never reloaded)."""
 
     def __init__(self, plan: SessionPlan) -> None:
         self.plan = plan
-        self.assignment: AssignmentConfig = load_config(plan.config)
+        self.assignment: AssignmentConfig = plan.grading.assignment
 
     def cases(self, problem: ProblemId) -> list[ProblemCase]:
         """The acceptance cases of one problem, one per submission (deselected unless planned)."""

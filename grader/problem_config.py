@@ -12,6 +12,8 @@ from grader.problem_id import ProblemId
 from grader.report import Visibility
 
 Probability = Annotated[float, Field(gt=0.0, lt=1.0)]
+Share = Annotated[float, Field(ge=0.0, le=1.0)]
+"""A share of a problem's points, 0 to 1 inclusive (a deduction, a part's weight)."""
 
 
 class StrictModel(BaseModel):
@@ -89,10 +91,8 @@ class PlayedProblemConfig(ProblemConfig):
         "absent = all of them.",
     )
 
-    post_terminal_steps_deduction: float = Field(
+    post_terminal_steps_deduction: Share = Field(
         default=0.0,
-        ge=0.0,
-        le=1.0,
         description="Share of the points deducted from a passing verdict when games kept stepping after they were over (steps that change nothing counted: each game is judged up to its end); "  # noqa: E501
         "0 = a note in the feedback only.",
     )
@@ -124,10 +124,8 @@ class PlayedProblemConfig(ProblemConfig):
 class CountedStepsConfig(PlayedProblemConfig):
     """Settings of a problem whose function returns the length of the episode it played."""
 
-    uncounted_steps_deduction: float = Field(
+    uncounted_steps_deduction: Share = Field(
         default=0.0,
-        ge=0.0,
-        le=1.0,
         description="Share of the problem's points deducted when every returned count misses exactly the steps taken before the counted loop (the lab-era 'one random step first' pattern); "  # noqa: E501
         "the verdict follows the replayed episodes either way.",
     )

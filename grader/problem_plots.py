@@ -1,9 +1,11 @@
-"""How the report plots a problem's measurements: the plotters a problem's declaration names (`Problem.plot`).
+"""How gymgrade plots: the look and canvas of every plot, and the plotters a problem's declaration names.
 
-Each plotter is a pure function of the problem's result and its settings, and returns a title, a caption and
-a matplotlib figure (drawn on the Agg canvas: no pyplot, no display, safe in threads), or None when the
-result holds nothing to plot. matplotlib is imported when a plot is drawn, not when the problems are
-declared. `grader.figures` encodes the figures for the report.
+Each plotter (`Problem.plot`) is a pure function of the problem's result and its settings, and returns a
+title, a caption and a matplotlib figure, or None when the result holds nothing to plot. Every plot, the
+class report's too, starts from `new_canvas` (matplotlib's Agg canvas: no pyplot, no display, safe in
+threads) and draws in the colours below. matplotlib is imported when a plot is drawn, not when the problems
+are declared. `grader.figures` encodes the figures for the HTML report, the class report and the service's
+page.
 """
 
 from __future__ import annotations
@@ -34,12 +36,19 @@ Plotter: TypeAlias = Callable[[ProblemResult, ProblemConfig], "tuple[str, str, P
 """Draws a problem's plot from its result and settings: (title, caption, figure), or None."""
 
 
-def _new_plot() -> tuple[PlotFigure, Any]:
+def new_canvas() -> PlotFigure:
+    """An empty figure of the plots' size on matplotlib's Agg canvas (no pyplot, no display)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure as PlotFigure
 
     figure = PlotFigure(figsize=PLOT_SIZE, dpi=PLOT_DPI, layout="constrained")
     FigureCanvasAgg(figure)
+    return figure
+
+
+def new_plot() -> tuple[PlotFigure, Any]:
+    """A canvas (`new_canvas`) with one set of axes."""
+    figure = new_canvas()
     return figure, figure.add_subplot()
 
 
@@ -62,7 +71,7 @@ def plot_blackjack(result: ProblemResult, settings: ProblemConfig) -> tuple[str,
     exact, student = _keyed(result.measurements.get("exact_curve")), _keyed(result.measurements.get("curve"))
     if not exact or not isinstance(settings, BlackjackConfig):
         return None
-    figure, axes = _new_plot()
+    figure, axes = new_plot()
     xs = sorted(exact)
     axes.plot(xs, [exact[n] for n in xs], color=EXACT_COLOUR, label="exact win probability")
     for index, (n, rate) in enumerate(sorted(student.items())):
@@ -99,7 +108,7 @@ def plot_lengths(result: ProblemResult, settings: ProblemConfig) -> tuple[str, s
     if not lengths:
         return None
     reference = reference_lengths(settings.problem_id)
-    figure, axes = _new_plot()
+    figure, axes = new_plot()
     bins = np.linspace(0, max(200, *lengths, *reference) + 1, 41)
     axes.hist(reference, bins=bins, color=REFERENCE_COLOUR, alpha=0.5, label="reference solution")
     axes.hist(lengths, bins=bins, color=STUDENT_COLOUR, alpha=0.7, label="your episodes")
@@ -137,11 +146,7 @@ def plot_taxi(result: ProblemResult, settings: ProblemConfig) -> tuple[str, str,
             rows.append((label, numbers[0], numbers[1], numbers[2]))
     if not rows:
         return None
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure as PlotFigure
-
-    figure = PlotFigure(figsize=PLOT_SIZE, dpi=PLOT_DPI, layout="constrained")
-    FigureCanvasAgg(figure)
+    figure = new_canvas()
     for index, (label, returned, exact, tolerance) in enumerate(rows):
         axes = figure.add_subplot(1, len(rows), index + 1)
         axes.axhspan(exact - tolerance, exact + tolerance, color=EXACT_COLOUR, alpha=0.2, label="accepted")
@@ -164,7 +169,7 @@ def plot_guess_counts(result: ProblemResult, settings: ProblemConfig) -> tuple[s
     oracle = midpoint_guess_counts()
     most = max(oracle.most, *counts)
     guesses = np.arange(1, most + 1)
-    figure, axes = _new_plot()
+    figure, axes = new_plot()
     axes.bar(guesses, [counts.count(int(k)) for k in guesses], color=STUDENT_COLOUR, alpha=0.7,
              label="your games")  # fmt: skip
     axes.plot(guesses, [len(counts) * oracle.probability(int(k)) for k in guesses], "o", color=EXACT_COLOUR,

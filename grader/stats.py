@@ -105,15 +105,32 @@ def binomial_acceptance(trials: int, probability: float, alpha: float) -> Binomi
             f"found {trials}, {probability}, {alpha}"
         )
     pmf = [math.exp(binomial_log_pmf(k, trials, probability)) for k in range(trials + 1)]
+    return BinomialAcceptance(trials, probability, *central_interval(pmf, alpha))
+
+
+def central_interval(pmf: Sequence[float], alpha: float) -> tuple[int, int, float]:
+    """The narrowest central interval of a law on 0 .. len(pmf) - 1 whose tails each hold at most alpha / 2.
+
+    Written out because scipy's `interval` gives quantiles, not the exact tail sums a false-fail
+    probability states; shared by every acceptance interval of an exact discrete law.
+
+    Args:
+        pmf: The probability of each value 0, 1, ..., len(pmf) - 1 (at least one).
+        alpha: Largest acceptable false-fail probability, in (0, 1).
+
+    Returns:
+        `(low, high, false_fail)`: accept `low <= k <= high`; `false_fail` is P(k < low) + P(k > high).
+    """
+    last = len(pmf) - 1
     low, lower_tail = 0, 0.0
-    while low < trials and lower_tail + pmf[low] <= alpha / 2:
+    while low < last and lower_tail + pmf[low] <= alpha / 2:
         lower_tail += pmf[low]
         low += 1
-    high, upper_tail = trials, 0.0
+    high, upper_tail = last, 0.0
     while high > low and upper_tail + pmf[high] <= alpha / 2:
         upper_tail += pmf[high]
         high -= 1
-    return BinomialAcceptance(trials, probability, low, high, math.fsum([lower_tail, upper_tail]))
+    return low, high, math.fsum([lower_tail, upper_tail])
 
 
 @dataclass(frozen=True)

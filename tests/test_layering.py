@@ -27,7 +27,10 @@ PACKAGES = ("grader", "api", "reference")
 GRADER_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("commands", ("cli", "acceptance")),
     ("outputs and classes", ("render", "gradescope", "class_report", "similarity", "classroom", "doctor")),
-    ("grading", ("batch", "grading", "session", "plugin", "execution", "scheduling", "progress")),
+    (
+        "grading",
+        ("batch", "grading", "collector", "session", "plugin", "plan", "execution", "scheduling", "progress"),
+    ),
     (
         "the lab's problems",
         (

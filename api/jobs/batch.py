@@ -21,9 +21,10 @@ from typing import Any
 from pydantic import ValidationError
 
 from api.settings import BrokerSettings
-from grader.batch import ReportCallback, ResultCallback
+from grader.collector import Collector, GradingListener, Silent, Submission
 from grader.errors import ExecutorUnavailable
-from grader.grading import GradingPlan, build_report, grade_files
+from grader.grading import grade_files
+from grader.plan import GradingPlan
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
 
@@ -74,13 +75,7 @@ class CeleryExecutor:
         return describe(self.settings)
 
     def grade(
-        self,
-        paths: Sequence[Path],
-        plan: GradingPlan,
-        *,
-        seed: int,
-        on_report: ReportCallback,
-        on_result: ResultCallback | None,
+        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
     ) -> None:
         """Send every file to the cluster and hand each report over as it arrives.
 
@@ -105,7 +100,7 @@ class CeleryExecutor:
             try:
                 data = path.read_bytes()
             except OSError:  # reported as unreadable without any grading: no need for the cluster
-                grade_files([path], plan, seed=seed, workers=1, policy=self.policy, on_report=on_report)
+                grade_files([path], plan, seed=seed, workers=1, policy=self.policy, listener=listener)
                 continue
             key = str(index)
             contents[key], pending[key] = data, path
@@ -143,10 +138,9 @@ class CeleryExecutor:
                     continue  # a duplicate delivery's report, already taken
                 path = pending.pop(key)
                 report = _report(path, contents[key], message, plan, seed)
-                if on_result is not None:
-                    for result in report.problems:
-                        on_result(path, result)
-                on_report(path, report)
+                for result in report.problems:
+                    listener.result(path, result)
+                listener.report(path, report)
             client.delete(reply_to)
         except KeyboardInterrupt:
             app.control.revoke([task_ids[key] for key in pending])
@@ -168,6 +162,8 @@ def _report(path: Path, data: bytes, message: dict[str, Any], plan: GradingPlan,
     if "report" in message:
         report = Report.model_validate(message["report"])
         return report.model_copy(update={"submission": path.name})
-    failed = build_report(path, data, seed, [], plan, 0.0, 0)
     reason = str(message.get("error", "the worker sent no report"))
-    return failed.model_copy(update={"grader_errors": [f"the cluster could not grade it: {reason}"]})
+    collector = Collector(plan, seed=seed, workers=0, listener=Silent())
+    collector.expect(Submission(path, data, path))
+    collector.close(f"the cluster could not grade it: {reason}")
+    return collector.reports[path]

@@ -14,7 +14,6 @@ from api.disclosure import disclosure_for
 from api.errors import NotAuthenticated
 from api.gradebook import gradebook_csv
 from api.models import JobStatus
-from api.schemas import SubmissionDetail
 from api.settings import Settings
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
@@ -96,8 +95,7 @@ def submission_page(
     request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep, settings: SettingsDep
 ) -> Response:
     """A submission's page; its live part is refreshed from the fragment below until grading ends."""
-    view = _view(session, _signed_in(caller), settings, submission_id)
-    return _page(request, "submission.html", {"submission": view, "final": view.status in FINAL_STATUSES})
+    return _submission(request, "submission.html", session, _signed_in(caller), settings, submission_id)
 
 
 @router.get("/ui/submissions/{submission_id}/live")
@@ -105,12 +103,19 @@ def submission_fragment(
     request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep, settings: SettingsDep
 ) -> Response:
     """The live part of a submission's page: status, finished problems, report."""
-    view = _view(session, _signed_in(caller), settings, submission_id)
-    return _page(request, "_live.html", {"submission": view, "final": view.status in FINAL_STATUSES})
+    return _submission(request, "_live.html", session, _signed_in(caller), settings, submission_id)
 
 
-def _view(session: Session, caller: Principal, settings: Settings, submission_id: int) -> SubmissionDetail:
-    return detail(get_submission(session, caller, submission_id), disclosure_for(caller, settings))
+def _submission(
+    request: Request,
+    template: str,
+    session: Session,
+    caller: Principal,
+    settings: Settings,
+    submission_id: int,
+) -> Response:
+    view = detail(get_submission(session, caller, submission_id), disclosure_for(caller, settings))
+    return _page(request, template, {"submission": view, "final": view.status in FINAL_STATUSES})
 
 
 @router.get("/ui/gradebook.csv")

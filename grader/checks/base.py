@@ -16,11 +16,21 @@ from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatu
 if TYPE_CHECKING:
     from grader.sandbox.replay import Replay
 
-__all__ = ["CallRecord", "ProblemCheck", "ProblemId", "Status", "Verdict", "outcome_verdict"]
+__all__ = [
+    "CallRecord",
+    "ProblemCheck",
+    "ProblemId",
+    "Status",
+    "Verdict",
+    "judged_when_all_returned",
+    "outcome_verdict",
+]
 
 
 P = ParamSpec("P")
 R = TypeVar("R")
+CheckT = TypeVar("CheckT")
+SettingsT = TypeVar("SettingsT")
 ConfigT_contra = TypeVar("ConfigT_contra", bound=ProblemConfig, contravariant=True)
 
 
@@ -166,3 +176,16 @@ def outcome_verdict(records: Sequence[CallRecord]) -> Verdict | None:
         return Verdict("failed", 0.0, _over_budget_text(first), measurements)
     status: Status = "timeout" if first.status is OutcomeStatus.TIMEOUT else "error"
     return Verdict(status, 0.0, f"{_call_text(first.call)}: {first.message}", measurements)
+
+
+def judged_when_all_returned(
+    judge: Callable[[CheckT, SettingsT, Sequence[CallRecord]], Verdict],
+) -> Callable[[CheckT, SettingsT, Sequence[CallRecord]], Verdict]:
+    """Judge only records whose calls all returned normally; else give `outcome_verdict(records)`."""
+
+    @functools.wraps(judge)
+    def judged(check: CheckT, settings: SettingsT, records: Sequence[CallRecord]) -> Verdict:
+        early = outcome_verdict(records)
+        return early if early is not None else judge(check, settings, records)
+
+    return judged

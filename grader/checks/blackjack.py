@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Annotated, NamedTuple
 
 from pydantic import Field, field_validator
 
-from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, HIT, count_games, player_sum
 from grader.checks.integrity import (
     Episode,
@@ -137,11 +137,9 @@ class BlackjackCheck:
 
     @noting_post_terminal_steps
     @paused_gc
+    @judged_when_all_returned
     def judge(self, settings: BlackjackConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge every call's rule, game count, returned rate and exact win probability."""
-        early = outcome_verdict(records)
-        if early is not None:
-            return early
         episodes = played_episodes(records)
         rules = settings.game_rules()
         problem = integrity_problem(records, episodes, rules)

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 from pydantic import Field
 
 from grader.checks.base import CallRecord, Verdict, paused_gc
-from grader.checks.integrity import games_budget, noting_post_terminal_steps
-from grader.checks.lengths import judge_lengths
+from grader.checks.integrity import noting_post_terminal_steps
+from grader.checks.lengths import judge_lengths, one_game_calls
 from grader.problem_config import CountedStepsConfig
 from grader.sandbox.outcome import Call, FunctionInfo
 
@@ -30,8 +30,7 @@ class CarCheck:
 
     def plan(self, settings: CarConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of car() calls."""
-        budget = games_budget(1, EPISODE_STEPS)
-        return [Call("car", budget=budget) for _ in range(settings.calls)]
+        return one_game_calls("car", settings.calls, EPISODE_STEPS)
 
     @noting_post_terminal_steps
     @paused_gc
@@ -62,5 +61,5 @@ class CarCheck:
                 f"Push in the direction of the velocity on every step to swing up faster.{note}",
                 measurements,
             )
-        fraction = 1.0 - (settings.uncounted_steps_deduction if runs.uncounted_steps else 0.0)
+        fraction = runs.passing_fraction(settings.uncounted_steps_deduction)
         return Verdict("passed", fraction, f"car(): {measured}; {bar}.{note}", measurements)

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 from pydantic import Field
 
 from grader.checks.base import CallRecord, Verdict, paused_gc
-from grader.checks.integrity import games_budget, noting_post_terminal_steps
-from grader.checks.lengths import judge_lengths
+from grader.checks.integrity import noting_post_terminal_steps
+from grader.checks.lengths import judge_lengths, one_game_calls
 from grader.problem_config import CountedStepsConfig
 from grader.sandbox.outcome import Call, FunctionInfo
 
@@ -31,8 +31,7 @@ class CartpoleCheck:
 
     def plan(self, settings: CartpoleConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of cartpole() calls."""
-        budget = games_budget(1, EPISODE_STEPS)
-        return [Call("cartpole", budget=budget) for _ in range(settings.calls)]
+        return one_game_calls("cartpole", settings.calls, EPISODE_STEPS)
 
     @noting_post_terminal_steps
     @paused_gc
@@ -54,5 +53,5 @@ class CartpoleCheck:
                 f"action 1 (right) when the pole's angular velocity observation[3] is positive, else 0.{note}",  # noqa: E501
                 measurements,
             )
-        fraction = 1.0 - (settings.uncounted_steps_deduction if runs.uncounted_steps else 0.0)
+        fraction = runs.passing_fraction(settings.uncounted_steps_deduction)
         return Verdict("passed", fraction, f"cartpole(): {measured}; {bar}.{note}", measurements)

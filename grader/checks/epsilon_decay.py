@@ -17,7 +17,7 @@ from pydantic import Field
 from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.checks.integrity import NO_EPISODES
 from grader.checks.values import describe
-from grader.problem_config import ProblemConfig
+from grader.problem_config import ProblemConfig, Share
 from grader.sandbox.outcome import Call, FunctionInfo, PlainValue
 
 DEFAULT_START, DEFAULT_END = 1.0, 1e-6
@@ -118,11 +118,8 @@ class EpsilonDecayConfig(ProblemConfig):
         default=False,
         description="Also grade the optional decay_type='exp' (the additional-materials exercise).",
     )
-    exp_share: float = Field(
-        default=0.5,
-        ge=0.0,
-        le=1.0,
-        description="Share of the points for decay_type='exp' when grade_exp is true.",
+    exp_share: Share = Field(
+        default=0.5, description="Share of the points for decay_type='exp' when grade_exp is true."
     )
     relative_tolerance: float = Field(
         default=1e-9,

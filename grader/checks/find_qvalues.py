@@ -9,7 +9,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, paused_gc
 from grader.checks.integrity import NO_EPISODES
 from grader.checks.values import describe
 from grader.problem_config import ProblemConfig
@@ -55,13 +55,11 @@ class FindQvaluesCheck:
         return [Call("find_qvalues", (settings.env_id,), record_episodes=False, budget=NO_EPISODES)]
 
     @paused_gc
+    @judged_when_all_returned
     def judge(self, settings: FindQvaluesConfig, records: Sequence[CallRecord]) -> Verdict:
         """Validate the table and report the exact expected return of acting greedily on it."""
         if not settings.called:
             return Verdict("skipped", 0.0, NOT_RUN_FEEDBACK, {"calls_made": 0})
-        early = outcome_verdict(records)
-        if early is not None:
-            return early
         value = records[0].outcome.value
         table = np.asarray(value) if isinstance(value, np.ndarray | list) else None
         if (

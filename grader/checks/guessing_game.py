@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import itertools
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache
@@ -13,12 +12,13 @@ import numpy as np
 from pydantic import Field
 
 from grader.checks.base import CallRecord, Verdict, paused_gc
-from grader.checks.integrity import Episode, games_budget, played_episodes
-from grader.checks.lengths import LengthRuns, judge_lengths
+from grader.checks.integrity import Episode, played_episodes
+from grader.checks.lengths import LengthRuns, judge_lengths, one_game_calls
 from grader.checks.values import chance_text
 from grader.compat.envs.guessing_game import GUESS_EQUAL, GUESS_TOO_HIGH, GUESS_TOO_LOW
 from grader.problem_config import PlayedProblemConfig, Probability
 from grader.sandbox.outcome import Call, FunctionInfo, PlainValue
+from grader.stats import central_interval
 from reference.oracles.guessing_game import TARGET_HIGH, TARGET_LOW, TOLERANCE, midpoint_guess_counts
 
 EPISODE_STEPS = 400
@@ -92,16 +92,7 @@ def total_acceptance(games: int, alpha: float) -> TotalAcceptance:
         remaining >>= 1
         if remaining:
             power = np.convolve(power, power)
-    pmf = np.clip(total, 0.0, None).tolist()
-    low, lower_tail = 0, 0.0
-    while low < len(pmf) - 1 and lower_tail + pmf[low] <= alpha / 2:
-        lower_tail += pmf[low]
-        low += 1
-    high, upper_tail = len(pmf) - 1, 0.0
-    while high > low and upper_tail + pmf[high] <= alpha / 2:
-        upper_tail += pmf[high]
-        high -= 1
-    return TotalAcceptance(games, low, high, math.fsum([lower_tail, upper_tail]))
+    return TotalAcceptance(games, *central_interval(np.clip(total, 0.0, None).tolist(), alpha))
 
 
 def _guess_value(action: Any) -> float | None:
@@ -268,8 +259,7 @@ class GuessingGameCheck:
 
     def plan(self, settings: GuessingGameConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """The configured number of guessing_game() calls."""
-        budget = games_budget(1, EPISODE_STEPS)
-        return [Call("guessing_game", budget=budget) for _ in range(settings.calls)]
+        return one_game_calls("guessing_game", settings.calls, EPISODE_STEPS)
 
     @paused_gc
     def judge(self, settings: GuessingGameConfig, records: Sequence[CallRecord]) -> Verdict:

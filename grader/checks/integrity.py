@@ -201,6 +201,22 @@ def noting_post_terminal_steps(judge: JudgeT) -> JudgeT:
     return noted
 
 
+def played_games_problem(
+    records: Sequence[CallRecord], episodes: Sequence[Episode], rules: GameRules, *, across_calls: bool
+) -> str | None:
+    """`integrity_problem`, then `repeated_seed_problem` over every reset (played or not), or None.
+
+    Args:
+        records: The problem's call records.
+        episodes: Their played episodes (`played_episodes`).
+        rules: The games the episodes must be played in.
+        across_calls: Count repeated seeds over all calls (True) or within each call only (False).
+    """
+    return integrity_problem(records, episodes, rules) or repeated_seed_problem(
+        all_resets(records), across_calls=across_calls
+    )
+
+
 def repeated_seed_problem(episodes: Sequence[Episode], *, across_calls: bool) -> str | None:
     """A diagnosis when several episodes were reset with the same seed of the student's, or None.
 

@@ -9,20 +9,26 @@ from typing import TYPE_CHECKING
 from grader.checks.base import CallRecord, Verdict, outcome_verdict
 from grader.checks.integrity import (
     Episode,
-    all_resets,
     episodes_per_call,
-    integrity_problem,
+    games_budget,
     played_episodes,
-    repeated_seed_problem,
+    played_games_problem,
 )
 from grader.checks.values import as_number, describe, same_number, step_count_mismatch_cause
 from grader.games import Game, GameRules
+from grader.sandbox.outcome import Call
 
 if TYPE_CHECKING:
     from grader.sandbox.outcome import PlainValue
 
 MAX_UNCOUNTED_STEPS = 3
 """Most steps before the counted loop that still read as the lab-era counting slip (one, in the lab)."""
+
+
+def one_game_calls(function: str, calls: int, episode_steps: int) -> list[Call]:
+    """`calls` calls of `function()`, each budgeted for one game of up to `episode_steps` recorded steps."""
+    budget = games_budget(1, episode_steps)
+    return [Call(function, budget=budget) for _ in range(calls)]
 
 
 @dataclass(frozen=True)
@@ -58,6 +64,10 @@ class LengthRuns:
             "game": self.game.name,
             "uncounted_steps": self.uncounted_steps,
         }
+
+    def passing_fraction(self, deduction: float) -> float:
+        """The share of the points a passing verdict earns: all, less `deduction` on a counting slip."""
+        return 1.0 - (deduction if self.uncounted_steps else 0.0)
 
     def counting_note(self, function: str, deduction: float) -> str:
         """The feedback sentence on a counting slip ("" when every count was right)."""
@@ -98,9 +108,7 @@ def judge_lengths(function: str, rules: GameRules, records: Sequence[CallRecord]
     if early is not None:
         return early
     episodes = played_episodes(records)
-    problem = integrity_problem(records, episodes, rules) or repeated_seed_problem(
-        all_resets(records), across_calls=True
-    )
+    problem = played_games_problem(records, episodes, rules, across_calls=True)
     if problem:
         return Verdict("failed", 0.0, f"{function}(): {problem}.", {})
     game = rules.played_game(episode.log for episode in episodes)

@@ -8,15 +8,13 @@ from typing import TYPE_CHECKING, Any
 
 from pydantic import Field
 
-from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, paused_gc
 from grader.checks.blackjack_games import GAME_STEPS, count_games, hits_by_sum
 from grader.checks.integrity import (
-    all_resets,
     games_budget,
-    integrity_problem,
     noting_post_terminal_steps,
     played_episodes,
-    repeated_seed_problem,
+    played_games_problem,
 )
 from grader.checks.values import as_number, chance_text, describe, rate_mismatch_cause, read_rate
 from grader.problem_config import PlayedProblemConfig, Probability
@@ -52,11 +50,9 @@ class RandomBlackjackCheck:
 
     @noting_post_terminal_steps
     @paused_gc
+    @judged_when_all_returned
     def judge(self, settings: RandomBlackjackConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the call against its replayed games and the exact random-policy win probability."""
-        early = outcome_verdict(records)
-        if early is not None:
-            return early
         call = f"random_blackjack({settings.games})"
         returned = as_number(records[0].outcome.value)
         if returned is None:
@@ -65,9 +61,7 @@ class RandomBlackjackCheck:
             )
         episodes = played_episodes(records)
         rules = settings.game_rules()
-        problem = integrity_problem(records, episodes, rules) or repeated_seed_problem(
-            all_resets(records), across_calls=False
-        )
+        problem = played_games_problem(records, episodes, rules, across_calls=False)
         if problem:
             return _fail(f"{call}: {problem}.")
         game = rules.played_game(episode.log for episode in episodes)

@@ -29,6 +29,7 @@ from grader.checks.integrity import Episode, integrity_problem, played_episodes
 from grader.checks.sarsa_updates import (
     RULES,
     EpisodeSteps,
+    Precision,
     Recomputed,
     Transition,
     bernstein_half_width,
@@ -87,6 +88,12 @@ class SarsaConfig(ProblemConfig):
         gt=0.0,
         lt=1e-2,
         description="Largest difference (absolute, and relative to the value) between a returned cell and the recomputed one.",  # noqa: E501
+    )
+    float32_table_tolerance: float = Field(
+        default=1e-5,
+        gt=0.0,
+        lt=1e-2,
+        description="The same for a table of float32 cells (np.zeros(..., dtype=np.float32)): it is recomputed in float32, where algebraically equal update formulas differ by up to about 1e-6.",  # noqa: E501
     )
     behaviour_alpha: Probability = Field(
         default=1e-6,
@@ -304,14 +311,15 @@ def _judge_run(
         )
     rates = schedule if run.decay and schedule is not None else [settings.epsilon] * run.episodes
     played = [episode_steps(episode, rate) for episode, rate in zip(episodes, rates, strict=True)]
-    honest = recompute(played, TAXI_SHAPE, settings.alpha, settings.gamma)
+    precision, tolerance = _precision(settings, table)
+    honest = recompute(played, TAXI_SHAPE, settings.alpha, settings.gamma, precision=precision)
     expected = honest.array()
-    cells = mismatched_cells(table, expected, settings.table_tolerance)
+    cells = mismatched_cells(table, expected, tolerance)
     updates = sum(len(episode.transitions) for episode in played)
     measurements[f"{key}_updates"] = updates
     if cells:
         measurements[f"{key}_mismatched_cells"] = len(cells)
-        return _fail(_mismatch_text(settings, run, played, table, honest, cells))
+        return _fail(_mismatch_text(settings, run, played, table, honest, cells, precision, tolerance))
     penalty_count = sum(
         1 for episode in played for step in episode.transitions if step.reward == PENALTY_REWARD
     )
@@ -327,14 +335,23 @@ def _judge_run(
         measurements[f"{key}_expected_non_greedy"] = float("nan")
         measurements[f"{key}_tolerance"] = float("nan")
         return None
-    tolerance = bernstein_half_width(honest.variance, settings.behaviour_alpha)
+    half_width = bernstein_half_width(honest.variance, settings.behaviour_alpha)
     measurements[f"{key}_non_greedy"] = honest.non_greedy
     measurements[f"{key}_expected_non_greedy"] = honest.expected_non_greedy
-    measurements[f"{key}_tolerance"] = tolerance
+    measurements[f"{key}_tolerance"] = half_width
     deviation = honest.non_greedy - honest.expected_non_greedy
-    if abs(deviation) <= tolerance:
+    if abs(deviation) <= half_width:
         return None
-    return _fail(_behaviour_text(settings, run, honest, tolerance))
+    return _fail(_behaviour_text(settings, run, honest, half_width))
+
+
+def _precision(settings: SarsaConfig, table: npt.NDArray[np.float64]) -> tuple[Precision, float]:
+    """The cells' precision of a returned table and the tolerance it is compared with: float32 when every
+    cell is a float32 number (a table made with dtype=np.float32, returned as an array or as lists; a
+    float64 learner's table with gamma < 1 is not), else float64."""
+    if bool(np.all(table.astype(np.float32) == table)):
+        return np.float32, max(settings.table_tolerance, settings.float32_table_tolerance)
+    return float, settings.table_tolerance
 
 
 def _mismatch_text(
@@ -344,6 +361,8 @@ def _mismatch_text(
     table: npt.NDArray[np.float64],
     honest: Recomputed,
     cells: Sequence[tuple[int, int]],
+    precision: Precision,
+    tolerance: float,
 ) -> str:
     expected = honest.array()
     (state, action), where = first_mismatch(cells, honest.last_update)
@@ -356,8 +375,10 @@ def _mismatch_text(
             f"{table[state, action]:.6g}; SARSA(0) from the transitions you played gives {expected[state, action]:.6g}"  # noqa: E501
         )
     for rule in RULES:
-        variant = recompute(played, TAXI_SHAPE, settings.alpha, settings.gamma, rule, judge_actions=False)
-        if not mismatched_cells(table, variant.array(), settings.table_tolerance):
+        variant = recompute(
+            played, TAXI_SHAPE, settings.alpha, settings.gamma, rule, judge_actions=False, precision=precision
+        )
+        if not mismatched_cells(table, variant.array(), tolerance):
             return f"sarsa0, {run.text}: {place}; {rule.explanation}."
     return (
         f"sarsa0, {run.text}: {place} ({len(cells)} cells differ). Your table is not the one SARSA(0) computes from the zero table over the episodes this call played, "  # noqa: E501

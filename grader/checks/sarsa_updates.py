@@ -13,10 +13,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+Precision = Callable[[float], Any]
+"""The type of a table's cells, as a constructor: `float`, or a NumPy scalar type (`np.float32`)."""
 TIE_TOLERANCE = 1e-9
 """Values within this (relative to the row's largest magnitude, at least 1) of a row's maximum are
 maximisers: two algebraically equal update formulas differ in the last bits."""
@@ -154,8 +157,14 @@ def recompute(
     rule: Rule = SARSA,
     *,
     judge_actions: bool = True,
+    precision: Precision = float,
 ) -> Recomputed:
     """The table `rule` computes from the zero table over the episodes, in play order.
+
+    `precision` is the type of the learner's table cells: `float` (float64), or a NumPy scalar type such
+    as `np.float32` for a table made with `dtype=np.float32`. The zero table is made of it, so every update
+    rounds as the learner's own NumPy arithmetic does (NumPy 2 keeps a float32 cell's arithmetic with
+    Python numbers in float32).
 
     With `judge_actions`, every action (the first of an episode, and each `a'`) is judged against the
     table as it was when an honest SARSA learner chose it: before the update of the step that reached its
@@ -163,7 +172,8 @@ def recompute(
     with probability epsilon * (non-maximisers / actions).
     """
     states, actions = shape
-    table = [[0.0] * actions for _ in range(states)]
+    zero = precision(0.0)
+    table = [[zero] * actions for _ in range(states)]
     result = Recomputed(table)
     rate, discount = rule.fixed if rule.fixed is not None else (alpha, gamma)
     for number, episode in enumerate(episodes):

@@ -12,15 +12,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 from pydantic import Field
 
-from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, paused_gc
 from grader.checks.integrity import (
     Episode,
-    all_resets,
     games_budget,
-    integrity_problem,
     noting_post_terminal_steps,
     played_episodes,
-    repeated_seed_problem,
+    played_games_problem,
     seed_problem,
 )
 from grader.checks.truncation import ignored_truncation
@@ -146,11 +144,9 @@ class TaxiCheck:
 
     @noting_post_terminal_steps
     @paused_gc
+    @judged_when_all_returned
     def judge(self, settings: TaxiConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned means against the replayed scenarios and the exact expectations."""
-        early = outcome_verdict(records)
-        if early is not None:
-            return early
         outcome = records[0].outcome
         value = outcome.value
         means = [as_number(item) for item in value] if isinstance(value, list) and len(value) == 2 else [None]
@@ -160,9 +156,7 @@ class TaxiCheck:
             )
         random_mean, greedy_mean = float(means[0]), float(means[1])  # type: ignore[arg-type]
         episodes = played_episodes(records)
-        problem = integrity_problem(records, episodes, settings.game_rules()) or repeated_seed_problem(
-            all_resets(records), across_calls=False
-        )
+        problem = played_games_problem(records, episodes, settings.game_rules(), across_calls=False)
         if problem:
             # An altered log is named as such; otherwise a loop that ignored `truncated` is named as that.
             diagnosis = None if seed_problem(records) else ignored_truncation(episodes)

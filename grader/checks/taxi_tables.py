@@ -17,7 +17,7 @@ import numpy as np
 import numpy.typing as npt
 from pydantic import Field
 
-from grader.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, paused_gc
 from grader.checks.integrity import Episode, games_budget, integrity_problem, played_episodes
 from grader.checks.taxi import EPISODE_STEPS, split_scenarios
 from grader.checks.values import as_number, describe
@@ -58,11 +58,9 @@ class TaxiTablesCheck:
         return [Call("taxi", tables, budget=budget)]
 
     @paused_gc
+    @judged_when_all_returned
     def judge(self, settings: TaxiTablesConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned pair against the replayed episodes and the exact expectations."""
-        early = outcome_verdict(records)
-        if early is not None:
-            return early
         value = records[0].outcome.value
         means = (
             [as_number(item) for item in value]

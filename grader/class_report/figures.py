@@ -1,20 +1,20 @@
 """The class page's figures: the score histogram and each problem's pass rate, like the student report's.
 
-PNG plots on matplotlib's Agg canvas (no pyplot, no display), the size and colours of ``grader.figures``,
-embedded as ``data:`` URIs. Labels are the problems' registry ids (never student text).
+Drawn by the report's plotting stack: the canvas and colours of ``grader.problem_plots``, encoded by
+``grader.figures`` as PNGs embedded as ``data:`` URIs. Labels are the problems' registry ids (never student
+text).
 """
 
 from __future__ import annotations
 
-import io
 import time
-from typing import Any
+from collections.abc import Callable
 
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure as PlotFigure
 
 from grader.class_report.summary import ClassSummary
-from grader.figures import BAR_COLOUR, EXACT_COLOUR, PLOT_DPI, PLOT_SIZE, STUDENT_COLOUR, Figure
+from grader.figures import Figure, png_figure
+from grader.problem_plots import BAR_COLOUR, EXACT_COLOUR, STUDENT_COLOUR, new_plot
 
 TICK_CHARS = 24
 CLASS_FIGURE = "class"
@@ -32,16 +32,16 @@ def class_figures(summary: ClassSummary) -> list[Figure]:
     """
     figures: list[Figure] = []
     if summary.scores.count:
-        figures.append(_drawn(*score_histogram(summary)))
+        figures.append(_drawn(score_histogram, summary))
     if any(problem.graded for problem in summary.problems):
-        figures.append(_drawn(*pass_rate_bars(summary)))
+        figures.append(_drawn(pass_rate_bars, summary))
     return figures
 
 
 def score_histogram(summary: ClassSummary) -> tuple[str, str, PlotFigure]:
     """How many submissions scored in each tenth of the points, with the mean marked."""
     scores = summary.scores
-    figure, axes = _new_plot()
+    figure, axes = new_plot()
     width = (scores.bins[0].high - scores.bins[0].low) or 1.0
     axes.bar([row.low for row in scores.bins], [row.count for row in scores.bins], width=width * 0.95,
              align="edge", color=STUDENT_COLOUR, alpha=0.8, label="submissions")  # fmt: skip
@@ -57,7 +57,7 @@ def score_histogram(summary: ClassSummary) -> tuple[str, str, PlotFigure]:
 def pass_rate_bars(summary: ClassSummary) -> tuple[str, str, PlotFigure]:
     """Each problem's share of passing submissions among those that ran it."""
     rows = [problem for problem in summary.problems if problem.graded]
-    figure, axes = _new_plot()
+    figure, axes = new_plot()
     positions = list(range(len(rows)))
     rates = [problem.pass_rate or 0.0 for problem in rows]
     axes.bar(positions, rates, color=EXACT_COLOUR, alpha=0.8)
@@ -73,14 +73,6 @@ def pass_rate_bars(summary: ClassSummary) -> tuple[str, str, PlotFigure]:
     return "Pass rate per problem", caption, figure
 
 
-def _new_plot() -> tuple[PlotFigure, Any]:
-    figure = PlotFigure(figsize=PLOT_SIZE, dpi=PLOT_DPI, layout="constrained")
-    FigureCanvasAgg(figure)
-    return figure, figure.add_subplot()
-
-
-def _drawn(title: str, caption: str, plot: PlotFigure) -> Figure:
+def _drawn(plotter: Callable[[ClassSummary], tuple[str, str, PlotFigure]], summary: ClassSummary) -> Figure:
     started = time.perf_counter()
-    buffer = io.BytesIO()
-    plot.savefig(buffer, format="png")
-    return Figure(CLASS_FIGURE, title, caption, "image/png", buffer.getvalue(), time.perf_counter() - started)
+    return png_figure(CLASS_FIGURE, *plotter(summary), started=started)

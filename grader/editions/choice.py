@@ -7,16 +7,15 @@ downstream of the command line needs another argument.
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from grader.config import read_config_file
 from grader.editions import DEFAULT_EDITION, EDITIONS, edition_of
 from grader.editions.detection import detect_edition
 from grader.editions.errors import EditionConflict
 from grader.editions.pack import BUNDLED_CONFIG, Edition
 from grader.editions.rl1 import RL1
-from grader.errors import ConfigError
 
 
 @dataclass(frozen=True)
@@ -39,17 +38,7 @@ def configured_edition(config: Path) -> str:
     Raises:
         ConfigError: The file cannot be read as TOML (the loader says the same when grading).
     """
-    try:
-        raw = tomllib.loads(config.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ConfigError(
-            f"assignment configuration {config} not found: pass an existing TOML file"
-        ) from None
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
-        raise ConfigError(
-            f"{config} is not a readable UTF-8 TOML file ({error}): fix the path or the syntax"
-        ) from None
-    name = raw.get("edition", DEFAULT_EDITION)
+    name = read_config_file(config).get("edition", DEFAULT_EDITION)
     edition_of(name, where=f"{config}: edition")
     return str(name)
 

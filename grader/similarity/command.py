@@ -22,7 +22,7 @@ JSON_FILE = "similarity.json"
 
 def add_similarity_command(subparsers: Any) -> None:
     """Register the subcommand on `gymgrade`'s subparsers."""
-    from grader.classroom.layouts import LAYOUTS
+    from grader.classroom.layouts import add_layout_option
 
     parser = subparsers.add_parser(
         "similarity",
@@ -34,12 +34,7 @@ def add_similarity_command(subparsers: Any) -> None:
         metavar="CLASS_DIR",
         help="the class download as `gymgrade grade` takes it (folder or zip, any layout)",
     )
-    parser.add_argument(
-        "--layout",
-        choices=tuple(LAYOUTS),
-        default=None,
-        help="the download's layout (default: recognised from its names; see docs/instructors.md)",
-    )
+    add_layout_option(parser)
     parser.add_argument(
         "--reference",
         type=Path,

@@ -109,7 +109,7 @@ def submissions_from(
             "pass the folder the submissions were downloaded into"
         )
     if rule is None:
-        from grader.grading import GradingPlan
+        from grader.plan import GradingPlan
 
         rule = GradedFileRule(functions=GradingPlan.load(None, None).problems)
     try:

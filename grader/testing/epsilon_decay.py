@@ -1,145 +1,106 @@
 """Simulated `epsilon_decay` students (edition rl1): an honest one and the typical mistakes.
 
 Each is run by `grader.testing.simulation` (first argument: the simulated `Lab`, unused by a pure
-function). `MISTAKES` maps a name to the function and the words its feedback must contain;
-`submissions/editions/` holds the same mistakes as real student files.
+function). A student is a decay formula of `(episode, N, epsilon_start, epsilon_end)` given the lab's
+signature by `student` (or `student_with_exp`, which also takes `decay_type`). `MISTAKES` maps a name to
+the function and the words its feedback must contain; `submissions/editions/` holds the same mistakes as
+real student files.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
-
-def honest(
-    _lab: Any,
-    episode: int,
-    N: int,
-    epsilon_start: float = 1.0,
-    epsilon_end: float = 1e-6,
-    decay_type: str = "linear",
-) -> float:
-    """The lab's linear decay, and the additional materials' exponential one."""
-    if decay_type == "exp":
-        return float(epsilon_start * (epsilon_end / epsilon_start) ** (episode / N))
-    delta = (epsilon_start - epsilon_end) / N
-    return epsilon_start - (episode - 1) * delta
+Decay = Callable[[int, int, float, float], float]
+"""A decay formula: epsilon for `(episode, N, epsilon_start, epsilon_end)`."""
 
 
-def honest_rewritten(
-    _lab: Any,
-    episode: int,
-    N: int,
-    epsilon_start: float = 1.0,
-    epsilon_end: float = 1e-6,
-) -> float:
-    """The same decay written another way (a fraction of the way from start to end): equal up to rounding."""
-    fraction = (episode - 1) / N
-    return (1 - fraction) * epsilon_start + fraction * epsilon_end
+def student(decay: Decay) -> Callable[..., float]:
+    """`decay` as the lab's `epsilon_decay(episode, N, epsilon_start=1.0, epsilon_end=1e-6)`."""
+
+    def epsilon_decay(
+        _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6
+    ) -> float:
+        return decay(episode, N, epsilon_start, epsilon_end)
+
+    return epsilon_decay
 
 
-def honest_loop(
-    _lab: Any,
-    episode: int,
-    N: int,
-    epsilon_start: float = 1.0,
-    epsilon_end: float = 1e-6,
-) -> float:
-    """The decay applied once per episode: rounding accumulates, within the check's tolerance."""
-    delta = (epsilon_start - epsilon_end) / N
-    epsilon = epsilon_start
-    for _ in range(episode - 1):
-        epsilon -= delta
-    return epsilon
+def student_with_exp(linear: Decay, exp: Decay) -> Callable[..., float]:
+    """`linear`, and `exp` for `decay_type="exp"` (the additional materials' optional parameter)."""
+
+    def epsilon_decay(
+        _lab: Any,
+        episode: int,
+        N: int,
+        epsilon_start: float = 1.0,
+        epsilon_end: float = 1e-6,
+        decay_type: str = "linear",
+    ) -> float:
+        decay = exp if decay_type == "exp" else linear
+        return decay(episode, N, epsilon_start, epsilon_end)
+
+    return epsilon_decay
 
 
-HONEST = {"formula": honest, "rewritten": honest_rewritten, "loop": honest_loop}
-"""Honest ways to write the linear decay: each must pass."""
+def _lab_formula(episode: int, n: int, start: float, end: float) -> float:
+    delta = (start - end) / n
+    return start - (episode - 1) * delta
 
 
 def _linear(episode: int, n: int, start: float, end: float) -> float:
     return start - (episode - 1) * (start - end) / n
 
 
-def zero_based(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6
-) -> float:
-    return epsilon_start - episode * (epsilon_start - epsilon_end) / N
+def _exponential(episode: int, n: int, start: float, end: float) -> float:
+    return float(start * (end / start) ** (episode / n))
 
 
-def divides_by_n_minus_1(
-    _lab: Any,
-    episode: int,
-    N: int,
-    epsilon_start: float = 1.0,
-    epsilon_end: float = 1e-6,
-) -> float:
-    return epsilon_start - (episode - 1) * (epsilon_start - epsilon_end) / (N - 1)
+def _fraction_of_the_way(episode: int, n: int, start: float, end: float) -> float:
+    fraction = (episode - 1) / n
+    return (1 - fraction) * start + fraction * end
 
 
-def end_at_last(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6
-) -> float:
-    if episode >= N:
-        return epsilon_end
-    return _linear(episode, N, epsilon_start, epsilon_end)
+def _loop(episode: int, n: int, start: float, end: float) -> float:
+    delta = (start - end) / n
+    epsilon = start
+    for _ in range(episode - 1):
+        epsilon -= delta
+    return epsilon
 
 
-def ignores_bounds(
-    _lab: Any,
-    episode: int,
-    N: int,
-    epsilon_start: float = 1.0,
-    epsilon_end: float = 1e-6,
-) -> float:
-    return _linear(episode, N, 1.0, 1e-6)
+def _end_at_last(episode: int, n: int, start: float, end: float) -> float:
+    return end if episode >= n else _linear(episode, n, start, end)
 
 
-def decays_to_zero(
-    _lab: Any,
-    episode: int,
-    N: int,
-    epsilon_start: float = 1.0,
-    epsilon_end: float = 1e-6,
-) -> float:
-    return epsilon_start - (episode - 1) * epsilon_start / N
+def _exp_from_zero(episode: int, n: int, start: float, end: float) -> float:
+    return float(start * (end / start) ** ((episode - 1) / n))
 
 
-def exponential(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6
-) -> float:
-    return float(epsilon_start * (epsilon_end / epsilon_start) ** (episode / N))
+honest = student_with_exp(_lab_formula, _exponential)
+"""The lab's linear decay, and the additional materials' exponential one."""
+honest_rewritten = student(_fraction_of_the_way)
+"""The same decay written another way (a fraction of the way from start to end): equal up to rounding."""
+honest_loop = student(_loop)
+"""The decay applied once per episode: rounding accumulates, within the check's tolerance."""
 
+HONEST = {"formula": honest, "rewritten": honest_rewritten, "loop": honest_loop}
+"""Honest ways to write the linear decay: each must pass."""
 
-def floor_division(
-    _lab: Any,
-    episode: int,
-    N: int,
-    epsilon_start: float = 1.0,
-    epsilon_end: float = 1e-6,
-) -> float:
-    return epsilon_start - (episode - 1) * ((epsilon_start - epsilon_end) // N)
-
-
-def exp_off_by_one(
-    _lab: Any,
-    episode: int,
-    N: int,
-    epsilon_start: float = 1.0,
-    epsilon_end: float = 1e-6,
-    decay_type: str = "linear",
-) -> float:
-    """Right linear decay; the optional exponential one counts episodes from 0."""
-    if decay_type == "exp":
-        return float(epsilon_start * (epsilon_end / epsilon_start) ** ((episode - 1) / N))
-    return _linear(episode, N, epsilon_start, epsilon_end)
-
-
-def returns_nan(
-    _lab: Any, episode: int, N: int, epsilon_start: float = 1.0, epsilon_end: float = 1e-6
-) -> float:
-    return math.nan if episode == N else _linear(episode, N, epsilon_start, epsilon_end)
-
+zero_based = student(lambda episode, n, start, end: start - episode * (start - end) / n)
+divides_by_n_minus_1 = student(lambda episode, n, start, end: start - (episode - 1) * (start - end) / (n - 1))
+end_at_last = student(_end_at_last)
+ignores_bounds = student(lambda episode, n, _start, _end: _linear(episode, n, 1.0, 1e-6))
+decays_to_zero = student(lambda episode, n, start, _end: start - (episode - 1) * start / n)
+exponential = student(_exponential)
+floor_division = student(lambda episode, n, start, end: start - (episode - 1) * ((start - end) // n))
+exp_off_by_one = student_with_exp(_linear, _exp_from_zero)
+"""Right linear decay; the optional exponential one counts episodes from 0."""
+returns_nan = student(
+    lambda episode, n, start, end: math.nan if episode == n else _linear(episode, n, start, end)
+)
 
 MISTAKES: dict[str, tuple[Any, str]] = {
     "zero_based": (zero_based, "0-based episodes"),

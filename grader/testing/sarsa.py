@@ -51,6 +51,7 @@ def learner(
     runs: int = 1,
     keeps_first_table: bool = False,
     schedule: Callable[..., float] = epsilon_decay,
+    dtype: Any = np.float64,
 ) -> Callable[..., Any]:
     """A SARSA(0) learner on the lab's skeleton, with one of the typical departures switched on."""
     kept: list[Any] = []
@@ -62,7 +63,7 @@ def learner(
             alpha, gamma = fixed
         env = _env(lab, env_argument)
         for _ in range(runs):
-            q_table = np.zeros((env.observation_space.n, env.action_space.n))
+            q_table = np.zeros((env.observation_space.n, env.action_space.n), dtype=dtype)
             penalties = 0
 
             def choose(state: int, rate: float, table: Any = q_table) -> int:
@@ -100,6 +101,8 @@ def learner(
             q_table = kept[0]
         if returns == "table":
             return q_table
+        if returns == "lists":
+            return q_table.tolist()
         return q_table, penalties + penalty_offset
 
     return sarsa0
@@ -110,8 +113,11 @@ HONEST: dict[str, Callable[..., Any]] = {
     "table_only": learner(returns="table"),
     "random_ties": learner(argmax=_random_argmax),
     "stops_on_truncated": learner(stop_on_truncated=True),
+    "float32_table": learner(dtype=np.float32),
+    "float32_lists": learner(dtype=np.float32, returns="lists", argmax=_random_argmax),
 }
-"""Honest learners: the lab's loop, the table alone returned, ties broken at random, a stop on truncated."""
+"""Honest learners: the lab's loop, the table alone returned, ties broken at random, a stop on truncated, a
+float32 table (as an array, and as lists)."""
 
 MISTAKES: dict[str, tuple[Callable[..., Any], str]] = {
     "q_learning": (learner(target="max"), "which is Q-learning"),
@@ -126,5 +132,7 @@ MISTAKES: dict[str, tuple[Callable[..., Any], str]] = {
     "never_explores": (learner(explore=False), "you explored less than epsilon asks"),
     "ignores_decay": (learner(decays=False), "less than the decayed schedule"),
     "wrong_penalties": (learner(penalty_offset=1), "penalties"),
+    "float32_q_learning": (learner(target="max", dtype=np.float32), "which is Q-learning"),
+    "float32_missing_gamma": (learner(gamma_used=False, dtype=np.float32), "did not discount"),
 }
 """Typical sarsa0 mistakes: (the learner, words its feedback must contain)."""

@@ -131,3 +131,20 @@ def test_an_unreachable_broker_is_refused_with_a_remedy(monkeypatch: pytest.Monk
         executor_from_environment(IsolationPolicy.REQUIRE_FULL)
     monkeypatch.delenv("GYMGRADE_BROKER_URL")
     assert executor_from_environment(IsolationPolicy.REQUIRE_FULL) is None
+
+
+def test_a_file_the_cluster_could_not_grade_is_a_grader_error_in_every_problem(tmp_path: Path) -> None:
+    from api.jobs.batch import _report
+    from grader.plan import GradingPlan
+
+    path = tmp_path / "alice.py"
+    path.write_bytes(b"def car():\n    return 1\n")
+    plan = GradingPlan.load(None, ["cartpole", "car"])
+    report = _report(path, path.read_bytes(), {"error": "the worker was killed"}, plan, 7)
+    assert (report.submission, report.seed, report.score) == ("alice.py", 7, 0.0)
+    assert [(result.id, result.status) for result in report.problems] == [("cartpole", "error"), ("car", "error")]
+    assert report.grader_errors == [
+        "cartpole: the cluster could not grade it: the worker was killed",
+        "car: the cluster could not grade it: the worker was killed",
+    ]
+    assert "not your code's fault" in report.problems[0].feedback

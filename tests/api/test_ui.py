@@ -13,6 +13,8 @@ from api.main import create_app
 
 SOLUTION = b"def random_blackjack(n):\n    return 0.3\n\ndef blackjack(n=11):\n    return 0.4\n"
 GRADING_WAIT_SECONDS = 60
+BLACKJACK_PLOT = "Blackjack win rate against n"
+FIGURE = r'<figure class="figure"><img src="data:image/png;base64,[A-Za-z0-9+/=]+" alt="([^"]+)">'
 
 
 def _sign_in(client: TestClient, token: str) -> None:
@@ -91,15 +93,21 @@ def test_upload_then_watch_the_checks_complete(make_settings: SettingsFactory) -
         page = client.get(page_url).text
         assert 'data-src="' + page_url + '/live"' in page and 'data-final="false"' in page
         seen_statuses = set()
+        figures_while_running: set[str] = set()
         deadline = time.monotonic() + GRADING_WAIT_SECONDS
         live = ""
         while 'data-final="true"' not in live and time.monotonic() < deadline:
             live = client.get(page_url + "/live").text
-            seen_statuses.add(re.search(r"Status: (\w+)", live).group(1))  # type: ignore[union-attr]
+            status = re.search(r"Status: (\w+)", live).group(1)  # type: ignore[union-attr]
+            seen_statuses.add(status)
+            if status == "running":
+                figures_while_running.update(re.findall(FIGURE, live))
             time.sleep(0.1)
         assert "Score: 2 / 3" in live
         assert "running" in seen_statuses, "the live fragment should show the grading while it runs"
-        assert live.count("<svg") == 1, "the blackjack curve is drawn"
+        assert figures_while_running == {BLACKJACK_PLOT}, "a finished problem's plot shows early"
+        assert re.findall(FIGURE, live) == [BLACKJACK_PLOT], "the report's plot, drawn as the HTML report's"
+        assert "<svg" not in live
         assert "&lt;output of blackjack&gt;" in live
 
 

@@ -13,8 +13,9 @@ from grading_support import write_config
 
 import grader
 from grader.batch import GRADES_FILE, grade_many, report_names, write_grades
+from grader.collector import GradingListener
 from grader.errors import BatchInterrupted
-from grader.grading import GradingPlan
+from grader.plan import GradingPlan
 from grader.report import ProblemResult, Report
 
 
@@ -49,12 +50,7 @@ def _report(name: str, scores: dict[str, float], error: str | None = None) -> Re
 
 
 def test_grades_csv_has_a_row_per_submission_and_a_column_per_problem(tmp_path: Path) -> None:
-    plan = GradingPlan(
-        problems=("cartpole", "car"),
-        points={"cartpole": 1.0, "car": 1.0},
-        titles={"cartpole": "CartPole", "car": "MountainCar"},
-        config=None,
-    )
+    plan = GradingPlan.load(None, ["cartpole", "car"])
     reports = [
         _report("alice.py", {"cartpole": 1.0, "car": 0.0}),
         _report("bob.py", {"cartpole": 0.0, "car": 0.0}, error="bob.py is empty"),
@@ -81,19 +77,13 @@ class FakeExecutor:
     asked: list[list[str]] = field(default_factory=list)
 
     def grade(
-        self,
-        paths: Sequence[Path],
-        plan: GradingPlan,
-        *,
-        seed: int,
-        on_report: Callable[[Path, Report], None],
-        on_result: Callable[[Path, ProblemResult], None] | None,
+        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
     ) -> None:
         self.asked.append([path.name for path in paths])
         for done, path in enumerate(paths):
             if self.interrupt_after is not None and done >= self.interrupt_after:
                 raise KeyboardInterrupt
-            on_report(path, graded_report(path, plan, seed))
+            listener.report(path, graded_report(path, plan, seed))
 
 
 def graded_report(path: Path, plan: GradingPlan, seed: int) -> Report:

@@ -269,6 +269,13 @@ def test_not_toml_says_so(tmp_path: Path) -> None:
         load_config(_write(tmp_path, "[problems\n"))
 
 
+def test_an_unreadable_path_says_so(tmp_path: Path) -> None:
+    with pytest.raises(
+        ConfigError, match=r"cannot read the assignment configuration .* pass a readable TOML file"
+    ):
+        load_config(tmp_path)
+
+
 # The power analysis of grader/ASSIGNMENT.md, pinned: exact binomial probabilities and exact Taxi moments.
 
 

@@ -15,8 +15,10 @@ from grading_support import CLASSIC_COMPLETE, FAST_OVERRIDES, SUBMISSIONS, write
 import grader.grading
 import grader.sandbox.runner
 from grader.batch import grade_many
+from grader.collector import OnResult
 from grader.errors import BatchInterrupted
-from grader.grading import GradingPlan, grade_files, grade_submission
+from grader.grading import grade_files, grade_submission
+from grader.plan import GradingPlan
 from grader.plugin import GraderFailure, SessionPlan
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
@@ -156,7 +158,7 @@ def test_an_abandoned_run_leaves_no_process_behind(fast_config: Path) -> None:
             seed=918273645,
             workers=2,
             policy=IsolationPolicy.ALLOW_FALLBACK,
-            on_result=give_up,
+            listener=OnResult(give_up),
         )
     assert workers, "the session's workers are children of the calling process"
     deadline = time.monotonic() + 10  # SIGKILLed workers take a moment to exit

@@ -15,7 +15,8 @@ from grading_support import SUBMISSIONS
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 
 from grader import cli
-from grader.grading import grade_submission, with_notebook
+from grader.collector import with_notebook
+from grader.grading import grade_submission
 from grader.notebook import NotebookModule, bounded, build_module
 from grader.notebook.building import MAX_LISTED_SKIPPED, MAX_NOTED_GLOBALS
 from grader.report import ProblemResult, Report

@@ -5,14 +5,18 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 from grading_support import CLASSIC_COMPLETE, FAST_OVERRIDES, write_config
 
-from grader.config import load_config
-from grader.grading import GradingPlan, grade_files, run_acceptance
+from grader.config import DEFAULT_CONFIG_PATH, load_config
+from grader.editions import EDITIONS
+from grader.editions.choice import edition_config
+from grader.grading import grade_files
+from grader.plan import GradingPlan
 from grader.plugin import (
     CASE_OUTCOME,
     GraderFailure,
@@ -23,7 +27,7 @@ from grader.plugin import (
 )
 from grader.report import ProblemResult, ProblemRun, Report
 from grader.sandbox import IsolationPolicy
-from grader.session import acceptance_args, session_environment
+from grader.session import SessionEnd, acceptance_args, session_environment
 
 PROBLEMS = ("random_blackjack", "cartpole", "car")
 
@@ -67,11 +71,10 @@ class Collected:
 def test_collection_runs_the_longest_expected_checks_first_under_the_planned_ids(fast_config: Path) -> None:
     grading = GradingPlan.load(fast_config, None)
     plan = SessionPlan(
+        grading=grading,
         submissions=(CLASSIC_COMPLETE, CLASSIC_COMPLETE),
-        problems=grading.problems,
         seed=0,
         policy=IsolationPolicy.ALLOW_FALLBACK,
-        config=fast_config,
     )
     collected = Collected()
     with session_environment({}), contextlib.redirect_stdout(io.StringIO()):
@@ -86,12 +89,34 @@ def test_collection_runs_the_longest_expected_checks_first_under_the_planned_ids
     ]
 
 
-def test_the_plan_reaches_the_workers_whatever_the_files_are_called() -> None:
+def test_the_plan_reaches_the_workers_whatever_the_files_are_called(fast_config: Path) -> None:
     names = (Path(os.fsdecode(b"/srv/caf\xe9.py")), Path("/home/zoë/[final] = opengym.py"))
-    plan = SessionPlan(submissions=names, problems=("car",), seed=7, policy=IsolationPolicy.REQUIRE_FULL)
+    grading = GradingPlan.load(fast_config, ["car"])
+    plan = SessionPlan(grading=grading, submissions=names, seed=7, policy=IsolationPolicy.REQUIRE_FULL)
     name, value = plan.option().split("=", 1)
     assert name == "--gymgrade-plan"
     assert SessionPlan.from_option(value) == plan
+
+
+@pytest.mark.parametrize("edition", sorted(EDITIONS))
+def test_the_plan_carries_its_configuration_as_data_not_as_a_path(edition: str, tmp_path: Path) -> None:
+    source = edition_config(edition)
+    copy = tmp_path / "assignment.toml"
+    copy.write_text((source or DEFAULT_CONFIG_PATH).read_text(encoding="utf-8"), encoding="utf-8")
+    grading = GradingPlan.load(copy, None)
+    option = SessionPlan(
+        grading=grading, submissions=(), seed=1, policy=IsolationPolicy.ALLOW_FALLBACK
+    ).option()
+    copy.write_text(
+        "this file changed after the plan was made = [", encoding="utf-8"
+    )  # nobody reads it again
+    carried = SessionPlan.from_option(option.split("=", 1)[1]).grading
+    assert carried == grading
+    assert (carried.edition, carried.registry, carried.config_sha256) == (
+        grading.edition,
+        grading.registry,
+        grading.config_sha256,
+    )
 
 
 def test_a_case_is_known_by_an_ascii_id_whatever_the_file_is_called() -> None:
@@ -159,30 +184,53 @@ def test_every_check_reports_its_timings_apart_from_the_verdict(reports: dict[st
         assert problem.timings.student_seconds <= problem.timings.wall_seconds
 
 
+@contextlib.contextmanager
+def _deleted_when_the_session_starts(path: Path) -> Iterator[None]:
+    """Delete ``path`` once the plan is made and the files validated, as the session starts."""
+    import grader.grading
+
+    start = grader.grading.run_session
+
+    def delete_then_start(*args: Any, **kwargs: Any) -> SessionEnd:
+        path.unlink()
+        return start(*args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(grader.grading, "run_session", delete_then_start)
+        yield
+
+
+def _vanished_report(plan: GradingPlan, tmp_path: Path) -> Report:
+    """The report of a file deleted after it was validated, before its check ran (a grader failure)."""
+    vanished = tmp_path / "vanished.py"
+    vanished.write_text("import math\n")
+    with _deleted_when_the_session_starts(vanished):
+        [report] = grade_files([vanished], plan, seed=0, workers=1, policy=IsolationPolicy.ALLOW_FALLBACK)
+    return report
+
+
 def test_a_grader_failure_is_reported_as_such(plan: GradingPlan, tmp_path: Path) -> None:
-    vanished = tmp_path / "vanished.py"  # validated, then deleted before its check runs
-    single = GradingPlan.load(plan.config, ["car"])
-    runs = run_acceptance(
-        [vanished], single, seed=0, workers=1, policy=IsolationPolicy.ALLOW_FALLBACK, on_result=None
-    )
-    [run] = runs[str(vanished)]
-    assert run.internal_error is not None and run.internal_error.startswith("FileNotFoundError")
-    assert run.result.status == "error"
-    assert run.result.feedback.startswith(
-        "The grader failed while checking this problem (not your code's fault)"
-    )
+    report = _vanished_report(GradingPlan.load(plan.config, ["car"]), tmp_path)
+    [result] = report.problems
+    assert report.grader_errors and report.grader_errors[0].startswith("car: FileNotFoundError")
+    assert result.status == "error"
+    assert result.feedback.startswith("The grader failed while checking this problem (not your code's fault)")
 
 
 def test_a_grader_failure_keeps_the_problems_visibility(tmp_path: Path) -> None:
     config = write_config(tmp_path / "assignment.toml", {"car": {"visibility": "hidden"}})
-    vanished = tmp_path / "vanished.py"
-    runs = run_acceptance(
-        [vanished],
-        GradingPlan.load(config, ["car"]),
-        seed=0,
-        workers=1,
-        policy=IsolationPolicy.ALLOW_FALLBACK,
-        on_result=None,
-    )
-    [run] = runs[str(vanished)]
-    assert (run.result.status, run.result.visibility) == ("error", "hidden")
+    [result] = _vanished_report(GradingPlan.load(config, ["car"]), tmp_path).problems
+    assert (result.status, result.visibility) == ("error", "hidden")
+
+
+def test_the_workers_grade_with_the_plans_configuration_even_if_its_file_is_gone(tmp_path: Path) -> None:
+    config = write_config(tmp_path / "assignment.toml", {"car": {"points": 3.0, "visibility": "hidden"}})
+    plan = GradingPlan.load(config, ["car"])
+    with _deleted_when_the_session_starts(config):  # no process of the session may read it again
+        [report] = grade_files(
+            [CLASSIC_COMPLETE], plan, seed=0, workers=1, policy=IsolationPolicy.ALLOW_FALLBACK
+        )
+    assert not config.exists() and report.grader_errors == []
+    [result] = report.problems
+    assert (result.status, result.max_score, result.visibility) == ("passed", 3.0, "hidden")
+    assert report.config_sha256 == plan.config_sha256

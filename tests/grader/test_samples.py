@@ -18,7 +18,8 @@ import pytest
 from grading_support import SUBMISSIONS, write_config
 
 from grader.config import load_config
-from grader.grading import GradingPlan, grade_files
+from grader.grading import grade_files
+from grader.plan import GradingPlan
 from grader.problems import PROBLEM_IDS, ProblemId
 from grader.report import Report
 from grader.sandbox import IsolationPolicy

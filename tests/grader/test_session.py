@@ -19,6 +19,7 @@ import pytest
 import xdist.workermanage
 from faulty_worker import CRASH_CASE, NO_ISOLATION
 
+from grader.plan import GradingPlan
 from grader.plugin import CaseOutcome, GraderFailure, ProblemCase, SessionPlan
 from grader.report import ProblemRun
 from grader.sandbox import IsolationPolicy
@@ -34,8 +35,8 @@ def _plan(tmp_path: Path, *problems: str, submissions: int = 1, source: str = "i
         path.write_text(source)
         paths.append(path)
     return SessionPlan(
+        grading=GradingPlan.load(None, problems),
         submissions=tuple(paths),
-        problems=problems,  # type: ignore[arg-type]
         seed=0,
         policy=IsolationPolicy.ALLOW_FALLBACK,
     )

@@ -86,6 +86,22 @@ def test_binomial_acceptance_rejects_bad_arguments() -> None:
         stats.binomial_acceptance(0, 0.5, 0.05)
 
 
+@pytest.mark.parametrize(
+    ("pmf", "alpha", "interval"),
+    [
+        ([0.25, 0.5, 0.25], 0.6, (1, 1, 0.5)),
+        ([0.25, 0.5, 0.25], 0.4, (0, 2, 0.0)),
+        ([0.1, 0.1, 0.8], 0.5, (2, 2, 0.2)),
+        ([1.0], 0.5, (0, 0, 0.0)),
+    ],
+    ids=["both-tails-cut", "tails-too-heavy", "lower-tail-to-the-mode", "one-value"],
+)
+def test_central_interval_cuts_each_tail_up_to_half_alpha(
+    pmf: list[float], alpha: float, interval: tuple[int, int, float]
+) -> None:
+    assert stats.central_interval(pmf, alpha) == interval
+
+
 def test_mean_tolerance() -> None:
     tolerance = stats.mean_tolerance(expected=3.0, variance=4.0, samples=100, alpha=0.05)
     assert tolerance.half_width == pytest.approx(Z_975 * 0.2, abs=1e-8)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import argparse
+
 from grader.classroom.layouts.blackboard import BlackboardLayout
 from grader.classroom.layouts.canvas import CanvasLayout
 from grader.classroom.layouts.github_classroom import GitHubClassroomLayout
@@ -25,4 +27,15 @@ LAYOUTS: dict[str, Layout] = {
 }
 """Every layout by its ``--layout`` name."""
 
-__all__ = ["LAYOUTS", "Group", "Grouping", "Layout"]
+
+def add_layout_option(parser: argparse.ArgumentParser) -> None:
+    """Give a command that reads a class download the ``--layout`` option (one of `LAYOUTS`)."""
+    parser.add_argument(
+        "--layout",
+        choices=tuple(LAYOUTS),
+        default=None,
+        help="the download's layout (default: recognised from its names; see docs/instructors.md)",
+    )
+
+
+__all__ = ["LAYOUTS", "Group", "Grouping", "Layout", "add_layout_option"]

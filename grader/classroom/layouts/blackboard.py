@@ -11,7 +11,7 @@ import re
 from collections import defaultdict
 from datetime import datetime
 
-from grader.classroom.layouts.protocol import Group, Grouping, fraction, top_names
+from grader.classroom.layouts.protocol import Group, Grouping, marked_share
 from grader.classroom.model import Member, Skipped
 from grader.classroom.tree import Entry, Tree
 
@@ -39,8 +39,7 @@ class BlackboardLayout:
 
     def score(self, tree: Tree) -> float:
         """The share of top-level names with Blackboard's ``_attempt_{timestamp}`` mark."""
-        names = top_names(tree)
-        return fraction(sum(1 for name in names if ATTEMPT.match(name)), len(names))
+        return marked_share(tree, ATTEMPT.match)
 
     def group(self, tree: Tree) -> Grouping:
         """A group per username, holding the files of their latest attempt."""

@@ -12,7 +12,7 @@ import re
 from collections import defaultdict
 
 from grader.classroom.graded_file import base_name
-from grader.classroom.layouts.protocol import Group, Grouping, fraction, top_names
+from grader.classroom.layouts.protocol import Group, Grouping, marked_share
 from grader.classroom.model import Member, Skipped
 from grader.classroom.tree import Entry, Tree
 
@@ -42,8 +42,7 @@ class CanvasLayout:
 
     def score(self, tree: Tree) -> float:
         """The share of top-level names that are Canvas download names."""
-        names = top_names(tree)
-        return fraction(sum(1 for name in names if parse(name)), len(names))
+        return marked_share(tree, parse)
 
     def group(self, tree: Tree) -> Grouping:
         """A group per user id; of two uploads of one name, the later."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 from collections import defaultdict
 
-from grader.classroom.layouts.protocol import Group, Grouping, fraction, top_names
+from grader.classroom.layouts.protocol import Group, Grouping, marked_share
 from grader.classroom.model import Member, Skipped
 from grader.classroom.tree import Entry, Tree
 
@@ -25,8 +25,7 @@ class MoodleLayout:
 
     def score(self, tree: Tree) -> float:
         """The share of top-level names carrying Moodle's ``_{id}_assignsubmission_`` mark."""
-        names = top_names(tree)
-        return fraction(sum(1 for name in names if MOODLE_NAME.match(name)), len(names))
+        return marked_share(tree, MOODLE_NAME.match)
 
     def group(self, tree: Tree) -> Grouping:
         """A group per participant id."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import datetime
 from typing import Protocol
@@ -63,9 +64,15 @@ class Layout(Protocol):
         ...
 
 
-def fraction(matching: int, total: int) -> float:
-    """Share of the top-level names that carry a layout's mark (0 for an empty download)."""
-    return matching / total if total else 0.0
+def marked_share(tree: Tree, marked: Callable[[str], object]) -> float:
+    """Share of the top-level names (`top_names`) that carry a layout's mark (0 for an empty download).
+
+    Args:
+        tree: The download.
+        marked: Truthy for a name carrying the mark (a compiled pattern's ``match``, say).
+    """
+    names = top_names(tree)
+    return sum(1 for name in names if marked(name)) / len(names) if names else 0.0
 
 
 def top_names(tree: Tree) -> set[str]:

@@ -13,9 +13,31 @@ NO_GUESS_YET = 0
 GUESS_TOO_LOW = 1
 GUESS_EQUAL = 2
 GUESS_TOO_HIGH = 3
+"""The observations of both number-guessing games (this one, `HotterColderEnv`): none yet, then the side."""
 
 
-class GuessingGameEnv(Env[Any, Any]):
+def guess_side(guess: float, number: float) -> int:
+    """The observation after a guess: too low (1), equal (2) or too high (3)."""
+    return GUESS_TOO_LOW if guess < number else GUESS_EQUAL if guess == number else GUESS_TOO_HIGH
+
+
+class HiddenNumberEnv(Env[Any, Any]):
+    """What classic gym's two number-guessing games share: a number hidden anew at every reset.
+
+    Subclasses set `range` (the number is drawn uniformly from [-range, range)) and count `guess_count`.
+    """
+
+    range: int
+    number: float
+    guess_count: int
+
+    def _hide_number(self, seed: int | None) -> None:
+        super().reset(seed=seed)
+        self.number = float(self.np_random.uniform(-self.range, self.range))
+        self.guess_count = 0
+
+
+class GuessingGameEnv(HiddenNumberEnv):
     """Guess a hidden real number within 200 guesses; each observation says which side it lies on.
 
     Rules (classic gym 0.9 to 0.17, `gym/envs/toy_text/guessing_game.py`, registered as
@@ -61,9 +83,7 @@ class GuessingGameEnv(Env[Any, Any]):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[int, dict[str, Any]]:
         """Draw a new target and forget all guesses; the observation is 0 (no guess yet)."""
-        super().reset(seed=seed)
-        self.number = float(self.np_random.uniform(-self.range, self.range))
-        self.guess_count = 0
+        self._hide_number(seed)
         self.observation = NO_GUESS_YET
         return self.observation, {}
 
@@ -74,12 +94,7 @@ class GuessingGameEnv(Env[Any, Any]):
             InvalidActionError: the guess is not one finite number within [-10000, 10000].
         """
         guess = self._guess(action)
-        if guess < self.number:
-            self.observation = GUESS_TOO_LOW
-        elif guess == self.number:
-            self.observation = GUESS_EQUAL
-        else:
-            self.observation = GUESS_TOO_HIGH
+        self.observation = guess_side(guess, self.number)
         tolerance = self.range * 0.01
         hit = self.number - tolerance < guess < self.number + tolerance
         self.guess_count += 1

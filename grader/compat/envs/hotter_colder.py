@@ -5,17 +5,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from gymnasium import Env, spaces
+from gymnasium import spaces
 
 from ..errors import InvalidActionError
-
-NO_GUESS_YET = 0
-GUESS_TOO_LOW = 1
-GUESS_EQUAL = 2
-GUESS_TOO_HIGH = 3
+from .guessing_game import NO_GUESS_YET, HiddenNumberEnv, guess_side
 
 
-class HotterColderEnv(Env[Any, Any]):
+class HotterColderEnv(HiddenNumberEnv):
     """Guess a hidden number; the reward grows the closer the guess is ("hotter").
 
     Rules (classic gym `toy_text/hotter_colder.py`, `gym_toytext.HotterColder`, registered with
@@ -41,9 +37,7 @@ class HotterColderEnv(Env[Any, Any]):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[int, dict[str, Any]]:
         """Draw a new target; observe 0 (no guess yet)."""
-        super().reset(seed=seed)
-        self.number = float(self.np_random.uniform(-self.range, self.range))
-        self.guess_count = 0
+        self._hide_number(seed)
         return NO_GUESS_YET, self._info()
 
     def step(self, action: Any) -> tuple[int, float, bool, bool, dict[str, Any]]:
@@ -54,9 +48,7 @@ class HotterColderEnv(Env[Any, Any]):
                 f"HotterColder-v0 takes one guess in [-{self.bounds}, {self.bounds}], found {action!r}"
             )
         value = float(guess[0])
-        observation = (
-            GUESS_TOO_LOW if value < self.number else GUESS_EQUAL if value == self.number else GUESS_TOO_HIGH
-        )
+        observation = guess_side(value, self.number)
         reward = ((min(value, self.number) + self.bounds) / (max(value, self.number) + self.bounds)) ** 2
         self.guess_count += 1
         return observation, reward, False, self.guess_count >= self.guess_max, self._info()

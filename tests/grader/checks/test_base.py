@@ -1,8 +1,10 @@
 """The outcome mapping every check shares: sandbox statuses to verdicts."""
 
+from collections.abc import Sequence
+
 import pytest
 
-from grader.checks.base import CallRecord, outcome_verdict
+from grader.checks.base import CallRecord, Verdict, judged_when_all_returned, outcome_verdict
 from grader.checks.integrity import games_budget
 from grader.sandbox.outcome import Call, CallOutcome, OutcomeStatus
 
@@ -102,3 +104,21 @@ def test_a_call_beyond_its_budget_is_a_described_wrong_answer() -> None:
         "it again for more games)"
     )
     assert "easy start" not in verdict.feedback
+
+
+def test_a_judge_sees_only_records_whose_calls_all_returned() -> None:
+    judged: list[int] = []
+
+    @judged_when_all_returned
+    def judge(_check: object, _settings: object, records: Sequence[CallRecord]) -> Verdict:
+        judged.append(len(records))
+        return Verdict("passed", 1.0, "judged")
+
+    ok, timeout = (
+        _record(OutcomeStatus.OK),
+        _record(OutcomeStatus.TIMEOUT, "car() did not return within 30 s"),
+    )
+    assert judge(None, None, [ok, timeout]) == outcome_verdict([ok, timeout])
+    assert judged == []
+    assert judge(None, None, [ok, ok]).feedback == "judged"
+    assert judged == [2]

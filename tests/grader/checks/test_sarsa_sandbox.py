@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from grader.editions.rl1 import RL1
-from grader.grading import GradingPlan, grade_files
+from grader.grading import grade_files
+from grader.plan import GradingPlan
 from grader.report import ProblemResult
 from grader.sandbox import IsolationPolicy
 

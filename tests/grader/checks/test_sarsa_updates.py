@@ -75,3 +75,29 @@ def test_bernsteins_bound_meets_its_level(variance: float) -> None:
     alpha = 1e-6
     t = bernstein_half_width(variance, alpha)
     assert 2 * math.exp(-(t**2) / (2 * variance + 2 * t / 3)) == pytest.approx(alpha)
+
+
+def _float32_learner(episodes: list[EpisodeSteps], alpha: float, gamma: float) -> np.ndarray:
+    """A learner's own float32 table, updated with the lab's `+=` line on the same transitions."""
+    q = np.zeros((3, 2), dtype=np.float32)
+    for episode in episodes:
+        for step in episode.transitions:
+            bootstrap = (
+                q[step.next_state, step.next_action]
+                if step.next_action is not None
+                else q[step.next_state].max()
+            )
+            q[step.state, step.action] += alpha * (
+                step.reward + gamma * bootstrap - q[step.state, step.action]
+            )
+    return q
+
+
+def test_a_float32_table_is_recomputed_with_float32_rounding() -> None:
+    episodes = [EPISODE] * 6
+    learner = _float32_learner(episodes, 0.3, 0.7).astype(np.float64)
+    in_float32 = recompute(episodes, (3, 2), 0.3, 0.7, precision=np.float32, judge_actions=False).array()
+    in_float64 = recompute(episodes, (3, 2), 0.3, 0.7, judge_actions=False).array()
+    assert np.array_equal(learner, in_float32)  # the same rounding, step for step
+    assert mismatched_cells(learner, in_float64, 1e-8) != []  # which float64 arithmetic does not reproduce
+    assert mismatched_cells(learner, in_float64, 1e-5) == []

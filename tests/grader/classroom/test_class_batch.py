@@ -6,7 +6,7 @@ from __future__ import annotations
 import csv
 import hashlib
 import json
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,7 +18,8 @@ from grader import cli
 from grader.batch import grade_many, identity_stem
 from grader.classroom import GradedFileRule, discover
 from grader.classroom.output import ClassGradebook
-from grader.grading import GradingPlan
+from grader.collector import GradingListener
+from grader.plan import GradingPlan
 from grader.report import ProblemResult, Report
 
 from .canvas_import import canvas_import
@@ -35,13 +36,7 @@ class FakeExecutor:
     asked: list[list[Path]] = field(default_factory=list)
 
     def grade(
-        self,
-        paths: Sequence[Path],
-        plan: GradingPlan,
-        *,
-        seed: int,
-        on_report: Callable[[Path, Report], None],
-        on_result: Callable[[Path, ProblemResult], None] | None,
+        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
     ) -> None:
         self.asked.append(list(paths))
         for path in paths:
@@ -58,7 +53,7 @@ class FakeExecutor:
                 )
                 for p in plan.problems
             ]
-            on_report(
+            listener.report(
                 path,
                 Report(
                     submission=path.name,

@@ -16,7 +16,8 @@ from typing import Any
 import pytest
 
 from grader.editions import edition_of
-from grader.grading import GradingPlan, grade_files
+from grader.grading import grade_files
+from grader.plan import GradingPlan
 from grader.problem_registry import ProblemId
 from grader.report import Report
 from grader.sandbox import IsolationPolicy

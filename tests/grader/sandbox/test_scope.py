@@ -11,7 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from grader.grading import GradingPlan, grade_files
+from grader.collector import OnResult
+from grader.grading import grade_files
+from grader.plan import GradingPlan
 from grader.sandbox import IsolationPolicy, probe_isolation
 from grader.sandbox.isolation.cgroup import CGROUP_RECORDS
 from grader.sandbox.isolation.scope import SCOPE_PREFIX, sandbox_scope
@@ -102,12 +104,17 @@ def test_a_grading_leaves_nothing_behind(private_tmp: Path, tmp_path: Path, aban
                 seed=5,
                 workers=2,
                 policy=IsolationPolicy.ALLOW_FALLBACK,
-                on_result=on_result,
+                listener=OnResult(on_result),
             )
         assert seen, "cartpole()'s sandbox was running when the run was killed"
     else:
         [report] = grade_files(
-            [submission], plan, seed=5, workers=2, policy=IsolationPolicy.ALLOW_FALLBACK, on_result=on_result
+            [submission],
+            plan,
+            seed=5,
+            workers=2,
+            policy=IsolationPolicy.ALLOW_FALLBACK,
+            listener=OnResult(on_result),
         )
         assert [problem.status for problem in report.problems] == ["passed"], report.problems[0].feedback
 

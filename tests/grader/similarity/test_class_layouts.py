@@ -12,7 +12,7 @@ import os
 import stat
 import tempfile
 import zipfile
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +23,8 @@ from grading_support import FAST_OVERRIDES, write_config
 import grader
 from grader import cli
 from grader.batch import identity_stem
-from grader.grading import GradingPlan
+from grader.collector import GradingListener
+from grader.plan import GradingPlan
 from grader.report import ProblemResult, Report
 from grader.similarity.run import run_similarity
 from grader.similarity.sources import submissions_from
@@ -149,13 +150,7 @@ class PlannedExecutor:
     rates: dict[bytes, float]
 
     def grade(
-        self,
-        paths: Sequence[Path],
-        plan: GradingPlan,
-        *,
-        seed: int,
-        on_report: Callable[[Path, Report], None],
-        on_result: Callable[[Path, ProblemResult], None] | None,
+        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
     ) -> None:
         for path in paths:
             data = path.read_bytes()
@@ -171,7 +166,7 @@ class PlannedExecutor:
                 )
                 for problem in plan.problems
             ]
-            on_report(
+            listener.report(
                 path,
                 Report(
                     submission=path.name,
