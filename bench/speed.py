@@ -162,8 +162,15 @@ def timed_run(command: Sequence[str], root: Path = ROOT, **extra: str) -> Run:
     environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(root), environment.get("PYTHONPATH")]))
     group = CpuGroup(f"speed-{next(_run_numbers)}")
     started = time.perf_counter()
+    # In the tree's directory: `python -c` puts the working directory first on sys.path, before PYTHONPATH.
     done = subprocess.run(
-        list(command), capture_output=True, text=True, env=environment, check=False, preexec_fn=group.join
+        list(command),
+        capture_output=True,
+        text=True,
+        env=environment,
+        check=False,
+        preexec_fn=group.join,
+        cwd=root,
     )
     wall = time.perf_counter() - started
     cpu = group.seconds()
@@ -651,6 +658,8 @@ def main() -> int:
     from grader.plan import GradingPlan
 
     submission = args.submission.resolve()
+    if args.config is not None:
+        args.config = args.config.resolve()
     config = load_config(args.config)
     only = [name for name in args.only.split(",") if name] if args.only else None
     plan = GradingPlan.load(args.config, only)
