@@ -23,7 +23,9 @@
 
 `--write` replaces the `## Speed (issue 11)` section at the end of bench/RESULTS.md. `--ab BASELINE_ROOT` runs
 only step 2, with the grader of another tree (a worktree of `main`, say) alternated with this one's: an
-A/B of a change, e.g. `--ab /work/main --only taxi --rounds 2`.
+A/B of a change, e.g. `--ab /work/main --only taxi --rounds 2`, wall and CPU (every process of a run, in a
+cgroup v1 `cpuacct` group where available). `--breakdown` runs only step 1 and prints its per-problem table
+and the grader process's own CPU.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ import argparse
 import contextlib
 import importlib.util
 import io
+import itertools
 import json
 import os
 import pickle
@@ -50,6 +53,7 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from cpu_group import CpuGroup  # noqa: E402
 from grading_probe import ProblemCost, SharedChild, grade_serially, graded, leaky_orders  # noqa: E402
 from results_section import replace_section  # noqa: E402
 
@@ -137,21 +141,41 @@ def _route_lab_ids() -> None:
 
 @dataclass
 class Run:
-    """One timed subprocess: its wall time and what it printed."""
+    """One timed subprocess: its wall time, the CPU of all its processes (None without a cgroup), output."""
 
     wall: float
     stdout: str
     returncode: int
+    cpu: float | None = None
+
+
+_run_numbers = itertools.count()
 
 
 def timed_run(command: Sequence[str], root: Path = ROOT, **extra: str) -> Run:
-    """Run a command with a tree's sources (default: this one) first on PYTHONPATH; time it."""
+    """Run a command with a tree's sources (default: this one) first on PYTHONPATH; time it.
+
+    Its CPU is every process's of the run (the grader, its xdist workers, the sandbox children), counted in
+    a cgroup v1 `cpuacct` group (`bench/cpu_group.py`; None where that is not available).
+    """
     environment = dict(os.environ, **extra)
     environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(root), environment.get("PYTHONPATH")]))
+    group = CpuGroup(f"speed-{next(_run_numbers)}")
     started = time.perf_counter()
-    done = subprocess.run(list(command), capture_output=True, text=True, env=environment, check=False)
+    # In the tree's directory: `python -c` puts the working directory first on sys.path, before PYTHONPATH.
+    done = subprocess.run(
+        list(command),
+        capture_output=True,
+        text=True,
+        env=environment,
+        check=False,
+        preexec_fn=group.join,
+        cwd=root,
+    )
     wall = time.perf_counter() - started
-    return Run(wall, done.stdout, done.returncode)
+    cpu = group.seconds()
+    group.remove()
+    return Run(wall, done.stdout, done.returncode, cpu)
 
 
 def plain_run(submission: Path, calls_file: Path) -> tuple[Run, dict[str, Any]]:
@@ -411,23 +435,35 @@ def fixed_lines(figures: Figures) -> list[str]:
         "Per problem, graded serially in one process (`run_problem`, timers around the sandbox, the replay "
         "and the teardown; seconds):",
         "",
-        row(
-            "problem",
-            "status",
-            "calls",
-            "wall",
-            "child start + import",
-            "student",
-            "transfer",
-            "replay",
-            "judge + rest",
-            "teardown",
-        ),
-        row("---", "---", *["---:"] * 8),
     ]
-    lines += [cost_row(cost.problem, cost.status, [cost]) for cost in figures.costs]
-    lines.append(cost_row("all", "", figures.costs))
+    return lines + cost_table(figures.costs)
+
+
+def cost_table(costs: Sequence[ProblemCost]) -> list[str]:
+    """The per-problem table: where each problem's serial grading time went, and the sum."""
+    header = ["problem", "status", "calls", "wall", "child start + import", "student", "transfer", "replay"]
+    lines = [row(*header, "judge + rest", "teardown"), row("---", "---", *["---:"] * 8)]
+    lines += [cost_row(cost.problem, cost.status, [cost]) for cost in costs]
+    lines.append(cost_row("all", "", costs))
     return lines
+
+
+def breakdown_main(args: argparse.Namespace, submission: Path, problems: Sequence[str], config: Any) -> int:
+    """`--breakdown`: only step 1's per-problem table, and the CPU of this (the grader's) process."""
+    load_before = os.getloadavg()[0]
+    cpu_before = time.process_time()
+    costs, _, _ = grade_serially(submission, problems, config, args.seed)
+    cpu = time.process_time() - cpu_before
+    print(
+        f"`{submission.name}`, load average {load_before:.1f} before, {os.getloadavg()[0]:.1f} after",
+        flush=True,
+    )
+    print("\n".join(cost_table(costs)))
+    print(
+        f"\nThe grader's own process: {cpu:.2f} s of CPU (frames decoded, replay, judging; the children's "
+        "start, the student's calls and the recording are not in it)."
+    )
+    return 0
 
 
 def shared_lines(figures: Figures) -> list[str]:
@@ -506,9 +542,18 @@ def ab_lines(
     lines = [
         f"A/B against `{baseline}` ({load}); alternated baseline, this tree, plain, then reversed:",
         "",
-        row("run", "wall (s), each", "median wall (s)", "student (s)", "grader overhead (s)"),
-        row("---", "---", "---:", "---:", "---:"),
+        row(
+            "run",
+            "wall (s), each",
+            "median wall (s)",
+            "CPU (s), each",
+            "median CPU (s)",
+            "student (s)",
+            "grader overhead (s)",
+        ),
+        row("---", "---", "---:", "---", "---:", "---:", "---:"),
     ]
+    plain_cpu = _median_cpu([run for run, _ in plain])
     for label, runs in grades.items():
         reports = [report for _, report in runs]
         lines.append(
@@ -516,6 +561,8 @@ def ab_lines(
                 label,
                 seconds([run.wall for run, _ in runs]),
                 f"{median([run.wall for run, _ in runs]):.1f}",
+                seconds([run.cpu for run, _ in runs if run.cpu is not None]),
+                _cpu_text(_median_cpu([run for run, _ in runs])),
                 f"{median([report.timings.student_seconds for report in reports]):.1f}",
                 f"{median([report.timings.overhead_seconds for report in reports]):.1f}",
             )
@@ -525,11 +572,28 @@ def ab_lines(
             "plain, 1 process",
             seconds([run.wall for run, _ in plain]),
             f"{median([run.wall for run, _ in plain]):.1f}",
+            seconds([run.cpu for run, _ in plain if run.cpu is not None]),
+            _cpu_text(plain_cpu),
             f"{median([summary['calls_seconds'] for _, summary in plain]):.1f}",
             "",
         )
     )
+    lines.append("")
+    for label, runs in grades.items():
+        cpu = _median_cpu([run for run, _ in runs])
+        wall_ratio = median([run.wall for run, _ in runs]) / median([run.wall for run, _ in plain])
+        cpu_ratio = f"{cpu / plain_cpu:.2f}" if cpu is not None and plain_cpu else "n/a (no cgroup)"
+        lines.append(f"- {label}: wall / plain {wall_ratio:.2f}, CPU / plain CPU {cpu_ratio} (goal <= 1.0).")
     return lines
+
+
+def _median_cpu(runs: Sequence[Run]) -> float | None:
+    values = [run.cpu for run in runs if run.cpu is not None]
+    return statistics.median(values) if values else None
+
+
+def _cpu_text(cpu: float | None) -> str:
+    return "n/a" if cpu is None else f"{cpu:.1f}"
 
 
 def ab_main(args: argparse.Namespace, submission: Path, problems: Sequence[str], config: Any) -> int:
@@ -580,6 +644,9 @@ def main() -> int:
         help="only compare this tree's grader with another tree's (a worktree of main) and the plain run",
     )
     parser.add_argument(
+        "--breakdown", action="store_true", help="only the per-problem table of one serial grading (step 1)"
+    )
+    parser.add_argument(
         "--plain-child", nargs=2, type=Path, metavar=("CALLS", "SUBMISSION"), help=argparse.SUPPRESS
     )
     args = parser.parse_args()
@@ -591,11 +658,15 @@ def main() -> int:
     from grader.plan import GradingPlan
 
     submission = args.submission.resolve()
+    if args.config is not None:
+        args.config = args.config.resolve()
     config = load_config(args.config)
     only = [name for name in args.only.split(",") if name] if args.only else None
     plan = GradingPlan.load(args.config, only)
     if args.ab is not None:
         return ab_main(args, submission, plan.problems, config)
+    if args.breakdown:
+        return breakdown_main(args, submission, plan.problems, config)
     load_before = os.getloadavg()[0]
 
     print("1. grading serially, instrumented: one child per problem, then one child for all ...", flush=True)

@@ -19,7 +19,12 @@ from pydantic import AfterValidator, Field, TypeAdapter, ValidationError, with_c
 from typing_extensions import TypedDict
 
 from grader.sandbox.boundary import STRICT, describe, one_of, problem
-from grader.sandbox.child.episode_fields import EPISODE_COLUMNS, EPISODE_FIELDS, check_declaration
+from grader.sandbox.child.episode_fields import (
+    EPISODE_COLUMNS,
+    EPISODE_FIELDS,
+    EpisodeHeader,
+    check_declaration,
+)
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
 from grader.sandbox.child.frames import MAX_DEPTH, MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
 from grader.sandbox.limits import CallBudget
@@ -32,17 +37,10 @@ ARRAY_BATCH = 256
 
 
 @dataclass(frozen=True, eq=False)
-class EpisodeLog:
-    """One episode: which env, how it was reset, and every step the student took.
+class EpisodeLog(EpisodeHeader):
+    """One episode: which env, how it was reset (`EpisodeHeader`), and every step the student took.
 
     Attributes:
-        env_index: which env instance, numbered in the order of its first reset within the call.
-        requested_id: the id the student asked for (`"Blackjack-v0"`).
-        env_id: the gymnasium id actually made (`"Blackjack-v1"`).
-        env_kwargs: the other `gymnasium.make` arguments (`max_episode_steps` included when given);
-            `gymnasium.make(env_id, **env_kwargs)` rebuilds the env.
-        reset_seed: the seed the episode was actually reset with (grader-chosen or mapped).
-        student_seed: the seed the student passed to reset, if any.
         actions: one per step: int for `Discrete`, a numpy array for `Box` (dtype as the student sent it).
         rewards: what the student saw, one per step.
         terminated: the flags the student saw, one per step.
@@ -50,12 +48,6 @@ class EpisodeLog:
         reset_options: the `options` passed to reset, if any.
     """
 
-    env_index: int
-    requested_id: str
-    env_id: str
-    env_kwargs: dict[str, Any]
-    reset_seed: int
-    student_seed: int | None
     actions: list[Any]
     rewards: list[float]
     terminated: list[bool]
@@ -198,7 +190,11 @@ def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[Epi
         if budget is not None:
             _check_steps(episodes, budget)
         arrays = _decoded_arrays(episodes)
-        return [_episode(episode, f"episode {number}", arrays) for number, episode in enumerate(episodes)]
+        mappings: dict[tuple[Any, ...], dict[str, Any]] = {}
+        return [
+            _episode(episode, f"episode {number}", arrays, mappings)
+            for number, episode in enumerate(episodes)
+        ]
 
 
 def _problem(error: ValidationError) -> str:
@@ -249,7 +245,12 @@ def _decoded_arrays(episodes: list[WireEpisode]) -> Iterator[np.ndarray]:
         yield from arrays
 
 
-def _episode(episode: WireEpisode, where: str, arrays: Iterator[np.ndarray]) -> EpisodeLog:
+def _episode(
+    episode: WireEpisode,
+    where: str,
+    arrays: Iterator[np.ndarray],
+    mappings: dict[tuple[Any, ...], dict[str, Any]],
+) -> EpisodeLog:
     actions = _actions(episode["actions"], arrays, f"{where}: actions")
     rewards = _rewards(episode["rewards"], arrays, f"{where}: rewards")
     terminated = _flags(episode["terminated"], arrays, f"{where}: terminated")
@@ -263,7 +264,7 @@ def _episode(episode: WireEpisode, where: str, arrays: Iterator[np.ndarray]) -> 
         env_index=episode["env_index"],
         requested_id=episode["requested_id"],
         env_id=episode["env_id"],
-        env_kwargs=_mapping(episode["env_kwargs"], f"{where}: env_kwargs"),
+        env_kwargs=_env_kwargs(episode["env_kwargs"], f"{where}: env_kwargs", mappings),
         reset_seed=episode["reset_seed"],
         student_seed=episode["student_seed"],
         actions=actions,
@@ -302,6 +303,26 @@ def _array(array: np.ndarray, kinds: str, where: str) -> np.ndarray:
             f"{where} should be a 1-D array of kind {kinds!r} or a list, found {describe(array)}"
         )
     return array
+
+
+def _env_kwargs(
+    value: dict[str, Any], where: str, decoded: dict[tuple[Any, ...], dict[str, Any]]
+) -> dict[str, Any]:
+    """`_mapping` of an episode's env arguments, decoded once per call for arguments of plain scalars.
+
+    Every episode of one env repeats the same arguments (Blackjack's `natural` and `sab`, 10 000 games a
+    call); the key holds each value's type, so `True` and `1` stay apart. Each episode gets its own copy.
+    """
+    if not value:
+        return value
+    try:
+        key = tuple((name, type(item), item) for name, item in value.items())
+        known = decoded.get(key)
+    except TypeError:  # a list or dict among the values: decoded every time
+        return _mapping(value, where)
+    if known is None:
+        known = decoded[key] = _mapping(value, where)
+    return dict(known)
 
 
 def _mapping(value: dict[str, Any], where: str) -> dict[str, Any]:

@@ -19,7 +19,7 @@ import random
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import gymnasium
@@ -27,7 +27,7 @@ import numpy as np
 
 from grader.checks.base import CallRecord
 from grader.compat import resolve_env_id
-from grader.sandbox.child.episode_fields import EPISODE_FIELDS
+from grader.sandbox.child.episode_fields import EPISODE_COLUMNS, EPISODE_FIELDS
 from grader.sandbox.child.seeding import SeedStream, Stream, space_seed
 from grader.sandbox.episode_log import EpisodeLog
 from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
@@ -49,36 +49,29 @@ class _FastCards:
 
 @dataclass
 class _Episode:
-    env_index: int
-    requested_id: str
-    env_id: str
-    env_kwargs: dict[str, Any]
-    reset_seed: int
-    student_seed: int | None
+    played: EpisodeLog
+    """The wire's fields (`EpisodeLog`), its columns appended to as the episode runs."""
     observations: list[Any]
-    actions: list[Any] = field(default_factory=list)
-    rewards: list[float] = field(default_factory=list)
-    terminated: list[bool] = field(default_factory=list)
-    truncated: list[bool] = field(default_factory=list)
     ended: bool = False
-    reset_options: dict[str, Any] | None = None
 
     def log(self) -> EpisodeLog:
         """The episode as the parent decodes it: every wire field (`EPISODE_FIELDS`), containers copied."""
-        return EpisodeLog(**{name: copy.copy(getattr(self, name)) for name in EPISODE_FIELDS})
+        return EpisodeLog(**{name: copy.copy(getattr(self.played, name)) for name in EPISODE_FIELDS})
 
     def replay_as_played(self) -> Replay:
-        ends = [step for step, end in enumerate(map(operator.or_, self.terminated, self.truncated)) if end]
+        played = self.played
+        flags = map(operator.or_, played.terminated, played.truncated)
+        ends = [step for step, end in enumerate(flags) if end]
         finished = bool(ends)
-        length = ends[0] + 1 if finished else len(self.actions)
+        length = ends[0] + 1 if finished else played.steps
         return Replay(
             observations=self.observations,
-            rewards=self.rewards,
-            terminated=self.terminated,
-            truncated=self.truncated,
+            rewards=played.rewards,
+            terminated=played.terminated,
+            truncated=played.truncated,
             length=length,
             finished=finished,
-            steps_after_done=len(self.actions) - length if finished else 0,
+            steps_after_done=played.steps - length if finished else 0,
             mismatch=None,
             env_spec=None,
         )
@@ -116,16 +109,10 @@ class LabEnv:
             observation, info = self._env.reset()
         else:
             observation, info = self._env.reset(seed=reset_seed, options=options)
-        self._episode = _Episode(
-            self._index,
-            self._requested_id,
-            self._env_id,
-            dict(self._kwargs),
-            reset_seed,
-            seed,
-            [observation],
-            reset_options=options,
-        )
+        header = (self._index, self._requested_id, self._env_id, dict(self._kwargs), reset_seed, seed)
+        columns: dict[str, Any] = {name: [] for name in EPISODE_COLUMNS}
+        played = EpisodeLog(*header, **columns, reset_options=options)
+        self._episode = _Episode(played, [observation])
         self._lab.episodes.append(self._episode)
         return observation, info
 
@@ -133,8 +120,8 @@ class LabEnv:
         """Step the env and log the step (steps after the end are logged too)."""
         if self._episode is None:
             raise RuntimeError("reset() before step()")
-        episode = self._episode
-        if episode.terminated and (episode.terminated[-1] or episode.truncated[-1] or episode.ended):
+        episode, played = self._episode, self._episode.played
+        if played.terminated and (played.terminated[-1] or played.truncated[-1] or episode.ended):
             episode.ended = True
             with warnings.catch_warnings():  # gymnasium warns about stepping after the end; the log says it
                 warnings.simplefilter("ignore")
@@ -142,10 +129,10 @@ class LabEnv:
         else:
             observation, reward, terminated, truncated, info = self._env.step(action)
         episode.observations.append(observation)
-        episode.actions.append(action if not isinstance(action, np.integer) else int(action))
-        episode.rewards.append(float(reward))
-        episode.terminated.append(bool(terminated))
-        episode.truncated.append(bool(truncated))
+        played.actions.append(action if not isinstance(action, np.integer) else int(action))
+        played.rewards.append(float(reward))
+        played.terminated.append(bool(terminated))
+        played.truncated.append(bool(truncated))
         return observation, float(reward), bool(terminated), bool(truncated), info
 
 

@@ -13,19 +13,13 @@ replayed again by the scalar env, which stays the authority for every mismatch.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
+import gymnasium
 import numpy as np
 from gymnasium.envs.classic_control.cartpole import CartPoleEnv
 
-from grader.sandbox.batched.replayer import (
-    BatchedEpisode,
-    action_matrix,
-    finish,
-    horizon,
-    int_actions,
-    plain_arguments,
-    unlimited_env,
-)
+from grader.sandbox.batched.replayer import BatchedEpisode, int_actions, lockstep, plain_arguments
 from grader.sandbox.episode_log import EpisodeLog
 
 ENV_IDS = frozenset({"CartPole-v0", "CartPole-v1"})
@@ -40,20 +34,18 @@ class CartPoleReplayer:
 
     def replay(self, logs: Sequence[EpisodeLog]) -> list[BatchedEpisode]:
         """Replay CartPole logs sharing `env_id` and `env_kwargs` in lockstep."""
-        scalar = unlimited_env(logs[0].env_id)
-        cartpole = scalar.unwrapped
-        if type(cartpole) is not CartPoleEnv:
-            raise TypeError(f"{logs[0].env_id} is not gymnasium's CartPoleEnv")
-        try:
-            initial = np.empty((4, len(logs)))
-            for column, log in enumerate(logs):
-                scalar.reset(seed=log.reset_seed)
-                initial[:, column] = cartpole.state
-        finally:
-            scalar.close()
-        actions = action_matrix(logs, horizon(logs))
-        observations, terminated = _run(cartpole, initial, actions)
-        return finish(logs, observations, np.ones(terminated.shape), terminated)
+        return lockstep(logs, CartPoleEnv, _advance)
+
+
+def _advance(
+    scalar: gymnasium.Env[Any, Any], cartpole: CartPoleEnv, logs: Sequence[EpisodeLog], actions: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    initial = np.empty((4, len(logs)))
+    for column, log in enumerate(logs):
+        scalar.reset(seed=log.reset_seed)
+        initial[:, column] = cartpole.state
+    observations, terminated = _run(cartpole, initial, actions)
+    return observations, np.ones(terminated.shape), terminated
 
 
 def _run(env: CartPoleEnv, initial: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

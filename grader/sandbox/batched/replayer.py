@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, TypeVar
 
 import gymnasium
 import numpy as np
@@ -13,7 +13,13 @@ import numpy as np
 from grader.sandbox.episode_log import EpisodeLog
 
 MAX_HORIZON = 10_000
-"""Longest time limit a batch accepts; episodes of envs without a time limit are replayed one by one."""
+"""Longest time limit a batch accepts by default; episodes of envs without a time limit are replayed one
+by one."""
+_Env = TypeVar("_Env")
+Arrays = tuple[np.ndarray, np.ndarray, np.ndarray]
+Advance = Callable[[gymnasium.Env[Any, Any], _Env, Sequence[EpisodeLog], np.ndarray], Arrays]
+"""Plays every log in lockstep: (the scalar env, its unwrapped core, the logs, the action matrix) to
+(observations, rewards, terminated) as `finish` takes them."""
 
 
 @dataclass(frozen=True)
@@ -47,8 +53,9 @@ class BatchedReplayer(Protocol):
         ...
 
 
-def plain_arguments(log: EpisodeLog, env_ids: frozenset[str]) -> bool:
-    """An episode of one of `env_ids`, no reset options, at most `max_episode_steps` given, a time limit."""
+def plain_arguments(log: EpisodeLog, env_ids: frozenset[str], max_horizon: int = MAX_HORIZON) -> bool:
+    """An episode of one of `env_ids`, no reset options, at most `max_episode_steps` given, a time limit
+    of at most `max_horizon` steps (a lockstep batch is as long as its longest episode, never longer)."""
     if log.env_id not in env_ids or log.reset_options is not None or not log.actions:
         return False
     if set(log.env_kwargs) - {"max_episode_steps"}:
@@ -56,7 +63,7 @@ def plain_arguments(log: EpisodeLog, env_ids: frozenset[str]) -> bool:
     limit = log.env_kwargs.get("max_episode_steps")
     if limit is not None and type(limit) is not int:
         return False
-    return 0 < time_limit(log) <= MAX_HORIZON
+    return 0 < time_limit(log) <= max_horizon
 
 
 def int_actions(actions: Sequence[Any], count: int) -> bool:
@@ -82,6 +89,25 @@ def unlimited_env(env_id: str) -> gymnasium.Env[Any, Any]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
         return gymnasium.make(env_id, disable_env_checker=True, max_episode_steps=-1)
+
+
+def lockstep(logs: Sequence[EpisodeLog], core: type[_Env], advance: Advance[_Env]) -> list[BatchedEpisode]:
+    """The episodes of `logs` (sharing env id and arguments) played in lockstep by `advance`.
+
+    `advance` gets the parent's own env of the logs' id (without time limit, for its `reset(seed)`), its
+    unwrapped core, checked to be `core`, and the actions step-major (`action_matrix` up to `horizon`).
+
+    Raises:
+        TypeError: the registered env is not `core` (re-registered): the caller replays one by one.
+    """
+    scalar = unlimited_env(logs[0].env_id)
+    try:
+        env = scalar.unwrapped
+        if type(env) is not core:
+            raise TypeError(f"{logs[0].env_id} is not gymnasium's {core.__name__}")
+        return finish(logs, *advance(scalar, env, logs, action_matrix(logs, horizon(logs))))
+    finally:
+        scalar.close()
 
 
 def action_matrix(logs: Sequence[EpisodeLog], steps: int) -> np.ndarray:

@@ -4,7 +4,7 @@
 terminated)`; with default arguments (no rain, no fickle passenger) every list holds one transition
 of probability 1.0, so the random draw `step` makes cannot change the outcome and an episode is
 a chain of table lookups. Here the parent's own env provides the table (checked to be deterministic)
-and the initial-state distribution, sampled as its `reset(seed)` does (`SeededDraws`); all episodes
+and the initial-state distribution, sampled as its `reset(seed)` does (`seeded_draws`); all episodes
 advance in lockstep, one array lookup per step. `grader.sandbox.replay` checks every batch against
 the scalar env, which stays the authority for every mismatch.
 """
@@ -12,24 +12,22 @@ the scalar env, which stays the authority for every mismatch.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
+import gymnasium
 import numpy as np
 from gymnasium.envs.toy_text.taxi import TaxiEnv
 
-from grader.sandbox.batched.draws import SeededDraws
-from grader.sandbox.batched.replayer import (
-    BatchedEpisode,
-    action_matrix,
-    finish,
-    horizon,
-    int_actions,
-    plain_arguments,
-    unlimited_env,
-)
+from grader.sandbox.batched.draws import seeded_draws
+from grader.sandbox.batched.replayer import BatchedEpisode, int_actions, lockstep, plain_arguments
 from grader.sandbox.episode_log import EpisodeLog
 
 ENV_IDS = frozenset({"Taxi-v4"})
 ACTIONS = 6
+MAX_HORIZON = 10_000_000
+"""Longest time limit a Taxi batch accepts: sarsa0's env has one beyond its call's step budget (400 001
+steps). A batch is as long as its longest logged episode, whose steps the call's budget bounds, and a
+Taxi step takes 25 bytes of arrays, so the time limit itself costs nothing."""
 
 
 class TaxiReplayer:
@@ -37,7 +35,7 @@ class TaxiReplayer:
 
     def is_batchable(self, log: EpisodeLog) -> bool:
         """Plain Taxi arguments, no reset options, actions 0 to 5."""
-        return plain_arguments(log, ENV_IDS) and int_actions(log.actions, ACTIONS)
+        return plain_arguments(log, ENV_IDS, MAX_HORIZON) and int_actions(log.actions, ACTIONS)
 
     def replay(self, logs: Sequence[EpisodeLog]) -> list[BatchedEpisode]:
         """Replay Taxi logs sharing `env_id` and `env_kwargs` in lockstep.
@@ -45,24 +43,19 @@ class TaxiReplayer:
         Raises:
             TypeError: the registered env is not gymnasium's deterministic `TaxiEnv`.
         """
-        scalar = unlimited_env(logs[0].env_id)
-        taxi = scalar.unwrapped
-        if type(taxi) is not TaxiEnv:
-            raise TypeError(f"{logs[0].env_id} is not gymnasium's TaxiEnv")
-        try:
-            next_states, rewards, terminal = _tables(taxi)
-            states = _initial_states(taxi, logs)
-        finally:
-            scalar.close()
-        actions = action_matrix(logs, horizon(logs))
-        observations = np.empty((actions.shape[0] + 1, len(logs)), dtype=np.int64)
-        observations[0] = states
-        for step in range(actions.shape[0]):
-            observations[step + 1] = next_states[observations[step], actions[step]]
-        before = observations[:-1]
-        step_rewards = rewards[before, actions]
-        step_terminated = terminal[before, actions]
-        return finish(logs, observations, step_rewards, step_terminated)
+        return lockstep(logs, TaxiEnv, _advance)
+
+
+def _advance(
+    scalar: gymnasium.Env[Any, Any], taxi: TaxiEnv, logs: Sequence[EpisodeLog], actions: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    next_states, rewards, terminal = _tables(taxi)
+    observations = np.empty((actions.shape[0] + 1, len(logs)), dtype=np.int64)
+    observations[0] = _initial_states(taxi, logs)
+    for step in range(actions.shape[0]):
+        observations[step + 1] = next_states[observations[step], actions[step]]
+    before = observations[:-1]
+    return observations, rewards[before, actions], terminal[before, actions]
 
 
 def _initial_states(taxi: TaxiEnv, logs: Sequence[EpisodeLog]) -> np.ndarray:
@@ -71,7 +64,7 @@ def _initial_states(taxi: TaxiEnv, logs: Sequence[EpisodeLog]) -> np.ndarray:
     That is `argmax(cumsum(distribution) > np_random.random())`, the first draw of each seed's generator.
     """
     cumulative = np.cumsum(np.asarray(taxi.initial_state_distrib))
-    uniforms = np.array([SeededDraws(log.reset_seed).random() for log in logs])
+    uniforms = np.array([draws.random() for draws in seeded_draws([log.reset_seed for log in logs])])
     states: np.ndarray = np.argmax(cumulative[None, :] > uniforms[:, None], axis=1).astype(np.int64)
     return states
 

@@ -33,6 +33,7 @@ from grader.sandbox.child.episode_fields import (
     EPISODE_FIELDS,
     EPISODE_HEADER,
     SHORT_EPISODE_STEPS,
+    EpisodeHeader,
     check_declaration,
 )
 from grader.sandbox.child.frames import MAX_NODES
@@ -52,22 +53,17 @@ _NO_STEP_LIMIT = sys.maxsize
 _FLOAT_ERRORS = (TypeError, ValueError, OverflowError)
 
 
-@dataclass
-class EpisodeRecord:
-    """One episode as the student played it (child-side, mutable while the episode runs).
+@dataclass(frozen=True)
+class EpisodeRecord(EpisodeHeader):
+    """One episode as the student played it (child-side; its columns grow while the episode runs).
 
     Its first fields are the wire's (`episode_fields.EPISODE_FIELDS`, checked at import). The columns are
     compact typed arrays, appended to without creating a Python object per step: actions as 64-bit ints
     (a list from the first action that is not a plain int, a `Box` env's arrays say), rewards as doubles,
-    the flags as bytes.
+    the flags as bytes. Frozen as its header is; the two fields that change (`actions` becoming a list,
+    `short_as_lists`) are set through `_replace_field`.
     """
 
-    env_index: int
-    requested_id: str
-    env_id: str
-    env_kwargs: dict[str, Any]
-    reset_seed: int
-    student_seed: int | None
     reset_options: dict[str, Any] | None
     actions: array[int] | list[Any] = field(default_factory=lambda: array("q"))
     rewards: array[float] = field(default_factory=lambda: array("d"))
@@ -116,8 +112,16 @@ class EpisodeRecord:
                 with contextlib.suppress(OverflowError):
                     actions.append(copied)
                     return
-            actions = self.actions = list(actions)
+            actions = list(actions)
+            self._replace_field("actions", actions)
         actions.append(copied)
+
+    def send_arrays(self) -> None:
+        """Send every column as an array, however short the episode (see `finish_call`)."""
+        self._replace_field("short_as_lists", False)
+
+    def _replace_field(self, name: str, value: Any) -> None:
+        object.__setattr__(self, name, value)  # the frozen header's dataclass forbids plain assignment
 
 
 check_declaration(
@@ -224,7 +228,7 @@ class Recorder:
         )
         if list_nodes > LIST_NODE_BUDGET:
             for episode in episodes:
-                episode.short_as_lists = False
+                episode.send_arrays()
         return episodes
 
     def keep_generator(self, generator: np.random.Generator, *, seeded: bool) -> None:

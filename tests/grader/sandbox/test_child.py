@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import textwrap
 from collections.abc import Iterator
 from pathlib import Path
@@ -10,6 +12,8 @@ import pytest
 from child_client import ChildClient, write_submission
 
 from grader.sandbox.child.frames import decode_value
+
+ROOT = Path(__file__).resolve().parents[3]
 
 STUDENT = textwrap.dedent("""
     import os
@@ -307,3 +311,20 @@ def test_lab_only_ids_and_clear_output_work_at_import(tmp_path: Path) -> None:
 
     with ChildClient(write_submission(tmp_path, source)) as client:
         assert client.first_frame is not None and client.first_frame["type"] == "ready"
+
+
+def test_the_child_harness_imports_none_of_the_parents_modules() -> None:
+    # grader.sandbox's public names load lazily, so a child (one per problem) starts without pydantic,
+    # the runner, the replay or the isolation layers.
+    parent_only = ["pydantic", "grader.sandbox.runner", "grader.sandbox.replay", "grader.sandbox.episode_log"]
+    program = (
+        f"import sys, grader.sandbox.child.harness; print([m for m in {parent_only!r} if m in sys.modules])"
+    )
+    found = subprocess.run(
+        [sys.executable, "-I", "-c", f"import sys; sys.path.insert(0, {str(ROOT)!r}); {program}"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
+
+    assert found == "[]"

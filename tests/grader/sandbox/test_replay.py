@@ -14,7 +14,7 @@ from child_client import ChildClient, write_submission
 
 from grader.sandbox import replay
 from grader.sandbox.batched import BatchedReplayer, BlackjackReplayer, CartPoleReplayer, TaxiReplayer
-from grader.sandbox.batched.draws import SeededDraws
+from grader.sandbox.batched.draws import SeededDraws, seeded_draws
 from grader.sandbox.child.seeding import reset_seeds
 from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
 from grader.sandbox.replay import Replay, replay_episode, replay_episodes, verify_reset_seeds
@@ -277,6 +277,24 @@ def test_batched_replay_matches_the_scalar_env_bit_for_bit(
         assert_same_replay(batched, replay_episode(log))
 
 
+WIDE_SEEDS = [0, 1, 2**32 - 1, 2**32, 2**63 - 1, 2**64 - 1, 2**64, 2**100 + 3, 2**128 - 1]
+
+
+@pytest.mark.parametrize("mixed", [False, True], ids=["wide-seeds-alone", "wide-seeds-among-stream-seeds"])
+def test_seeded_draws_follow_numpys_generators_for_seeds_of_every_width(mixed: bool) -> None:
+    # 1 to 4 words of entropy; below 2**64 the seeds are hashed from one uint64 array, above it from lists.
+    seeds = [*WIDE_SEEDS, *reset_seeds(5, 200)] if mixed else [seed for seed in WIDE_SEEDS if seed < 2**64]
+    for seed, draws in zip(seeds, seeded_draws(seeds), strict=True):
+        generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
+
+        assert [draws.random() for _ in range(5)] == [generator.random() for _ in range(5)], seed
+
+
+def test_seeded_draws_refuse_a_seed_numpy_would_hash_differently() -> None:
+    with pytest.raises(ValueError, match=r"seeds in \[0, 2\*\*128\), found -1 to 2"):
+        seeded_draws([-1, 2])
+
+
 BOUNDED_COUNTS = [1, 2, 3, 4, 13, 3 * 2**30, 2**31 + 1, 2**32 - 5, 2**32]
 
 
@@ -285,7 +303,7 @@ def test_card_draws_are_numpys_bounded_draws(count: int) -> None:
     # Counts near 2**32 reject about a third of the draws, so Lemire's rejection loop is exercised.
     for seed in (0, 1, 2**40 + 7, 2**63 - 1):
         generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
-        draws = SeededDraws(seed)
+        draws = seeded_draws([seed])[0]
 
         assert [draws.bounded(count) for _ in range(50)] == [
             int(generator.integers(0, count)) for _ in range(50)
@@ -299,7 +317,7 @@ def test_card_draws_are_numpys_bounded_draws(count: int) -> None:
 )
 def test_card_draws_choose_as_generator_choice_does(sequence: list[object]) -> None:
     generator, _ = gymnasium.utils.seeding.np_random(2024)
-    draws = SeededDraws(2024)
+    draws = seeded_draws([2024])[0]
 
     assert [draws.choice(sequence) for _ in range(100)] == [
         generator.choice(sequence).item() for _ in range(100)
@@ -311,7 +329,7 @@ def test_seeded_draws_interleave_doubles_and_bounded_draws_as_numpy_does() -> No
     operations = [13, "random", 13, 4, "random", "random", 3, 13, 13, 13, "random", 2**32 - 5] * 5
     for seed in (0, 5, 2**62 + 3):
         generator, _ = gymnasium.utils.seeding.np_random(seed)
-        draws = SeededDraws(seed)
+        draws = seeded_draws([seed])[0]
 
         expected = [
             generator.random() if op == "random" else int(generator.integers(0, op)) for op in operations
@@ -319,10 +337,22 @@ def test_seeded_draws_interleave_doubles_and_bounded_draws_as_numpy_does() -> No
         assert [draws.random() if op == "random" else draws.bounded(op) for op in operations] == expected
 
 
-def test_batched_blackjack_matches_gymnasiums_env_over_many_seeds() -> None:
-    # Deterministic: 3000 grader-stream seeds, random hit/stick sequences (long ones run past the end).
+BLACKJACK_RULES = [
+    {},
+    {"natural": False, "sab": False},
+    {"natural": True},
+    {"sab": True},
+    {"natural": True, "sab": True},
+]
+
+
+@pytest.mark.parametrize(
+    "kwargs", BLACKJACK_RULES, ids=["defaults", "plain", "natural", "sab", "natural-sab"]
+)
+def test_batched_blackjack_matches_gymnasiums_env_over_many_seeds(kwargs: dict[str, bool]) -> None:
+    # Deterministic: 3000 grader-stream seeds, random hit/stick sequences (long ones run past the end);
+    # about 1 in 20 deals is a natural, so each rule's payout is met about 150 times.
     rng = np.random.default_rng(4096)
-    kwargs = {"natural": False, "sab": False}
     seeds = reset_seeds(77, 3000)
     logs = [played("Blackjack-v1", seed, rng.integers(0, 2, 1 + seed % 7).tolist(), kwargs) for seed in seeds]
     env = gymnasium.make("Blackjack-v1", **kwargs)
