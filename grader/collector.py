@@ -85,14 +85,24 @@ class Collector:
         seed: The grading seed.
         workers: The workers the session runs on (recorded in each report's timings).
         listener: Hears each result and each report as they come.
+        started: When the grading started (`time.perf_counter()`; now when None): each report's elapsed
+            time counts from it.
     """
 
-    def __init__(self, plan: GradingPlan, *, seed: int, workers: int, listener: GradingListener) -> None:
+    def __init__(
+        self,
+        plan: GradingPlan,
+        *,
+        seed: int,
+        workers: int,
+        listener: GradingListener,
+        started: float | None = None,
+    ) -> None:
         self.plan = plan
         self.seed = seed
         self.workers = workers
         self.listener = listener
-        self.started = time.perf_counter()
+        self.started = time.perf_counter() if started is None else started
         self.graded: list[Submission] = []
         self.runs: dict[Path, dict[ProblemId, ProblemRun]] = {}
         self.reports: dict[Path, Report] = {}
@@ -109,7 +119,7 @@ class Collector:
                 max_score=self.plan.points[problem],
                 feedback=verdict.message,
                 seed=problem_seed(self.seed, problem),
-                visibility=self.plan.visibility.get(problem, "visible"),
+                visibility=self.plan.visibility[problem],
             )
             for problem in self.plan.problems
         ]
@@ -118,11 +128,10 @@ class Collector:
             self.listener.result(path, result)
         self._finish(path, report)
 
-    def expect(self, submission: Submission) -> int:
-        """A file whose problems the session grades; its index in the session's plan."""
+    def expect(self, submission: Submission) -> None:
+        """A file whose problems the session grades (its index in the session's plan is its place here)."""
         self.graded.append(submission)
         self.runs[submission.path] = {}
-        return len(self.graded) - 1
 
     def receive(self, case: ProblemCase, outcome: CaseOutcome) -> None:
         """A case's outcome, as the session hands it over (at most once per case)."""
@@ -170,7 +179,7 @@ class Collector:
             points=self.plan.points[problem],
             seed=problem_seed(self.seed, problem),
             detail=detail,
-            visibility=self.plan.visibility.get(problem, "visible"),
+            visibility=self.plan.visibility[problem],
         )
 
     def _build(self, submission: Submission) -> Report:

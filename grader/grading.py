@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -103,17 +104,23 @@ def grade_files(
         grader.sandbox.errors.IsolationUnavailable: ``REQUIRE_FULL`` and this machine cannot isolate
             (checked before anything starts, and raised after the session if a worker found it so).
     """
+    started = time.perf_counter()
     files = list(dict.fromkeys(paths))
-    worker_count = min(workers or default_workers(), max(len(files) * len(plan.problems), 1))
-    collector = Collector(plan, seed=seed, workers=worker_count, listener=listener or Silent())
     with tempfile.TemporaryDirectory(prefix="gymgrade-modules-") as modules_dir:
+        prepared: dict[Path, tuple[bytes | None, Submission | FileVerdict]] = {}
         for index, path in enumerate(files):
             data = _read(path)
-            prepared = _prepare(path, data, Path(modules_dir) / str(index), plan)
-            if isinstance(prepared, FileVerdict):
-                collector.reject(path, data or b"", prepared)
+            prepared[path] = (data, _prepare(path, data, Path(modules_dir) / str(index), plan))
+        graded = sum(1 for _, submission in prepared.values() if isinstance(submission, Submission))
+        worker_count = min(workers or default_workers(), max(graded * len(plan.problems), 1))
+        collector = Collector(
+            plan, seed=seed, workers=worker_count, listener=listener or Silent(), started=started
+        )
+        for path, (data, submission) in prepared.items():
+            if isinstance(submission, FileVerdict):
+                collector.reject(path, data or b"", submission)
             else:
-                collector.expect(prepared)
+                collector.expect(submission)
         if not collector.graded or not plan.problems:
             collector.close()
             return collector.reports_of(paths)

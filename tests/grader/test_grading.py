@@ -267,3 +267,16 @@ def test_each_result_carries_its_problems_visibility(tmp_path: Path) -> None:
         ("car", "hidden"),
         ("taxi", "visible"),
     ]
+
+
+def test_the_workers_a_report_records_are_those_its_valid_files_needed(
+    tmp_path: Path, fast_config: Path
+) -> None:
+    empty = tmp_path / "empty.py"
+    empty.write_bytes(b"")
+    plan = GradingPlan.load(fast_config, ["car"])
+    refused, graded = grade_files(
+        [empty, CLASSIC_COMPLETE], plan, seed=3, workers=2, policy=IsolationPolicy.ALLOW_FALLBACK
+    )
+    assert refused.submission_error is not None and refused.timings is None
+    assert graded.timings is not None and graded.timings.workers == 1  # one case: one worker, not two
