@@ -14,6 +14,7 @@ import pytest
 from grader.collector import OnResult
 from grader.grading import grade_files
 from grader.plan import GradingPlan
+from grader.report import Report
 from grader.sandbox import IsolationPolicy, probe_isolation
 from grader.sandbox.isolation.cgroup import CGROUP_RECORDS
 from grader.sandbox.isolation.scope import SCOPE_PREFIX, sandbox_scope
@@ -96,19 +97,8 @@ def test_a_grading_leaves_nothing_behind(private_tmp: Path, tmp_path: Path, aban
         if abandoned:
             raise KeyboardInterrupt
 
-    if abandoned:
-        with pytest.raises(KeyboardInterrupt):
-            grade_files(
-                [submission],
-                plan,
-                seed=5,
-                workers=2,
-                policy=IsolationPolicy.ALLOW_FALLBACK,
-                listener=OnResult(on_result),
-            )
-        assert seen, "cartpole()'s sandbox was running when the run was killed"
-    else:
-        [report] = grade_files(
+    def grade() -> list[Report]:
+        return grade_files(
             [submission],
             plan,
             seed=5,
@@ -116,6 +106,13 @@ def test_a_grading_leaves_nothing_behind(private_tmp: Path, tmp_path: Path, aban
             policy=IsolationPolicy.ALLOW_FALLBACK,
             listener=OnResult(on_result),
         )
+
+    if abandoned:
+        with pytest.raises(KeyboardInterrupt):
+            grade()
+        assert seen, "cartpole()'s sandbox was running when the run was killed"
+    else:
+        [report] = grade()
         assert [problem.status for problem in report.problems] == ["passed"], report.problems[0].feedback
 
     assert sorted(path.name for path in private_tmp.glob("gymgrade-*")) == []  # pytest's own dirs may stay
