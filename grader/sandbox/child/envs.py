@@ -68,11 +68,17 @@ class BlackjackEnv(blackjack.BlackjackEnv):
     `Generator.choice` of a 13-item list without probabilities draws one `integers(0, 13)` (64-bit) and
     indexes the list; the suit and face shown by `render` are drawn the same way (`choice` of 4 and of 3)
     and kept as the numpy strings `choice` returns. An action other than a plain int 0 or 1 takes
-    gymnasium's check of the action space.
+    gymnasium's check of the action space; a generator that is not numpy's own `Generator` (a student's
+    `RandomState`, say) takes gymnasium's `choice`.
     """
 
     def step(self, action: Any) -> tuple[tuple[int, int, int], float, bool, bool, dict[str, Any]]:
-        if type(action) is not int or not 0 <= action <= 1 or self.render_mode == "human":
+        if (
+            type(action) is not int
+            or not 0 <= action <= 1
+            or self.render_mode == "human"
+            or type(self.np_random) is not np.random.Generator
+        ):
             return super().step(action)
         integers = self.np_random.integers
         if action:
@@ -97,7 +103,10 @@ class BlackjackEnv(blackjack.BlackjackEnv):
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[tuple[int, int, int], dict[str, Any]]:
-        if self.render_mode == "human":
+        kept = self._np_random
+        if self.render_mode == "human" or (
+            seed is None and kept is not None and type(kept) is not np.random.Generator
+        ):
             return super().reset(seed=seed, options=options)
         gymnasium.Env.reset(self, seed=seed)
         integers = self.np_random.integers

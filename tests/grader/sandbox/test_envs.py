@@ -127,6 +127,20 @@ def test_blackjack_plays_gymnasiums_game(natural: bool, sab: bool) -> None:
     assert episodes > 2_000
 
 
+def test_blackjack_with_a_students_own_generator() -> None:
+    stock, cheap = _pair("Blackjack-v1")
+    for env in (stock, cheap):
+        env.reset(seed=1)
+        env.unwrapped.np_random = np.random.RandomState(4)  # type: ignore[assignment]  # a student's choice
+    for _ in range(300):
+        _same(_call(stock, "reset"), _call(cheap, "reset"), "reset with a RandomState")
+        _same(_call(stock, "step", 1), _call(cheap, "step", 1), "hit with a RandomState")
+        _same(_call(stock, "step", 0), _call(cheap, "step", 0), "stick with a RandomState")
+    assert (
+        stock.unwrapped.np_random.get_state()[1].tolist() == cheap.unwrapped.np_random.get_state()[1].tolist()
+    )
+
+
 def test_blackjack_renders_the_same_cards() -> None:
     stock, cheap = _pair("Blackjack-v1", render_mode="rgb_array")
     for seed in range(40):  # aces, faces and numbers on top
