@@ -67,14 +67,15 @@ class BlackjackEnv(blackjack.BlackjackEnv):
 
     `Generator.choice` of a 13-item list without probabilities draws one `integers(0, 13)` (64-bit) and
     indexes the list; the suit and face shown by `render` are drawn the same way (`choice` of 4 and of 3)
-    and kept as the numpy strings `choice` returns. An action other than a plain int 0 or 1 takes
-    gymnasium's check of the action space; a generator that is not numpy's own `Generator` (a student's
-    `RandomState`, say) takes gymnasium's `choice`.
+    and kept as the numpy strings `choice` returns. An action other than an int or numpy integer 0 or 1
+    (`action_space.sample()` gives a numpy integer) takes gymnasium's check of the action space; a
+    generator that is not numpy's own `Generator` (a student's `RandomState`, say) takes gymnasium's
+    `choice`.
     """
 
     def step(self, action: Any) -> tuple[tuple[int, int, int], float, bool, bool, dict[str, Any]]:
         if (
-            type(action) is not int
+            not (type(action) is int or isinstance(action, np.integer))
             or not 0 <= action <= 1
             or self.render_mode == "human"
             or type(self.np_random) is not np.random.Generator

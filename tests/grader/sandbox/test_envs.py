@@ -122,7 +122,23 @@ def test_blackjack_plays_gymnasiums_game(natural: bool, sab: bool) -> None:
     assert type(cheap.unwrapped) is envs.BlackjackEnv
     rng = np.random.default_rng(8)
     actions: list[Any] = rng.integers(0, 2, 6_000).tolist()
-    actions[50:58] = [np.int64(1), True, False, 2, -1, 1.0, np.array(1), None]
+    actions[50:62] = [
+        np.int64(1),
+        True,
+        False,
+        2,
+        -1,
+        1.0,
+        np.array(1),
+        None,
+        np.uint8(1),
+        np.int8(-1),
+        np.bool_(1),
+        np.int32(0),
+    ]
+    actions[100:3000:2] = [
+        np.int64(action) for action in actions[100:3000:2]
+    ]  # as `action_space.sample()` gives
     episodes = _play(stock, cheap, actions, BLACKJACK_STATE, seed=5)
     assert episodes > 2_000
 
