@@ -22,6 +22,7 @@ from grader.sandbox.child import frames
 from grader.sandbox.child.calls import parse_call, run_call
 from grader.sandbox.child.errors import ProtocolError
 from grader.sandbox.child.importer import ImportFailure, function_table, import_submission
+from grader.sandbox.child.light_ipython import LightIPython
 from grader.sandbox.child.recorder import DEFAULT_MAX_RECORDED_STEPS, Recorder, install
 
 EXIT_PROTOCOL_ERROR = 70
@@ -64,11 +65,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def prepare_process(submission: Path) -> None:
-    """Make the process look like `python submission.py` with the compat layer and no display."""
+    """Make the process look like `python submission.py` with the compat layer and no display (IPython's
+    display calls served without loading IPython: `light_ipython`)."""
     grader.compat.activate()
     sys.path.insert(1, str(submission.resolve().parent))
     sys.argv = [str(submission)]
     sys.meta_path.insert(0, _QuietPyplot())
+    sys.meta_path.insert(0, LightIPython())
 
 
 def _serve(module: ModuleType, requests: Any, recorder: Recorder, arguments: argparse.Namespace) -> int:
