@@ -28,7 +28,14 @@ from grader.sandbox.child.episode_fields import (
     check_log_declaration,
 )
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
-from grader.sandbox.child.frames import ARRAY_DTYPES, MAX_DEPTH, NDARRAY_TAG, decode_value, paused_gc
+from grader.sandbox.child.frames import (
+    ARRAY_DTYPES,
+    MAX_DEPTH,
+    NDARRAY_TAG,
+    decode_array,
+    decode_value,
+    paused_gc,
+)
 from grader.sandbox.limits import CallBudget
 from grader.sandbox.text import clean_plain, clean_text
 
@@ -304,8 +311,10 @@ def _shape(
 
 def _array(column: TaggedArray, name: str) -> np.ndarray:
     """The decoded array (its spec already checked by `_shape`)."""
-    array: np.ndarray = _decoded({NDARRAY_TAG: column["spec"]}, name)
-    return array
+    try:
+        return decode_array(column["spec"], f"the episode log ({name})")
+    except InvalidValueError as error:
+        raise InvalidEpisodeLogError(error.message) from None
 
 
 def _ints(column: TaggedArray, name: str, low: int, high: int) -> list[int]:

@@ -178,6 +178,18 @@ def decode_value(data: Any, what: str = "the value", *, allow_envs: bool = False
         return _Decoder(what, allow_envs).decode(data, "", 0)
 
 
+def decode_array(spec: Any, what: str = "the array") -> np.ndarray:
+    """Decode the payload of one ``{"$ndarray": spec}`` tag, as `decode_value` would (for many arrays).
+
+    Raises:
+        InvalidValueError: `spec` is not a dict with a bool/int/float dtype, a shape and base64 data of
+            exactly that size (checked before decoding).
+    """
+    if type(spec) is not dict:
+        raise _invalid(what, "", "an array's payload must be a dict")
+    return _decode_array(spec, what, "")
+
+
 class _Encoder:
     def __init__(self, what: str, max_bytes: int | None) -> None:
         self.what = what

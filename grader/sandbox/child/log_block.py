@@ -22,6 +22,9 @@ if TYPE_CHECKING:
     from grader.sandbox.child.recorder import EpisodeRecord
 
 _SCALARS = (str, int, float, bool, type(None))
+_INT_RANGES = [
+    (dtype, int(np.iinfo(dtype).min), int(np.iinfo(dtype).max)) for dtype in (np.int8, np.int16, np.int32)
+]
 NO_EPISODES: list[Any] = []
 """What a call that logged no episode sends instead of a block (a call that does not record, say)."""
 
@@ -110,7 +113,10 @@ def _actions(episodes: Sequence[EpisodeRecord]) -> tuple[str, Any]:
 
 
 def _smallest_ints(values: list[int]) -> np.ndarray:
-    return _smallest_int_array(np.array(values, dtype=np.int64))
+    """`values` (each within int64) in the smallest int dtype that holds them."""
+    if not values:
+        return np.zeros(0, dtype=np.int8)
+    return np.array(values, dtype=_smallest_dtype(min(values), max(values)))
 
 
 def _compact_numbers(values: np.ndarray) -> np.ndarray:
@@ -123,12 +129,14 @@ def _compact_numbers(values: np.ndarray) -> np.ndarray:
 def _smallest_int_array(values: np.ndarray) -> np.ndarray:
     if values.size == 0:
         return values.astype(np.int8)
-    low, high = int(values.min()), int(values.max())
-    for dtype in (np.int8, np.int16, np.int32):
-        info = np.iinfo(dtype)
-        if info.min <= low and high <= info.max:
-            return values.astype(dtype)
-    return values
+    return values.astype(_smallest_dtype(int(values.min()), int(values.max())))
+
+
+def _smallest_dtype(low: int, high: int) -> type[np.signedinteger[Any]]:
+    for dtype, smallest, largest in _INT_RANGES:
+        if smallest <= low and high <= largest:
+            return dtype
+    return np.int64
 
 
 check_log_declaration(tuple(log_block(())), "log_block.log_block")
