@@ -184,6 +184,8 @@ def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[Epi
     """
     if type(data) is list and not data:  # `log_block.NO_EPISODES`
         return []
+    if budget is not None:
+        _check_tables(data, budget)
     with paused_gc():
         try:
             log = WIRE_LOG.validate_python(data)
@@ -243,6 +245,22 @@ def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[Epi
 _INT_KINDS = "iu"
 _COLUMN_KINDS = {"rewards": "iuf", "terminated": "b", "truncated": "b"}
 """What each per-step array may hold (the actions depend on `action_form`)."""
+
+
+def _check_tables(data: Any, budget: CallBudget) -> None:
+    """Refuse an env table or a list of reset options longer than the call's episodes before pydantic
+    validates their entries (each entry is validated; an array's steps are not)."""
+    if type(data) is not dict:
+        return
+    options = data.get("reset_options")
+    for name, table in (
+        ("envs", data.get("envs")),
+        ("reset_options", type(options) is dict and options.get("values")),
+    ):
+        if type(table) is list and len(table) > budget.max_episodes:
+            raise InvalidEpisodeLogError(
+                f"the episode log: {name} holds {len(table):,} entries, more than the call's limit of {budget.max_episodes:,} episodes"  # noqa: E501
+            )
 
 
 def _announced(log: WireLog, budget: CallBudget | None) -> tuple[int, int]:

@@ -484,6 +484,29 @@ def test_logs_beyond_the_calls_budget_are_refused_from_the_announced_shapes(
     assert str(caught.value) == message
 
 
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        (
+            {"envs": [{"requested_id": "a", "env_id": "b", "env_kwargs": {"x": [1] * 100}}] * 5},
+            "the episode log: envs holds 5 entries, more than the call's limit of 4 episodes",
+        ),
+        (
+            {"reset_options": {"episodes": encode_value(np.arange(5)), "values": [{}] * 5}},
+            "the episode log: reset_options holds 5 entries, more than the call's limit of 4 episodes",
+        ),
+    ],
+    ids=["env-table", "reset-options"],
+)
+def test_tables_longer_than_the_calls_episodes_are_refused_before_their_entries_are_validated(
+    changes: dict[str, Any], message: str
+) -> None:
+    with pytest.raises(InvalidEpisodeLogError) as caught:
+        episodes_from_plain(wire(**changes), CallBudget(max_episodes=4, max_steps=100))
+
+    assert str(caught.value) == message
+
+
 def test_logs_within_the_calls_budget_decode() -> None:
     data = encode_value(log_block([recorded(2), recorded()]))
 
