@@ -212,34 +212,36 @@ def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[Epi
             (entry["requested_id"], entry["env_id"], _mapping(entry["env_kwargs"], f"envs[{number}]"))
             for number, entry in enumerate(log["envs"])
         ]
-        actions = _actions(log["action_form"], log["actions"], steps)
-        rewards = _array(log["rewards"], "rewards").astype(np.float64).tolist()
-        terminated = (_array(log["terminated"], "terminated").view(np.uint8) != 0).tolist()
-        truncated = (_array(log["truncated"], "truncated").view(np.uint8) != 0).tolist()
+        ends = list(itertools.accumulate(lengths))
+        bounds = list(zip([0, *ends], ends, strict=False))
+        # Each column is split as soon as it is decoded: one whole column alive at a time, not four.
+        actions = _split(_actions(log["action_form"], log["actions"], steps), bounds)
+        rewards = _split(_array(log["rewards"], "rewards").astype(np.float64).tolist(), bounds)
+        terminated = _split((_array(log["terminated"], "terminated").view(np.uint8) != 0).tolist(), bounds)
+        truncated = _split((_array(log["truncated"], "truncated").view(np.uint8) != 0).tolist(), bounds)
         logs = []
-        start = 0
-        for number, (length, made_number, env_index, reset_seed) in enumerate(
-            zip(lengths, made, env_indices, reset_seeds, strict=True)
-        ):
-            end = start + length
+        for number, made_number in enumerate(made):
             requested_id, env_id, env_kwargs = envs[made_number]
             logs.append(
                 EpisodeLog(
-                    env_index,
+                    env_indices[number],
                     requested_id,
                     env_id,
                     dict(env_kwargs),
-                    reset_seed,
+                    reset_seeds[number],
                     student_seeds.get(number),
-                    actions[start:end],
-                    rewards[start:end],
-                    terminated[start:end],
-                    truncated[start:end],
+                    actions[number],
+                    rewards[number],
+                    terminated[number],
+                    truncated[number],
                     options.get(number),
                 )
             )
-            start = end
         return logs
+
+
+def _split(column: list[Any], bounds: list[tuple[int, int]]) -> list[list[Any]]:
+    return [column[start:end] for start, end in bounds]
 
 
 _INT_KINDS = "iu"
