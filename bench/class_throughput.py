@@ -14,7 +14,9 @@
    its PYTHONPATH, logs every call the grader makes.
 3. Runs one file's logged calls of each edition plainly and serially in a fresh process (as
    `bench/speed.py` does: `grader.compat.activate()`, import, the same calls with the same arguments; no
-   sandbox, no recording, no replay): the plain serial CPU per submission of that edition.
+   sandbox, no recording, no replay): the plain serial CPU per submission of that edition; then once more
+   on the sandbox child's envs (`grader/sandbox/child/envs.py`), which separates the grader's own work
+   from what the child's cheaper Taxi and Blackjack give back.
 4. Prints the ratio of the class's wall time to the bound K x (plain serial CPU per submission) / cores
    (goal <= 1.1), the grading CPU per submission against the plain one, the machine's load average
    sampled during the run, and the projection for 300 submissions on 2 cores and on 4 cores with Celery.
@@ -88,6 +90,8 @@ class EditionRun:
     statuses: Counter[str]
     plain_cpu: float = 0.0
     plain_wall: float = 0.0
+    same_envs_cpu: float = 0.0
+    """The plain run's CPU with the sandbox child's envs (`speed.py --plain-child-envs`)."""
     calls: int = 0
     log: Path | None = None
     logged_file: str = ""
@@ -177,12 +181,13 @@ def grade_edition(
     return wall, cpu, statuses
 
 
-def plain_cpu(submission: Path, calls_file: Path) -> tuple[float, float]:
+def plain_cpu(submission: Path, calls_file: Path, *, child_envs: bool = False) -> tuple[float, float]:
     """CPU (import + calls) and wall of the logged calls run plainly in a fresh interpreter
-    (`bench/speed.py --plain-child`)."""
+    (`bench/speed.py --plain-child`; with `child_envs`, on the sandbox child's envs)."""
     environment = dict(os.environ)
     environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), environment.get("PYTHONPATH")]))
     command = [sys.executable, str(BENCH / "speed.py"), "--plain-child", str(calls_file), str(submission)]
+    command += ["--plain-child-envs"] if child_envs else []
     started = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True, env=environment, check=False)
     wall = time.perf_counter() - started
@@ -209,6 +214,7 @@ def section(runs: list[EditionRun], cores: int, workers: int, load: LoadSampler,
     per_plain = plain_cpu / total_files
     per_grade = grade_cpu / total_files
     cpu_ratio = per_grade / per_plain
+    per_same_envs = sum(run.same_envs_cpu * run.files for run in runs) / total_files
     chunks = -(-PROJECTED_CLASS // CHUNK_SUBMISSIONS)
     longest = max(run.cpu / run.files for run in runs)
     two_core = PROJECTED_CLASS * per_grade / 2
@@ -233,7 +239,8 @@ def section(runs: list[EditionRun], cores: int, workers: int, load: LoadSampler,
         "different bytes (header comment, blank lines), graded with `gymgrade grade --edition E` (one run "
         "per edition, as a batch grades one edition). Plain: one file's calls of each edition, exactly as "
         "the grader made them (logged by `bench/class_calls.py`), run serially in one fresh process "
-        "(`grader.compat.activate()`, import, call; no sandbox, no recording, no replay).",
+        "(`grader.compat.activate()`, import, call; no sandbox, no recording, no replay) on gymnasium's "
+        "envs, and again on the sandbox child's envs.",
         "",
         row(
             "edition",
@@ -244,8 +251,10 @@ def section(runs: list[EditionRun], cores: int, workers: int, load: LoadSampler,
             "grade CPU per file (s)",
             "plain CPU per file (s)",
             "CPU ratio",
+            "plain CPU per file, the child's envs (s)",
+            "CPU ratio, the child's envs",
         ),
-        row("---", "---:", "---:", "---", "---:", "---:", "---:", "---:"),
+        row("---", "---:", "---:", "---", "---:", "---:", "---:", "---:", "---:", "---:"),
     ]
     for run in runs:
         statuses = ", ".join(f"{count} {status}" for status, count in sorted(run.statuses.items()))
@@ -259,6 +268,8 @@ def section(runs: list[EditionRun], cores: int, workers: int, load: LoadSampler,
                 f"{run.cpu / run.files:.1f}",
                 f"{run.plain_cpu:.1f}",
                 f"{run.cpu / run.files / run.plain_cpu:.2f}",
+                f"{run.same_envs_cpu:.1f}",
+                f"{run.cpu / run.files / run.same_envs_cpu:.2f}",
             )
         )
     lines += [
@@ -271,13 +282,19 @@ def section(runs: list[EditionRun], cores: int, workers: int, load: LoadSampler,
             f"{per_grade:.1f}",
             f"{per_plain:.1f}",
             f"{cpu_ratio:.2f}",
+            f"{per_same_envs:.1f}",
+            f"{per_grade / per_same_envs:.2f}",
         ),
         "",
         f"- **Wall / bound: {wall / bound:.2f}** (goal <= 1.1): the class took {wall:.1f} s; the bound "
         f"K x plain CPU per submission / cores = {plain_cpu:.1f} s / {cores} = {bound:.1f} s.",
         f"- **Grading CPU / plain CPU per submission: {cpu_ratio:.2f}** ({per_grade:.1f} s against "
-        f"{per_plain:.1f} s): what the grader spends besides the student's own work (sandbox start, "
-        "recording, transfer, replay, judging, pytest and xdist), the figure load cannot stretch.",
+        f"{per_plain:.1f} s), the figure load cannot stretch. The sandbox child deals Taxi and Blackjack "
+        "with cheaper twins of gymnasium's classes (`grader/sandbox/child/envs.py`), so the student's calls "
+        "cost less in the grading than plainly.",
+        f"- Grading CPU / plain CPU on the child's envs: {per_grade / per_same_envs:.2f} ({per_grade:.1f} s "
+        f"against {per_same_envs:.1f} s): the grader's own work alone (sandbox start, recording, transfer, "
+        "replay, judging, pytest and xdist), with what the cheaper envs give back taken out.",
         f"- Cores busy on average: {grade_cpu / wall:.2f} of {cores} (grading CPU / wall).",
         "",
         f"Projection for {PROJECTED_CLASS} submissions (this mix of editions), from the CPU per submission "
@@ -357,7 +374,12 @@ def main() -> int:
             calls_file = run.log / "plain.calls"
             calls_file.write_bytes(pickle.dumps(read_calls(run.log)[run.logged_file]))
             run.plain_cpu, run.plain_wall = plain_cpu(EDITIONS[run.edition], calls_file)
-            print(f"plain {run.edition}: {run.plain_cpu:.1f} s CPU ({run.plain_wall:.1f} s wall)", flush=True)
+            run.same_envs_cpu, _ = plain_cpu(EDITIONS[run.edition], calls_file, child_envs=True)
+            print(
+                f"plain {run.edition}: {run.plain_cpu:.1f} s CPU ({run.plain_wall:.1f} s wall); "
+                f"on the child's envs {run.same_envs_cpu:.1f} s CPU",
+                flush=True,
+            )
     command = " ".join(["python", "bench/class_throughput.py", *sys.argv[1:]])
     text = section(runs, cores, args.workers, load, command)
     print(text)

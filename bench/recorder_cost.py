@@ -93,8 +93,9 @@ def play_block(env: Any, steps: int, actions: int) -> int:
 def interleaved(steps: int, game: str, blocks: int) -> dict[str, float]:
     """Median CPU per step of three variants in this one process, block by block in turn.
 
-    - bare: the compat `ClassicEnv` straight on gymnasium's env, as the plain run has it;
-    - wrapped: through the recorder's wrapper while the call does not record;
+    - bare: the compat `ClassicEnv` straight on gymnasium's env, as the plain run has it (made before the
+      recorder is installed, so gymnasium's own class, not the child's cheaper twin);
+    - wrapped: through the recorder's wrapper (and the child's env) while the call does not record;
     - recording: through the wrapper while the call records (then `finish_call` and `log_block`).
     Interleaving the blocks in one process cancels most of the load's drift between variants.
     """
@@ -109,11 +110,12 @@ def interleaved(steps: int, game: str, blocks: int) -> dict[str, float]:
     from grader.sandbox.child.budget import WireBudget
     from grader.sandbox.child.recorder import Recorder, install
 
+    env_id = "Taxi-v3" if game == "taxi" else "Blackjack-v0"
+    bare = gym.make(env_id)  # made before `install`: gymnasium's own game, as the plain run plays it
+    assert isinstance(bare, ClassicEnv)
     recorder = Recorder(0)
     install(recorder)
-    env_id = "Taxi-v3" if game == "taxi" else "Blackjack-v0"
     wrapped = gym.make(env_id)
-    bare = ClassicEnv(wrapped.env.env, env_id)
     actions = int(wrapped.action_space.n)
     random.seed(0)
     times: dict[str, list[float]] = {"bare": [], "wrapped": [], "recording": []}

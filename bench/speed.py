@@ -58,6 +58,7 @@ from grading_probe import ProblemCost, SharedChild, grade_serially, graded, leak
 from results_section import replace_section  # noqa: E402
 
 HEADING = "## Speed (issue 11)"
+PLAIN_CHILD_ENVS = "plain, the child's envs"
 DEFAULT_SUBMISSION = ROOT / "submissions" / "classic_complete.py"
 ACCEPTANCE_DIR = ROOT / "grader" / "acceptance"
 _PR_SET_CHILD_SUBREAPER = 36
@@ -77,13 +78,17 @@ def _plain_argument(value: Any) -> Any:
     return value
 
 
-def plain_child(calls_file: Path, submission: Path) -> None:
-    """Run the recorded calls plainly in this process; print the times as one JSON line on stdout."""
+def plain_child(calls_file: Path, submission: Path, child_envs: bool = False) -> None:
+    """Run the recorded calls plainly in this process; print the times as one JSON line on stdout.
+
+    With `child_envs`, every env is dealt by the sandbox child's cheaper class of the same game
+    (`grader.sandbox.child.envs.cheaper`), so the run differs from the grading only by the grader's own work.
+    """
     import grader.compat
 
     started, cpu = time.perf_counter(), time.process_time()
     grader.compat.activate()
-    _route_lab_ids()
+    _route_lab_ids(child_envs)
     spec = importlib.util.spec_from_file_location("opengym", submission)
     if spec is None or spec.loader is None:
         raise SystemExit(f"cannot import {submission}")
@@ -115,17 +120,18 @@ def plain_child(calls_file: Path, submission: Path) -> None:
     print(json.dumps(summary))
 
 
-def _route_lab_ids() -> None:
+def _route_lab_ids(child_envs: bool = False) -> None:
     """Let plain `gymnasium.make("Taxi-v3")` make the env the lab means, as the sandbox's recorder does.
 
     Gymnasium-API submissions of the later editions keep the lab's ids, which today's gymnasium no longer
     registers; the grader resolves them (`grader.compat.resolve_env_id`), so the plain run does too (once
-    per `make`, nothing per step).
+    per `make`, nothing per step). With `child_envs`, each env made is swapped to the child's class.
     """
     import gymnasium
     import gymnasium.envs.registration
 
     from grader.compat import register_envs, resolve_env_id
+    from grader.sandbox.child import envs
 
     original = gymnasium.envs.registration.make
 
@@ -133,8 +139,12 @@ def _route_lab_ids() -> None:
         if isinstance(id, str) and ":" not in id and id not in gymnasium.envs.registration.registry:
             target = resolve_env_id(id)
             register_envs()
-            return original(target.gymnasium_id, *args, **target.merged_kwargs(kwargs))
-        return original(id, *args, **kwargs)
+            env = original(target.gymnasium_id, *args, **target.merged_kwargs(kwargs))
+        else:
+            env = original(id, *args, **kwargs)
+        if child_envs:
+            envs.cheaper(env.unwrapped)
+        return env
 
     gymnasium.make = gymnasium.envs.make = gymnasium.envs.registration.make = make
 
@@ -178,11 +188,16 @@ def timed_run(command: Sequence[str], root: Path = ROOT, **extra: str) -> Run:
     return Run(wall, done.stdout, done.returncode, cpu)
 
 
-def plain_run(submission: Path, calls_file: Path) -> tuple[Run, dict[str, Any]]:
-    """The recorded calls run plainly in a fresh interpreter."""
-    run = timed_run(
-        [sys.executable, str(Path(__file__).resolve()), "--plain-child", str(calls_file), str(submission)]
-    )
+def plain_run(submission: Path, calls_file: Path, *, child_envs: bool = False) -> tuple[Run, dict[str, Any]]:
+    """The recorded calls run plainly in a fresh interpreter (with the child's envs: `plain_child`)."""
+    command = [
+        sys.executable,
+        str(Path(__file__).resolve()),
+        "--plain-child",
+        str(calls_file),
+        str(submission),
+    ]
+    run = timed_run(command + (["--plain-child-envs"] if child_envs else []))
     if run.returncode != 0:
         raise SystemExit(f"the plain run failed (exit {run.returncode}): {run.stdout[-2000:]}")
     return run, json.loads(run.stdout.strip().splitlines()[-1])
@@ -536,11 +551,17 @@ def ab_lines(
     grades: dict[str, list[tuple[Run, Any]]],
     plain: list[tuple[Run, dict[str, Any]]],
     load: str,
+    plain_child_envs: Sequence[tuple[Run, dict[str, Any]]] = (),
 ) -> list[str]:
-    """The A/B table: the same check graded by a baseline tree's grader and this tree's, and plainly."""
+    """The A/B table: the same check graded by a baseline tree's grader and this tree's, and plainly.
+
+    `plain_child_envs`, the plain run with the sandbox child's envs, separates the grader's own work from
+    what the child's cheaper envs give back: "this tree" against it is the grader's cost alone.
+    """
     median = statistics.median
+    order = "baseline, this tree, plain" + (f", {PLAIN_CHILD_ENVS}" if plain_child_envs else "")
     lines = [
-        f"A/B against `{baseline}` ({load}); alternated baseline, this tree, plain, then reversed:",
+        f"A/B against `{baseline}` ({load}); alternated {order}, then reversed:",
         "",
         row(
             "run",
@@ -567,23 +588,37 @@ def ab_lines(
                 f"{median([report.timings.overhead_seconds for report in reports]):.1f}",
             )
         )
-    lines.append(
-        row(
-            "plain, 1 process",
-            seconds([run.wall for run, _ in plain]),
-            f"{median([run.wall for run, _ in plain]):.1f}",
-            seconds([run.cpu for run, _ in plain if run.cpu is not None]),
-            _cpu_text(plain_cpu),
-            f"{median([summary['calls_seconds'] for _, summary in plain]):.1f}",
-            "",
-        )
-    )
+    for label, runs_of_plain in (("plain, 1 process", plain), (PLAIN_CHILD_ENVS, plain_child_envs)):
+        if runs_of_plain:
+            lines.append(
+                row(
+                    label,
+                    seconds([run.wall for run, _ in runs_of_plain]),
+                    f"{median([run.wall for run, _ in runs_of_plain]):.1f}",
+                    seconds([run.cpu for run, _ in runs_of_plain if run.cpu is not None]),
+                    _cpu_text(_median_cpu([run for run, _ in runs_of_plain])),
+                    f"{median([summary['calls_seconds'] for _, summary in runs_of_plain]):.1f}",
+                    "",
+                )
+            )
     lines.append("")
     for label, runs in grades.items():
         cpu = _median_cpu([run for run, _ in runs])
         wall_ratio = median([run.wall for run, _ in runs]) / median([run.wall for run, _ in plain])
         cpu_ratio = f"{cpu / plain_cpu:.2f}" if cpu is not None and plain_cpu else "n/a (no cgroup)"
         lines.append(f"- {label}: wall / plain {wall_ratio:.2f}, CPU / plain CPU {cpu_ratio} (goal <= 1.0).")
+    if plain_child_envs and "this tree" in grades:
+        runs = grades["this tree"]
+        cpu, same_envs_cpu = (
+            _median_cpu([run for run, _ in runs]),
+            _median_cpu([run for run, _ in plain_child_envs]),
+        )
+        wall_ratio = median([run.wall for run, _ in runs]) / median([run.wall for run, _ in plain_child_envs])
+        cpu_ratio = f"{cpu / same_envs_cpu:.2f}" if cpu is not None and same_envs_cpu else "n/a (no cgroup)"
+        lines.append(
+            f"- this tree against {PLAIN_CHILD_ENVS} (the grader's own work alone): wall {wall_ratio:.2f}, "
+            f"CPU {cpu_ratio}."
+        )
     return lines
 
 
@@ -604,15 +639,19 @@ def ab_main(args: argparse.Namespace, submission: Path, problems: Sequence[str],
     labels = {"baseline": args.ab.resolve(), "this tree": ROOT}
     grades: dict[str, list[tuple[Run, Any]]] = {label: [] for label in labels}
     plain: list[tuple[Run, dict[str, Any]]] = []
+    plain_child_envs: list[tuple[Run, dict[str, Any]]] = []
     with tempfile.TemporaryDirectory(prefix="gymgrade-speed-") as scratch:
         calls_file = Path(scratch) / "calls.pickle"
         calls_file.write_bytes(pickle.dumps(calls))
         for round_index in range(args.rounds):
-            order = ["baseline", "this tree", "plain"]
+            order = ["baseline", "this tree", "plain", PLAIN_CHILD_ENVS]
             for kind in order if round_index % 2 == 0 else order[::-1]:
                 if kind == "plain":
                     plain.append(plain_run(submission, calls_file))
                     run = plain[-1][0]
+                elif kind == PLAIN_CHILD_ENVS:
+                    plain_child_envs.append(plain_run(submission, calls_file, child_envs=True))
+                    run = plain_child_envs[-1][0]
                 else:
                     grades[kind].append(
                         gymgrade_run(submission, args.workers, args.seed, args.config, problems, labels[kind])
@@ -620,7 +659,7 @@ def ab_main(args: argparse.Namespace, submission: Path, problems: Sequence[str],
                     run = grades[kind][-1][0]
                 print(f"2. {kind}: {run.wall:.1f} s wall", flush=True)
     load = f"load average {load_before:.1f} before, {os.getloadavg()[0]:.1f} after"
-    print("\n".join(ab_lines(labels["baseline"], grades, plain, load)))
+    print("\n".join(ab_lines(labels["baseline"], grades, plain, load, plain_child_envs)))
     return 0
 
 
@@ -649,9 +688,11 @@ def main() -> int:
     parser.add_argument(
         "--plain-child", nargs=2, type=Path, metavar=("CALLS", "SUBMISSION"), help=argparse.SUPPRESS
     )
+    parser.add_argument("--plain-child-envs", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.plain_child:
-        plain_child(*args.plain_child)
+        calls_file, submission = args.plain_child
+        plain_child(calls_file, submission, child_envs=args.plain_child_envs)
         return 0
 
     from grader.config import load_config

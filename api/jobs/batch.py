@@ -12,6 +12,7 @@ import base64
 import json
 import logging
 import time
+import tomllib
 import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -22,7 +23,8 @@ from pydantic import ValidationError
 
 from api.settings import BrokerSettings
 from grader.collector import Collector, GradingListener, Silent, Submission
-from grader.errors import ExecutorUnavailable
+from grader.config import config_from_data
+from grader.errors import ConfigError, ExecutorUnavailable
 from grader.grading import grade_files
 from grader.plan import GradingPlan
 from grader.report import Report
@@ -55,6 +57,38 @@ def executor_from_environment(policy: IsolationPolicy) -> CeleryExecutor | None:
     if problem is not None:
         raise ExecutorUnavailable(problem + "; or unset GYMGRADE_BROKER_URL to grade on this machine")
     return CeleryExecutor(settings, policy)
+
+
+def configuration_text(plan: GradingPlan) -> str | None:
+    """The text of the plan's configuration file, which every worker reads, checked to be the plan's.
+
+    The workers are sent the file's text; the plan was made from the same file when the batch started. A
+    file edited in between would grade the cluster's files with another configuration than the one the
+    batch checked and records, so that is refused.
+
+    Raises:
+        ConfigError: The file cannot be read any more, or now says something else than the plan.
+    """
+    if plan.config is None:
+        return None
+    where = str(plan.config)
+    try:
+        text = plan.config.read_text(encoding="utf-8")
+        now = config_from_data(tomllib.loads(text), where=where)
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
+        raise ConfigError(
+            f"cannot read the assignment configuration {where} again to send it to the workers ({error}): "
+            "keep the file in place until the batch has been sent, then grade again"
+        ) from None
+    if (
+        GradingPlan(assignment=now, problems=plan.problems, config=plan.config).config_sha256
+        != plan.config_sha256
+    ):
+        raise ConfigError(
+            f"the assignment configuration {where} changed after the batch read it: the workers would grade "
+            "with a configuration other than the one checked; grade the batch again"
+        )
+    return text
 
 
 @dataclass(frozen=True)
@@ -92,7 +126,7 @@ class CeleryExecutor:
         app = make_celery(self.settings)
         client = redis_client(self.settings)
         reply_to = REPLY_PREFIX + uuid.uuid4().hex
-        config_toml = plan.config.read_text(encoding="utf-8") if plan.config is not None else None
+        config_toml = configuration_text(plan)
         requests: dict[str, dict[str, Any]] = {}
         contents: dict[str, bytes] = {}
         pending: dict[str, Path] = {}

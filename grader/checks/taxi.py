@@ -206,11 +206,15 @@ def _action_problem(
             "Use env.action_space.sample()."
         )
     chosen: dict[int, int] = {}
+    # The table's greedy action of every state, computed once (np.argmax per row: the first largest value).
+    best_actions = (
+        np.argmax(q_table, axis=1).tolist() if isinstance(q_table, np.ndarray) and q_table.ndim == 2 else None
+    )
     for episode in scenarios.greedy:
         for state, action in episode.decisions():
             state, action = int(state), int(action)
             if isinstance(q_table, np.ndarray):
-                best = int(np.argmax(q_table[state]))
+                best = best_actions[state] if best_actions is not None else int(np.argmax(q_table[state]))
                 if action != best:
                     return (
                         f"in a Q-table episode you chose action {action} in state {state}, but argmax(q_table[{state}]) is {best}: "  # noqa: E501

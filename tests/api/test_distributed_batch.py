@@ -142,9 +142,36 @@ def test_a_file_the_cluster_could_not_grade_is_a_grader_error_in_every_problem(t
     plan = GradingPlan.load(None, ["cartpole", "car"])
     report = _report(path, path.read_bytes(), {"error": "the worker was killed"}, plan, 7)
     assert (report.submission, report.seed, report.score) == ("alice.py", 7, 0.0)
-    assert [(result.id, result.status) for result in report.problems] == [("cartpole", "error"), ("car", "error")]
+    assert [(result.id, result.status) for result in report.problems] == [
+        ("cartpole", "error"),
+        ("car", "error"),
+    ]
     assert report.grader_errors == [
         "cartpole: the cluster could not grade it: the worker was killed",
         "car: the cluster could not grade it: the worker was killed",
     ]
     assert "not your code's fault" in report.problems[0].feedback
+
+
+def test_the_workers_are_sent_the_configuration_the_batch_checked(tmp_path: Path) -> None:
+    from api.jobs.batch import configuration_text
+    from grader.config import DEFAULT_CONFIG_PATH
+    from grader.errors import ConfigError
+    from grader.plan import GradingPlan
+
+    bundled = DEFAULT_CONFIG_PATH.read_text(encoding="utf-8")
+    config = tmp_path / "assignment.toml"
+    config.write_text(bundled, encoding="utf-8")
+    plan = GradingPlan.load(config, None)
+    assert configuration_text(plan) == bundled
+    assert configuration_text(GradingPlan.load(None, None)) is None
+    config.write_text("# the same configuration, with a comment\n" + bundled, encoding="utf-8")
+    assert configuration_text(plan) is not None  # the same configuration: sent as the file now reads
+    edited = bundled.replace("[problems.car]\npoints = 1.0", "[problems.car]\npoints = 4.0")
+    assert edited != bundled
+    config.write_text(edited, encoding="utf-8")
+    with pytest.raises(ConfigError, match="changed after the batch read it"):
+        configuration_text(plan)
+    config.write_text("[problems.car\n", encoding="utf-8")
+    with pytest.raises(ConfigError, match="cannot read the assignment configuration"):
+        configuration_text(plan)

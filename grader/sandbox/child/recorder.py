@@ -2,9 +2,11 @@
 
 `install` replaces `gymnasium.make` (all three names it is bound to), `numpy.random.default_rng`
 and `gymnasium.utils.seeding.np_random` so that unseeded randomness comes from the call's seed
-streams. The recorder sits outermost on each env, sees the gymnasium-API `reset`/`step` (the compat
-`gym` shim wraps it in turn), reseeds every reset from the grader's stream and logs actions and what
-the student saw. The parent replays the logs (`grader.sandbox.replay`); nothing here is trusted.
+streams. An env that is one of gymnasium's lab games is dealt by its cheaper twin (`envs.cheaper`:
+the same game, the same draws, fewer numpy calls per step). The recorder sits outermost on each env,
+sees the gymnasium-API `reset`/`step` (the compat `gym` shim wraps it in turn), reseeds every reset
+from the grader's stream and logs actions and what the student saw. The parent replays the logs
+(`grader.sandbox.replay`); nothing here is trusted.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ import numpy as np
 from grader.compat import events as compat_events
 from grader.compat import make as compat_make
 from grader.compat import register_envs, resolve_env_id
+from grader.sandbox.child import envs
 from grader.sandbox.child.budget import WireBudget
 from grader.sandbox.child.episode_fields import EPISODE_FIELDS, EpisodeHeader, check_declaration
 from grader.sandbox.child.seeding import CallSeeds, kept_generator_seed
@@ -326,6 +329,7 @@ def install(recorder: Recorder) -> None:
         if isinstance(id, str) and ":" not in id and id not in gymnasium.envs.registration.registry:
             id, kwargs = _resolve_lab_id(id, kwargs)
         env = original_make(id, max_episode_steps, disable_env_checker, **kwargs)
+        envs.cheaper(env.unwrapped)
         made = describe_make(id, max_episode_steps, kwargs, sys._getframe(1), env.unwrapped.spec)
         if requested is not id:
             made = MadeEnv(requested, made.env_id, made.env_kwargs)
