@@ -8,8 +8,8 @@ Each variant runs in a fresh interpreter, alternated A/B, B/A, ... for `--rounds
 - plain: `grader.compat.activate()`, then the lab's random Taxi play (`gym.make("Taxi-v3")`, reset, random
   actions until done, `--steps` steps in all), as the plain run of `bench/speed.py` does;
 - recorded: the same after the child's set-up (`Recorder`, `install`, `begin_call(record=True)` with a
-  budget, as `grader.sandbox.child.calls.run_call` does), then `finish_call` and `to_plain` of every
-  episode (the log as sent, before JSON encoding).
+  budget, as `grader.sandbox.child.calls.run_call` does), then `finish_call` and the call's wire block
+  (`log_block`: the log as sent, before JSON encoding).
 
 Prints the median CPU per step of each and the median of the rounds' differences: what the recorder costs
 per step. `--baseline TREE` adds a third variant, the recorder of another tree (a worktree of `main`), in
@@ -96,7 +96,7 @@ def interleaved(steps: int, game: str, blocks: int) -> dict[str, float]:
     - bare: the compat `ClassicEnv` straight on gymnasium's env, as the plain run has it (made before the
       recorder is installed, so gymnasium's own class, not the child's cheaper twin);
     - wrapped: through the recorder's wrapper (and the child's env) while the call does not record;
-    - recording: through the wrapper while the call records (then `finish_call` and `to_plain`).
+    - recording: through the wrapper while the call records (then `finish_call` and `log_block`).
     Interleaving the blocks in one process cancels most of the load's drift between variants.
     """
     import random
@@ -126,12 +126,21 @@ def interleaved(steps: int, game: str, blocks: int) -> dict[str, float]:
             started = time.process_time()
             taken = play_block(bare if name == "bare" else wrapped, steps, actions)
             if name == "recording":
-                episodes = recorder.finish_call()
-                [episode.to_plain() for episode in episodes]
+                wire_log(recorder.finish_call())
             else:
                 recorder.finish_call()
             times[name].append((time.process_time() - started) / taken * 1e6)
     return {name: statistics.median(values) for name, values in times.items()}
+
+
+def wire_log(episodes: list[Any]) -> Any:
+    """The call's episodes as the child puts them on the wire (per episode in a tree older than the
+    columnar block, which an A/B baseline may be)."""
+    try:
+        from grader.sandbox.child.log_block import log_block
+    except ImportError:
+        return [episode.to_plain() for episode in episodes]
+    return log_block(episodes)
 
 
 def child(variant: str, steps: int, api: str, game: str) -> None:
@@ -155,7 +164,7 @@ def child(variant: str, steps: int, api: str, game: str) -> None:
     taken = play(steps, api, game)
     if recorder is not None:
         episodes = recorder.finish_call()
-        plain = [episode.to_plain() for episode in episodes]
+        plain = wire_log(episodes)
         assert sum(len(episode.actions) for episode in episodes) == taken, "every step logged"
         del plain
     print(json.dumps({"cpu": time.process_time() - started, "steps": taken}))

@@ -1,6 +1,6 @@
 """How data from the child is validated: declared pydantic models in strict mode, errors a person can read.
 
-Everything the child sends is untrusted. `episode_log.WireEpisode` and the frame models in `messages`
+Everything the child sends is untrusted. `episode_log.WireLog` and the frame models in `messages`
 declare what it may send; this module holds what they share: the strict configuration, unions that fail
 with one message, and the conversion of a `ValidationError` into one readable sentence (what was expected,
 where, what was found).

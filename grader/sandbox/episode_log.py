@@ -1,16 +1,17 @@
 """`EpisodeLog`: one episode as the student's code played it, decoded by a declared model from the child.
 
-The child sends each episode in the layout `grader.sandbox.child.episode_fields` declares (`EPISODE_HEADER`
-and `EPISODE_COLUMNS`: per-step columns as numpy arrays, or plain lists for short episodes), a stdlib-only
-module the child's recorder imports too. `WireEpisode` is that layout on the parent's side (pydantic,
-strict, no other fields); it and `EpisodeLog` are checked against the declaration at import.
-`episodes_from_plain` validates it, checks the call's budget from list lengths and array shapes, and only
-then decodes arrays. Nothing in a log is trusted: `grader.sandbox.replay` replays it.
+The child sends a call's episodes as one columnar block in the layout `grader.sandbox.child.episode_fields`
+declares (`LOG_FIELDS`: a table of made envs, per-episode arrays, per-step arrays concatenated over the
+episodes, one array of lengths), a stdlib-only module the child's recorder imports too. `WireLog` is that
+layout on the parent's side (pydantic, strict, no other fields); it and `EpisodeLog` are checked against the
+declaration at import. `episodes_from_plain` validates the block, checks the call's budget and every
+array's dtype and shape from what they announce, and only then decodes arrays; each `EpisodeLog` holds
+slices of the decoded columns. Nothing in a log is trusted: `grader.sandbox.replay` replays it.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import itertools
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
@@ -20,20 +21,26 @@ from typing_extensions import TypedDict
 
 from grader.sandbox.boundary import STRICT, describe, one_of, problem
 from grader.sandbox.child.episode_fields import (
-    EPISODE_COLUMNS,
+    ACTION_FORMS,
     EPISODE_FIELDS,
     EpisodeHeader,
     check_declaration,
+    check_log_declaration,
 )
 from grader.sandbox.child.errors import InvalidEpisodeLogError, InvalidValueError
-from grader.sandbox.child.frames import MAX_DEPTH, MAX_INT_BITS, NDARRAY_TAG, decode_value, paused_gc
+from grader.sandbox.child.frames import (
+    ARRAY_DTYPES,
+    MAX_DEPTH,
+    NDARRAY_TAG,
+    decode_array,
+    decode_value,
+    paused_gc,
+)
 from grader.sandbox.limits import CallBudget
 from grader.sandbox.text import clean_plain, clean_text
 
 MAX_ID_LENGTH = 200
 MAX_SEED = 2**64
-ARRAY_BATCH = 256
-"""Array columns decoded by one `decode_value` call."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,14 +88,6 @@ def _same_action(mine: Any, theirs: Any) -> bool:
     return bool(type(mine) is type(theirs) and mine == theirs)
 
 
-@dataclass(frozen=True)
-class PlainList:
-    """A per-step column of plain values that are not all ints (a `Box` env's actions, say): it is decoded
-    as plain data (`decode_value`) only after the budget check."""
-
-    items: list[Any]
-
-
 class ArraySpec(TypedDict):
     """The payload of a tagged numpy array: its data are decoded (and sized against the shape) later."""
 
@@ -97,232 +96,284 @@ class ArraySpec(TypedDict):
     data: str
 
 
+@with_config(STRICT)
 class TaggedArray(TypedDict):
     """`{"$ndarray": {...}}`, a column sent as one array (`grader.sandbox.child.frames`)."""
 
     spec: Annotated[ArraySpec, Field(alias=NDARRAY_TAG)]
 
 
-TaggedFloat = TypedDict("TaggedFloat", {"$float": Literal["nan", "inf", "-inf"]})
-"""A non-finite reward in a list column (JSON has no NaN): `{"$float": "nan"}`."""
-
-Int = Annotated[int, Field(gt=-(2**MAX_INT_BITS), lt=2**MAX_INT_BITS)]
-Seed = Annotated[int, Field(ge=0, lt=MAX_SEED)]
 EnvId = Annotated[
     str,
     Field(min_length=1, max_length=MAX_ID_LENGTH),
     AfterValidator(lambda text: clean_text(text, MAX_ID_LENGTH)),
 ]
-Number = Annotated[
-    Annotated[float, Field(allow_inf_nan=False)]
-    | Annotated[TaggedFloat, AfterValidator(lambda tag: float(tag["$float"]))],
-    Field(union_mode="left_to_right"),
-]
-"""A reward in a list column, as a float: an int (converted exactly as `float()` does), a finite float, or
-a tagged non-finite one."""
-Actions = Annotated[
-    list[Int] | TaggedArray | Annotated[list[Any], AfterValidator(PlainList)],
-    Field(union_mode="left_to_right"),
-    one_of("should be a list of actions or an int array"),
-]
-Rewards = Annotated[
-    list[Number] | TaggedArray,
-    Field(union_mode="left_to_right"),
-    one_of("should be a list of numbers or a numeric array"),
-]
-Flags = Annotated[
-    list[bool] | TaggedArray,
-    Field(union_mode="left_to_right"),
-    one_of("should be a list of bools or a bool array"),
-]
 
 
 @with_config(STRICT)
-class WireEpisode(TypedDict):
-    """One episode as the child sends it (`EpisodeRecord.to_plain`), validated but not yet decoded."""
+class WireMade(TypedDict):
+    """One entry of the log's `envs` table: how an env was made (`episode_fields.MADE_FIELDS`)."""
 
-    env_index: Annotated[int, Field(ge=0, lt=2**31)]
     requested_id: EnvId
     env_id: EnvId
     env_kwargs: dict[str, Any]
-    reset_seed: Seed
-    student_seed: Seed | None
-    reset_options: dict[str, Any] | None
-    actions: Actions
-    rewards: Rewards
-    terminated: Flags
-    truncated: Flags
 
 
-check_declaration(tuple(WireEpisode.__annotations__), "episode_log.WireEpisode")
+@with_config(STRICT)
+class SparseSeeds(TypedDict):
+    """`student_seed` where the student passed one: the episodes' numbers and their seeds."""
+
+    episodes: TaggedArray
+    values: TaggedArray
+
+
+@with_config(STRICT)
+class SparseOptions(TypedDict):
+    """`reset_options` where the student passed some: the episodes' numbers and their options."""
+
+    episodes: TaggedArray
+    values: list[dict[str, Any]]
+
+
+@with_config(STRICT)
+class WireLog(TypedDict):
+    """A call's episode log as the child sends it (`grader.sandbox.child.log_block`), before decoding."""
+
+    envs: list[WireMade]
+    made: TaggedArray
+    env_index: TaggedArray
+    reset_seed: TaggedArray
+    student_seed: SparseSeeds
+    reset_options: SparseOptions
+    lengths: TaggedArray
+    action_form: Literal[ACTION_FORMS]  # type: ignore[valid-type]
+    actions: Annotated[
+        TaggedArray | list[Any],
+        Field(union_mode="left_to_right"),
+        one_of("should be an array or a list of actions"),
+    ]
+    rewards: TaggedArray
+    terminated: TaggedArray
+    truncated: TaggedArray
+
+
+check_log_declaration(tuple(WireLog.__annotations__), "episode_log.WireLog")
 check_declaration(
     tuple(sorted(EpisodeLog.__dataclass_fields__, key=EPISODE_FIELDS.index)), "episode_log.EpisodeLog"
 )
 
-WIRE_EPISODES: TypeAdapter[list[WireEpisode]] = TypeAdapter(
-    Annotated[list[WireEpisode], Field(fail_fast=True)]
-)
-"""Validates the `episodes` of a result frame, stopping at the first bad episode."""
+WIRE_LOG: TypeAdapter[WireLog] = TypeAdapter(WireLog)
+"""Validates the `episodes` of a result frame: its structure, array specs and table, no array data."""
 
 
 def episodes_from_plain(data: Any, budget: CallBudget | None = None) -> list[EpisodeLog]:
-    """Decode and validate the `episodes` field of a result frame (JSON data, as parsed).
+    """Validate and decode the `episodes` field of a result frame (JSON data, as parsed): one columnar block.
 
-    Each per-step column is either a tagged numpy array or, for short episodes, a plain list.
+    Everything announced is checked before any array is decoded: the block's structure, every array's
+    dtype and shape, the episode count and the step count against `budget`, the table's size. Then the
+    per-episode arrays (lengths summing to the step count, table indices in range, seeds non-negative),
+    then the per-step arrays; each episode's columns are slices of them.
 
     Args:
-        data: The parsed field.
-        budget: The call's budget: more episodes, or more steps summed over them, are refused from the
-            list lengths and array shapes, before any array is decoded.
+        data: The parsed field: a block, or `[]` for a call that logged no episode.
+        budget: The call's budget: more episodes, or more steps, are refused from the announced shapes.
 
     Raises:
-        InvalidEpisodeLogError: the data does not have the layout the child sends, or exceeds `budget`.
+        InvalidEpisodeLogError: the data does not have the layout the child sends, or exceeds `budget`;
+            the message says what was expected and what was found.
     """
-    if budget is not None and type(data) is list and len(data) > budget.max_episodes:
-        raise InvalidEpisodeLogError(
-            f"the log holds {len(data):,} episodes, more than the call's limit of {budget.max_episodes:,}"
-        )
+    if type(data) is list and not data:  # `log_block.NO_EPISODES`
+        return []
+    if budget is not None:
+        _check_tables(data, budget)
     with paused_gc():
         try:
-            episodes = WIRE_EPISODES.validate_python(data)
+            log = WIRE_LOG.validate_python(data)
         except ValidationError as error:
-            raise InvalidEpisodeLogError(_problem(error)) from None
-        if budget is not None:
-            _check_steps(episodes, budget)
-        arrays = _decoded_arrays(episodes)
-        mappings: dict[tuple[Any, ...], dict[str, Any]] = {}
-        return [
-            _episode(episode, f"episode {number}", arrays, mappings)
-            for number, episode in enumerate(episodes)
-        ]
-
-
-def _problem(error: ValidationError) -> str:
-    location = error.errors(include_url=False)[0]["loc"]
-    if location and type(location[0]) is int:
-        return problem(error, f"episode {location[0]}", skip=1)
-    return problem(error, "the episode log")
-
-
-def _check_steps(episodes: list[WireEpisode], budget: CallBudget) -> None:
-    steps = 0
-    for episode in episodes:
-        steps += max(_length(episode[name]) for name in EPISODE_COLUMNS)  # type: ignore[literal-required]
-        if steps > budget.max_steps:
+            raise InvalidEpisodeLogError(problem(error, "the episode log")) from None
+        episodes, steps = _announced(log, budget)
+        lengths = _ints(log["lengths"], "lengths", 0, steps)
+        if sum(lengths) != steps:
             raise InvalidEpisodeLogError(
-                f"the log holds more than {budget.max_steps:,} steps, the call's limit"
+                f"the episode log: lengths should sum to the {steps:,} entries of each per-step column, found a sum of {sum(lengths):,}"  # noqa: E501
+            )
+        made = _ints(log["made"], "made", 0, len(log["envs"]) - 1)
+        env_indices = _ints(log["env_index"], "env_index", 0, 2**31 - 1)
+        reset_seeds = _ints(log["reset_seed"], "reset_seed", 0, MAX_SEED - 1)
+        student_seeds = dict(
+            zip(
+                _positions(log["student_seed"]["episodes"], "student_seed", episodes),
+                _ints(log["student_seed"]["values"], "student_seed.values", 0, MAX_SEED - 1),
+                strict=True,
+            )
+        )
+        options = _sparse_options(log["reset_options"], episodes)
+        envs = [
+            (entry["requested_id"], entry["env_id"], _mapping(entry["env_kwargs"], f"envs[{number}]"))
+            for number, entry in enumerate(log["envs"])
+        ]
+        ends = list(itertools.accumulate(lengths))
+        bounds = list(zip([0, *ends], ends, strict=False))
+        # Each column is split as soon as it is decoded: one whole column alive at a time, not four.
+        actions = _split(_actions(log["action_form"], log["actions"], steps), bounds)
+        rewards = _split(_array(log["rewards"], "rewards").astype(np.float64).tolist(), bounds)
+        terminated = _split((_array(log["terminated"], "terminated").view(np.uint8) != 0).tolist(), bounds)
+        truncated = _split((_array(log["truncated"], "truncated").view(np.uint8) != 0).tolist(), bounds)
+        logs = []
+        for number, made_number in enumerate(made):
+            requested_id, env_id, env_kwargs = envs[made_number]
+            logs.append(
+                EpisodeLog(
+                    env_indices[number],
+                    requested_id,
+                    env_id,
+                    dict(env_kwargs),
+                    reset_seeds[number],
+                    student_seeds.get(number),
+                    actions[number],
+                    rewards[number],
+                    terminated[number],
+                    truncated[number],
+                    options.get(number),
+                )
+            )
+        return logs
+
+
+def _split(column: list[Any], bounds: list[tuple[int, int]]) -> list[list[Any]]:
+    return [column[start:end] for start, end in bounds]
+
+
+_INT_KINDS = "iu"
+_COLUMN_KINDS = {"rewards": "iuf", "terminated": "b", "truncated": "b"}
+"""What each per-step array may hold (the actions depend on `action_form`)."""
+
+
+def _check_tables(data: Any, budget: CallBudget) -> None:
+    """Refuse an env table or a list of reset options longer than the call's episodes before pydantic
+    validates their entries (each entry is validated; an array's steps are not)."""
+    if type(data) is not dict:
+        return
+    options = data.get("reset_options")
+    for name, table in (
+        ("envs", data.get("envs")),
+        ("reset_options", type(options) is dict and options.get("values")),
+    ):
+        if type(table) is list and len(table) > budget.max_episodes:
+            raise InvalidEpisodeLogError(
+                f"the episode log: {name} holds {len(table):,} entries, more than the call's limit of {budget.max_episodes:,} episodes"  # noqa: E501
             )
 
 
-def _length(column: list[Any] | PlainList | TaggedArray) -> int:
-    """Entries of a per-step column as announced (list length or array shape), without decoding it."""
-    if isinstance(column, list):
-        return len(column)
-    if isinstance(column, PlainList):
-        return len(column.items)
-    shape = column["spec"]["shape"]
-    return shape[0] if shape else 0
-
-
-def _decoded_arrays(episodes: list[WireEpisode]) -> Iterator[np.ndarray]:
-    """Every array column of the log, episode by episode in `EPISODE_COLUMNS` order (the order `_episode`
-    takes them in), decoded `ARRAY_BATCH` at a time: one decoder per batch, not one per column, and only a
-    batch of arrays alive at once."""
-    columns = [
-        (number, name, column["spec"])
-        for number, episode in enumerate(episodes)
-        for name in EPISODE_COLUMNS
-        if isinstance(column := episode[name], dict)  # type: ignore[literal-required]
-    ]
-    for start in range(0, len(columns), ARRAY_BATCH):
-        batch = columns[start : start + ARRAY_BATCH]
-        try:
-            arrays: list[np.ndarray] = decode_value([{NDARRAY_TAG: spec} for _, _, spec in batch], "the log")
-        except InvalidValueError:
-            for number, name, spec in batch:  # the first bad one again, for a message that names it
-                _decoded({NDARRAY_TAG: spec}, f"episode {number}: {name}")
-            raise
-        yield from arrays
-
-
-def _episode(
-    episode: WireEpisode,
-    where: str,
-    arrays: Iterator[np.ndarray],
-    mappings: dict[tuple[Any, ...], dict[str, Any]],
-) -> EpisodeLog:
-    actions = _actions(episode["actions"], arrays, f"{where}: actions")
-    rewards = _rewards(episode["rewards"], arrays, f"{where}: rewards")
-    terminated = _flags(episode["terminated"], arrays, f"{where}: terminated")
-    truncated = _flags(episode["truncated"], arrays, f"{where}: truncated")
-    if not len(actions) == len(rewards) == len(terminated) == len(truncated):
+def _announced(log: WireLog, budget: CallBudget | None) -> tuple[int, int]:
+    """`(episodes, steps)` as the arrays' specs announce them, every spec checked, no data decoded."""
+    episodes = _shape(log["lengths"], "lengths", _INT_KINDS, 1)[0]
+    if budget is not None and episodes > budget.max_episodes:
         raise InvalidEpisodeLogError(
-            f"{where}: actions, rewards, terminated and truncated must have one entry per step, found {len(actions)}, {len(rewards)}, {len(terminated)} and {len(truncated)}"  # noqa: E501
+            f"the log holds {episodes:,} episodes, more than the call's limit of {budget.max_episodes:,}"
         )
-    reset_options = episode["reset_options"]
-    return EpisodeLog(
-        env_index=episode["env_index"],
-        requested_id=episode["requested_id"],
-        env_id=episode["env_id"],
-        env_kwargs=_env_kwargs(episode["env_kwargs"], f"{where}: env_kwargs", mappings),
-        reset_seed=episode["reset_seed"],
-        student_seed=episode["student_seed"],
-        actions=actions,
-        rewards=rewards,
-        terminated=terminated,
-        truncated=truncated,
-        reset_options=None if reset_options is None else _mapping(reset_options, f"{where}: reset_options"),
-    )
-
-
-def _actions(
-    column: list[int] | PlainList | TaggedArray, arrays: Iterator[np.ndarray], where: str
-) -> list[Any]:
-    if isinstance(column, list):
-        return column
-    if isinstance(column, PlainList):
-        return _decoded(column.items, where)  # type: ignore[no-any-return]
-    return _array(next(arrays), "iu", where).tolist()  # type: ignore[no-any-return]
-
-
-def _rewards(column: list[Any] | TaggedArray, arrays: Iterator[np.ndarray], where: str) -> list[float]:
-    if isinstance(column, list):
-        return column
-    return _array(next(arrays), "biuf", where).astype(np.float64).tolist()  # type: ignore[no-any-return]
-
-
-def _flags(column: list[bool] | TaggedArray, arrays: Iterator[np.ndarray], where: str) -> list[bool]:
-    if isinstance(column, list):
-        return column
-    return _array(next(arrays), "b", where).tolist()  # type: ignore[no-any-return]
-
-
-def _array(array: np.ndarray, kinds: str, where: str) -> np.ndarray:
-    if array.ndim != 1 or array.dtype.kind not in kinds:
+    steps = _shape(log["rewards"], "rewards", _COLUMN_KINDS["rewards"], 1)[0]
+    if budget is not None and steps > budget.max_steps:
         raise InvalidEpisodeLogError(
-            f"{where} should be a 1-D array of kind {kinds!r} or a list, found {describe(array)}"
+            f"the log holds {steps:,} steps, more than the call's limit of {budget.max_steps:,}"
         )
-    return array
+    for name in ("made", "env_index", "reset_seed"):
+        _shape(log[name], name, _INT_KINDS, 1, episodes)  # type: ignore[literal-required]
+    for name in ("terminated", "truncated"):
+        _shape(log[name], name, _COLUMN_KINDS[name], 1, steps)  # type: ignore[literal-required]
+    form, actions = log["action_form"], log["actions"]
+    if form == "plain":
+        if type(actions) is not list or len(actions) != steps:
+            raise InvalidEpisodeLogError(
+                f"the episode log: actions sent as plain values should be a list of {steps:,} entries, found {describe(actions)}"  # noqa: E501
+            )
+    elif type(actions) is list:
+        raise InvalidEpisodeLogError(
+            f"the episode log: actions of form {form!r} should be an array, found a list of {len(actions):,} entries"  # noqa: E501
+        )
+    elif form == "int":
+        _shape(actions, "actions", _INT_KINDS, 1, steps)  # type: ignore[arg-type]
+    else:
+        _shape(actions, "actions", "biuf", None, steps)  # type: ignore[arg-type]
+    if len(log["envs"]) > max(episodes, 1):
+        raise InvalidEpisodeLogError(
+            f"the episode log: envs should list at most one env per episode ({episodes:,}), found {len(log['envs']):,}"  # noqa: E501
+        )
+    for name in ("student_seed", "reset_options"):
+        sparse = log[name]  # type: ignore[literal-required]
+        count = _shape(sparse["episodes"], f"{name}.episodes", _INT_KINDS, 1)[0]
+        values = sparse["values"]
+        found = len(values) if type(values) is list else _shape(values, f"{name}.values", _INT_KINDS, 1)[0]
+        if count > episodes or found != count:
+            raise InvalidEpisodeLogError(
+                f"the episode log: {name} should give one value for each of at most {episodes:,} episodes, found {count:,} episodes and {found:,} values"  # noqa: E501
+            )
+    return episodes, steps
 
 
-def _env_kwargs(
-    value: dict[str, Any], where: str, decoded: dict[tuple[Any, ...], dict[str, Any]]
-) -> dict[str, Any]:
-    """`_mapping` of an episode's env arguments, decoded once per call for arguments of plain scalars.
+def _shape(
+    column: TaggedArray, name: str, kinds: str, ndim: int | None, length: int | None = None
+) -> list[int]:
+    """The announced shape of an array, refused unless its dtype is of `kinds`, it has `ndim` dimensions
+    (at least one when None) and `length` entries along the first."""
+    spec = column["spec"]
+    dtype, shape = spec["dtype"], spec["shape"]
+    kind = np.dtype(dtype).kind if dtype in ARRAY_DTYPES else None
+    dimensions_ok = len(shape) == ndim if ndim is not None else len(shape) >= 1
+    if kind is None or kind not in kinds or not dimensions_ok or (length is not None and shape[0] != length):
+        expected = f"{ndim}-D" if ndim is not None else "an at least 1-D"
+        entries = f" of {length:,} entries" if length is not None else ""
+        raise InvalidEpisodeLogError(
+            f"the episode log: {name} should be {expected} array of kind {kinds!r}{entries}, found dtype {str(dtype)[:20]!r} and shape {shape}"  # noqa: E501
+        )
+    return shape
 
-    Every episode of one env repeats the same arguments (Blackjack's `natural` and `sab`, 10 000 games a
-    call); the key holds each value's type, so `True` and `1` stay apart. Each episode gets its own copy.
-    """
-    if not value:
-        return value
+
+def _array(column: TaggedArray, name: str) -> np.ndarray:
+    """The decoded array (its spec already checked by `_shape`)."""
     try:
-        key = tuple((name, type(item), item) for name, item in value.items())
-        known = decoded.get(key)
-    except TypeError:  # a list or dict among the values: decoded every time
-        return _mapping(value, where)
-    if known is None:
-        known = decoded[key] = _mapping(value, where)
-    return dict(known)
+        return decode_array(column["spec"], f"the episode log ({name})")
+    except InvalidValueError as error:
+        raise InvalidEpisodeLogError(error.message) from None
+
+
+def _ints(column: TaggedArray, name: str, low: int, high: int) -> list[int]:
+    """An int array's values as a list, refused unless each is within [low, high]."""
+    array = _array(column, name)
+    if array.size and (int(array.min()) < low or int(array.max()) > high):
+        raise InvalidEpisodeLogError(
+            f"the episode log: {name} should hold ints from {low:,} to {high:,}, found {int(array.min()):,} to {int(array.max()):,}"  # noqa: E501
+        )
+    values: list[int] = array.tolist()
+    return values
+
+
+def _positions(column: TaggedArray, name: str, episodes: int) -> list[int]:
+    """The episode numbers of a sparse field: increasing, each below `episodes`."""
+    positions = _ints(column, f"{name}.episodes", 0, max(episodes - 1, 0))
+    if any(later <= earlier for earlier, later in itertools.pairwise(positions)):
+        raise InvalidEpisodeLogError(
+            f"the episode log: {name}.episodes should be strictly increasing episode numbers, found {describe(positions)}"  # noqa: E501
+        )
+    return positions
+
+
+def _sparse_options(sparse: SparseOptions, episodes: int) -> dict[int, dict[str, Any]]:
+    positions = _positions(sparse["episodes"], "reset_options", episodes)
+    return {
+        number: _mapping(options, f"episode {number}: reset_options")
+        for number, options in zip(positions, sparse["values"], strict=True)
+    }
+
+
+def _actions(form: str, column: TaggedArray | list[Any], steps: int) -> list[Any]:
+    """Every step's action (shape and length already checked by `_announced`)."""
+    if type(column) is list:
+        return _decoded(column, "actions")  # type: ignore[no-any-return]
+    array = _array(column, "actions")  # type: ignore[arg-type]
+    if form == "int":
+        return array.tolist()  # type: ignore[no-any-return]
+    return [array[step, ...] for step in range(steps)]  # one array per step, of the action's shape
 
 
 def _mapping(value: dict[str, Any], where: str) -> dict[str, Any]:
@@ -330,7 +381,7 @@ def _mapping(value: dict[str, Any], where: str) -> dict[str, Any]:
         return value
     decoded = clean_plain(_decoded(value, where))
     if type(decoded) is not dict:
-        raise InvalidEpisodeLogError(f"{where} should be a dict, found {describe(decoded)}")
+        raise InvalidEpisodeLogError(f"the episode log: {where} should be a dict, found {describe(decoded)}")
     return decoded
 
 

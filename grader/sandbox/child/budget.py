@@ -19,16 +19,19 @@ FRAME_ALLOWANCE_BYTES = 4 << 20
 FRAME_ALLOWANCE_NODES = 500_000
 """Structural characters (`,` `[` `{`) of a result frame besides its episodes."""
 EPISODE_BYTES = 1024
-"""Bytes of one encoded episode besides its steps (a Blackjack game: about 260, ids and arguments too)."""
+"""Bytes of one encoded episode besides its steps (in the columnar block a few in the per-episode arrays,
+plus its env's table entry and reset options where it has them: a few hundred)."""
 EPISODE_NODES = 64
-"""Structural characters of one encoded episode besides its steps (about 20 in list form, 33 with arrays)."""
+"""Structural characters of one encoded episode besides its steps (none in the per-episode arrays; about
+10 for a table entry or reset options, plus their contents)."""
 STEP_BYTES = 64
-"""Bytes of one step: at most 35 in list form (float reward), 16 in arrays; a Box action takes about 62."""
+"""Bytes of one step: about 6 in the block's arrays (int8 action and reward, two flags, base64); an action
+sent in the plain form takes up to about 62 (a tagged array)."""
 STEP_NODES = 8
-"""Structural characters of one step in list form (4 columns; a Box action takes about 7 alone)."""
+"""Structural characters of one step whose action travels in the plain form (an array action: about 7)."""
 LIST_STEPS = MAX_NODES // 2 // 4
-"""Most steps a call's log sends in list form (`recorder.LIST_NODE_BUDGET` entries over 4 columns);
-beyond that every column is one array, whose steps add no structural characters."""
+"""Most steps whose structural characters the limit counts: beyond them a log's actions are arrays, whose
+steps add none (`encode_value` refuses a plain form of more than `MAX_NODES` elements anyway)."""
 UNBUDGETED_NODES = 4 * MAX_NODES
 """Structural characters of a recording call without a budget (a 120 000-episode Taxi log has 4 million)."""
 

@@ -20,6 +20,7 @@ from grader.sandbox.child.cells import RUN_CELLS, run_cells
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
 from grader.sandbox.child.frames import EnvArgument, decode_value, encode_value
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
+from grader.sandbox.child.log_block import NO_EPISODES, log_block
 from grader.sandbox.child.provided import PROVIDED
 from grader.sandbox.child.recorder import Recorder
 from grader.sandbox.child.stubs import RAISING_STUB, stub_body
@@ -119,8 +120,8 @@ def run_call(
         )
     if result["status"] == "ok":
         try:
-            plain = [episode.to_plain() for episode in episodes]
-            result["episodes"] = encode_value(plain, "the episode log", max_bytes=max_frame)
+            block = log_block(episodes) if episodes else NO_EPISODES
+            result["episodes"] = encode_value(block, "the episode log", max_bytes=max_frame)
         except InvalidValueError as error:
             result = _status("invalid_value", error.message, wall_time=result["wall_time"])
         except FrameTooLargeError as error:
@@ -281,7 +282,7 @@ def _status(status: str, message: str, *, traceback: str = "", wall_time: float 
         "value": None,
         "message": shortened(message),
         "traceback": shortened(traceback),
-        "episodes": [],
+        "episodes": NO_EPISODES,
         "wall_time": wall_time,
     }
 

@@ -1,9 +1,12 @@
-"""The fields of an episode on the wire, declared once for the child's recorder and the parent's decoder.
+"""The fields of an episode and of a call's columnar episode log on the wire, declared once for both sides.
 
 Standard library only (the child imports it before the student's code, the parent without the child's
-gymnasium set-up). The child's `EpisodeRecord.to_plain` sends exactly these keys in this order; the
-parent's `grader.sandbox.episode_log.WireEpisode` validates exactly these keys and refuses to import if its
-declaration drifts from them.
+gymnasium set-up). An episode has the fields `EPISODE_FIELDS` (the child's `EpisodeRecord`, the parent's
+`EpisodeLog`, the in-process simulation of `grader.testing`). A call's episodes travel as one block with the
+keys `LOG_FIELDS` (`grader.sandbox.child.log_block` builds it, `grader.sandbox.episode_log.WireLog`
+validates it): the made-env fields as a table of distinct descriptions, the other header fields as
+per-episode columns (sparse where mostly absent), the per-step columns concatenated over all episodes, and
+one array of episode lengths. Both models are checked against these declarations at import.
 """
 
 from __future__ import annotations
@@ -22,11 +25,28 @@ EPISODE_HEADER = (
 )
 """The fields of an episode besides its per-step columns, in the order they are sent."""
 EPISODE_COLUMNS = ("actions", "rewards", "terminated", "truncated")
-"""The per-step columns: one entry per step, as a list for short episodes and a numpy array otherwise."""
+"""The per-step columns: one entry per step."""
 EPISODE_FIELDS = EPISODE_HEADER + EPISODE_COLUMNS
-"""Every field of an episode on the wire, in the order they are sent."""
-SHORT_EPISODE_STEPS = 16
-"""Episodes up to this many steps send their columns as lists, longer ones as numpy arrays."""
+"""Every field of an episode, in this order."""
+
+MADE_FIELDS = ("requested_id", "env_id", "env_kwargs")
+"""How an episode's env was made: the fields of one entry of the log's `envs` table (distinct entries)."""
+DENSE_FIELDS = ("env_index", "reset_seed")
+"""Header fields every episode has: one integer array each, one entry per episode."""
+SPARSE_FIELDS = ("student_seed", "reset_options")
+"""Header fields most episodes leave empty (None): `{"episodes": int array, "values": ...}` where present."""
+LOG_FIELDS = ("envs", "made", *DENSE_FIELDS, *SPARSE_FIELDS, "lengths", "action_form", *EPISODE_COLUMNS)
+"""The keys of a call's episode log on the wire, in the order they are sent:
+
+- `envs`: the distinct `MADE_FIELDS` dicts of the call; `made`: per episode, its index in `envs`;
+- `env_index`, `reset_seed`: per episode; `student_seed`, `reset_options`: sparse, as above;
+- `lengths`: per episode, its steps; the per-step columns hold `sum(lengths)` entries, episode after episode;
+- `action_form`: one of `ACTION_FORMS`, how `actions` is sent.
+"""
+ACTION_FORMS = ("int", "array", "plain")
+"""`actions` as a 1-D int array (`Discrete` envs: every action a plain int); as one array of shape
+(steps, *shape) when every action is a numpy array of one shape and dtype (`Box` envs, one step per row);
+else as one plain list of the actions (any mix the student passed, each decoded as plain data)."""
 
 
 @dataclass(frozen=True)
@@ -52,6 +72,19 @@ class EpisodeHeader:
     env_kwargs: dict[str, Any]
     reset_seed: int
     student_seed: int | None
+
+
+def check_log_declaration(declared: tuple[str, ...], where: str) -> None:
+    """Refuse a model of the wire log whose keys are not `LOG_FIELDS` in order (see `check_declaration`).
+
+    Raises:
+        TypeError: `declared` differs from `LOG_FIELDS`, or `LOG_FIELDS` does not cover `EPISODE_FIELDS`.
+    """
+    covered = MADE_FIELDS + DENSE_FIELDS + SPARSE_FIELDS + EPISODE_COLUMNS
+    if declared != LOG_FIELDS or sorted(covered) != sorted(EPISODE_FIELDS):
+        raise TypeError(
+            f"{where} declares the log fields {declared}, expected {LOG_FIELDS} covering {EPISODE_FIELDS} (grader/sandbox/child/episode_fields.py is the one declaration: change it there and in the models)"  # noqa: E501
+        )
 
 
 def check_declaration(declared: tuple[str, ...], where: str) -> None:

@@ -47,11 +47,12 @@ _NUMPY_SCALARS: dict[type, Callable[[Any], Any]] = {
     **{getattr(np, name): float for name in ("float16", "float32", "float64", "longdouble")},
 }
 _ARRAY_KINDS = frozenset("biuf")
-_ALLOWED_DTYPES = frozenset(
+ARRAY_DTYPES = frozenset(
     np.dtype(code).newbyteorder(order).str
     for code in ("?", "i1", "i2", "i4", "i8", "u1", "u2", "u4", "u8", "f2", "f4", "f8")
     for order in ("<", ">")
 )
+"""The dtypes (`dtype.str`) an array may have on the wire: bool, int, uint and float, either byte order."""
 
 
 @dataclass(frozen=True)
@@ -177,6 +178,18 @@ def decode_value(data: Any, what: str = "the value", *, allow_envs: bool = False
         return _Decoder(what, allow_envs).decode(data, "", 0)
 
 
+def decode_array(spec: Any, what: str = "the array") -> np.ndarray:
+    """Decode the payload of one ``{"$ndarray": spec}`` tag, as `decode_value` would (for many arrays).
+
+    Raises:
+        InvalidValueError: `spec` is not a dict with a bool/int/float dtype, a shape and base64 data of
+            exactly that size (checked before decoding).
+    """
+    if type(spec) is not dict:
+        raise _invalid(what, "", "an array's payload must be a dict")
+    return _decode_array(spec, what, "")
+
+
 class _Encoder:
     def __init__(self, what: str, max_bytes: int | None) -> None:
         self.what = what
@@ -280,7 +293,7 @@ def _decode_env(spec: Any, what: str, where: str) -> EnvArgument:
 
 
 def _encode_array(array: np.ndarray, what: str, where: str) -> dict[str, Any]:
-    if array.dtype.kind not in _ARRAY_KINDS or array.dtype.str not in _ALLOWED_DTYPES:
+    if array.dtype.kind not in _ARRAY_KINDS or array.dtype.str not in ARRAY_DTYPES:
         raise _invalid(
             what,
             where,
@@ -297,7 +310,7 @@ def _decode_array(spec: dict[str, Any], what: str, where: str) -> np.ndarray:
     if spec.keys() != {"dtype", "shape", "data"}:
         raise _invalid(what, where, f"an array needs exactly dtype, shape and data, found {sorted(spec)}")
     dtype_name, shape, data = spec["dtype"], spec["shape"], spec["data"]
-    if type(dtype_name) is not str or dtype_name not in _ALLOWED_DTYPES:
+    if type(dtype_name) is not str or dtype_name not in ARRAY_DTYPES:
         raise _invalid(what, where, f"array dtype {dtype_name!r} is not a bool/int/float dtype")
     if (
         type(shape) is not list

@@ -32,26 +32,14 @@ from grader.compat import make as compat_make
 from grader.compat import register_envs, resolve_env_id
 from grader.sandbox.child import envs
 from grader.sandbox.child.budget import WireBudget
-from grader.sandbox.child.episode_fields import (
-    EPISODE_FIELDS,
-    EPISODE_HEADER,
-    SHORT_EPISODE_STEPS,
-    EpisodeHeader,
-    check_declaration,
-)
-from grader.sandbox.child.frames import MAX_NODES
+from grader.sandbox.child.episode_fields import EPISODE_FIELDS, EpisodeHeader, check_declaration
 from grader.sandbox.child.seeding import CallSeeds, kept_generator_seed
 
 DEFAULT_MAX_RECORDED_STEPS = 5_000_000
-LIST_NODE_BUDGET = MAX_NODES // 2
-"""Most elements a call's episode log may take with list columns; beyond it all columns are arrays."""
-EPISODE_NODES = 16
-"""Elements of one encoded episode besides its columns' entries and its env arguments (a bound)."""
 MAX_KEPT_GENERATORS = 10_000
 """Generators made at import that are reset at every call (strong references, so capped)."""
 _DROPPED_KWARGS = ("render_mode", "disable_env_checker")
 _COMPAT_MAKE_CODE = compat_make.__code__
-_EXACT_INTS = 2**53
 _NO_STEP_LIMIT = sys.maxsize
 _FLOAT_ERRORS = (TypeError, ValueError, OverflowError)
 
@@ -63,8 +51,8 @@ class EpisodeRecord(EpisodeHeader):
     Its first fields are the wire's (`episode_fields.EPISODE_FIELDS`, checked at import). The columns are
     compact typed arrays, appended to without creating a Python object per step: actions as 64-bit ints
     (a list from the first action that is not a plain int, a `Box` env's arrays say), rewards as doubles,
-    the flags as bytes. Frozen as its header is; the two fields that change (`actions` becoming a list,
-    `short_as_lists`) are set through `_replace_field`.
+    the flags as bytes. `grader.sandbox.child.log_block` joins a call's episodes into one block for the
+    wire. Frozen as its header is; `actions` becoming a list is set through `_replace_field`.
     """
 
     reset_options: dict[str, Any] | None
@@ -72,35 +60,6 @@ class EpisodeRecord(EpisodeHeader):
     rewards: array[float] = field(default_factory=lambda: array("d"))
     terminated: bytearray = field(default_factory=bytearray)
     truncated: bytearray = field(default_factory=bytearray)
-    short_as_lists: bool = True
-
-    def to_plain(self) -> dict[str, Any]:
-        """The wire layout parsed by `grader.sandbox.episode_log.episodes_from_plain`.
-
-        Per-step columns are compact numpy arrays, or plain lists for episodes of at most
-        `SHORT_EPISODE_STEPS` steps (a Blackjack game), where four arrays would cost more to encode and
-        decode than the steps themselves (unless `short_as_lists` was turned off, see `finish_call`).
-        """
-        plain: dict[str, Any] = {name: getattr(self, name) for name in EPISODE_HEADER}
-        if self.short_as_lists and len(self.actions) <= SHORT_EPISODE_STEPS:
-            plain["actions"] = list(self.actions)
-            # Integral rewards travel as ints: JSON parses ints without a Python callback per number.
-            plain["rewards"] = [
-                int(reward) if reward.is_integer() and -_EXACT_INTS <= reward <= _EXACT_INTS else reward
-                for reward in self.rewards
-            ]
-            plain["terminated"] = list(map(bool, self.terminated))
-            plain["truncated"] = list(map(bool, self.truncated))
-            return plain
-        actions = self.actions
-        if isinstance(actions, array):
-            plain["actions"] = _smallest_int_array(np.frombuffer(actions, dtype=np.int64).copy())
-        else:
-            plain["actions"] = _compact_actions(actions)
-        plain["rewards"] = _compact_numbers(np.frombuffer(self.rewards, dtype=np.float64))
-        plain["terminated"] = np.frombuffer(self.terminated, dtype=np.bool_)
-        plain["truncated"] = np.frombuffer(self.truncated, dtype=np.bool_)
-        return plain
 
     def add_action(self, action: Any) -> None:
         """Log one action (a copy: the student may mutate an array they passed), the general case.
@@ -118,10 +77,6 @@ class EpisodeRecord(EpisodeHeader):
             actions = list(actions)
             self._replace_field("actions", actions)
         actions.append(copied)
-
-    def send_arrays(self) -> None:
-        """Send every column as an array, however short the episode (see `finish_call`)."""
-        self._replace_field("short_as_lists", False)
 
     def _replace_field(self, name: str, value: Any) -> None:
         object.__setattr__(self, name, value)  # the frozen header's dataclass forbids plain assignment
@@ -216,22 +171,10 @@ class Recorder:
                 bit_generator.state = initial_state
 
     def finish_call(self) -> list[EpisodeRecord]:
-        """Stop recording and return the call's episodes in reset order.
-
-        Short episodes send their columns as lists unless that would take the call's log past
-        `LIST_NODE_BUDGET` elements; then every episode sends arrays (an element count that grows with
-        the episodes, not with their steps, as `grader.sandbox.child.frames.MAX_NODES` requires).
-        """
+        """Stop recording and return the call's episodes in reset order (for `log_block.log_block`)."""
         self.recording = False
         self.record_call = False
         episodes, self.episodes = self.episodes, []
-        list_nodes = sum(
-            EPISODE_NODES + len(episode.env_kwargs) + 4 * _list_entries(len(episode.actions))
-            for episode in episodes
-        )
-        if list_nodes > LIST_NODE_BUDGET:
-            for episode in episodes:
-                episode.send_arrays()
         return episodes
 
     def keep_generator(self, generator: np.random.Generator, *, seeded: bool) -> None:
@@ -518,35 +461,3 @@ def _copy_action(action: Any) -> Any:
     if kind is list or kind is tuple:
         return [_copy_action(item) for item in action]
     return action
-
-
-def _list_entries(steps: int) -> int:
-    """Entries per column as sent: one per step in list form, one array otherwise."""
-    return steps if steps <= SHORT_EPISODE_STEPS else 1
-
-
-def _compact_actions(actions: list[Any]) -> Any:
-    if actions and set(map(type, actions)) == {int}:
-        try:
-            return _smallest_int_array(np.array(actions, dtype=np.int64))
-        except OverflowError:
-            return actions
-    return actions
-
-
-def _compact_numbers(values: np.ndarray) -> np.ndarray:
-    """The smallest dtype that holds `values` exactly (Taxi's rewards fit int8)."""
-    if values.size and np.all(np.abs(values) < 2**31) and np.all(values == np.trunc(values)):
-        return _smallest_int_array(values.astype(np.int64))
-    return values.copy()
-
-
-def _smallest_int_array(values: np.ndarray) -> np.ndarray:
-    if values.size == 0:
-        return values.astype(np.int8)
-    low, high = int(values.min()), int(values.max())
-    for dtype in (np.int8, np.int16, np.int32):
-        info = np.iinfo(dtype)
-        if info.min <= low and high <= info.max:
-            return values.astype(dtype)
-    return values

@@ -14,8 +14,11 @@ import numpy as np
 import pytest
 from child_client import ChildClient, write_submission
 
-from grader.sandbox.child.frames import MAX_NODES, decode_value, encode_value
-from grader.sandbox.child.recorder import SHORT_EPISODE_STEPS, EpisodeRecord, MadeEnv, Recorder, RecordingEnv
+from grader.sandbox.child.budget import structural_count
+from grader.sandbox.child.episode_fields import EPISODE_FIELDS
+from grader.sandbox.child.frames import decode_value, encode_frame, encode_value
+from grader.sandbox.child.log_block import log_block
+from grader.sandbox.child.recorder import EpisodeRecord, MadeEnv, Recorder, RecordingEnv
 from grader.sandbox.child.seeding import derive_call_seed, reset_seeds
 from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
 from grader.sandbox.replay import verify_reset_seeds
@@ -386,13 +389,13 @@ def test_results_larger_than_a_frame_are_output_too_large(submission: Path) -> N
     assert result["message"].endswith(" bytes, more than the limit of 2000 bytes; play fewer episodes")
 
 
-def short_episodes(count: int) -> Recorder:
+def short_episodes(count: int, steps: int = 2) -> Recorder:
     recorder = Recorder(seed=3)
     for number in range(count):
         episode = EpisodeRecord(
-            0, "Blackjack-v0", "Blackjack-v1", {"natural": False, "sab": False}, number, None, None
+            number % 2, "Blackjack-v0", "Blackjack-v1", {"natural": False, "sab": False}, number, None, None
         )
-        for _ in range(SHORT_EPISODE_STEPS):
+        for _ in range(steps):
             episode.actions.append(1)
             episode.rewards.append(0.0)
             episode.terminated.append(False)
@@ -401,18 +404,36 @@ def short_episodes(count: int) -> Recorder:
     return recorder
 
 
-@pytest.mark.parametrize(
-    ("count", "lists"),
-    [(100, True), (MAX_NODES // (4 * SHORT_EPISODE_STEPS), False)],
-    ids=["within-budget-lists", "over-budget-arrays"],
-)
-def test_short_episodes_use_lists_only_within_the_element_budget(count: int, lists: bool) -> None:
+@pytest.mark.parametrize("count", [1, 100, 100_000], ids=["one", "hundred", "hundred-thousand"])
+def test_a_calls_log_takes_the_same_few_json_elements_however_many_episodes_it_holds(count: int) -> None:
     episodes = short_episodes(count).finish_call()
 
-    plain = [episode.to_plain() for episode in episodes]
-    assert {type(episode["actions"]) for episode in plain} == {list if lists else np.ndarray}
-    encoded = encode_value(plain, "the episode log")  # as lists, the second case would pass MAX_NODES
-    assert len(episodes_from_plain(encoded)) == count
+    block = log_block(episodes)
+    frame = encode_frame({"episodes": encode_value(block, "the episode log")})
+
+    assert structural_count(frame[4:]) < 100  # a table entry and a dozen arrays, none per episode
+    assert (block["envs"], block["made"].tolist()) == (
+        [
+            {
+                "requested_id": "Blackjack-v0",
+                "env_id": "Blackjack-v1",
+                "env_kwargs": {"natural": False, "sab": False},
+            }
+        ],
+        [0] * count,
+    )
+    assert (block["actions"].dtype, block["rewards"].dtype, len(block["actions"])) == (
+        np.int8,
+        np.int8,
+        2 * count,
+    )
+    assert episodes_from_plain(encode_value(block)) == [
+        EpisodeLog(
+            **{name: getattr(episode, name) for name in EPISODE_FIELDS}
+            | {"actions": [1, 1], "rewards": [0.0, 0.0], "terminated": [False] * 2, "truncated": [False] * 2}
+        )
+        for episode in episodes
+    ]
 
 
 BUDGET = {"max_episodes": 4, "max_steps": 20}
