@@ -221,7 +221,8 @@ def section(runs: list[EditionRun], cores: int, workers: int, load: LoadSampler,
     two_core_bound = PROJECTED_CLASS * per_plain / 2
     four_core = PROJECTED_CLASS * per_grade / 4 + longest
     four_core_bound = PROJECTED_CLASS * per_plain / 4
-    busy = statistics.median(load.samples) > cores
+    # The run itself keeps `workers` processes busy (a load of about `workers`); beyond that, others ran.
+    busy = statistics.median(load.samples) > workers + 0.5
     stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
     lines = [
         HEADING,
@@ -229,7 +230,7 @@ def section(runs: list[EditionRun], cores: int, workers: int, load: LoadSampler,
         f"`{command}`, {stamp}, {platform.machine()}, {cores} cores, full isolation, `--workers {workers}`. "
         f"Machine load during the run: {load.summary()}."
         + (
-            f" **The machine was shared with other engineers' jobs (median load above {cores} cores)**: "
+            f" **The machine was shared with other jobs (median load above this run's {workers} workers)**: "
             "the wall times and the wall ratio are stretched by them; the CPU figures are not."
             if busy
             else ""
