@@ -43,15 +43,17 @@ def display(*objs: Any, **kwargs: Any) -> None:
 class LightIPython(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     """Serves the light `IPython` and `IPython.display` until something else of IPython is wanted.
 
-    It serves nothing when IPython is not installed (the compat layer's stand-in answers then), and
-    nothing once the real IPython is loaded. It stays on `sys.meta_path` either way: the import system
+    It serves nothing when IPython is not installed (the compat layer's stand-in answers then) or when
+    `IPython` on `sys.path` is not IPython's package (a student's own `IPython.py`), and nothing once the
+    real IPython is loaded. It stays on `sys.meta_path` either way: the import system
     iterates that very list while asking it, so removing an entry there would skip the next finder.
     """
 
     def __init__(self) -> None:
         real = importlib.machinery.PathFinder.find_spec(PACKAGE)
-        self._locations = list(real.submodule_search_locations or []) if real is not None else None
-        self.light = self._locations is not None
+        # Only IPython's package: a module of the student's own named IPython is theirs to import.
+        self._locations = list(real.submodule_search_locations or []) if real is not None else []
+        self.light = bool(self._locations)
 
     def find_spec(
         self, fullname: str, path: Sequence[str] | None, target: ModuleType | None = None
@@ -74,7 +76,7 @@ class LightIPython(importlib.abc.MetaPathFinder, importlib.abc.Loader):
         module = ModuleType(spec.name)
         module.__getattr__ = self._forward(spec.name)  # type: ignore[method-assign]
         if spec.name == PACKAGE:
-            module.__path__ = list(self._locations or [])
+            module.__path__ = list(self._locations)
         else:
             module.clear_output = clear_output  # type: ignore[attr-defined]
             module.display = display  # type: ignore[attr-defined]

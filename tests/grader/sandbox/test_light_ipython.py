@@ -7,21 +7,23 @@ import json
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import pytest
 
-INSTALL = """
+ROOT = Path(__file__).resolve().parents[3]
+INSTALL = f"""
 import sys
+sys.path.insert(1, {str(ROOT)!r})
 from grader.sandbox.child.light_ipython import LightIPython
 sys.meta_path.insert(0, LightIPython())
 """
 
 
-def _run(code: str, *, light: bool = True) -> subprocess.CompletedProcess[str]:
+def _run(code: str, *, light: bool = True, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
     source = (INSTALL if light else "") + textwrap.dedent(code)
-    return subprocess.run(
-        [sys.executable, "-c", source], capture_output=True, text=True, check=False, timeout=120
-    )
+    command = [sys.executable, "-c", source]
+    return subprocess.run(command, capture_output=True, text=True, check=False, timeout=120, cwd=cwd)
 
 
 def _facts(code: str) -> dict[str, object]:
@@ -122,3 +124,12 @@ def test_a_missing_name_is_still_an_import_error() -> None:
 def _real_version() -> str:
     done = _run("import IPython; print(IPython.__version__)", light=False)
     return done.stdout.strip()
+
+
+def test_a_students_own_ipython_module_is_theirs(tmp_path: Path) -> None:
+    (tmp_path / "IPython.py").write_text(
+        "def clear_output(wait=False):\n    print('mine')\n", encoding="utf-8"
+    )
+    done = _run("import IPython\nIPython.clear_output()\nprint(IPython.__file__)", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == ["mine", str(tmp_path / "IPython.py")]
