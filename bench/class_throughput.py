@@ -58,6 +58,7 @@ sys.path.insert(0, str(BENCH))
 from class_calls import LOG_VARIABLE, read_calls  # noqa: E402
 from cpu_group import CpuGroup  # noqa: E402
 from results_section import replace_section  # noqa: E402
+from speed import plain_command  # noqa: E402
 
 HEADING = "## Class throughput"
 EDITIONS = {
@@ -186,8 +187,7 @@ def plain_cpu(submission: Path, calls_file: Path, *, child_envs: bool = False) -
     (`bench/speed.py --plain-child`; with `child_envs`, on the sandbox child's envs)."""
     environment = dict(os.environ)
     environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), environment.get("PYTHONPATH")]))
-    command = [sys.executable, str(BENCH / "speed.py"), "--plain-child", str(calls_file), str(submission)]
-    command += ["--plain-child-envs"] if child_envs else []
+    command = plain_command(submission, calls_file, child_envs=child_envs)
     started = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True, env=environment, check=False)
     wall = time.perf_counter() - started

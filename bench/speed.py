@@ -188,16 +188,16 @@ def timed_run(command: Sequence[str], root: Path = ROOT, **extra: str) -> Run:
     return Run(wall, done.stdout, done.returncode, cpu)
 
 
+def plain_command(submission: Path, calls_file: Path, *, child_envs: bool = False) -> list[str]:
+    """The command that runs the recorded calls plainly in a fresh interpreter (`plain_child`)."""
+    script = str(Path(__file__).resolve())
+    command = [sys.executable, script, "--plain-child", str(calls_file), str(submission)]
+    return command + (["--plain-child-envs"] if child_envs else [])
+
+
 def plain_run(submission: Path, calls_file: Path, *, child_envs: bool = False) -> tuple[Run, dict[str, Any]]:
     """The recorded calls run plainly in a fresh interpreter (with the child's envs: `plain_child`)."""
-    command = [
-        sys.executable,
-        str(Path(__file__).resolve()),
-        "--plain-child",
-        str(calls_file),
-        str(submission),
-    ]
-    run = timed_run(command + (["--plain-child-envs"] if child_envs else []))
+    run = timed_run(plain_command(submission, calls_file, child_envs=child_envs))
     if run.returncode != 0:
         raise SystemExit(f"the plain run failed (exit {run.returncode}): {run.stdout[-2000:]}")
     return run, json.loads(run.stdout.strip().splitlines()[-1])
@@ -574,7 +574,6 @@ def ab_lines(
         ),
         row("---", "---", "---:", "---", "---:", "---:", "---:"),
     ]
-    plain_cpu = _median_cpu([run for run, _ in plain])
     for label, runs in grades.items():
         reports = [report for _, report in runs]
         lines.append(
@@ -603,23 +602,23 @@ def ab_lines(
             )
     lines.append("")
     for label, runs in grades.items():
-        cpu = _median_cpu([run for run, _ in runs])
-        wall_ratio = median([run.wall for run, _ in runs]) / median([run.wall for run, _ in plain])
-        cpu_ratio = f"{cpu / plain_cpu:.2f}" if cpu is not None and plain_cpu else "n/a (no cgroup)"
+        wall_ratio, cpu_ratio = _ratios([run for run, _ in runs], [run for run, _ in plain])
         lines.append(f"- {label}: wall / plain {wall_ratio:.2f}, CPU / plain CPU {cpu_ratio} (goal <= 1.0).")
     if plain_child_envs and "this tree" in grades:
-        runs = grades["this tree"]
-        cpu, same_envs_cpu = (
-            _median_cpu([run for run, _ in runs]),
-            _median_cpu([run for run, _ in plain_child_envs]),
-        )
-        wall_ratio = median([run.wall for run, _ in runs]) / median([run.wall for run, _ in plain_child_envs])
-        cpu_ratio = f"{cpu / same_envs_cpu:.2f}" if cpu is not None and same_envs_cpu else "n/a (no cgroup)"
+        this_tree = [run for run, _ in grades["this tree"]]
+        wall_ratio, cpu_ratio = _ratios(this_tree, [run for run, _ in plain_child_envs])
         lines.append(
             f"- this tree against {PLAIN_CHILD_ENVS} (the grader's own work alone): wall {wall_ratio:.2f}, "
             f"CPU {cpu_ratio}."
         )
     return lines
+
+
+def _ratios(runs: Sequence[Run], against: Sequence[Run]) -> tuple[float, str]:
+    """Median wall of `runs` over that of `against`, and the same for CPU (text: n/a without a cgroup)."""
+    wall = statistics.median(run.wall for run in runs) / statistics.median(run.wall for run in against)
+    cpu, against_cpu = _median_cpu(runs), _median_cpu(against)
+    return wall, f"{cpu / against_cpu:.2f}" if cpu is not None and against_cpu else "n/a (no cgroup)"
 
 
 def _median_cpu(runs: Sequence[Run]) -> float | None:

@@ -83,7 +83,7 @@ class BlackjackEnv(blackjack.BlackjackEnv):
             return super().step(action)
         integers = self.np_random.integers
         if action:
-            self.player.append(_DECK[integers(0, _DECK_SIZE)])
+            self.player.append(_card(integers))
             if blackjack.is_bust(self.player):
                 terminated = True
                 reward = -1.0
@@ -93,7 +93,7 @@ class BlackjackEnv(blackjack.BlackjackEnv):
         else:
             terminated = True
             while blackjack.sum_hand(self.dealer) < 17:
-                self.dealer.append(_DECK[integers(0, _DECK_SIZE)])
+                self.dealer.append(_card(integers))
             reward = blackjack.cmp(blackjack.score(self.player), blackjack.score(self.dealer))
             if self.sab and blackjack.is_natural(self.player) and not blackjack.is_natural(self.dealer):
                 reward = 1.0
@@ -111,8 +111,8 @@ class BlackjackEnv(blackjack.BlackjackEnv):
             return super().reset(seed=seed, options=options)
         gymnasium.Env.reset(self, seed=seed)
         integers = self.np_random.integers
-        self.dealer = [_DECK[integers(0, _DECK_SIZE)], _DECK[integers(0, _DECK_SIZE)]]
-        self.player = [_DECK[integers(0, _DECK_SIZE)], _DECK[integers(0, _DECK_SIZE)]]
+        self.dealer = [_card(integers), _card(integers)]
+        self.player = [_card(integers), _card(integers)]
         dealer_card_value = self.dealer[0]
         self.dealer_top_card_suit = np.str_(_SUITS[integers(0, len(_SUITS))])
         if dealer_card_value == 1:
@@ -124,7 +124,13 @@ class BlackjackEnv(blackjack.BlackjackEnv):
         return self._get_obs(), {}
 
 
+def _card(integers: Any) -> int:
+    """gymnasium's `draw_card`: `int(np_random.choice(deck))`, drawn as `choice` draws it."""
+    return _DECK[integers(0, _DECK_SIZE)]
+
+
 _CHEAPER: dict[type, type] = {taxi.TaxiEnv: TaxiEnv, blackjack.BlackjackEnv: BlackjackEnv}
+"""gymnasium's class -> the cheaper one, of the same name (what `str(env)` and `type(env).__name__` show)."""
 
 
 def cheaper(env: gymnasium.Env[Any, Any]) -> None:
@@ -132,8 +138,3 @@ def cheaper(env: gymnasium.Env[Any, Any]) -> None:
     cheaper_class = _CHEAPER.get(type(env))
     if cheaper_class is not None:
         env.__class__ = cheaper_class
-
-
-for _cheaper_class in _CHEAPER.values():
-    # The student sees gymnasium's names (`str(env)`, `type(env.unwrapped).__name__`).
-    _cheaper_class.__qualname__ = _cheaper_class.__name__

@@ -45,8 +45,8 @@ class LightIPython(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
     It serves nothing when IPython is not installed (the compat layer's stand-in answers then) or when
     `IPython` on `sys.path` is not IPython's package (a student's own `IPython.py`), and nothing once the
-    real IPython is loaded. It stays on `sys.meta_path` either way: the import system
-    iterates that very list while asking it, so removing an entry there would skip the next finder.
+    real IPython is loaded. It stays on `sys.meta_path` either way: the import system iterates that very
+    list while asking it, so removing an entry there would skip the next finder.
     """
 
     def __init__(self) -> None:

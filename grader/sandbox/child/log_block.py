@@ -114,9 +114,7 @@ def _actions(episodes: Sequence[EpisodeRecord]) -> tuple[str, Any]:
 
 def _smallest_ints(values: list[int]) -> np.ndarray:
     """`values` (each within int64) in the smallest int dtype that holds them."""
-    if not values:
-        return np.zeros(0, dtype=np.int8)
-    return np.array(values, dtype=_smallest_dtype(min(values), max(values)))
+    return _smallest_int_array(np.array(values, dtype=np.int64))
 
 
 def _compact_numbers(values: np.ndarray) -> np.ndarray:
