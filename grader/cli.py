@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import io
 import signal
 import sys
 import tempfile
@@ -308,6 +309,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     0: full marks (check) or success (grade); 1: not full marks; 2: usage or grader error; 130: interrupted.
     """
+    _utf8_output()
     args = build_parser().parse_args(argv)
     handler: Handler = args.handler
     # A terminated run unwinds like Ctrl-C, so the grading processes it started are ended too.
@@ -323,6 +325,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def _utf8_output() -> None:
+    """Writes UTF-8 to a pipe or file whatever the locale says (Windows' is cp1252 or the like), and never
+    fails on a character a terminal's encoding lacks (it is shown as `?`)."""
+    for stream in (sys.stdout, sys.stderr):
+        if not isinstance(stream, io.TextIOWrapper):
+            continue
+        if stream.isatty():
+            stream.reconfigure(errors="replace")
+        else:
+            stream.reconfigure(encoding="utf-8")
 
 
 def _choose_edition(args: argparse.Namespace) -> None:

@@ -8,7 +8,6 @@ each file's report the moment its last problem is graded and tells the caller's 
 
 from __future__ import annotations
 
-import os
 import tempfile
 import time
 from collections.abc import Callable, Sequence
@@ -21,6 +20,7 @@ from grader.plan import GradingPlan
 from grader.plugin import SessionPlan
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
+from grader.sandbox.host import usable_cpus
 from grader.sandbox.isolation.scope import sandbox_scope
 from grader.sandbox.runner import require_isolation
 from grader.session import run_session
@@ -29,7 +29,7 @@ from grader.validation import FileVerdict, check_source
 
 def default_workers() -> int:
     """The cores this process may run on."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return usable_cpus()
 
 
 def grade_submission(

@@ -30,6 +30,7 @@ _PLUGINS = (
     "grader.plugin",
     "xdist.plugin",
     "no:cacheprovider",
+    "no:tmpdir",
     "no:faulthandler",
     "no:unraisableexception",
     "no:threadexception",
@@ -53,9 +54,12 @@ class SessionEnd:
 def acceptance_args(plan: SessionPlan, workers: int) -> list[str]:
     """The pytest arguments of a session (the workers rebuild their configuration from them).
 
-    ``-c`` and ``--rootdir`` keep the caller's own pytest settings out. The faulthandler,
-    unraisableexception and threadexception plugins are off: they replace process-wide hooks of the
-    calling process, and the second forces garbage collections that cost about a second per session.
+    ``-c`` and ``--rootdir`` keep the caller's own pytest settings out. No case uses pytest's temporary
+    directories (the sandbox makes its own in the grading's scope), so the tmpdir plugin is off too: it
+    would make a directory per session under the temp dir, named by a user id that Windows lacks. The
+    faulthandler, unraisableexception and threadexception plugins are off: they replace process-wide
+    hooks of the calling process, and the second forces garbage collections that cost about a second per
+    session.
     """
     args = [str(ACCEPTANCE_DIR), "-c", str(ACCEPTANCE_DIR / "pytest.ini"), "--rootdir", str(ACCEPTANCE_DIR)]
     return [*args, *_BASE_ARGS, "-n", str(max(workers, 1)), plan.option()]

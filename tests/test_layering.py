@@ -25,7 +25,7 @@ THIRD_PARTY_OF_THE_CHILD = ("numpy", "gymnasium")
 PACKAGES = ("grader", "api", "reference")
 """The project's packages: the import graph whose circles are counted."""
 GRADER_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("commands", ("cli", "acceptance")),
+    ("commands", ("cli", "__main__", "acceptance")),
     ("outputs and classes", ("render", "gradescope", "class_report", "similarity", "classroom", "doctor")),
     (
         "grading",

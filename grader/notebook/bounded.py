@@ -6,14 +6,15 @@ and allocate in proportion to their input: a cell of ten thousand nested bracket
 ``gymgrade grade`` batch grades every other file), so the parent only spawns ``python -m
 grader.notebook.bounded``, sends the bytes, and validates the reply; whatever goes wrong in the child
 (an exception, a limit, a crash) becomes that submission's verdict with a message saying what to fix.
+The CPU and memory limits are set where the system has them (`grader.sandbox.host`); elsewhere (Windows)
+the wall-clock limit and the recursion limit bound the reader.
 """
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
-import resource
-import signal
 import subprocess
 import sys
 import traceback
@@ -25,6 +26,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError
 
 from grader.notebook.models import NotebookModule, NotebookSummary
 from grader.notebook.reading import MAX_NOTEBOOK_BYTES
+from grader.sandbox.host import HOST, Feature, signal_number
 from grader.validation import FileVerdict
 
 MEMORY_BYTES = 1536 * 1024 * 1024
@@ -110,7 +112,7 @@ def _unreadable(name: str, what: str) -> FileVerdict:
 
 
 def _death(returncode: int, stderr: bytes) -> str:
-    if returncode in (-signal.SIGXCPU, -signal.SIGKILL):
+    if returncode < 0 and -returncode in (signal_number("SIGXCPU"), signal_number("SIGKILL")):
         return f"reading it used more than {CPU_SECONDS} seconds of CPU"
     if b"MemoryError" in stderr[-2000:]:
         return f"reading it needed more than {MEMORY_BYTES // 2**20:,} MiB of memory"
@@ -120,10 +122,18 @@ def _death(returncode: int, stderr: bytes) -> str:
 
 
 def _limit_self() -> None:
-    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_BYTES, MEMORY_BYTES))
-    resource.setrlimit(resource.RLIMIT_CPU, (CPU_SECONDS, CPU_SECONDS + 1))
     sys.setrecursionlimit(RECURSION_LIMIT)
+    if not HOST.has(Feature.RESOURCE_LIMITS):
+        return
+    resource = importlib.import_module("resource")
+    limits = {"RLIMIT_CORE": (0, 0), "RLIMIT_AS": (MEMORY_BYTES, MEMORY_BYTES)}
+    limits["RLIMIT_CPU"] = (CPU_SECONDS, CPU_SECONDS + 1)
+    for name, values in limits.items():
+        try:
+            resource.setrlimit(getattr(resource, name), values)
+        except (ValueError, OSError):  # macOS refuses some address-space limits; Linux has every one
+            if HOST.has(Feature.LINUX_KERNEL):
+                raise
 
 
 def _main() -> None:
@@ -153,7 +163,7 @@ def _main() -> None:
             origins=list(built.origins),
             cells=list(built.cells),
         )
-    sys.stdout.write(reply.model_dump_json())
+    sys.stdout.buffer.write(reply.model_dump_json().encode("utf-8"))
 
 
 def _unreadable_message(name: str, what: str) -> str:

@@ -7,13 +7,13 @@ import contextlib
 import os
 import re
 import selectors
-import signal
 import subprocess
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 
+from grader.sandbox import process_model
 from grader.sandbox.child.frames import HEADER
 from grader.sandbox.isolation.layer import Launch
 from grader.sandbox.text import clean_text
@@ -127,16 +127,12 @@ class ChildProcess:
         launch: Launch | None = None
         try:
             launch = make_launch(requests_read, results_write)
-            process = subprocess.Popen(
+            process = process_model.start(
                 launch.argv,
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.PIPE,
-                stderr=subprocess.PIPE,
-                pass_fds=(requests_read, results_write, *launch.pass_fds),
                 env=launch.env,
-                start_new_session=True,
-                close_fds=True,
                 cwd=launch.cwd,
+                channel=(requests_read, results_write),
+                extra_fds=launch.pass_fds,
             )
         except BaseException:
             for descriptor in (requests_write, results_read):
@@ -166,7 +162,7 @@ class ChildProcess:
             results_read: None,
         }
         for descriptor in (*child._open, requests_write):
-            os.set_blocking(descriptor, False)
+            process_model.make_nonblocking(descriptor)
         _RUNNING.add(child)
         return child
 
@@ -178,7 +174,7 @@ class ChildProcess:
         """
         deadline = time.monotonic() + timeout
         view = memoryview(frame)
-        with selectors.DefaultSelector() as selector:
+        with process_model.pipe_selector() as selector:
             selector.register(self.requests_fd, selectors.EVENT_WRITE)
             while view:
                 try:
@@ -201,7 +197,7 @@ class ChildProcess:
         Bytes beyond the frame already on the channel mean someone else wrote to it (EXTRA_DATA).
         """
         deadline = time.monotonic() + timeout
-        with selectors.DefaultSelector() as selector:
+        with process_model.pipe_selector() as selector:
             for descriptor in self._open:
                 selector.register(descriptor, selectors.EVENT_READ)
             while True:
@@ -235,9 +231,8 @@ class ChildProcess:
 
     def _read(self, descriptor: int) -> bool:
         """Reads what is available from one descriptor; False at end of stream."""
-        try:
-            data = os.read(descriptor, _READ_CHUNK)
-        except BlockingIOError:
+        data = process_model.read_available(descriptor, _READ_CHUNK)
+        if data is None:
             return True
         if not data:
             self._open.pop(descriptor, None)
@@ -253,9 +248,8 @@ class ChildProcess:
         """Reads whatever the child has already written (output and result channel) without waiting."""
         for descriptor in list(self._open):
             for _ in range(4096):
-                try:
-                    data = os.read(descriptor, _READ_CHUNK)
-                except BlockingIOError:
+                data = process_model.read_available(descriptor, _READ_CHUNK)
+                if data is None:
                     break
                 if not data:
                     self._open.pop(descriptor, None)
@@ -288,15 +282,11 @@ class ChildProcess:
         return cgroup is not None and cgroup.oom_kills() > self.oom_kills_at_start
 
     def kill_tree(self) -> None:
-        """SIGKILLs the whole tree: the cgroup, the outermost process (bwrap takes its PID namespace
-        down with it), and its process group."""
+        """Kills the whole tree: the cgroup, the outermost process (bwrap takes its PID namespace down with
+        it), and what `process_model.end` ends on this system (its process group on POSIX)."""
         if self.launch.cgroup is not None:
             self.launch.cgroup.kill()
-        if self.process.returncode is None:  # not reaped yet: its pid and group id cannot be reused
-            with contextlib.suppress(ProcessLookupError, PermissionError):
-                os.killpg(self.process.pid, signal.SIGKILL)
-            with contextlib.suppress(ProcessLookupError):
-                self.process.kill()
+        process_model.end(self.process)
 
     def close(self) -> bool:
         """Ends the child (EOF on its requests, then SIGKILL) and releases everything; False if a process

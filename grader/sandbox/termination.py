@@ -5,6 +5,7 @@ from __future__ import annotations
 import signal
 from dataclasses import dataclass
 
+from grader.sandbox.host import signal_number
 from grader.sandbox.isolation.bubblewrap import without_new_root
 from grader.sandbox.isolation.cgroup import JOIN_FAILED_EXIT
 from grader.sandbox.limits import Limits
@@ -76,13 +77,13 @@ def classify_exit(child: ChildProcess, function: str | None, limits: Limits) -> 
             f"the sandbox failed to start ({_start_failure(child)}); "
             "this is not your fault: tell the instructor (`gymgrade doctor` shows the sandbox's binds and layers on this machine)",  # noqa: E501
         )
-    if number == signal.SIGXCPU:
+    if number and number == signal_number("SIGXCPU"):
         return Ending(
             OutcomeStatus.TIMEOUT,
             f"{_during(function)} used more than {limits.cpu_seconds} seconds of CPU time and was stopped",
         )
     if number:
-        if number == signal.SIGKILL and child.launch.cgroup is None:
+        if number == signal_number("SIGKILL") and child.launch.cgroup is None:
             hint = " (possibly for using too much memory)"
         else:
             hint = ""

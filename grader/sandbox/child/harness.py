@@ -35,6 +35,9 @@ def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--submission", type=Path, required=True)
     parser.add_argument("--requests", type=int, required=True, help="fd carrying call frames from the runner")
     parser.add_argument("--results", type=int, required=True, help="fd carrying result frames to the runner")
+    parser.add_argument(
+        "--handles", action="store_true", help="--requests and --results are Windows handles, not fds"
+    )
     parser.add_argument("--max-frame", type=int, default=frames.DEFAULT_MAX_FRAME)
     parser.add_argument(
         "--seed", type=int, default=0, help="seeds randomness while the submission is imported"
@@ -46,6 +49,8 @@ def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the harness; returns the process exit status (0 after the runner closes the request fd)."""
     arguments = parse_arguments(sys.argv[1:] if argv is None else argv)
+    if arguments.handles:
+        _descriptors_from_handles(arguments)
     for fd in (arguments.requests, arguments.results):
         os.set_inheritable(fd, False)
     requests = os.fdopen(arguments.requests, "rb")
@@ -62,6 +67,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     _send(arguments, {"type": "ready", "functions": function_table(loaded)})
     return _serve(loaded, requests, recorder, arguments)
+
+
+def _descriptors_from_handles(arguments: argparse.Namespace) -> None:
+    """Turns the inherited Windows handles of the two pipes into descriptors (the runner names handles
+    where descriptors cannot be passed: `grader.sandbox.process_model`)."""
+    import msvcrt
+
+    arguments.requests = msvcrt.open_osfhandle(arguments.requests, os.O_RDONLY)
+    arguments.results = msvcrt.open_osfhandle(arguments.results, os.O_WRONLY)
 
 
 def prepare_process(submission: Path) -> None:

@@ -2,10 +2,21 @@
 
 from __future__ import annotations
 
+from grader.sandbox.host import HOST
 from grader.sandbox.isolation import registry
 from grader.sandbox.isolation.layer import IsolationReport, Layer, LayerReport
 
 __all__ = ["IsolationReport", "Layer", "LayerReport", "probe_isolation"]
+
+
+def _not_on_this_system(layer: Layer) -> LayerReport:
+    """A layer this system cannot run at all: reported, never probed (its probe may need what is missing)."""
+    return LayerReport(
+        layer.name,
+        False,
+        HOST.unavailable_detail(layer.needs),
+        "none needed to check your own code: each call still stops at its time limit",
+    )
 
 
 def _switched_off(report: LayerReport) -> LayerReport:
@@ -37,6 +48,9 @@ def probe_isolation(disable: frozenset[str] = frozenset()) -> IsolationReport:
         raise ValueError(f"unknown isolation layers {sorted(unknown)}; expected some of {names}")
     reports: list[LayerReport] = []
     for layer in registry.LAYERS:
+        if HOST.lacking(layer.needs):
+            reports.append(_not_on_this_system(layer))
+            continue
         report = layer.probe(IsolationReport(tuple(reports)))
         reports.append(_switched_off(report) if layer.name in disable and report.active else report)
     return IsolationReport(tuple(reports))

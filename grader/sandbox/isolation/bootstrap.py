@@ -1,7 +1,10 @@
 """First code run in the child: applies rlimits (and Landlock in fallback mode), then starts the harness.
 
-Run as ``python -S -B bootstrap.py CONFIG_JSON`` with a cleared environment; stdlib only. CONFIG_JSON
-holds ``sys_path``, ``rlimits`` ([name, soft, hard] triples), ``landlock`` ({"read": [...], "write":
+Run as ``python -S -B bootstrap.py CONFIG_JSON`` with a cleared environment; stdlib only, and nothing
+POSIX-only imported unless a step asks for it (the parent decides what this system offers:
+`grader.sandbox.host`). CONFIG_JSON holds ``sys_path``, ``no_new_privileges`` (Linux's prctl),
+``rlimits`` ([name, soft, hard] triples), ``rlimits_may_fail`` (a limit the system refuses is named on
+stderr instead of stopping the child), ``landlock`` ({"read": [...], "write":
 [...]} or null), ``seccomp_fd`` (a BPF program to install, or null) and ``harness_argv`` (the
 harness's own arguments).
 """
@@ -10,7 +13,6 @@ import ctypes
 import importlib.util
 import json
 import os
-import resource
 import runpy
 import sys
 
@@ -46,14 +48,16 @@ def _apply_seccomp(descriptor: int) -> None:
 
 def main() -> None:
     config = json.loads(sys.argv[1])
-    linux = sys.platform.startswith("linux")
-    if linux and ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0:
+    libc = ctypes.CDLL(None, use_errno=True) if config["no_new_privileges"] else None
+    if libc is not None and libc.prctl(_PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0:
         raise OSError(ctypes.get_errno(), "prctl(PR_SET_NO_NEW_PRIVS) failed")
     for name, soft, hard in config["rlimits"]:
+        import resource
+
         try:
             resource.setrlimit(getattr(resource, name), (soft, hard))
         except (ValueError, OSError):
-            if linux:
+            if not config["rlimits_may_fail"]:
                 raise
             os.write(2, f"gymgrade: {name} cannot be set on this system\n".encode())
     if config["landlock"] is not None:

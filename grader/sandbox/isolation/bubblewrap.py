@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from grader.sandbox.errors import SandboxLayoutError
+from grader.sandbox.host import Feature
 from grader.sandbox.isolation.filesystem import (
     SYSTEM_CONFIG_DIRS,
     SYSTEM_DIRS,
@@ -266,6 +267,7 @@ class BubblewrapLayer:
     """Namespaces (no network, own PID space), a minimal read-only file system, `--die-with-parent`."""
 
     name = "bubblewrap"
+    needs = (Feature.LINUX_KERNEL,)
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Whether bwrap and its namespaces work here (checked once per process)."""

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from grader.sandbox.host import Feature
 from grader.sandbox.isolation import scope
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 
@@ -296,6 +297,7 @@ class CgroupLayer:
     """Memory, process-count and CPU limits for the child's whole tree, and killing that tree."""
 
     name = "cgroup"
+    needs = (Feature.LINUX_KERNEL,)
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Whether a job cgroup with every controller can be made here (checked once per process)."""

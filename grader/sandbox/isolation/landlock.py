@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 from typing import TYPE_CHECKING
 
+from grader.sandbox.host import Feature
 from grader.sandbox.isolation import landlock_syscalls
 from grader.sandbox.isolation.filesystem import SYSTEM_CONFIG_DIRS, SYSTEM_DIRS
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
@@ -25,6 +26,7 @@ class LandlockLayer:
     """Reads limited to what the child runs, writes to its scratch (optional: bubblewrap hides more)."""
 
     name = "landlock"
+    needs = (Feature.LINUX_KERNEL,)
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Not needed under bubblewrap (read from `outer`); else whether this kernel offers Landlock."""

@@ -3,6 +3,7 @@ composed into a `Launch` (the contract, `grader.sandbox.isolation.layer`, declar
 
 from __future__ import annotations
 
+from grader.sandbox import process_model
 from grader.sandbox.isolation import registry
 from grader.sandbox.isolation.filesystem import harness_tree, python_paths
 from grader.sandbox.isolation.layer import IsolationReport, Launch, LaunchSpec
@@ -33,10 +34,7 @@ def build_launch(
         harness_argv = [
             "--submission",
             spec.child_view().submission,
-            "--requests",
-            str(requests_fd),
-            "--results",
-            str(results_fd),
+            *process_model.channel_arguments(requests_fd, results_fd),
             "--max-frame",
             str(limits.frame_bytes),
             "--seed",

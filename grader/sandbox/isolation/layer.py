@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
 
+from grader.sandbox import process_model
+from grader.sandbox.host import HOST, Feature
 from grader.sandbox.isolation.filesystem import ChildView, PythonPaths, host_view, remove_host_scratch
 from grader.sandbox.limits import Limits
 
@@ -46,6 +48,9 @@ class Layer(Protocol):
     """
 
     name: str
+    needs: tuple[Feature, ...]
+    """What the layer needs of the operating system; where any is missing it is reported as not available
+    on this system without being probed (`grader.sandbox.host`)."""
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """What the layer can enforce here and, when nothing, the remedy (no side effects left behind).
@@ -187,12 +192,18 @@ class BootstrapSteps:
     """The child-side steps bootstrap.py knows, run in this order before the harness; off until set.
 
     Attributes:
+        no_new_privileges: Whether the child sets Linux's no-new-privileges first (on for every child where
+            the kernel has it).
         rlimits: (name, soft, hard) resource limits the child sets on itself.
+        rlimits_may_fail: Whether a limit the system refuses is only named on stderr (outside Linux, where
+            not every limit exists in every kernel) instead of stopping the child.
         landlock: Landlock rules ({"read": [...], "write": [...]}) the child restricts itself to.
         seccomp_fd: A descriptor holding a BPF program the child installs.
     """
 
+    no_new_privileges: bool = field(default_factory=lambda: HOST.has(Feature.LINUX_KERNEL))
     rlimits: list[tuple[str, int, int]] = field(default_factory=list)
+    rlimits_may_fail: bool = field(default_factory=lambda: not HOST.has(Feature.LINUX_KERNEL))
     landlock: dict[str, list[str]] | None = None
     seccomp_fd: int | None = None
 
@@ -259,7 +270,9 @@ class LaunchSpec:
             "LANG": "C.UTF-8",
             "PYTHONHASHSEED": "0",
             "PYTHONDONTWRITEBYTECODE": "1",
+            "PYTHONUTF8": "1",
             "MPLCONFIGDIR": f"{scratch}/.matplotlib",
+            **process_model.system_environment(),
             **self.environment,
         }
 

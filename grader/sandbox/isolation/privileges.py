@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import functools
+import importlib
 import os
-import pwd
 import shutil
 from typing import TYPE_CHECKING
 
+from grader.sandbox.host import HOST, Feature
 from grader.sandbox.isolation.filesystem import python_paths
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 
@@ -43,8 +44,9 @@ def _probe_machine() -> LayerReport:
     """When root, checks that `setpriv` exists; otherwise the grader's own uid is already unprivileged."""
     layer = PrivilegesLayer.name
     if not running_as_root():
+        no_new_privileges = ", no-new-privileges" if HOST.has(Feature.LINUX_KERNEL) else ""
         return LayerReport(
-            layer, True, f"runs as the grader's own unprivileged uid {os.geteuid()}, no-new-privileges"
+            layer, True, f"runs as the grader's own unprivileged uid {os.geteuid()}{no_new_privileges}"
         )
     if shutil.which("setpriv") is None:
         return LayerReport(
@@ -54,7 +56,7 @@ def _probe_machine() -> LayerReport:
             "install util-linux (`apt-get install util-linux`)",
         )
     try:
-        name = pwd.getpwuid(SANDBOX_UID).pw_name
+        name = importlib.import_module("pwd").getpwuid(SANDBOX_UID).pw_name
     except KeyError:
         name = "unnamed"
     return LayerReport(
@@ -74,6 +76,7 @@ class PrivilegesLayer:
     """Unprivileged uid, no capabilities, no-new-privileges."""
 
     name = "privileges"
+    needs = (Feature.USER_IDS,)
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Whether the child can run unprivileged; as root without bubblewrap (read from `outer`), only

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import resource
+import importlib
 from typing import TYPE_CHECKING
 
+from grader.sandbox.host import HOST, Feature
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 from grader.sandbox.isolation.privileges import running_as_root
 from grader.sandbox.limits import Limits
@@ -45,9 +46,11 @@ class RlimitsLayer:
     """CPU time, address space, file size, open files and core dumps, set by the child on itself."""
 
     name = "rlimits"
+    needs = (Feature.RESOURCE_LIMITS,)
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Checks that the resource module offers every limit used."""
+        resource = importlib.import_module("resource")
         table = rlimit_table(Limits(), dropped_uid=True, own_user_namespace=False)
         missing = [name for name, _, _ in table if not hasattr(resource, name)]
         if missing:
@@ -56,6 +59,13 @@ class RlimitsLayer:
                 False,
                 f"this system lacks {', '.join(missing)}",
                 "grade on Linux, where every limit exists",
+            )
+        if not HOST.has(Feature.LINUX_KERNEL):
+            return LayerReport(
+                self.name,
+                True,
+                "CPU time, file size, open files, no core dumps; the address-space limit is asked for, "
+                f"but {HOST.system} may not enforce it (a limit it refuses is named on the child's stderr)",
             )
         return LayerReport(self.name, True, "CPU time, address space, file size, open files, no core dumps")
 

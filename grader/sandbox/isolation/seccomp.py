@@ -10,6 +10,7 @@ import sys
 from types import ModuleType
 from typing import TYPE_CHECKING
 
+from grader.sandbox.host import Feature
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 
 if TYPE_CHECKING:
@@ -140,6 +141,7 @@ class SeccompLayer:
     the child starts, else by the child's bootstrap."""
 
     name = "seccomp"
+    needs = (Feature.LINUX_KERNEL,)
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Whether the filter can be built here (checked once per process)."""

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from grader.sandbox.host import Feature
 from grader.sandbox.isolation.layer import IsolationReport, LaunchSpec, LayerReport
 
 MARKER_VARIABLE = "GYMGRADE_MARKER"
@@ -18,6 +19,7 @@ class MarkerLayer:
 
     available: bool = True
     name: str = "marker"
+    needs: tuple[Feature, ...] = ()
     outer_seen: list[tuple[str, ...]] = field(default_factory=list)
     applied: int = 0
 
