@@ -14,7 +14,7 @@ def _not_on_this_system(layer: Layer) -> LayerReport:
     return LayerReport(
         layer.name,
         False,
-        HOST.unavailable_detail(layer.needs),
+        f"{HOST.unavailable_detail(layer.needs)}: {layer.guards} not enforced",
         "none needed to check your own code: each call still stops at its time limit",
     )
 

@@ -268,6 +268,7 @@ class BubblewrapLayer:
 
     name = "bubblewrap"
     needs = (Feature.LINUX_KERNEL,)
+    guards = "a private read-only file system, no network"
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Whether bwrap and its namespaces work here (checked once per process)."""

@@ -298,6 +298,7 @@ class CgroupLayer:
 
     name = "cgroup"
     needs = (Feature.LINUX_KERNEL,)
+    guards = "memory, process-count and CPU limits on the child's whole tree"
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Whether a job cgroup with every controller can be made here (checked once per process)."""

@@ -27,6 +27,7 @@ class LandlockLayer:
 
     name = "landlock"
     needs = (Feature.LINUX_KERNEL,)
+    guards = "the file-system restriction"
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Not needed under bubblewrap (read from `outer`); else whether this kernel offers Landlock."""

@@ -51,6 +51,9 @@ class Layer(Protocol):
     needs: tuple[Feature, ...]
     """What the layer needs of the operating system; where any is missing it is reported as not available
     on this system without being probed (`grader.sandbox.host`)."""
+    guards: str
+    """What the layer enforces, as the report names it when the layer cannot run here ("... not
+    enforced")."""
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """What the layer can enforce here and, when nothing, the remedy (no side effects left behind).

@@ -77,6 +77,7 @@ class PrivilegesLayer:
 
     name = "privileges"
     needs = (Feature.USER_IDS,)
+    guards = "a separate unprivileged user"
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Whether the child can run unprivileged; as root without bubblewrap (read from `outer`), only

@@ -47,6 +47,7 @@ class RlimitsLayer:
 
     name = "rlimits"
     needs = (Feature.RESOURCE_LIMITS,)
+    guards = "the CPU-time, memory, file-size and open-file limits"
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Checks that the resource module offers every limit used."""

@@ -142,6 +142,7 @@ class SeccompLayer:
 
     name = "seccomp"
     needs = (Feature.LINUX_KERNEL,)
+    guards = "the denied system calls"
 
     def probe(self, outer: IsolationReport) -> LayerReport:
         """Whether the filter can be built here (checked once per process)."""

@@ -20,6 +20,7 @@ class MarkerLayer:
     available: bool = True
     name: str = "marker"
     needs: tuple[Feature, ...] = ()
+    guards: str = "the marker"
     outer_seen: list[tuple[str, ...]] = field(default_factory=list)
     applied: int = 0
 
