@@ -9,7 +9,8 @@ Three models, chosen once from `grader.sandbox.host.HOST`:
 - **windows**: the pipes reach the child as inheritable handles named on its command line (`--handles`;
   `subprocess.STARTUPINFO`'s handle list gives it exactly those), and ending it is `Popen.kill()`
   (TerminateProcess). `select` waits on sockets only there, so pipes are polled with PeekNamedPipe and
-  read only as far as they hold data. Processes the child started itself are not ended with it.
+  read only as far as they hold data; requests are written blocking (they go to a child waiting for
+  them). Processes the child started itself are not ended with it.
 - **inherited**: a system that has neither (a Python without `fork` and `pass_fds` that is not Windows):
   the pipes are made inheritable and every inheritable descriptor is kept (`close_fds=False`); ended with
   `Popen.kill()`. The project's tests use it to run the check under a Windows-shaped Python.
@@ -38,11 +39,11 @@ elif HOST.has(Feature.WINDOWS_HANDLES):
     MODEL = "windows"
 else:
     MODEL = "inherited"
-ENDS_WHOLE_TREE = MODEL == "posix"
-"""Whether ending a child also ends the processes it started (its process group)."""
 _WINDOWS_ENVIRONMENT = ("SYSTEMROOT", "WINDIR", "COMSPEC", "PATHEXT")
 """Variables a Windows process needs whatever else its environment holds (sockets, random numbers)."""
 _POLL_SECONDS = 0.002
+_QUERY_LIMITED_INFORMATION = 0x1000
+_STILL_ACTIVE = 259
 
 
 def channel_arguments(requests_fd: int, results_fd: int) -> list[str]:
@@ -50,7 +51,7 @@ def channel_arguments(requests_fd: int, results_fd: int) -> list[str]:
     if MODEL == "windows":
         import msvcrt
 
-        handles = [msvcrt.get_osfhandle(fd) for fd in (requests_fd, results_fd)]
+        handles = [msvcrt.get_osfhandle(fd) for fd in (requests_fd, results_fd)]  # type: ignore[attr-defined,unused-ignore]
         return ["--requests", str(handles[0]), "--results", str(handles[1]), "--handles"]
     return ["--requests", str(requests_fd), "--results", str(results_fd)]
 
@@ -84,12 +85,12 @@ def start(
     elif MODEL == "windows":
         import msvcrt
 
-        handles = [msvcrt.get_osfhandle(fd) for fd in channel]
+        handles = [msvcrt.get_osfhandle(fd) for fd in channel]  # type: ignore[attr-defined,unused-ignore]
         for handle in handles:
-            os.set_handle_inheritable(handle, True)
+            os.set_handle_inheritable(handle, True)  # type: ignore[attr-defined,unused-ignore]
         options = {
-            "startupinfo": subprocess.STARTUPINFO(lpAttributeList={"handle_list": handles}),
-            "creationflags": subprocess.CREATE_NEW_PROCESS_GROUP | subprocess.CREATE_NO_WINDOW,
+            "startupinfo": subprocess.STARTUPINFO(lpAttributeList={"handle_list": handles}),  # type: ignore[attr-defined,unused-ignore]
+            "creationflags": subprocess.CREATE_NEW_PROCESS_GROUP | subprocess.CREATE_NO_WINDOW,  # type: ignore[attr-defined,unused-ignore]
             "close_fds": True,
         }
     else:
@@ -118,6 +119,34 @@ def end(process: subprocess.Popen[bytes]) -> None:
         process.kill()
 
 
+def exists(pid: int) -> bool | None:
+    """Whether a process `pid` is running; None when this process may not ask (another user's).
+
+    Windows' `os.kill(pid, 0)` would end the process (TerminateProcess with exit code 0), so there it is
+    asked with OpenProcess and GetExitCodeProcess.
+    """
+    if MODEL == "windows":
+        import _winapi
+
+        try:
+            handle = _winapi.OpenProcess(_QUERY_LIMITED_INFORMATION, False, pid)  # type: ignore[attr-defined,unused-ignore]
+        except PermissionError:
+            return None
+        except OSError:
+            return False
+        try:
+            return bool(_winapi.GetExitCodeProcess(handle) == _STILL_ACTIVE)  # type: ignore[attr-defined,unused-ignore]
+        finally:
+            _winapi.CloseHandle(handle)  # type: ignore[attr-defined,unused-ignore]
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return None
+    return True
+
+
 def make_nonblocking(fd: int) -> None:
     """Lets `read_available` and writes on `fd` return at once (Windows pipes are polled instead)."""
     if MODEL != "windows":
@@ -138,11 +167,12 @@ def read_available(fd: int, size: int) -> bytes | None:
         return None
 
 
+# The Windows-only calls below carry `type: ignore`: mypy checks this module as Linux sees it.
 def _peek(fd: int) -> int:
-    import _winapi  # type: ignore[import-not-found]
+    import _winapi
     import msvcrt
 
-    available: int = _winapi.PeekNamedPipe(msvcrt.get_osfhandle(fd), 0)[0]
+    available: int = _winapi.PeekNamedPipe(msvcrt.get_osfhandle(fd), 0)[0]  # type: ignore[attr-defined,unused-ignore]
     return available
 
 

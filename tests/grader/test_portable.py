@@ -25,6 +25,8 @@ from typing import Any
 import pytest
 from shaped_python import shaped_python
 
+from grader.sandbox.host import HOST
+
 ROOT = Path(__file__).resolve().parents[2]
 SUBMISSIONS = ROOT / "submissions"
 SHAPES = ("windows", "macos")
@@ -37,6 +39,8 @@ CASES = (
     ("rl1", "editions/rl1_complete.py"),
     ("classic", "notebooks/classic_complete.ipynb"),
 )
+FULL_MARKS = ("passed", "skipped")
+"""Statuses of a complete solution ("skipped": not run, as find_qvalues is unless a verdict needs it)."""
 NON_ASCII_NOTE = "Notes by Zoë: ε-greedy, Q ← Q + α·δ ✓"
 
 
@@ -56,7 +60,7 @@ def _place(sample: str, directory: Path) -> Path:
 def _check(python: Path | str, submission: Path, edition: str, *extra: str) -> dict[str, Any]:
     environment = {key: value for key, value in os.environ.items() if not key.startswith(("PYTHON", "LC_"))}
     environment.update(LANG="C", PATH=f"{Path(python).parent}{os.pathsep}/usr/bin{os.pathsep}/bin")
-    if python == sys.executable:
+    if Path(python) == Path(sys.executable):
         environment["PATH"] = os.environ["PATH"]
     completed = subprocess.run(
         [
@@ -96,11 +100,15 @@ def _verdicts(report: dict[str, Any]) -> dict[str, tuple[Any, ...]]:
 
 @pytest.fixture(scope="module")
 def pythons(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """The shaped interpreters on Linux; on another system (the CI runners), its own interpreter."""
+    if HOST.system != "Linux":
+        return {HOST.system: Path(sys.executable)}
     root = tmp_path_factory.mktemp("shaped")
     return {shape: shaped_python(root / shape, shape) for shape in SHAPES}
 
 
 @pytest.mark.slow
+@pytest.mark.skipif(HOST.system != "Linux", reason="shapes this Linux CPython; CI compares real runs")
 def test_shaped_checks_give_the_linux_verdicts(pythons: dict[str, Path], tmp_path: Path) -> None:
     directory = tmp_path / "Zoë"
     directory.mkdir()
@@ -109,7 +117,10 @@ def test_shaped_checks_give_the_linux_verdicts(pythons: dict[str, Path], tmp_pat
         submission = _place(sample, directory)
         linux = _check(sys.executable, submission, edition)
         expected = _verdicts(linux)
-        assert expected and all(status == "passed" for status, _, _ in expected.values()), (sample, expected)
+        assert expected and all(status in FULL_MARKS for status, _, _ in expected.values()), (
+            sample,
+            expected,
+        )
         for shape, python in pythons.items():
             report = _check(python, submission, edition)
             if _verdicts(report) != expected:

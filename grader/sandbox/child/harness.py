@@ -74,8 +74,8 @@ def _descriptors_from_handles(arguments: argparse.Namespace) -> None:
     where descriptors cannot be passed: `grader.sandbox.process_model`)."""
     import msvcrt
 
-    arguments.requests = msvcrt.open_osfhandle(arguments.requests, os.O_RDONLY)
-    arguments.results = msvcrt.open_osfhandle(arguments.results, os.O_WRONLY)
+    arguments.requests = msvcrt.open_osfhandle(arguments.requests, os.O_RDONLY)  # type: ignore[attr-defined,unused-ignore]
+    arguments.results = msvcrt.open_osfhandle(arguments.results, os.O_WRONLY)  # type: ignore[attr-defined,unused-ignore]
 
 
 def prepare_process(submission: Path) -> None:

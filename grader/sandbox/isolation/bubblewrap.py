@@ -267,7 +267,7 @@ class BubblewrapLayer:
     """Namespaces (no network, own PID space), a minimal read-only file system, `--die-with-parent`."""
 
     name = "bubblewrap"
-    needs = (Feature.LINUX_KERNEL,)
+    needs: tuple[Feature, ...] = (Feature.LINUX_KERNEL,)
     guards = "a private read-only file system, no network"
 
     def probe(self, outer: IsolationReport) -> LayerReport:

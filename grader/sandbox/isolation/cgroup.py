@@ -297,7 +297,7 @@ class CgroupLayer:
     """Memory, process-count and CPU limits for the child's whole tree, and killing that tree."""
 
     name = "cgroup"
-    needs = (Feature.LINUX_KERNEL,)
+    needs: tuple[Feature, ...] = (Feature.LINUX_KERNEL,)
     guards = "memory, process-count and CPU limits on the child's whole tree"
 
     def probe(self, outer: IsolationReport) -> LayerReport:

@@ -14,6 +14,8 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from grader.sandbox import process_model
+from grader.sandbox.host import HOST, Feature
 from grader.sandbox.isolation.scope import temp_root
 
 SYSTEM_DIRS = ("/usr", "/bin", "/sbin", "/lib", "/lib64", "/lib32")
@@ -108,11 +110,14 @@ def remove_host_scratch(scratch: Path) -> None:
     own uid may have replaced it.
     """
     with contextlib.suppress(OSError):
-        descriptor = os.open(scratch / _SUBMISSION_SUBDIR, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
-        try:
-            os.fchmod(descriptor, 0o700)
-        finally:
-            os.close(descriptor)
+        if not HOST.has(Feature.POSIX_PROCESSES):  # Windows: chmod only clears the read-only attribute
+            os.chmod(scratch / _SUBMISSION_SUBDIR, 0o700)
+        else:
+            descriptor = os.open(scratch / _SUBMISSION_SUBDIR, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
+            try:
+                os.fchmod(descriptor, 0o700)
+            finally:
+                os.close(descriptor)
     shutil.rmtree(scratch, ignore_errors=True)
 
 
@@ -163,11 +168,11 @@ def remove_stale_trees() -> None:
     """Removes trees of grader processes that ended without running their exit handlers (e.g. SIGKILL)."""
     for path in Path(tempfile.gettempdir()).glob(f"{TREE_PREFIX}*-*"):
         try:
-            os.kill(int(path.name.removeprefix(TREE_PREFIX).split("-")[0]), 0)
-        except ProcessLookupError:
-            shutil.rmtree(path, ignore_errors=True)
-        except (ValueError, PermissionError):
+            pid = int(path.name.removeprefix(TREE_PREFIX).split("-")[0])
+        except ValueError:
             continue
+        if process_model.exists(pid) is False:
+            shutil.rmtree(path, ignore_errors=True)
 
 
 @functools.cache

@@ -26,7 +26,7 @@ class LandlockLayer:
     """Reads limited to what the child runs, writes to its scratch (optional: bubblewrap hides more)."""
 
     name = "landlock"
-    needs = (Feature.LINUX_KERNEL,)
+    needs: tuple[Feature, ...] = (Feature.LINUX_KERNEL,)
     guards = "the file-system restriction"
 
     def probe(self, outer: IsolationReport) -> LayerReport:

@@ -76,7 +76,7 @@ class PrivilegesLayer:
     """Unprivileged uid, no capabilities, no-new-privileges."""
 
     name = "privileges"
-    needs = (Feature.USER_IDS,)
+    needs: tuple[Feature, ...] = (Feature.USER_IDS,)
     guards = "a separate unprivileged user"
 
     def probe(self, outer: IsolationReport) -> LayerReport:

@@ -46,7 +46,7 @@ class RlimitsLayer:
     """CPU time, address space, file size, open files and core dumps, set by the child on itself."""
 
     name = "rlimits"
-    needs = (Feature.RESOURCE_LIMITS,)
+    needs: tuple[Feature, ...] = (Feature.RESOURCE_LIMITS,)
     guards = "the CPU-time, memory, file-size and open-file limits"
 
     def probe(self, outer: IsolationReport) -> LayerReport:
@@ -65,8 +65,7 @@ class RlimitsLayer:
             return LayerReport(
                 self.name,
                 True,
-                "CPU time, file size, open files, no core dumps; the address-space limit is asked for, "
-                f"but {HOST.system} may not enforce it (a limit it refuses is named on the child's stderr)",
+                f"CPU time, file size, open files, no core dumps; the address-space limit is asked for, but {HOST.system} may not enforce it (a limit it refuses is named on the child's stderr)",  # noqa: E501
             )
         return LayerReport(self.name, True, "CPU time, address space, file size, open files, no core dumps")
 

@@ -52,7 +52,7 @@ def record(kind: str, name: str, line: str) -> None:
         return
     records = scope / kind
     records.mkdir(exist_ok=True)
-    with (records / name).open("a") as recorded:
+    with (records / name).open("a", encoding="utf-8") as recorded:
         recorded.write(f"{line}\n")
 
 
@@ -86,4 +86,4 @@ def release_recorded(root: Path) -> None:
     for kind, cleanup in sorted(CLEANUPS.items()):
         for recorded in sorted((root / kind).glob("*")):
             with contextlib.suppress(OSError, ValueError):
-                cleanup([line for line in recorded.read_text().splitlines() if line])
+                cleanup([line for line in recorded.read_text(encoding="utf-8").splitlines() if line])

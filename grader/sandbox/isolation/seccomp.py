@@ -141,7 +141,7 @@ class SeccompLayer:
     the child starts, else by the child's bootstrap."""
 
     name = "seccomp"
-    needs = (Feature.LINUX_KERNEL,)
+    needs: tuple[Feature, ...] = (Feature.LINUX_KERNEL,)
     guards = "the denied system calls"
 
     def probe(self, outer: IsolationReport) -> LayerReport:

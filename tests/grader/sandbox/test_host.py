@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 
 import pytest
 from marker_layer import MarkerLayer
@@ -50,6 +52,7 @@ def test_a_missing_feature_is_named_with_the_system(
 def test_every_layer_the_system_cannot_run_is_reported_unprobed(
     monkeypatch: pytest.MonkeyPatch, host: Host
 ) -> None:
+    host = Host(host.system, host.features & HOST.features)  # a layer this machine lacks is never probed
     marker = MarkerLayer(needs=(Feature.LINUX_KERNEL,), guards="the marker's limits")
     layers = (*registry.LAYERS, marker)
     monkeypatch.setattr(registry, "LAYERS", layers)
@@ -62,24 +65,36 @@ def test_every_layer_the_system_cannot_run_is_reported_unprobed(
     )
     unavailable = {layer.name for layer in report.layers if "not available on this system" in layer.detail}
     expected = {"cgroup", "bubblewrap", "seccomp", "landlock", "marker"}
-    if host is WINDOWS:
+    if host.system == "Windows":
         expected |= {"privileges", "rlimits"}
     assert unavailable == expected
     assert not report.full
-    if host is WINDOWS:
+    if host.system == "Windows":
         assert report.layer("rlimits").detail == (
             "not available on this system (Windows without resource limits (the resource module)): "
             "the CPU-time, memory, file-size and open-file limits not enforced"
         )
 
 
-def test_this_linux_machine_offers_what_the_sandbox_uses() -> None:
-    assert HOST.system == "Linux"
-    assert HOST.has(Feature.POSIX_PROCESSES) and HOST.has(Feature.LINUX_KERNEL)
-    assert process_model.MODEL == "posix" and process_model.ENDS_WHOLE_TREE
-    assert usable_cpus() == len(os.sched_getaffinity(0))
-    assert signal_number("SIGKILL") == 9
+EXPECTED_MODELS = {
+    "Linux": (
+        "posix",
+        {Feature.POSIX_PROCESSES, Feature.RESOURCE_LIMITS, Feature.USER_IDS, Feature.LINUX_KERNEL},
+    ),
+    "macOS": ("posix", {Feature.POSIX_PROCESSES, Feature.RESOURCE_LIMITS, Feature.USER_IDS}),
+    "Windows": ("windows", {Feature.WINDOWS_HANDLES}),
+}
+
+
+def test_this_system_is_served_by_its_own_process_model() -> None:
+    model, features = EXPECTED_MODELS[HOST.system]
+    assert model == process_model.MODEL
+    assert features <= HOST.features
+    assert not HOST.has(Feature.LINUX_KERNEL) or HOST.system == "Linux"
+    assert 1 <= usable_cpus() <= (os.cpu_count() or 1)
+    assert signal_number("SIGTERM") == 15
     assert signal_number("SIGNOSUCHTHING") is None
+    assert (signal_number("SIGKILL") == 9) == (HOST.system != "Windows")
 
 
 def test_a_pipe_is_read_as_far_as_it_holds_data_then_to_its_end() -> None:
@@ -103,3 +118,11 @@ def test_a_system_without_pass_fds_refuses_extra_descriptors(monkeypatch: pytest
     monkeypatch.setattr(process_model, "MODEL", "inherited")
     with pytest.raises(OSError, match=r"cannot pass the descriptors \[7\] to a child"):
         process_model.start(["true"], env={}, cwd=None, channel=(), extra_fds=(7,))
+
+
+def test_a_running_process_exists_and_an_ended_one_does_not() -> None:
+    ended = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, check=True
+    )
+    assert process_model.exists(os.getpid()) is True
+    assert process_model.exists(int(ended.stdout)) is False
