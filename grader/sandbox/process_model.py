@@ -39,8 +39,9 @@ elif HOST.has(Feature.WINDOWS_HANDLES):
     MODEL = "windows"
 else:
     MODEL = "inherited"
-_WINDOWS_ENVIRONMENT = ("SYSTEMROOT", "WINDIR", "COMSPEC", "PATHEXT")
-"""Variables a Windows process needs whatever else its environment holds (sockets, random numbers)."""
+_WINDOWS_ENVIRONMENT = ("SYSTEMROOT", "WINDIR", "COMSPEC", "PATHEXT", "PATH")
+"""Variables a Windows process needs whatever else its environment holds: the system's folders (sockets,
+random numbers) and PATH, where a conda Python finds the DLLs of numpy's libraries."""
 _POLL_SECONDS = 0.002
 _QUERY_LIMITED_INFORMATION = 0x1000
 _STILL_ACTIVE = 259
