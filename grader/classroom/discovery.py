@@ -99,6 +99,7 @@ def discover(
                 graded_file=None,
                 why=f"nothing to grade: every file was refused ({_refusals(refused)})",
                 source=chosen.name,
+                refused=tuple(refused),
             )
         )
     download.submissions.sort(key=lambda submission: submission.identity)
@@ -139,26 +140,52 @@ def _duplicate(later: Submission, kept: Submission) -> Skipped:
     )
 
 
-def _regroup(layout: Layout, tree: Tree) -> list[Group]:
+REFUSED_ENTRY = "(refused entry)"
+"""The stand-in name of a refused zip entry whose own name climbs out or is absolute: it is attributed to
+the folder or zip that holds it, never named for a student by its name (``../x`` is nobody's)."""
+MAX_REFUSALS_NAMED = 5
+"""Refused files a submission's ``why`` names; the rest are counted (``Submission.refused`` has them all)."""
+
+
+def _holder(where: str) -> str | None:
+    """Where a refused file is attributed from: ``where`` when it is a plain relative path, else a stand-in
+    inside the folder or zip holding it (``alice/sub.zip/../x`` -> ``alice/sub.zip/(refused entry)``), or
+    None when nothing holds it (``../x``, ``/tmp/x``, ``C:/x`` at the top of the download)."""
+    parts = where.replace("\\", "/").split("/")
+    for number, part in enumerate(parts):
+        if part in ("", ".", "..") or "\x00" in part or (len(part) > 1 and part[1] == ":"):
+            return "/".join([*parts[:number], REFUSED_ENTRY]) if number else None
+    return where
+
+
+def _regroup(layout: Layout, tree: Tree) -> tuple[list[Group], dict[str, list[Skipped]]]:
     """The groups of the download with its refused files put back as stand-ins (``os.devnull``: nothing of
-    theirs is read), so that each refused file can be said to be some student's."""
-    stand_ins = [Entry(skipped.where, Path(os.devnull)) for skipped in tree.refused]
-    return layout.group(
+    theirs is read), so that each refused file can be said to be some student's; and the refused files of
+    each stand-in."""
+    refused_at: dict[str, list[Skipped]] = {}
+    for skipped in tree.refused:
+        holder = _holder(skipped.where)
+        if holder is not None:
+            refused_at.setdefault(holder, []).append(skipped)
+    stand_ins = [Entry(holder, Path(os.devnull)) for holder in refused_at]
+    grouping = layout.group(
         Tree(root=tree.root, entries=sorted([*tree.entries, *stand_ins], key=lambda e: e.relative))
-    ).groups
+    )
+    return grouping.groups, refused_at
 
 
 def _refused_by_student(layout: Layout, tree: Tree) -> dict[str, tuple[tuple[Member, ...], list[Skipped]]]:
     """The refused files of each student a layout can name for them, with the student's members."""
     if not tree.refused:
         return {}
-    reasons = {skipped.where: skipped for skipped in tree.refused}
+    groups, refused_at = _regroup(layout, tree)
     found: dict[str, tuple[tuple[Member, ...], list[Skipped]]] = {}
-    for group in _merged(_regroup(layout, tree)):
+    for group in _merged(groups):
         mine = [
-            reasons[entry.relative]
+            skipped
             for entry, _ in group.files
-            if entry.relative in reasons and entry.path == Path(os.devnull)
+            if entry.path == Path(os.devnull)
+            for skipped in refused_at.get(entry.relative, ())
         ]
         if mine:
             found[group.identity] = (group.members, mine)
@@ -166,7 +193,9 @@ def _refused_by_student(layout: Layout, tree: Tree) -> dict[str, tuple[tuple[Mem
 
 
 def _refusals(refused: list[Skipped]) -> str:
-    return "; ".join(f"{skipped.where}: {skipped.reason}" for skipped in refused)
+    named = "; ".join(f"{skipped.where}: {skipped.reason}" for skipped in refused[:MAX_REFUSALS_NAMED])
+    more = len(refused) - MAX_REFUSALS_NAMED
+    return f"{named}; and {more:,} more" if more > 0 else named
 
 
 def _display(members: tuple[Member, ...], identity: str) -> str:
@@ -205,6 +234,7 @@ def _submission(
         submitted_at=group.submitted_at,
         late=late,
         source=source,
+        refused=tuple(refused),
     )
 
 

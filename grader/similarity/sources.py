@@ -12,10 +12,12 @@ from __future__ import annotations
 
 import ast
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from grader.classroom import ClassDownload, GradedFileRule, discover
+from grader.classroom.model import Skipped
 from grader.classroom.graded_file import is_candidate
 from grader.notebook import MAX_NOTEBOOK_BYTES
 from grader.similarity.errors import ClassDirectoryError
@@ -27,6 +29,8 @@ MAX_COMPARED_BYTES = 200_000
 (the grader itself accepts up to ``grader.validation.MAX_SUBMISSION_BYTES``)."""
 MAX_FILES_PER_SUBMISSION = 20
 """A student's folder may hold helpers beside the lab file; files beyond this many are listed, not read."""
+MAX_REFUSED_LISTED = 20
+"""Refused files listed per student (and for nobody); the rest are counted in one line."""
 IGNORED_PARTS = ("__pycache__", ".ipynb_checkpoints", "__MACOSX")
 UNATTRIBUTED = "(not attributed)"
 """The identity column of a file no student can be named for."""
@@ -125,17 +129,9 @@ def sources_of(download: ClassDownload) -> ClassSources:
     sources = ClassSources(layout=download.layout)
     claimed: set[str] = set()
     for submission in download.submissions:
-        # discovery names a student's refused files in its reason (``where: reason``): list them as theirs
-        mine = [
-            skipped for skipped in download.refused if f"{skipped.where}: {skipped.reason}" in submission.why
-        ]
+        mine = submission.refused
         claimed.update(skipped.where for skipped in mine)
-        sources.skipped += [
-            UnreadableFile(
-                identity=submission.identity, file=skipped.where, reason=f"refused: {skipped.reason}."
-            )
-            for skipped in mine
-        ]
+        sources.skipped += _refused_listed(submission.identity, mine)
         candidates = [file for file in submission.files if is_candidate(file.original_name)]
         if submission.graded_file is not None and submission.graded_file in candidates:
             candidates.remove(submission.graded_file)
@@ -157,11 +153,9 @@ def sources_of(download: ClassDownload) -> ClassSources:
                     reason=f"nothing to compare: {submission.why}.",
                 )
             )
-    sources.skipped += [
-        UnreadableFile(identity=REFUSED, file=skipped.where, reason=f"refused: {skipped.reason}.")
-        for skipped in download.refused
-        if skipped.where not in claimed
-    ]
+    sources.skipped += _refused_listed(
+        REFUSED, [skipped for skipped in download.refused if skipped.where not in claimed]
+    )
     sources.skipped += [
         UnreadableFile(
             identity=UNATTRIBUTED,
@@ -171,6 +165,25 @@ def sources_of(download: ClassDownload) -> ClassSources:
         for skipped in download.unattributed
     ]
     return sources
+
+
+def _refused_listed(identity: str, refused: Sequence[Skipped]) -> list[UnreadableFile]:
+    """The refused files of one student (or of nobody) as listed: the first ``MAX_REFUSED_LISTED``, then
+    one line counting the rest (a zip of 80,000 links is one student's 21 lines)."""
+    listed = [
+        UnreadableFile(identity=identity, file=skipped.where, reason=f"refused: {skipped.reason}.")
+        for skipped in refused[:MAX_REFUSED_LISTED]
+    ]
+    if len(refused) > MAX_REFUSED_LISTED:
+        more = len(refused) - MAX_REFUSED_LISTED
+        listed.append(
+            UnreadableFile(
+                identity=identity,
+                file=f"{more:,} more refused files",
+                reason="refused like those above; `gymgrade grade` on the download lists each of them.",
+            )
+        )
+    return listed
 
 
 def _not_candidate(relative: str) -> str:

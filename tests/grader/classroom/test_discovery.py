@@ -145,3 +145,57 @@ def test_several_downloads_are_read_apart_and_a_student_twice_is_refused(tmp_pat
     assert twice == ["student0_1000_5001_opengym.py"]
     paths = [file.path for submission in download.submissions for file in submission.files]
     assert len(set(paths)) == len(paths), "each zip keeps its own scratch files"
+
+
+def _zip_of(path: Path, entries: dict[str, bytes]) -> Path:
+    import zipfile
+
+    with zipfile.ZipFile(path, "w") as bundle:
+        for name, data in entries.items():
+            bundle.writestr(name, data)
+    return path
+
+
+ESCAPING = {"../x.py": b"x = 1\n", "/tmp/x.py": b"x = 1\n", "C:/x.py": b"x = 1\n", "..\\y.py": b"y = 1\n"}
+
+
+@pytest.mark.parametrize("wrapped", [False, True], ids=["class-zip", "class-folder-holding-the-zip"])
+def test_refused_entry_names_never_become_students(tmp_path: Path, wrapped: bool) -> None:
+    """Hostile: entries named ``../x``, ``/tmp/x`` and ``C:/x`` are refused, listed, and nobody's row."""
+    entries = {"alice/opengym.py": b"def blackjack(n):\n    return 0\n", **ESCAPING}
+    if wrapped:
+        folder = tmp_path / "class"
+        folder.mkdir()
+        (folder / "bob").mkdir()
+        (folder / "bob" / "opengym.py").write_text("def blackjack(n):\n    return 1\n")
+        _zip_of(folder / "bob" / "extra.zip", ESCAPING)
+        target = folder
+    else:
+        target = _zip_of(tmp_path / "class.zip", entries)
+    download = discover(target, rule=RULE, scratch=tmp_path / "scratch")
+    expected = ["bob"] if wrapped else ["alice"]
+    assert [submission.identity for submission in download.submissions] == expected
+    assert len(download.refused) == len(ESCAPING)
+    if wrapped:  # bob's own zip: its refused entries are his, named in his row
+        (bob,) = download.submissions
+        assert len(bob.refused) == len(ESCAPING)
+        assert "refused bob/extra.zip/../x.py: a name climbing out of the zip" in bob.why
+
+
+def test_a_submissions_why_names_a_few_refused_files_and_counts_the_rest(tmp_path: Path) -> None:
+    """Hostile: 2,000 link entries in one student's zip make a bounded reason, listed in linear time."""
+    import zipfile
+
+    folder = tmp_path / "class"
+    (folder / "mallory").mkdir(parents=True)
+    (folder / "mallory" / "opengym.py").write_text("def blackjack(n):\n    return 0\n")
+    with zipfile.ZipFile(folder / "mallory" / "links.zip", "w") as bundle:
+        for number in range(2_000):
+            link = zipfile.ZipInfo(f"l{number}.py")
+            link.external_attr = (0o120777 << 16)
+            bundle.writestr(link, "/etc/passwd")
+    download = discover(folder, rule=RULE, scratch=tmp_path / "scratch")
+    (mallory,) = download.submissions
+    assert len(mallory.refused) == 2_000
+    assert mallory.why.endswith("; and 1,995 more")
+    assert len(mallory.why) < 1_000
