@@ -605,25 +605,39 @@ def _similarity_beside_grading(args: argparse.Namespace, download: ClassDownload
 
 def class_summary(download: ClassDownload) -> str:
     """What was found: the layout, which file is graded for whom and why, what was refused or unattributed."""
+    from grader.class_report.text import MAX_LINE_CHARS, display_text
     from grader.classroom import LAYOUTS
+
+    def shown(text: str) -> str:  # every name here is the student's choice: one inert line each
+        return display_text(text, MAX_LINE_CHARS)
 
     title = LAYOUTS[download.layout].title if download.layout in LAYOUTS else download.layout
     lines = [f"Found {len(download.submissions)} submissions ({title}):"]
     for submission in download.submissions:
         graded = submission.graded_file.relative if submission.graded_file else "nothing graded"
         late = " [late]" if submission.late else ""
-        lines.append(f"  {submission.display_name}{late}: {graded} ({submission.why})")
-    for skipped in download.refused:
-        lines.append(f"  refused {skipped.where}: {skipped.reason}")
-    for skipped in download.unattributed:
-        lines.append(f"  not attributed {skipped.where}: {skipped.reason}")
+        lines.append(f"  {shown(submission.display_name)}{late}: {shown(graded)} ({shown(submission.why)})")
+    for skipped in download.refused[:MAX_SKIPPED_SHOWN]:
+        lines.append(f"  refused {shown(skipped.where)}: {shown(skipped.reason)}")
+    if len(download.refused) > MAX_SKIPPED_SHOWN:
+        lines.append(f"  ... and {len(download.refused) - MAX_SKIPPED_SHOWN:,} more refused")
+    for skipped in download.unattributed[:MAX_SKIPPED_SHOWN]:
+        lines.append(f"  not attributed {shown(skipped.where)}: {shown(skipped.reason)}")
+    if len(download.unattributed) > MAX_SKIPPED_SHOWN:
+        lines.append(f"  ... and {len(download.unattributed) - MAX_SKIPPED_SHOWN:,} more not attributed")
     return "\n".join(lines)
+
+
+MAX_SKIPPED_SHOWN = 200
+"""Refused (and unattributed) files the summary names; the rest are counted (a zip of 80,000 links is one
+student's, and a reason in their row)."""
 
 
 def _grade_class(
     args: argparse.Namespace, paths: list[Path], identities: dict[Path, str], gradebook: ClassGradebook
 ) -> int:
     from grader.batch import BatchOutcome, grade_many
+    from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
 
     policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
     executor = find_executor(policy)
@@ -641,7 +655,9 @@ def _grade_class(
             print(f"Grading on {executor}.", file=sys.stderr)
 
     def advance(path: Path, result: ProblemResult) -> None:
-        bar.advance(f"{identities[path]}: {result.id} {result.status}")
+        bar.advance(f"{shown[path]}: {result.id} {result.status}")
+
+    shown = {path: display_identity(identity, IDENTITY_SHOWN_CHARS) for path, identity in identities.items()}
 
     seed = choose_seed(args.seed, args.out)
     try:
@@ -675,7 +691,11 @@ def _grade_class(
     if "canvas" in args.gradebook and gradebook.rows is not None:
         from grader.classroom.gradebooks import canvas_user_id
 
-        unmatched = [row.member.identity for row in gradebook.rows if not canvas_user_id(row)]
+        unmatched = [
+            display_identity(row.member.identity, IDENTITY_SHOWN_CHARS)
+            for row in gradebook.rows
+            if not canvas_user_id(row)
+        ]
         if unmatched:
             print(
                 f"canvas.csv leaves out {len(unmatched)} students without a Canvas user id ({', '.join(unmatched[:5])}{', ...' if len(unmatched) > 5 else ''}): "  # noqa: E501
@@ -696,8 +716,12 @@ def class_page_clash(page: Path, identities: Sequence[str], out_dir: Path) -> st
     """Why `gymgrade grade --html` would overwrite one of the batch's files (a student's report), or None."""
     from grader.batch import identity_stem
     from grader.class_report.from_batch import page_clash_of_reports
+    from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
 
-    reports = {out_dir / f"{identity_stem(identity)}.json": f"student {identity}" for identity in identities}
+    reports = {
+        out_dir / f"{identity_stem(identity)}.json": f"student {display_identity(identity, IDENTITY_SHOWN_CHARS)}"
+        for identity in identities
+    }
     return page_clash_of_reports(page, reports, out_dir)
 
 

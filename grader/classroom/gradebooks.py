@@ -1,6 +1,7 @@
 """Gradebooks people upload: ``grades.csv`` and the import formats of Canvas, Gradescope and GitHub
-Classroom, built as pure functions of the class's rows. Every cell a spreadsheet would evaluate
-(leading ``= + - @``, tab, carriage return) is neutralised with a leading apostrophe."""
+Classroom, built as pure functions of the class's rows. Every cell goes through
+``grader.class_report.text.safe_cell``: controls and bidi overrides inert, and a leading apostrophe where a
+spreadsheet would evaluate it (``= + - @`` after any blanks, their fullwidth forms, a tab, a carriage return)."""
 
 from __future__ import annotations
 
@@ -9,22 +10,11 @@ import io
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
+from grader.class_report.text import safe_cell
 from grader.classroom.errors import GradebookError
 from grader.classroom.model import ClassDownload, Member, Submission
 from grader.classroom.roster import Roster, RosterEntry
 from grader.report import Report
-
-FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
-
-
-def safe_cell(value: object) -> str:
-    """A cell's text, with an apostrophe before a start that would make a spreadsheet evaluate it.
-
-    Numbers we write ourselves (``-0.5`` never happens: scores are >= 0) pass through as text unchanged.
-    """
-    text = "" if value is None else str(value)
-    return "'" + text if text.startswith(FORMULA_STARTS) else text
-
 
 @dataclass(frozen=True)
 class GradeRow:

@@ -371,3 +371,26 @@ def test_a_broken_executor_entry_point_is_refused_with_a_remedy(
         "gymgrade grade: the batch executor 'cluster' could not be loaded (ImportError: No module named "
         "'celery'); reinstall the package providing it (pip install -e '.[distributed]')"
     ) in capsys.readouterr().err
+
+
+def test_the_class_summary_shows_each_name_a_student_chose_as_one_inert_line(tmp_path: Path) -> None:
+    """Hostile: folder and file names with escape sequences, BEL, a C1 control, a right-to-left override and
+    a newline that would forge a `refused alice` line are printed inert, one line per student."""
+    import zipfile
+
+    from grader.classroom import discover
+
+    klass = tmp_path / "class"
+    names = ["\x1b]0;owned\x07\x1b[2Jmallory", "\x9b31mtrudy", "\u202eecila", "eve\n  refused alice: forged"]
+    for name in names:
+        (klass / name).mkdir(parents=True)
+        (klass / name / "opengym.py").write_text("def blackjack(n):\n    return 0\n")
+    with zipfile.ZipFile(klass / "eve\n  refused alice: forged" / "more.zip", "w") as bundle:
+        bundle.writestr("../\x1b[2J.py", "x = 1\n")
+    printed = cli.class_summary(discover(klass, scratch=tmp_path / "scratch"))
+    lines = printed.split("\n")
+    assert len(lines) == 1 + len(names) + 1, printed
+    assert not any(line.startswith("  refused alice") for line in lines)
+    assert [character for character in printed if character in "\x1b\x07\x9b\u202e\r"] == []
+    assert "  \ufffd]0;owned\ufffd\ufffd[2Jmallory: " in printed
+    assert "  refused eve refused alice: forged/more.zip/../\ufffd[2J.py: a name climbing out" in printed
