@@ -107,7 +107,8 @@ def run_similarity(
     finally:
         if pool is not None:
             pool.shutdown()
-    report = build_report(documents, unreadable, behaviour, template.names, notes)
+    cache_notes = cache.notes if cache is not None else []
+    report = build_report(documents, unreadable, behaviour, template.names, [*notes, *cache_notes])
     return Outcome(report, files)
 
 
@@ -131,7 +132,7 @@ def _documents(
         unreadable.extend(_listed(identity, failure) for failure in failures)
         texts.append(readable)
         for position, source in enumerate(readable):
-            entry = cache.get(source.text) if cache is not None and is_reference else None
+            entry = cache.get(source.text, identity) if cache is not None and is_reference else None
             if entry is None:
                 missing.append((number, position, source))
             else:
