@@ -535,6 +535,7 @@ def run_grade(args: argparse.Namespace) -> int:
 def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> tuple[str, ...]:
     """Detect each submission's edition, grade the class as the edition most were written for (into
     ``args.config``), print which and why; return the functions of its enabled problems."""
+    from grader.class_report.text import terminal_line
     from grader.editions.per_submission import class_editions
     from grader.plan import GradingPlan
 
@@ -545,7 +546,7 @@ def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> 
     }
     editions = class_editions(files)
     for line in editions.lines():
-        print(line, file=sys.stderr, flush=True)
+        print(terminal_line(line), file=sys.stderr, flush=True)
     args.config = editions.choice.config
     return GradingPlan.load(args.config, None).problems
 
@@ -605,11 +606,8 @@ def _similarity_beside_grading(args: argparse.Namespace, download: ClassDownload
 
 def class_summary(download: ClassDownload) -> str:
     """What was found: the layout, which file is graded for whom and why, what was refused or unattributed."""
-    from grader.class_report.text import MAX_LINE_CHARS, display_text
+    from grader.class_report.text import terminal_line as shown  # every name here is the student's choice
     from grader.classroom import LAYOUTS
-
-    def shown(text: str) -> str:  # every name here is the student's choice: one inert line each
-        return display_text(text, MAX_LINE_CHARS)
 
     title = LAYOUTS[download.layout].title if download.layout in LAYOUTS else download.layout
     lines = [f"Found {len(download.submissions)} submissions ({title}):"]

@@ -71,6 +71,13 @@ def display_text(text: str, limit: int) -> str:
     return _cleaned(text, limit, HIDDEN_CATEGORIES)
 
 
+def terminal_line(text: str) -> str:
+    """A printed line that holds names a student chose: its leading indentation kept, the rest as
+    ``display_text`` (``MAX_LINE_CHARS``), so no name can retitle or clear the terminal or start a line."""
+    indent = text[: len(text) - len(text.lstrip(" "))]
+    return indent + display_text(text, MAX_LINE_CHARS)
+
+
 def display_identity(text: str, limit: int) -> str:
     """An identity to show: as ``display_text``, and every invisible format character (zero-width space,
     joiners, soft hyphen, byte order mark) also shown as ``\ufffd``, so two identities that differ only

@@ -136,11 +136,9 @@ def write_similarity(
 
 def summarise(report: SimilarityReport, out: Path, stream: Any) -> None:
     """Print what was compared, the notes, every file left out and what was written (each name and reason
-    one inert line: ``grader.class_report.text.display_text``)."""
-    from grader.class_report.text import IDENTITY_SHOWN_CHARS, MAX_LINE_CHARS, display_identity, display_text
-
-    def shown(text: str) -> str:
-        return display_text(text, MAX_LINE_CHARS)
+    one inert line: ``grader.class_report.text.terminal_line``)."""
+    from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
+    from grader.class_report.text import terminal_line as shown
 
     print(
         f"Compared {len(report.students)} students"
