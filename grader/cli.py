@@ -652,10 +652,10 @@ def _grade_class(
         if executor is not None:
             print(f"Grading on {executor}.", file=sys.stderr)
 
+    shown = {path: display_identity(identity, IDENTITY_SHOWN_CHARS) for path, identity in identities.items()}
+
     def advance(path: Path, result: ProblemResult) -> None:
         bar.advance(f"{shown[path]}: {result.id} {result.status}")
-
-    shown = {path: display_identity(identity, IDENTITY_SHOWN_CHARS) for path, identity in identities.items()}
 
     seed = choose_seed(args.seed, args.out)
     try:
