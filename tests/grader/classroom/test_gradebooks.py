@@ -250,7 +250,7 @@ def test_a_folder_named_like_a_roster_student_never_gets_their_row(
 def test_a_github_username_equal_to_another_students_roster_identifier_claims_nobody(
     tmp_path: Path,
 ) -> None:
-    # Hostile: the GitHub user "alice" is not Alice (her username is alice-gh; "alice" is her roster identifier).
+    # Hostile: the GitHub user "alice" is not Alice (her username is alice-gh, "alice" her roster identifier).
     root = tmp_path / "lab-1-submissions"
     download = discover(_folders(root, {"lab-1-alice-gh": b"x = 1\n", "lab-1-alice": b"x = 2\n"}), rule=RULE)
     assert download.layout == "github-classroom"
