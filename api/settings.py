@@ -125,8 +125,8 @@ class Settings(BrokerSettings):
     edition: str | None = Field(
         default=None,
         pattern=r"^[a-z][a-z0-9_]*$",
-        description="The edition of the lab every upload is graded as (grader/editions/: classic, gym026, volume2, rl1), "  # noqa: E501
-        "the course's assignment: set it once per course (rl1 for today's). Unset: the first edition, classic. "  # noqa: E501
+        description="The course's edition of the lab, set once per course: every upload is graded as it (grader/editions/: classic, gym026, volume2, rl1; rl1 for today's). "  # noqa: E501
+        "Unset: the first edition, classic. "
         "Never detected from an upload; a file written for another edition's problems is told so in its report.",  # noqa: E501
     )
     nice: int = Field(default=10, ge=0, le=19, description="Niceness added to grading processes.")

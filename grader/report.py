@@ -217,8 +217,8 @@ class Report(BaseModel):
     )
     edition_note: str | None = Field(
         default=None,
-        description="Said to a file that looks written for an edition asking other problems than the one "
-        "graded (the assignment's): which edition it shows and why; None otherwise.",
+        description="Said to a file that looks written for an edition asking other problems than the one graded (the assignment's): "  # noqa: E501
+        "which edition it shows and why; None otherwise.",
     )
     gymnasium_version: str = Field(description="Gymnasium version the episodes were replayed with.")
     grader_version: str = Field(description="gymgrade version.")

@@ -116,8 +116,7 @@ def _detected(trees: list[ast.Module] | None, name: str) -> Detection:
         )
     return Detection(
         CLASSIC,
-        "it shows no edition: it imports no gym and defines none of a later edition's functions or render "
-        "flags",
+        "it shows no edition: it imports no gym and defines none of a later edition's functions or render flags",  # noqa: E501
         shown=False,
     )
 

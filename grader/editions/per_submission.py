@@ -78,8 +78,8 @@ def class_editions(files: Mapping[str, Path]) -> ClassEditions:
     left_out = f"; {unshown} showing no edition not counted" if unshown else ""
     if len(problem_sets) == 1:
         reason = (
-            f"no --edition and no configuration; every file that shows an edition asks its problems "
-            f"({counts} of {len(detected)}{left_out})"
+            "no --edition and no configuration; "
+            f"every file that shows an edition asks its problems ({counts} of {len(detected)}{left_out})"
         )
         return ClassEditions(EditionChoice(edition, default_config(edition), reason), detected)
     reason = f"no --edition and no configuration, and the files disagree ({counts}{left_out})"
@@ -106,6 +106,7 @@ def _disagreement(shown: Mapping[str, Detection], unshown: int) -> str:
     return (
         f"the class's files were written for editions that ask different problems{left_out}: "
         f"{'; '.join(parts)}. What a student is graded on is the assignment's edition, not the files': "
-        f"nothing was graded; pass the assignment's edition ({choices}) or a configuration naming it "
-        f'(edition = "..."); a file written for another edition is then graded as the assignment and told so'
+        "nothing was graded; "
+        f'pass the assignment\'s edition ({choices}) or a configuration naming it (edition = "..."); '
+        "a file written for another edition is then graded as the assignment and told so"
     )

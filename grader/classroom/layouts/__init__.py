@@ -42,8 +42,8 @@ def add_layout_option(parser: argparse.ArgumentParser) -> None:
         type=_levels,
         default=None,
         metavar="N",
-        help="plain folders: N levels of section folders hold the students' folders (0: the top folders are "
-        "the students; default: decided from the download's shape as a whole)",
+        help="plain folders: N levels of section folders hold the students' folders; "
+        "0: the top folders are the students; by default decided from the download's shape as a whole",
     )
 
 
