@@ -31,8 +31,11 @@ KEY_COLUMNS: dict[str, tuple[str, ...]] = {
 never any column, so that one student's id cannot equal another column of another student's row (a GitHub
 username that is someone's roster identifier). Plain folders are named by the instructor, most often by login:
 its list is logins first. A roster with none of a layout's columns is matched on its first `ID_COLUMNS`
-column; an identity with an ``@`` (Gradescope's submitters without an SID) matches the email column."""
+column; an identity with an ``@`` matches the email column (`EMAIL_LAYOUTS`)."""
 EMAIL_COLUMNS = ("email", "email address")
+EMAIL_LAYOUTS = ("gradescope", "plain")
+"""Layouts whose identities may be emails (Gradescope's submitters without an SID, folders named by email):
+an identity with an ``@`` matches the email column there."""
 _ASCII_UPPER = str.maketrans("ABCDEFGHIJKLMNOPQRSTUVWXYZ", "abcdefghijklmnopqrstuvwxyz")
 
 
@@ -74,7 +77,8 @@ class Roster:
 
     def key_column(self, layout: str, identity: str = "") -> str | None:
         """The column identities of ``layout`` are matched on (None: the roster has no id column)."""
-        wanted = EMAIL_COLUMNS if "@" in identity and layout == "gradescope" else KEY_COLUMNS.get(layout, ())
+        by_email = "@" in identity and layout in EMAIL_LAYOUTS
+        wanted = EMAIL_COLUMNS if by_email else KEY_COLUMNS.get(layout, ())
         return next((column for column in (*wanted, *ID_COLUMNS) if column in self.columns), None)
 
     def find(self, identity: str, layout: str = "plain") -> RosterEntry | None:

@@ -204,8 +204,10 @@ def test_a_roster_matches_one_key_per_layout_and_keeps_leading_zeros() -> None:
     entry = roster.find("00123")
     assert entry is not None and entry.identity == "00123"
     assert roster.find("123") is None
-    assert roster.find("ada@uni.edu") is None, "plain folders match the roster's first id column only"
+    assert roster.find("Ada", "plain") is None, "only the layout's key column, never the name"
     assert roster.find("ADA@uni.edu", "gradescope") is entry, "Gradescope's email identities match the email"
+    assert roster.find("ada@uni.edu", "plain") is entry, "so do folders named by email"
+    assert roster.find("ada@uni.edu", "canvas") is None, "a Canvas identity is a user id"
 
 
 def _folders(root: Path, names: dict[str, bytes]) -> Path:
