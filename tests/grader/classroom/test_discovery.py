@@ -256,3 +256,19 @@ def test_sections_with_another_layout_are_refused(tmp_path: Path) -> None:
 
     with pytest.raises(LayoutMismatch, match="--sections 1 describes plain folders, but --layout canvas"):
         discover(tmp_path, layout="canvas", sections=1)
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [("-1", "expected 0 to 32 levels of section folders, found -1"), ("two", "found 'two'")],
+    ids=["negative", "not-a-number"],
+)
+def test_the_sections_option_says_what_it_expects(
+    value: str, message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from grader import cli
+
+    assert cli.build_parser().parse_args(["grade", "x", "--out", "o", "--sections", "1"]).sections == 1
+    with pytest.raises(SystemExit):
+        cli.build_parser().parse_args(["grade", "x", "--out", "o", "--sections", value])
+    assert message in capsys.readouterr().err
