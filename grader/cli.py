@@ -465,7 +465,7 @@ def run_gradescope_seed(args: argparse.Namespace) -> int:
 def run_grade(args: argparse.Namespace) -> int:
     """`gymgrade grade`: recognise the class download, grade each student's file not yet graded in --out
     (reports named by identity), keep each report and the gradebooks as they are done."""
-    from grader.classroom import GradedFileRule, discover_all
+    from grader.classroom import GradedFileRule, read_all, submissions_of_all
     from grader.classroom.errors import GradebookError
     from grader.classroom.gradebooks import Assignment
     from grader.classroom.output import ClassGradebook
@@ -481,23 +481,15 @@ def run_grade(args: argparse.Namespace) -> int:
     with tempfile.TemporaryDirectory(prefix="gymgrade-class-") as scratch:
         # Every enabled problem, not just --only's: the graded file must not change with --only.
         functions = GradingPlan.load(args.config, None).problems
-        download = discover_all(
-            args.targets,
-            layout=args.layout,
-            rule=GradedFileRule(functions=functions),
-            scratch=Path(scratch) / "first",
-            due=args.due,
-        )
+        # Read once, within one budget for every target; files are grouped again without reading anything.
+        reads = read_all(args.targets, layout=args.layout, sections=args.sections, scratch=Path(scratch))
+        download = submissions_of_all(reads, rule=GradedFileRule(functions=functions), due=args.due)
         if getattr(args, "detect_editions", False):
             asked = _detect_class_edition(args, download)
+            if asked is None:
+                return EXIT_ERROR
             if asked != functions:  # the class's edition asks other functions: choose each file by them
-                download = discover_all(
-                    args.targets,
-                    layout=args.layout,
-                    rule=GradedFileRule(functions=asked),
-                    scratch=Path(scratch) / "second",
-                    due=args.due,
-                )
+                download = submissions_of_all(reads, rule=GradedFileRule(functions=asked), due=args.due)
         plan = GradingPlan.load(args.config, args.only)
         print(class_summary(download), file=sys.stderr, flush=True)
         graded = [submission for submission in download.submissions if submission.graded_file is not None]
@@ -532,9 +524,11 @@ def run_grade(args: argparse.Namespace) -> int:
         return code
 
 
-def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> tuple[str, ...]:
-    """Detect each submission's edition, grade the class as the edition most were written for (into
-    ``args.config``), print which and why; return the functions of its enabled problems."""
+def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> tuple[str, ...] | None:
+    """Detect each submission's edition and grade the class as the edition every file showing one asks the
+    problems of (into ``args.config``), print which and why; return the functions of its enabled problems.
+    None (after saying which editions were found and whose files are behind each) when the files disagree:
+    the instructor names the assignment's edition, a majority of files never does."""
     from grader.class_report.text import terminal_line
     from grader.editions.per_submission import class_editions
     from grader.plan import GradingPlan
@@ -545,6 +539,11 @@ def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> 
         if submission.graded_file is not None
     }
     editions = class_editions(files)
+    if editions.disagreement is not None:
+        for line in editions.lines()[1:]:  # each file's edition and why
+            print(terminal_line(line), file=sys.stderr, flush=True)
+        print(terminal_line(f"gymgrade grade: {editions.disagreement}"), file=sys.stderr, flush=True)
+        return None
     for line in editions.lines():
         print(terminal_line(line), file=sys.stderr, flush=True)
     args.config = editions.choice.config

@@ -15,6 +15,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from grader.collector import Collector, GradingListener, OnResult, Silent, Submission
+from grader.editions import EDITIONS
+from grader.editions.detection import detect_source, edition_note
 from grader.notebook import build_module, is_notebook
 from grader.notebook.cells import write_cells
 from grader.plan import GradingPlan
@@ -147,7 +149,8 @@ def _prepare(path: Path, data: bytes | None, module_dir: Path, plan: GradingPlan
             "error", f"{path.name} could not be read: check that the file exists and is readable."
         )
     if not is_notebook(path.name):
-        return check_source(data, path.name) or Submission(path, data, path)
+        refused = check_source(data, path.name)
+        return refused or Submission(path, data, path, edition_note=_edition_note(data, path.name, plan))
     built = build_module(data, path.name, plan.problems)
     if isinstance(built, FileVerdict):
         return built
@@ -155,7 +158,15 @@ def _prepare(path: Path, data: bytes | None, module_dir: Path, plan: GradingPlan
     module_dir.mkdir()
     module.write_text(built.source, encoding="utf-8")
     write_cells(module, built.cells)
-    return Submission(path, data, module, built)
+    note = _edition_note(built.source.encode("utf-8"), path.name, plan)
+    return Submission(path, data, module, built, edition_note=note)
+
+
+def _edition_note(source: bytes, name: str, plan: GradingPlan) -> str | None:
+    """What the report tells a file written for another edition's problems than the plan's (read with
+    `ast`, never run): it is graded as the assignment's edition and told so."""
+    graded = EDITIONS.get(plan.edition)
+    return None if graded is None else edition_note(graded, detect_source(source, name))
 
 
 def _read(path: Path) -> bytes | None:

@@ -8,10 +8,15 @@ the reason the command line prints:
    `taxi` with two required parameters: `rl1`;
 2. `cartpole`/`car` with a `render` parameter, or `import gymnasium`: `volume2`;
 3. `import gym_toytext`, or gym 0.26's five-value `step` / two-value `reset` unpacking: `gym026`;
-4. otherwise the first edition, `classic`.
+4. `import gym` with none of the above: `classic`;
+5. otherwise the file shows no edition (`Detection.shown` is False: an empty file, one that cannot be read or
+   parsed, one defining a shared function and importing no gym); it is taken as the first edition, `classic`,
+   but a class's choice does not count it.
 
 Editions 1-3 grade the same problems (the compatibility layer runs every gym API), so telling them apart
-only names the edition; rule 1 changes what is graded.
+only names the edition; rule 1 changes what is graded. Detection chooses the edition of a student's own
+`check`; grading for a gradebook grades the edition the instructor chose, and `edition_note` tells a file
+written for other problems so.
 """
 
 from __future__ import annotations
@@ -35,10 +40,14 @@ MAX_CELLS = 10_000
 
 @dataclass(frozen=True)
 class Detection:
-    """The edition a submission was detected as, and why (one sentence a person reads)."""
+    """The edition a submission was detected as, and why (one sentence a person reads).
+
+    `shown` is False for a file that shows no edition's mark (it is then taken as the first edition).
+    """
 
     edition: Edition
     reason: str
+    shown: bool = True
 
 
 @dataclass(frozen=True)
@@ -50,11 +59,20 @@ class _Function:
 
 def detect_edition(path: Path) -> Detection:
     """The edition of a `.py` or `.ipynb` submission, from the functions it defines and what it imports."""
-    trees = _parse(path)
-    if trees is None:
-        return Detection(
-            CLASSIC, f"{path.name} could not be read as Python, so no later edition's mark was found"
-        )
+    return _detected(_parse(path), path.name)
+
+
+def detect_source(source: bytes, name: str) -> Detection:
+    """The edition of Python source already read (a `.py` file's bytes, or the module built from a
+    notebook's cells), bounded as `detect_edition` bounds a file."""
+    if len(source) > MAX_SUBMISSION_BYTES:
+        return _detected(None, name)
+    return _detected(_parsed([source]), name)
+
+
+def _detected(trees: list[ast.Module] | None, name: str) -> Detection:
+    if trees is None or not trees:
+        return Detection(CLASSIC, f"{name} could not be read as Python, so it shows no edition", shown=False)
     functions = {
         node.name: _signature(node)
         for tree in trees
@@ -91,7 +109,30 @@ def detect_edition(path: Path) -> Detection:
         return Detection(
             GYM026, "it imports gym and unpacks the five values of gym 0.26's step (or reset's two)"
         )
-    return Detection(CLASSIC, "it shows no mark of a later edition (their functions, render flags or APIs)")
+    if "gym" in imports:
+        return Detection(
+            CLASSIC,
+            "it imports gym and shows no mark of a later edition (their functions, render flags or APIs)",
+        )
+    return Detection(
+        CLASSIC,
+        "it shows no edition: it imports no gym and defines none of a later edition's functions or render flags",  # noqa: E501
+        shown=False,
+    )
+
+
+def edition_note(graded: Edition, found: Detection) -> str | None:
+    """What a report tells a file written for other problems than the edition graded (None: it is not).
+
+    Editions grading the same problems (1-3) are not told: the compatibility layer runs each one's API.
+    """
+    if not found.shown or found.edition.registry is graded.registry:
+        return None
+    return (
+        f"This file looks written for edition {found.edition.number} ({found.edition.name}, "
+        f"{found.edition.title}): {found.reason}. Your assignment is edition {graded.number} ({graded.name}, "
+        f"{graded.title}), so it was graded on that edition's problems; check the assignment's template."
+    )
 
 
 def _parse(path: Path) -> list[ast.Module] | None:
@@ -106,6 +147,10 @@ def _parse(path: Path) -> list[ast.Module] | None:
     sources = _notebook_cells(data) if path.suffix == ".ipynb" else [data]
     if sources is None or sum(len(source) for source in sources) > MAX_SUBMISSION_BYTES:
         return None
+    return _parsed(sources)
+
+
+def _parsed(sources: list[bytes]) -> list[ast.Module]:
     trees: list[ast.Module] = []
     for source in sources:
         try:

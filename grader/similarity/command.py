@@ -82,7 +82,9 @@ def run_similarity_command(args: argparse.Namespace) -> int:
     template = load_template(tuple(args.template) if args.template else BUNDLED)
     cache = None if args.no_cache else IndexCache(args.cache or default_cache_dir())
     with tempfile.TemporaryDirectory(prefix="gymgrade-similarity-") as scratch:
-        sources = submissions_from(args.class_dir, layout=args.layout, scratch=Path(scratch))
+        sources = submissions_from(
+            args.class_dir, layout=args.layout, sections=args.sections, scratch=Path(scratch)
+        )
         report = write_similarity(
             sources, args.out, args.reference, template=template, cache=cache, reports=args.reports
         )

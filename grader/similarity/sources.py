@@ -90,6 +90,7 @@ def submissions_from(
     path: Path,
     *,
     layout: str | None = None,
+    sections: int | None = None,
     scratch: Path | None = None,
     rule: GradedFileRule | None = None,
 ) -> ClassSources:
@@ -98,6 +99,8 @@ def submissions_from(
     Args:
         path: The download: a folder, a zip as the LMS gave it, or one file.
         layout: A ``grader.classroom.LAYOUTS`` name (``--layout``); recognised from the download when None.
+        sections: Plain folders: levels of section folders (``--sections``); None: from the download's
+            shape.
         scratch: Where zips are extracted (the caller removes it after the report is written); zips are
             listed as refused when None.
         rule: How the graded file (compared first) is chosen; by default as `gymgrade grade` chooses it
@@ -117,7 +120,7 @@ def submissions_from(
 
         rule = GradedFileRule(functions=GradingPlan.load(None, None).problems)
     try:
-        download = discover(path, layout=layout, rule=rule, scratch=scratch)
+        download = discover(path, layout=layout, sections=sections, rule=rule, scratch=scratch)
     except FileNotFoundError as error:
         raise ClassDirectoryError(str(error)) from None
     return sources_of(download)

@@ -199,3 +199,130 @@ def test_a_submissions_why_names_a_few_refused_files_and_counts_the_rest(tmp_pat
     assert len(mallory.refused) == 2_000
     assert mallory.why.endswith("; and 1,995 more")
     assert len(mallory.why) < 1_000
+
+
+LAB = b"import gym\n\ndef random_blackjack(n):\n    return 0.0\n"
+
+
+def _plain(root: Path, files: list[str]) -> Path:
+    for relative in files:
+        (root / relative).parent.mkdir(parents=True, exist_ok=True)
+        (root / relative).write_bytes(LAB)
+    return root
+
+
+def _graded_files(root: Path, **options: object) -> dict[str, str | None]:
+    download = discover(root, rule=RULE, **options)  # type: ignore[arg-type]
+    assert download.layout == "plain"
+    return {s.identity: s.graded_file.relative if s.graded_file else None for s in download.submissions}
+
+
+@pytest.mark.parametrize(
+    ("files", "graded"),
+    [
+        (
+            ["alice/opengym.ipynb", "bob/opengym.py", "mallory/alice/opengym.py", "mallory/x1/helper.py"],
+            {"alice": "alice/opengym.ipynb", "bob": "bob/opengym.py", "mallory": "mallory/alice/opengym.py"},
+        ),
+        (
+            [
+                "sec1/alice/opengym.py",
+                "sec1/mallory/bob/opengym.py",
+                "sec1/mallory/x1/helper.py",
+                "sec2/bob/opengym.py",
+                "sec2/carol/opengym.py",
+            ],
+            {
+                "alice": "sec1/alice/opengym.py",
+                "bob": "sec2/bob/opengym.py",
+                "carol": "sec2/carol/opengym.py",
+                "mallory": "sec1/mallory/bob/opengym.py",
+            },
+        ),
+        (
+            ["alice/lab/opengym.py", "bob/mallory/opengym.py", "bob/x1/helper.py", "carol/src/opengym.py"],
+            {
+                "alice": "alice/lab/opengym.py",
+                "bob": "bob/mallory/opengym.py",
+                "carol": "carol/src/opengym.py",
+            },
+        ),
+    ],
+    ids=["a-folder-holding-only-folders-is-a-student", "inside-sections", "when-every-student-nests"],
+)
+def test_a_students_own_subfolders_are_their_files_and_claim_nobody(
+    tmp_path: Path, files: list[str], graded: dict[str, str]
+) -> None:
+    # Hostile: mallory/alice/opengym.py must not be graded as alice's (outranking her notebook), nor
+    # mallory/x1/ become a student; sections are decided from the whole download, not one student's folder.
+    assert _graded_files(_plain(tmp_path / "class", files)) == graded
+
+
+@pytest.mark.parametrize(
+    ("files", "graded"),
+    [
+        (
+            ["sec1/alice/opengym.py", "sec1/bob/opengym.py", "sec2/carol/opengym.py", "sec2/dave/opengym.py"],
+            {
+                "alice": "sec1/alice/opengym.py",
+                "bob": "sec1/bob/opengym.py",
+                "carol": "sec2/carol/opengym.py",
+                "dave": "sec2/dave/opengym.py",
+            },
+        ),
+        (
+            [
+                "fall/sec1/alice/opengym.py",
+                "fall/sec1/bob/opengym.py",
+                "fall/sec2/carol/opengym.py",
+                "fall/sec2/dave/opengym.py",
+            ],
+            {
+                "alice": "fall/sec1/alice/opengym.py",
+                "bob": "fall/sec1/bob/opengym.py",
+                "carol": "fall/sec2/carol/opengym.py",
+                "dave": "fall/sec2/dave/opengym.py",
+            },
+        ),
+        (
+            ["0042.py", "alice/opengym.py", "alice/old/opengym.py", "notes.txt"],
+            {"0042": "0042.py", "alice": "alice/opengym.py"},
+        ),
+    ],
+    ids=["sections", "a-folder-wrapping-sections", "files-and-folders"],
+)
+def test_honest_sections_are_recognised_from_the_downloads_shape(
+    tmp_path: Path, files: list[str], graded: dict[str, str]
+) -> None:
+    assert _graded_files(_plain(tmp_path / "class", files)) == graded
+
+
+def test_sections_can_be_named_outright(tmp_path: Path) -> None:
+    root = _plain(tmp_path / "class", ["sec1/alice/opengym.py", "sec2/bob/opengym.py"])
+    assert _graded_files(root) == {"sec1": "sec1/alice/opengym.py", "sec2": "sec2/bob/opengym.py"}
+    assert _graded_files(root, sections=1) == {"alice": "sec1/alice/opengym.py", "bob": "sec2/bob/opengym.py"}
+    flat = _plain(tmp_path / "flat", ["sec1/alice/opengym.py", "sec1/bob/opengym.py"])
+    assert _graded_files(flat, sections=0) == {"sec1": None}, "two lab files at one depth: nothing guessed"
+
+
+def test_sections_with_another_layout_are_refused(tmp_path: Path) -> None:
+    from grader.classroom.errors import LayoutMismatch
+
+    with pytest.raises(LayoutMismatch, match="--sections 1 describes plain folders, but --layout canvas"):
+        discover(tmp_path, layout="canvas", sections=1)
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [("-1", "expected 0 to 32 levels of section folders, found -1"), ("two", "found 'two'")],
+    ids=["negative", "not-a-number"],
+)
+def test_the_sections_option_says_what_it_expects(
+    value: str, message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from grader import cli
+
+    assert cli.build_parser().parse_args(["grade", "x", "--out", "o", "--sections", "1"]).sections == 1
+    with pytest.raises(SystemExit):
+        cli.build_parser().parse_args(["grade", "x", "--out", "o", "--sections", value])
+    assert message in capsys.readouterr().err
