@@ -50,15 +50,14 @@ def read_untrusted(path: Path, *, limit: int, root: Path | None = None, one_name
     try:
         info = os.fstat(descriptor)
         _check_opened(path, info, one_name)
-        chunks: list[bytes] = []
-        remaining = limit + 1
-        while remaining > 0:
-            chunk = os.read(descriptor, min(remaining, 1 << 20))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            remaining -= len(chunk)
-        return b"".join(chunks)
+        # One read asks for everything (a regular file gives it at once, so the bytes are never copied);
+        # the loop only continues a read the system cut short.
+        chunks = [os.read(descriptor, min(limit + 1, info.st_size + 1))]
+        remaining = limit + 1 - len(chunks[0])
+        while remaining > 0 and chunks[-1]:
+            chunks.append(os.read(descriptor, min(remaining, 1 << 20)))
+            remaining -= len(chunks[-1])
+        return b"".join(chunks) if any(chunks[1:]) else chunks[0]
     except OSError as error:
         raise UnsafeFile(_unreadable(path, error)) from error
     finally:
