@@ -6,8 +6,8 @@ A valid notebook of 19.9 MB (the lab's classic notebook with 6.6 million empty J
 cells, generated here) is read by edition detection, grading (the module the sandbox imports) and
 similarity, each alone in a fresh process, and then a whole `gymgrade grade DIR --similarity --only
 random_blackjack` runs on a class of two honest notebooks with and without it. Each figure is the
-measuring process's own peak resident memory (RUSAGE_SELF: the parent; the bounded reading child is not
-in it), with the wall time. `--before REV` measures a `git archive` of REV the same way (the tree before
+measuring process's own peak resident memory (VmHWM: the parent; the bounded reading child is not in it),
+with the wall time. `--before REV` measures a `git archive` of REV the same way (the tree before
 the change); `--write` replaces the `## Fifth round: notebook memory` section of bench/RESULTS.md.
 """
 
@@ -23,6 +23,7 @@ import sys
 import tempfile
 from datetime import date
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "RESULTS.md"
@@ -47,29 +48,44 @@ STEPS = {
     ),
 }
 MEASURE = """
-import json, resource, sys, time
+import json, re, resource, sys, time
 from pathlib import Path
 path, out = Path(sys.argv[1]), Path(sys.argv[2])
+
+
+def peak():
+    # VmHWM: this process's own peak since its exec (ru_maxrss starts from its parent's size at the fork)
+    try:
+        status = Path("/proc/self/status").read_text()
+        return int(re.search(r"VmHWM:\\s+(\\d+) kB", status).group(1)) / 1024
+    except OSError:
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
 import grader.cli, grader.editions.detection, grader.notebook, grader.similarity.sources, grader.plan
-before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+before = peak()
 started = time.perf_counter()
 {step}
 wall = time.perf_counter() - started
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-print(json.dumps({{"before": before / 1024, "peak": peak / 1024, "wall": wall, "result": str(result)[:300],
+print(json.dumps({{"before": before, "peak": peak(), "wall": wall, "result": str(result)[:300],
                   "grader": grader.cli.__file__}}))
 """
 
 
-def hostile_notebook() -> bytes:
-    """The lab's classic notebook with empty objects among its cells, up to `TARGET_BYTES`."""
+def write_hostile_notebook(path: Path) -> None:
+    """The lab's classic notebook with empty objects among its cells, up to `TARGET_BYTES`, written in
+    pieces (this process stays small: a child's peak RSS starts from its parent's size at the fork)."""
     text = json.dumps(json.loads(HONEST["alice.ipynb"].read_text(encoding="utf-8")))
     at = text.index('"cells": [') + len('"cells": [')
-    filler = "{}," * ((TARGET_BYTES - len(text)) // 3)
-    return (text[:at] + filler + text[at:]).encode()
+    objects = (TARGET_BYTES - len(text)) // 3
+    with path.open("w", encoding="utf-8") as stream:
+        stream.write(text[:at])
+        for start in range(0, objects, 100_000):
+            stream.write("{}," * min(100_000, objects - start))
+        stream.write(text[at:])
 
 
-def measure(source: Path, step: str, path: Path, scratch: Path) -> dict[str, object]:
+def measure(source: Path, step: str, path: Path, scratch: Path) -> dict[str, Any]:
     out = scratch / f"out-{len(list(scratch.iterdir()))}"
     completed = subprocess.run(
         [sys.executable, "-c", MEASURE.format(step=STEPS[step]), str(path), str(out)],
@@ -79,20 +95,20 @@ def measure(source: Path, step: str, path: Path, scratch: Path) -> dict[str, obj
         text=True,
         check=True,
     )
-    figures: dict[str, object] = json.loads(completed.stdout.splitlines()[-1])
+    figures: dict[str, Any] = json.loads(completed.stdout.splitlines()[-1])
     if not Path(str(figures["grader"])).is_relative_to(source):
         raise RuntimeError(f"measured {figures['grader']}, not the tree in {source}")
     return figures
 
 
-def run(source: Path, scratch: Path) -> list[tuple[str, str, dict[str, object]]]:
+def run(source: Path, scratch: Path) -> list[tuple[str, str, dict[str, Any]]]:
     honest = scratch / "honest"
     hostile = scratch / "hostile"
     for folder in (honest, hostile):
         folder.mkdir()
         for name, sample in HONEST.items():
             (folder / name).write_bytes(sample.read_bytes())
-    (hostile / "mallory.ipynb").write_bytes(hostile_notebook())
+    write_hostile_notebook(hostile / "mallory.ipynb")
     rows = []
     for step in ("detection", "grading (module)", "similarity"):
         for label, path in (
@@ -105,17 +121,18 @@ def run(source: Path, scratch: Path) -> list[tuple[str, str, dict[str, object]]]
     return rows
 
 
-def table(title: str, rows: list[tuple[str, str, dict[str, object]]]) -> list[str]:
+def table(title: str, rows: list[tuple[str, str, dict[str, Any]]]) -> list[str]:
     lines = [
         title,
         "",
-        "| step | input | parent before MiB | parent peak MiB | wall s | outcome |",
-        "|---|---|---:|---:|---:|---|",
+        "| step | input | parent before MiB | parent peak MiB | growth MiB | wall s | outcome |",
+        "|---|---|---:|---:|---:|---:|---|",
     ]
     for step, label, figures in rows:
         outcome = str(figures["result"]).replace("|", "/").replace("\n", " ")[:110]
         lines.append(
-            f"| {step} | {label} | {figures['before']:.0f} | {figures['peak']:.0f} | {figures['wall']:.2f} | {outcome} |"  # noqa: E501
+            f"| {step} | {label} | {figures['before']:.0f} | {figures['peak']:.0f} | "
+            f"{figures['peak'] - figures['before']:.0f} | {figures['wall']:.2f} | {outcome} |"
         )
     return [*lines, ""]
 
@@ -131,7 +148,7 @@ def main() -> None:
         f"`python bench/notebook_memory.py{' --before ' + arguments.before if arguments.before else ''}` on "
         f"{date.today()}, {platform.python_implementation()} {platform.python_version()}, {os.cpu_count()} cores, "  # noqa: E501
         f"load average {os.getloadavg()[0]:.1f} (shared machine: wall times are inflated). "
-        "Peak resident memory of the measuring process itself (RUSAGE_SELF; the bounded reading child is "
+        "Peak resident memory of the measuring process itself (VmHWM; the bounded reading child is "
         'not counted), each row in a fresh process; "before" is after imports, "peak" after the step.',
         "",
     ]
@@ -140,10 +157,9 @@ def main() -> None:
         if arguments.before:
             old = scratch / "before-tree"
             old.mkdir()
-            archive = subprocess.run(
-                ["git", "-C", str(ROOT), "archive", arguments.before], capture_output=True, check=True
-            ).stdout
-            subprocess.run(["tar", "-x", "-C", str(old)], input=archive, check=True)
+            subprocess.run(
+                f"git -C '{ROOT}' archive '{arguments.before}' | tar -x -C '{old}'", shell=True, check=True
+            )
             (scratch / "before").mkdir()
             lines += table(f"Before ({arguments.before}):", run(old, scratch / "before"))
         (scratch / "now").mkdir()
