@@ -22,6 +22,7 @@ import resource
 import signal
 import subprocess
 import sys
+import threading
 import traceback
 from collections import OrderedDict
 from collections.abc import Collection
@@ -83,27 +84,31 @@ class _Reply(BaseModel):
 
 
 class _Kept:
-    """The notebooks this process read, by digest of their bytes and name: cells, or the reading's verdict."""
+    """The notebooks this process read, by digest of their bytes and name: cells, or the reading's verdict
+    (similarity reads a batch's files in threads, hence the lock)."""
 
     def __init__(self, characters: int) -> None:
         self.characters = characters
         self.entries: OrderedDict[tuple[bytes, str], NotebookCells | FileVerdict] = OrderedDict()
         self.size = 0
+        self.lock = threading.Lock()
 
     def get(self, key: tuple[bytes, str]) -> NotebookCells | FileVerdict | None:
-        found = self.entries.get(key)
-        if found is not None:
-            self.entries.move_to_end(key)
-        return found
+        with self.lock:
+            found = self.entries.get(key)
+            if found is not None:
+                self.entries.move_to_end(key)
+            return found
 
     def put(self, key: tuple[bytes, str], read: NotebookCells | FileVerdict) -> None:
-        if key in self.entries:
-            return
-        self.entries[key] = read
-        self.size += _characters(read)
-        while self.size > self.characters and self.entries:
-            _, dropped = self.entries.popitem(last=False)
-            self.size -= _characters(dropped)
+        with self.lock:
+            if key in self.entries:
+                return
+            self.entries[key] = read
+            self.size += _characters(read)
+            while self.size > self.characters and self.entries:
+                _, dropped = self.entries.popitem(last=False)
+                self.size -= _characters(dropped)
 
 
 def _characters(read: NotebookCells | FileVerdict) -> int:
@@ -132,9 +137,8 @@ def read_notebook(data: bytes, name: str) -> NotebookCells | FileVerdict:
     if kept is not None:
         return kept
     reply = _run(data, name, {"mode": "read"})
-    if isinstance(reply, FileVerdict):
-        return reply
-    read = _as_read(reply)
+    # A file the reader died on is kept too: grading and similarity give it the same verdict at once.
+    read = reply if isinstance(reply, FileVerdict) else _as_read(reply)
     _KEPT.put(key, read)
     return read
 

@@ -415,6 +415,26 @@ def test_two_uploads_get_different_starts_and_a_recorded_one_regrades_identicall
 
 
 @pytest.mark.slow
+def test_student_code_that_opens_the_secret_by_its_path_reads_nothing(
+    gradescope: Path, tmp_path: Path
+) -> None:
+    root = tmp_path / "root"
+    reader = tmp_path / "opengym.py"
+    reader.write_text(
+        "from pathlib import Path\n"
+        "try:\n"
+        f"    FOUND = 'read: ' + Path({str(root / 'source' / SECRET_FILE)!r}).read_text()\n"
+        "except OSError as error:\n"
+        "    FOUND = f'refused: {type(error).__name__}'\n\n\n"
+        "def cartpole():\n"
+        "    raise ValueError(FOUND)\n"
+    )
+    data = _upload(gradescope, root, reader, metadata(3003, "2026-11-26T09:10:00.000000-08:00", 9))
+    assert SECRET not in json.dumps(data)
+    assert "ValueError: refused: " in _cartpole(data)["output"], _cartpole(data)["output"]
+
+
+@pytest.mark.slow
 def test_a_current_edition_upload_is_graded_by_its_editions_bundle(tmp_path: Path) -> None:
     rl1 = EDITIONS["rl1"]
     overrides: dict[str, dict[str, Any]] = {problem: {"enabled": False} for problem in rl1.registry.ids}

@@ -507,3 +507,15 @@ def test_a_notebook_of_millions_of_empty_objects_is_refused_and_the_parent_stays
     # Parsed in the parent, these objects took ~495 MiB there (bench/notebook_memory.py); read by the
     # bounded child, the parent holds the file's 20 MB bytes and the child's short reply.
     assert int(measured[3]) < 100, f"the parent grew by {measured[3]} MiB"
+
+
+def test_the_kept_readings_drop_the_least_recently_used_past_their_budget() -> None:
+    from grader.notebook.reading import Cell, NotebookCells
+
+    kept = bounded._Kept(characters=10)
+    for name in ("a", "b", "c"):
+        kept.put((b"digest", name), NotebookCells([Cell(1, None, "x" * 4)], []))
+    assert kept.get((b"digest", "a")) is None, "12 characters: the oldest went"
+    assert kept.get((b"digest", "b")) is not None  # now the most recently used: c goes next
+    kept.put((b"digest", "d"), FileVerdict("missing", "dddd"))
+    assert [key[1] for key in kept.entries] == ["b", "d"] and kept.size == 8
