@@ -32,6 +32,8 @@ PROJECT_PACKAGES = ("grader", "reference")
 """What the bundle installs on Gradescope: the grader and its oracles (the service is not needed)."""
 BUNDLE_PYTHON = "python3.11"
 BUNDLE_VENV = "/opt/gymgrade"
+MAX_UPLOAD_DEPTH = 32
+"""Folders an upload is walked into (a lab's file sits at its top, or a folder or two down)."""
 SECRET_FILE = "seed_secret"
 """The bundle's seed secret (hex), drawn when the bundle is built; only the grader (root) reads it."""
 
@@ -62,8 +64,15 @@ def pick_submission(directory: Path) -> Path | str:
     )
 
 
-def _walk_upload(directory: Path, top: Path, candidates: list[Path], refused: dict[Path, str]) -> None:
+def _walk_upload(
+    directory: Path, top: Path, candidates: list[Path], refused: dict[Path, str], depth: int = 0
+) -> None:
     """Gradable names under ``directory`` (hidden ones skipped), never following a link."""
+    if depth > MAX_UPLOAD_DEPTH:
+        refused[directory] = (
+            f"{directory.relative_to(top)} is deeper than {MAX_UPLOAD_DEPTH} folders: not read."
+        )
+        return
     try:
         with os.scandir(directory) as listing:
             entries = sorted(listing, key=lambda entry: entry.name)
@@ -79,7 +88,7 @@ def _walk_upload(directory: Path, top: Path, candidates: list[Path], refused: di
             continue
         gradable = path.suffix.lower() in SUBMISSION_SUFFIXES
         if stat.S_ISDIR(info.st_mode):
-            _walk_upload(path, top, candidates, refused)
+            _walk_upload(path, top, candidates, refused, depth + 1)
             continue
         if gradable:
             candidates.append(path)

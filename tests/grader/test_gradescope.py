@@ -220,6 +220,14 @@ def test_the_graded_file_is_chosen_or_the_student_told(tmp_path: Path, files: li
     assert (choice.relative_to(tmp_path).as_posix() if isinstance(choice, Path) else choice) == picked
 
 
+def test_an_upload_is_walked_only_so_deep(tmp_path: Path) -> None:
+    deep = tmp_path.joinpath(*["d"] * 40)
+    deep.mkdir(parents=True)
+    (deep / "opengym.py").write_text("x = 1\n")
+    choice = pick_submission(tmp_path)
+    assert isinstance(choice, str) and choice.endswith(f"{'d/' * 32}d is deeper than 32 folders: not read.")
+
+
 NAME_LIKE_SECRET = "ab" * 32
 """A secret that parses as a Python name: run as a student's code, a NameError would print it."""
 
