@@ -26,11 +26,12 @@ from pydantic import ValidationError
 import grader
 from grader.collector import GradingListener
 from grader.errors import BatchInterrupted
-from grader.grading import grade_files
+from grader.grading import READ_LIMIT, grade_files
 from grader.notebook import NOTEBOOK_SUFFIX
 from grader.plan import GradingPlan
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
+from grader.untrusted_file import UnsafeFile, read_untrusted
 
 CHUNK_SUBMISSIONS = 24
 """Submissions per pytest run: large enough to keep every worker busy, small enough that a run that dies
@@ -391,7 +392,8 @@ def write_atomically(path: Path, text: str) -> None:
 
 
 def _read(path: Path) -> bytes | None:
+    """The bytes grading reads of ``path`` (so their SHA-256 is the report's), None when it refuses them."""
     try:
-        return path.read_bytes()
-    except OSError:
+        return read_untrusted(path, limit=READ_LIMIT)
+    except UnsafeFile:
         return None

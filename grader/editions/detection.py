@@ -1,8 +1,10 @@
 """Which edition a submission was written for, read statically from its source (never run) in the parent.
 
-The source is untrusted: it is read up to a bound, parsed with `ast` only (nothing is executed or imported),
-and a file that cannot be read or parsed simply shows no marker. The rules, newest edition first, each with
-the reason the command line prints:
+The source is untrusted: it is read up to a bound without following links, parsed with `ast` only (nothing
+is executed or imported), and a file that cannot be read or parsed simply shows no marker. A notebook's code
+cells come from the bounded reader (`grader.notebook.read_notebook`: its JSON is never parsed here).
+
+The rules, newest edition first, each with the reason the command line prints:
 
 1. a function only the current edition asks for (`epsilon_decay`, `qlearn`, `sarsa0`, `compare`), or a
    `taxi` with two required parameters: `rl1`;
@@ -22,7 +24,6 @@ written for other problems so.
 from __future__ import annotations
 
 import ast
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,11 +32,9 @@ from grader.editions.gym026 import GYM026
 from grader.editions.pack import Edition
 from grader.editions.rl1 import RL1
 from grader.editions.volume2 import VOLUME2
-from grader.validation import MAX_SUBMISSION_BYTES
-
-MAX_NOTEBOOK_BYTES = 32 * MAX_SUBMISSION_BYTES
-"""A notebook's outputs (plots) make it larger than its code; beyond this it is not read for detection."""
-MAX_CELLS = 10_000
+from grader.notebook import MAX_NOTEBOOK_BYTES, is_notebook, read_notebook
+from grader.untrusted_file import UnsafeFile, read_untrusted
+from grader.validation import MAX_SUBMISSION_BYTES, FileVerdict
 
 
 @dataclass(frozen=True)
@@ -136,15 +135,15 @@ def edition_note(graded: Edition, found: Detection) -> str | None:
 
 
 def _parse(path: Path) -> list[ast.Module] | None:
-    limit = MAX_NOTEBOOK_BYTES if path.suffix == ".ipynb" else MAX_SUBMISSION_BYTES
+    notebook = is_notebook(path.name)
+    limit = MAX_NOTEBOOK_BYTES if notebook else MAX_SUBMISSION_BYTES
     try:
-        with path.open("rb") as handle:
-            data = handle.read(limit + 1)
-    except OSError:
+        data = read_untrusted(path, limit=limit)
+    except UnsafeFile:
         return None
     if len(data) > limit:
         return None
-    sources = _notebook_cells(data) if path.suffix == ".ipynb" else [data]
+    sources = _notebook_cells(data, path.name) if notebook else [data]
     if sources is None or sum(len(source) for source in sources) > MAX_SUBMISSION_BYTES:
         return None
     return _parsed(sources)
@@ -160,25 +159,14 @@ def _parsed(sources: list[bytes]) -> list[ast.Module]:
     return trees
 
 
-def _notebook_cells(data: bytes) -> list[bytes] | None:
-    try:
-        notebook = json.loads(data)
-    except (ValueError, RecursionError, MemoryError):
-        return None
-    cells = notebook.get("cells") if isinstance(notebook, dict) else None
-    if not isinstance(cells, list) or len(cells) > MAX_CELLS:
+def _notebook_cells(data: bytes, name: str) -> list[bytes] | None:
+    read = read_notebook(data, name)
+    if isinstance(read, FileVerdict):
         return None
     sources: list[bytes] = []
-    for cell in cells:
-        if not isinstance(cell, dict) or cell.get("cell_type") != "code":
-            continue
-        source = cell.get("source")
-        text = (
-            "".join(part for part in source if isinstance(part, str)) if isinstance(source, list) else source
-        )
-        if isinstance(text, str):
-            lines = [line for line in text.splitlines() if not line.lstrip().startswith(("%", "!"))]
-            sources.append("\n".join(lines).encode("utf-8", "replace"))
+    for cell in read.cells:
+        lines = [line for line in cell.source.splitlines() if not line.lstrip().startswith(("%", "!"))]
+        sources.append("\n".join(lines).encode("utf-8", "replace"))
     return sources
 
 

@@ -11,17 +11,18 @@ setup file), the graded file first; docs/similarity.md says why not the graded f
 from __future__ import annotations
 
 import ast
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from grader.classroom import ClassDownload, GradedFileRule, discover
-from grader.classroom.model import Skipped
 from grader.classroom.graded_file import is_candidate
-from grader.notebook import MAX_NOTEBOOK_BYTES
+from grader.classroom.model import Skipped
+from grader.notebook import MAX_NOTEBOOK_BYTES, read_notebook
 from grader.similarity.errors import ClassDirectoryError
 from grader.similarity.report import UnreadableFile
+from grader.untrusted_file import UnsafeFile, read_untrusted
+from grader.validation import FileVerdict
 
 SOURCE_SUFFIXES = (".py", ".ipynb")
 MAX_COMPARED_BYTES = 200_000
@@ -215,10 +216,9 @@ def references_from(path: Path) -> list[tuple[str, Path]]:
 
 
 def read_source(path: Path) -> SourceText | Unreadable:
-    """Read one submitted file as Python text, bounded in size, never executing or importing it."""
-    if path.is_symlink():
-        return Unreadable(path, f"{path.name} is a symbolic link: only regular files are read, left out.")
-    if path.is_dir():
+    """Read one submitted file as Python text, bounded in size, never executing or importing it, never
+    following a link; a notebook's code cells come from the bounded reader (`grader.notebook`)."""
+    if path.is_dir() and not path.is_symlink():
         return Unreadable(path, f"{path.name} holds no .py or .ipynb file: nothing to compare.")
     if not _has_source_suffix(path):
         return Unreadable(
@@ -228,10 +228,9 @@ def read_source(path: Path) -> SourceText | Unreadable:
     notebook = path.suffix.lower() == ".ipynb"
     limit = MAX_NOTEBOOK_BYTES if notebook else MAX_COMPARED_BYTES
     try:
-        with path.open("rb") as stream:
-            data = stream.read(limit + 1)
-    except OSError as error:
-        return Unreadable(path, f"{path.name} could not be read ({error.strerror or error}).")
+        data = read_untrusted(path, limit=limit)
+    except UnsafeFile as error:
+        return Unreadable(path, f"{error} Left out.")
     if len(data) > limit:
         return Unreadable(
             path, f"{path.name} is larger than {limit:,} bytes: too large to be a lab solution, left out."
@@ -240,44 +239,30 @@ def read_source(path: Path) -> SourceText | Unreadable:
         return Unreadable(path, f"{path.name} is empty: nothing to compare.")
     if b"\0" in data:
         return Unreadable(path, f"{path.name} is binary (it contains NUL bytes), not Python text: left out.")
+    if notebook:  # read (its UTF-8 too) by the bounded reader: the parent never decodes it whole
+        return _notebook_code(path, data)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         return Unreadable(
             path, f"{path.name} is not UTF-8 text (byte {error.start} cannot be decoded): left out."
         )
-    if notebook:
-        return _notebook_code(path, text)
     return SourceText(path, text)
 
 
-def _notebook_code(path: Path, text: str) -> SourceText | Unreadable:
-    try:
-        notebook = json.loads(text)
-    except (json.JSONDecodeError, RecursionError) as error:
-        return Unreadable(
-            path, f"{path.name} is not a readable notebook: not valid JSON ({str(error)[:120]})."
-        )
-    cells = notebook.get("cells") if isinstance(notebook, dict) else None
-    if not isinstance(cells, list):
-        return Unreadable(
-            path, f'{path.name} is JSON but not a Jupyter notebook (no "cells" list): left out.'
-        )
+def _notebook_code(path: Path, data: bytes) -> SourceText | Unreadable:
+    read = read_notebook(data, path.name)
+    if isinstance(read, FileVerdict):
+        return Unreadable(path, f"left out: {read.message}")
     chunks: list[str] = []
     notes: list[str] = []
-    for number, cell in enumerate(cells, start=1):
-        if not isinstance(cell, dict) or cell.get("cell_type") != "code":
-            continue
-        source = cell.get("source", "")
-        if isinstance(source, list):
-            source = "".join(part for part in source if isinstance(part, str))
-        if isinstance(source, str) and source.strip():
-            lines = [_without_magic(line) for line in source.splitlines()]
-            if not _parses("\n".join(lines)):
-                # one broken cell (a half-typed line) must not hide the rest of the notebook
-                notes.append(f"{path.name}: cell {number} is not valid Python and was not compared.")
-                lines = [""] * len(lines)
-            chunks.append("\n".join(lines))
+    for cell in read.cells:
+        lines = [_without_magic(line) for line in cell.source.splitlines()]
+        if not _parses("\n".join(lines)):
+            # one broken cell (a half-typed line) must not hide the rest of the notebook
+            notes.append(f"{path.name}: cell {cell.number} is not valid Python and was not compared.")
+            lines = [""] * len(lines)
+        chunks.append("\n".join(lines))
     code = "\n\n".join(chunks)
     if len(code.encode()) > MAX_COMPARED_BYTES:
         return Unreadable(

@@ -67,6 +67,23 @@ def test_check_explains_what_is_missing_and_exits_1(
     )
 
 
+def test_check_of_a_symbolic_link_says_so_and_reads_nothing_of_its_target(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    secret = tmp_path / "secret.txt"
+    secret.write_text("def epsilon_decay(n):\n    return 'hunter2'\n")  # an rl1 mark, if it were read
+    (tmp_path / "opengym.py").symlink_to(secret)
+    assert (
+        cli.main(["check", str(tmp_path / "opengym.py"), "--only", "random_blackjack"]) == cli.EXIT_NOT_FULL
+    )
+    captured = capsys.readouterr()
+    assert (
+        f"opengym.py is a symbolic link (to {secret}): links are never followed, so it was not read. "
+        "Submit the file itself, not a link to it." in captured.out
+    )
+    assert "Edition: classic" in captured.err and "epsilon_decay" not in captured.err, "detection read it"
+
+
 QUICK_FIND_QVALUES = (
     "import numpy as np\n\n\ndef find_qvalues(env):\n    print('training a table')\n"
     "    return np.zeros((500, 6))\n"
