@@ -502,7 +502,7 @@ def test_a_notebook_of_millions_of_empty_objects_is_refused_and_the_parent_stays
         "not part of your solution (or submit your code as a .py file) and submit again."
     )
     assert measured[:3] == [
-        "mallory.ipynb could not be read as Python, so no later edition's mark was found",
+        "mallory.ipynb could not be read as Python, so it shows no edition",
         f"left out: {refusal}",
         refusal,
     ]
