@@ -7,12 +7,10 @@ import logging
 import signal
 import sys
 from types import FrameType
+from typing import TYPE_CHECKING
 
-from pydantic import ValidationError
-
-from api.errors import GraderUnavailable
-from api.grader_adapter import check_grader_target
-from api.settings import Settings, load_settings
+if TYPE_CHECKING:
+    from api.settings import Settings
 
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8000
@@ -52,6 +50,14 @@ def add_worker_command(subparsers: argparse._SubParsersAction[argparse.ArgumentP
 
 
 def _settings_or_none() -> Settings | None:
+    # Imported here: every `gymgrade` command builds this parser, and the settings' imports (pydantic-settings,
+    # the service's errors) cost a `gymgrade check` about 45 ms before its grading starts.
+    from pydantic import ValidationError
+
+    from api.errors import GraderUnavailable
+    from api.grader_adapter import check_grader_target
+    from api.settings import load_settings
+
     try:
         settings = load_settings()
         check_grader_target(settings.grader)

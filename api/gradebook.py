@@ -13,6 +13,7 @@ from sqlalchemy.orm import Session
 
 from api.models import JobStatus, Student, Submission
 from api.settings import GradebookPolicy
+from grader.class_report.text import safe_cell
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment, GradeRow
 from grader.classroom.model import Member
 from grader.classroom.roster import RosterEntry
@@ -20,8 +21,6 @@ from grader.report import ProblemResult, Report
 
 GRADEBOOK_FORMATS = ("gymgrade", *GRADEBOOKS)
 """The ``format`` values of the export: gymgrade's own columns, then every ``gymgrade grade --gradebook``."""
-
-_FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
 
 
 def _chosen(session: Session, policy: GradebookPolicy) -> tuple[list[Student], dict[int, Any]]:
@@ -120,14 +119,14 @@ def gradebook_csv(session: Session, policy: GradebookPolicy) -> str:
     for student in students:
         picked = chosen.get(student.id)
         if picked is None:
-            writer.writerow([_cell(student.name), "", "", "", *([""] * len(problem_ids)), "", ""])
+            writer.writerow([safe_cell(student.name), "", "", "", *([""] * len(problem_ids)), "", ""])
             continue
         scores = {
             problem.get("id"): problem.get("score") for problem in (picked.report or {}).get("problems", [])
         }
         writer.writerow(
             [
-                _cell(student.name),
+                safe_cell(student.name),
                 picked.id,
                 picked.created_at.isoformat(timespec="seconds"),
                 picked.sha256,
@@ -149,8 +148,3 @@ def _problem_ids(reports: Iterable[dict[str, Any] | None]) -> list[str]:
 
 def _number(value: object) -> str:
     return "" if value is None else f"{float(value):g}"  # type: ignore[arg-type]
-
-
-def _cell(text: str) -> str:
-    """Quote a text cell so that spreadsheets never evaluate it as a formula."""
-    return "'" + text if text.startswith(_FORMULA_STARTS) else text

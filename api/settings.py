@@ -125,8 +125,9 @@ class Settings(BrokerSettings):
     edition: str | None = Field(
         default=None,
         pattern=r"^[a-z][a-z0-9_]*$",
-        description="The edition of the lab every upload is graded as (grader/editions/: classic, gym026, volume2, rl1); "  # noqa: E501
-        "unset: detected per upload from the functions it defines (the report names the edition).",
+        description="The course's edition of the lab, set once per course: every upload is graded as it (grader/editions/: classic, gym026, volume2, rl1; rl1 for today's). "  # noqa: E501
+        "Unset: the first edition, classic. "
+        "Never detected from an upload; a file written for another edition's problems is told so in its report.",  # noqa: E501
     )
     nice: int = Field(default=10, ge=0, le=19, description="Niceness added to grading processes.")
     lease_seconds: float = Field(
@@ -145,6 +146,20 @@ class Settings(BrokerSettings):
         gt=0,
         description="A grading still running after this long is stopped and marked failed.",
     )
+
+    @field_validator("edition")
+    @classmethod
+    def _known_edition(cls, edition: str | None) -> str | None:
+        if edition is None:
+            return None
+        from grader.editions import edition_of  # the packs import the checks: only when an edition is set
+        from grader.editions.errors import UnknownEdition
+
+        try:
+            edition_of(edition, where="GYMGRADE_EDITION")
+        except UnknownEdition as error:
+            raise ValueError(str(error)) from None
+        return edition
 
     @field_validator("due_date")
     @classmethod

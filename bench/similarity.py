@@ -14,7 +14,12 @@ Part 2 (scale). 300 students and 1,000 reference files generated at random (abou
 functions of random loops, branches and env calls; 10 students copy a reference, renamed): a cold run
 (every reference indexed and cached), a warm run (references from the cache), the peak memory.
 
+Part 3 (refused entries, issue 33; only with --refused-links N ...): two students, one of whom hands in a
+zip of N symbolic-link entries; the seconds to read the class as the similarity check does
+(`submissions_from`, discovery included) and how many lines list the refusals.
+
     python bench/similarity.py [--students 300] [--references 1000] [--skip-copydetect] [--scale-only]
+    python bench/similarity.py --refused-links 20000 80000
 """
 
 from __future__ import annotations
@@ -470,6 +475,28 @@ def scale(students: int, references: int) -> dict[str, float]:
         }
 
 
+def refused_links(count: int) -> tuple[float, int]:
+    """Seconds to read a class whose one student hands in a zip of ``count`` link entries, and the lines
+    listing what was refused."""
+    import zipfile
+
+    from grader.similarity.sources import submissions_from
+
+    with tempfile.TemporaryDirectory() as folder:
+        klass = Path(folder) / "class"
+        for name in ("ana", "ben"):
+            (klass / name).mkdir(parents=True)
+            (klass / name / "opengym.py").write_text("def blackjack(n):\n    return 0\n", encoding="utf-8")
+        with zipfile.ZipFile(klass / "ben" / "links.zip", "w") as bundle:
+            for number in range(count):
+                link = zipfile.ZipInfo(f"l{number}.py")
+                link.external_attr = 0o120777 << 16
+                bundle.writestr(link, "/etc/passwd")
+        started = time.perf_counter()
+        sources = submissions_from(klass, scratch=Path(folder) / "scratch")
+        return time.perf_counter() - started, len(sources.skipped)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--students", type=int, default=300)
@@ -479,7 +506,15 @@ def main() -> None:
     parser.add_argument(
         "--scale-only", action="store_true", help="only part 2 (its peak memory is then its own)"
     )
+    parser.add_argument(
+        "--refused-links", type=int, nargs="+", default=None, metavar="N", help="only part 3, for each N"
+    )
     args = parser.parse_args()
+    if args.refused_links:
+        for count in args.refused_links:
+            seconds, listed = refused_links(count)
+            print(f"| {count:,} | {seconds:.2f} s | {listed} |")
+        return
     if args.scale_only:
         result = scale(args.students, args.references)
         print(f"scale: {args.students} students x {args.references} references: {result}")

@@ -26,11 +26,12 @@ from pydantic import ValidationError
 import grader
 from grader.collector import GradingListener
 from grader.errors import BatchInterrupted
-from grader.grading import grade_files
+from grader.grading import READ_LIMIT, grade_files
 from grader.notebook import NOTEBOOK_SUFFIX
 from grader.plan import GradingPlan
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
+from grader.untrusted_file import UnsafeFile, read_untrusted
 
 CHUNK_SUBMISSIONS = 24
 """Submissions per pytest run: large enough to keep every worker busy, small enough that a run that dies
@@ -98,11 +99,33 @@ def report_names(paths: Sequence[Path]) -> dict[Path, str]:
     return names
 
 
+MAX_STEM_CHARS = 150
+"""Longest report file stem kept as the identity itself (ASCII: bytes = characters). With ``.json`` and
+the temporary name of ``write_atomically`` (``.<name>.json.`` and 8 characters) it stays far below the
+255-byte name limit of common file systems."""
+HASHED_STEM_DIGITS = 20
+"""Hex digits of the identity's SHA-256 that end a longer identity's stem (80 bits: no student can make a
+name whose stem is another's)."""
+
+
 def identity_stem(identity: str) -> str:
     """A report file stem for a student's identity: the identity itself, with every character that is not
-    safe in a file name percent-encoded (``ada/../x`` -> ``ada%2F..%2Fx``; a leading dot too)."""
+    safe in a file name percent-encoded (``ada/../x`` -> ``ada%2F..%2Fx``; a leading dot too).
+
+    A stem longer than ``MAX_STEM_CHARS`` is cut (never inside a ``%XX``) and ends with ``~`` and
+    ``HASHED_STEM_DIGITS`` hex digits of the identity's SHA-256: bounded (at most ``MAX_STEM_CHARS + 3``
+    characters), the same in every run (resuming finds it), and never another identity's stem (it is longer
+    than every stem kept whole).
+    """
     stem = urllib.parse.quote(identity, safe=" -_.@+,()")
-    return "%2E" + stem[1:] if stem.startswith(".") else stem
+    stem = "%2E" + stem[1:] if stem.startswith(".") else stem
+    if len(stem) <= MAX_STEM_CHARS:
+        return stem
+    head = stem[: MAX_STEM_CHARS - HASHED_STEM_DIGITS + 2]
+    if "%" in head[-2:]:
+        head = head[: head.rindex("%")]
+    digest = hashlib.sha256(identity.encode("utf-8", "surrogatepass")).hexdigest()[:HASHED_STEM_DIGITS]
+    return f"{head}~{digest}"
 
 
 def stale_reason(report_text: str | None, data: bytes | None, *, seed: int, plan: GradingPlan) -> str | None:
@@ -206,9 +229,17 @@ class OutputDirectory:
 
     def report(self, path: Path, report: Report) -> None:
         """Write a finished file's report and rewrite ``grades.csv`` with every file finished so far (a
-        class's gradebooks at most every ``GRADEBOOK_INTERVAL`` seconds, the rest at :meth:`flush`)."""
+        class's gradebooks at most every ``GRADEBOOK_INTERVAL`` seconds, the rest at :meth:`flush`).
+
+        A report that cannot be written (the disk refuses the name, a folder is in its place) is that
+        submission's grader error, in its gradebook row; the batch goes on, and the next run grades it again.
+        """
+        try:
+            write_atomically(self.report_path(path), report.to_json() + "\n")
+        except OSError as error:
+            unwritten = unwritten_report(self.report_path(path), error)
+            report = report.model_copy(update={"grader_errors": [*report.grader_errors, unwritten]})
         self.reports[path] = report
-        write_atomically(self.report_path(path), report.to_json() + "\n")
         if self.gradebook is not None and time.monotonic() - self.written_at < GRADEBOOK_INTERVAL:
             self.pending = True
             return
@@ -340,6 +371,14 @@ def write_grades(path: Path, names: Sequence[str], reports: Sequence[Report], pl
     write_atomically(path, stream.getvalue())
 
 
+def unwritten_report(path: Path, error: OSError) -> str:
+    """The grader error of a report that could not be written to ``path``."""
+    return (
+        f"its report could not be written to {path.name} ({error.strerror or error}); "
+        "its scores are in the gradebook, and the next run grades it again"
+    )
+
+
 def write_atomically(path: Path, text: str) -> None:
     """Replace ``path`` with ``text`` in one rename, so an interruption never leaves half a file."""
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
@@ -353,7 +392,8 @@ def write_atomically(path: Path, text: str) -> None:
 
 
 def _read(path: Path) -> bytes | None:
+    """The bytes grading reads of ``path`` (so their SHA-256 is the report's), None when it refuses them."""
     try:
-        return path.read_bytes()
-    except OSError:
+        return read_untrusted(path, limit=READ_LIMIT)
+    except UnsafeFile:
         return None

@@ -479,7 +479,7 @@ def run_gradescope_seed(args: argparse.Namespace) -> int:
 def run_grade(args: argparse.Namespace) -> int:
     """`gymgrade grade`: recognise the class download, grade each student's file not yet graded in --out
     (reports named by identity), keep each report and the gradebooks as they are done."""
-    from grader.classroom import GradedFileRule, discover_all
+    from grader.classroom import GradedFileRule, read_all, submissions_of_all
     from grader.classroom.errors import GradebookError
     from grader.classroom.gradebooks import Assignment
     from grader.classroom.output import ClassGradebook
@@ -495,23 +495,15 @@ def run_grade(args: argparse.Namespace) -> int:
     with tempfile.TemporaryDirectory(prefix="gymgrade-class-") as scratch:
         # Every enabled problem, not just --only's: the graded file must not change with --only.
         functions = GradingPlan.load(args.config, None).problems
-        download = discover_all(
-            args.targets,
-            layout=args.layout,
-            rule=GradedFileRule(functions=functions),
-            scratch=Path(scratch) / "first",
-            due=args.due,
-        )
+        # Read once, within one budget for every target; files are grouped again without reading anything.
+        reads = read_all(args.targets, layout=args.layout, sections=args.sections, scratch=Path(scratch))
+        download = submissions_of_all(reads, rule=GradedFileRule(functions=functions), due=args.due)
         if getattr(args, "detect_editions", False):
             asked = _detect_class_edition(args, download)
+            if asked is None:
+                return EXIT_ERROR
             if asked != functions:  # the class's edition asks other functions: choose each file by them
-                download = discover_all(
-                    args.targets,
-                    layout=args.layout,
-                    rule=GradedFileRule(functions=asked),
-                    scratch=Path(scratch) / "second",
-                    due=args.due,
-                )
+                download = submissions_of_all(reads, rule=GradedFileRule(functions=asked), due=args.due)
         plan = GradingPlan.load(args.config, args.only)
         print(class_summary(download), file=sys.stderr, flush=True)
         graded = [submission for submission in download.submissions if submission.graded_file is not None]
@@ -546,9 +538,12 @@ def run_grade(args: argparse.Namespace) -> int:
         return code
 
 
-def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> tuple[str, ...]:
-    """Detect each submission's edition, grade the class as the edition most were written for (into
-    ``args.config``), print which and why; return the functions of its enabled problems."""
+def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> tuple[str, ...] | None:
+    """Detect each submission's edition and grade the class as the edition every file showing one asks the
+    problems of (into ``args.config``), print which and why; return the functions of its enabled problems.
+    None (after saying which editions were found and whose files are behind each) when the files disagree:
+    the instructor names the assignment's edition, a majority of files never does."""
+    from grader.class_report.text import terminal_line
     from grader.editions.per_submission import class_editions
     from grader.plan import GradingPlan
 
@@ -558,8 +553,13 @@ def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> 
         if submission.graded_file is not None
     }
     editions = class_editions(files)
+    if editions.disagreement is not None:
+        for line in editions.lines()[1:]:  # each file's edition and why
+            print(terminal_line(line), file=sys.stderr, flush=True)
+        print(terminal_line(f"gymgrade grade: {editions.disagreement}"), file=sys.stderr, flush=True)
+        return None
     for line in editions.lines():
-        print(line, file=sys.stderr, flush=True)
+        print(terminal_line(line), file=sys.stderr, flush=True)
     args.config = editions.choice.config
     return GradingPlan.load(args.config, None).problems
 
@@ -619,6 +619,7 @@ def _similarity_beside_grading(args: argparse.Namespace, download: ClassDownload
 
 def class_summary(download: ClassDownload) -> str:
     """What was found: the layout, which file is graded for whom and why, what was refused or unattributed."""
+    from grader.class_report.text import terminal_line as shown  # every name here is the student's choice
     from grader.classroom import LAYOUTS
 
     title = LAYOUTS[download.layout].title if download.layout in LAYOUTS else download.layout
@@ -626,18 +627,28 @@ def class_summary(download: ClassDownload) -> str:
     for submission in download.submissions:
         graded = submission.graded_file.relative if submission.graded_file else "nothing graded"
         late = " [late]" if submission.late else ""
-        lines.append(f"  {submission.display_name}{late}: {graded} ({submission.why})")
-    for skipped in download.refused:
-        lines.append(f"  refused {skipped.where}: {skipped.reason}")
-    for skipped in download.unattributed:
-        lines.append(f"  not attributed {skipped.where}: {skipped.reason}")
+        lines.append(f"  {shown(submission.display_name)}{late}: {shown(graded)} ({shown(submission.why)})")
+    for skipped in download.refused[:MAX_SKIPPED_SHOWN]:
+        lines.append(f"  refused {shown(skipped.where)}: {shown(skipped.reason)}")
+    if len(download.refused) > MAX_SKIPPED_SHOWN:
+        lines.append(f"  ... and {len(download.refused) - MAX_SKIPPED_SHOWN:,} more refused")
+    for skipped in download.unattributed[:MAX_SKIPPED_SHOWN]:
+        lines.append(f"  not attributed {shown(skipped.where)}: {shown(skipped.reason)}")
+    if len(download.unattributed) > MAX_SKIPPED_SHOWN:
+        lines.append(f"  ... and {len(download.unattributed) - MAX_SKIPPED_SHOWN:,} more not attributed")
     return "\n".join(lines)
+
+
+MAX_SKIPPED_SHOWN = 200
+"""Refused (and unattributed) files the summary names; the rest are counted (a zip of 80,000 links is one
+student's, and a reason in their row)."""
 
 
 def _grade_class(
     args: argparse.Namespace, paths: list[Path], identities: dict[Path, str], gradebook: ClassGradebook
 ) -> int:
     from grader.batch import BatchOutcome, grade_many
+    from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
 
     policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
     executor = find_executor(policy)
@@ -654,8 +665,10 @@ def _grade_class(
         if executor is not None:
             print(f"Grading on {executor}.", file=sys.stderr)
 
+    shown = {path: display_identity(identity, IDENTITY_SHOWN_CHARS) for path, identity in identities.items()}
+
     def advance(path: Path, result: ProblemResult) -> None:
-        bar.advance(f"{identities[path]}: {result.id} {result.status}")
+        bar.advance(f"{shown[path]}: {result.id} {result.status}")
 
     seed = choose_seed(args.seed, args.out)
     try:
@@ -689,7 +702,11 @@ def _grade_class(
     if "canvas" in args.gradebook and gradebook.rows is not None:
         from grader.classroom.gradebooks import canvas_user_id
 
-        unmatched = [row.member.identity for row in gradebook.rows if not canvas_user_id(row)]
+        unmatched = [
+            display_identity(row.member.identity, IDENTITY_SHOWN_CHARS)
+            for row in gradebook.rows
+            if not canvas_user_id(row)
+        ]
         if unmatched:
             print(
                 f"canvas.csv leaves out {len(unmatched)} students without a Canvas user id ({', '.join(unmatched[:5])}{', ...' if len(unmatched) > 5 else ''}): "  # noqa: E501
@@ -710,8 +727,12 @@ def class_page_clash(page: Path, identities: Sequence[str], out_dir: Path) -> st
     """Why `gymgrade grade --html` would overwrite one of the batch's files (a student's report), or None."""
     from grader.batch import identity_stem
     from grader.class_report.from_batch import page_clash_of_reports
+    from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
 
-    reports = {out_dir / f"{identity_stem(identity)}.json": f"student {identity}" for identity in identities}
+    reports = {
+        out_dir / f"{identity_stem(identity)}.json": f"student {display_identity(identity, IDENTITY_SHOWN_CHARS)}"
+        for identity in identities
+    }
     return page_clash_of_reports(page, reports, out_dir)
 
 

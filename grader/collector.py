@@ -75,6 +75,7 @@ class Submission:
     data: bytes
     module: Path
     notebook: NotebookModule | None = None
+    edition_note: str | None = None
 
 
 class Collector:
@@ -196,6 +197,7 @@ class Collector:
             self.plan,
             results,
             isolation=next((run.isolation for run in runs if run.isolation), None),
+            edition_note=submission.edition_note,
             grader_errors=[
                 f"{run.result.id}: {run.internal_error}" for run in runs if run.internal_error is not None
             ],

@@ -23,6 +23,7 @@ from grader.errors import GradescopeError
 from grader.gradescope_upload import METADATA_FILE, UploadSeed, read_metadata
 from grader.render.gradescope import GradescopeResults, failed_run, results, seed_record
 from grader.seeds import new_secret, upload_seed
+from grader.untrusted_file import UnsafeFile, read_untrusted
 
 DEFAULT_ROOT = Path("/autograder")
 PREFERRED_STEM = "opengym"
@@ -31,6 +32,8 @@ PROJECT_PACKAGES = ("grader", "reference")
 """What the bundle installs on Gradescope: the grader and its oracles (the service is not needed)."""
 BUNDLE_PYTHON = "python3.11"
 BUNDLE_VENV = "/opt/gymgrade"
+MAX_UPLOAD_DEPTH = 32
+"""Folders an upload is walked into (a lab's file sits at its top, or a folder or two down)."""
 SECRET_FILE = "seed_secret"
 """The bundle's seed secret (hex), drawn when the bundle is built; only the grader (root) reads it."""
 
@@ -39,25 +42,67 @@ def pick_submission(directory: Path) -> Path | str:
     """The file to grade in Gradescope's submission directory, or why there is none.
 
     One ``.py`` or ``.ipynb`` file is graded as it is; among several, the one named like the lab's
-    ``opengym.py`` (or ``opengym.ipynb``) is chosen; otherwise the student is told what was found.
+    ``opengym.py`` (or ``opengym.ipynb``) is chosen; otherwise the student is told what was found. The
+    directory is walked without following links: a symbolic link (to a file or a folder), a hard link or
+    anything but a regular file counts by its name, and when it is the one chosen the student is told
+    why it is not graded (it is never read).
     """
-    candidates = sorted(
-        path
-        for path in directory.rglob("*")
-        if path.is_file()
-        and path.suffix.lower() in SUBMISSION_SUFFIXES
-        and not any(part.startswith(".") for part in path.relative_to(directory).parts)
-    )
+    candidates: list[Path] = []
+    refused: dict[Path, str] = {}
+    _walk_upload(directory, directory, candidates, refused)
+    candidates.sort()
     if len(candidates) == 1:
-        return candidates[0]
+        return refused.get(candidates[0], candidates[0])
     preferred = [path for path in candidates if path.stem == PREFERRED_STEM]
     if len(preferred) == 1:
-        return preferred[0]
+        return refused.get(preferred[0], preferred[0])
     found = ", ".join(str(path.relative_to(directory)) for path in candidates) or "no .py or .ipynb file"
+    links = "".join(f" {reason}" for path, reason in sorted(refused.items()) if path not in candidates)
     return (
         f"Expected one Python file (.py) or Jupyter notebook (.ipynb) with your functions, ideally named {PREFERRED_STEM}.py; "  # noqa: E501
-        f"found {found}. Submit exactly one such file."
+        f"found {found}. Submit exactly one such file.{links}"
     )
+
+
+def _walk_upload(
+    directory: Path, top: Path, candidates: list[Path], refused: dict[Path, str], depth: int = 0
+) -> None:
+    """Gradable names under ``directory`` (hidden ones skipped), never following a link."""
+    if depth > MAX_UPLOAD_DEPTH:
+        refused[directory] = (
+            f"{directory.relative_to(top)} is deeper than {MAX_UPLOAD_DEPTH} folders: not read."
+        )
+        return
+    try:
+        with os.scandir(directory) as listing:
+            entries = sorted(listing, key=lambda entry: entry.name)
+    except OSError:
+        return
+    for entry in entries:
+        if entry.name.startswith("."):
+            continue
+        path = Path(entry.path)
+        try:
+            info = entry.stat(follow_symlinks=False)
+        except OSError:
+            continue
+        gradable = path.suffix.lower() in SUBMISSION_SUFFIXES
+        if stat.S_ISDIR(info.st_mode):
+            _walk_upload(path, top, candidates, refused, depth + 1)
+            continue
+        if gradable:
+            candidates.append(path)
+        if stat.S_ISLNK(info.st_mode) or (gradable and (not stat.S_ISREG(info.st_mode) or info.st_nlink > 1)):
+            refused[path] = _refusal(path, top)
+
+
+def _refusal(path: Path, top: Path) -> str:
+    """Why an upload's entry is not read (`grader.untrusted_file` says it as it would on reading it)."""
+    try:
+        read_untrusted(path, limit=0, root=top)
+    except UnsafeFile as error:
+        return str(error)
+    return f"{path.relative_to(top)} is not a regular file: it was not read."
 
 
 def bundle(out: Path, *, config: Path | None, secret: str | None = None) -> Path:
@@ -181,30 +226,50 @@ def run_autograder(
     from grader.sandbox import IsolationPolicy
 
     picked = pick_submission(root / "submission")
-    if isinstance(picked, str):
-        graded = failed_run(picked)
-    else:
-        try:
-            report = grade_submission(
-                picked,
-                seed=upload.seed,
-                workers=workers,
-                policy=IsolationPolicy.ALLOW_FALLBACK,
-                config=config,
-            )
-        except Exception as error:  # results.json must exist whatever happens, or Gradescope shows nothing
-            graded = failed_run(
-                f"The autograder failed (not your fault; please tell your instructor): "
-                f"{type(error).__name__}: {error}"
-            )
+    with tempfile.TemporaryDirectory(prefix="gymgrade-upload-") as private:
+        copy = _private_copy(picked, root / "submission", Path(private))
+        if isinstance(copy, str):
+            graded = failed_run(copy)
         else:
-            graded = results(report, upload=upload)
+            try:
+                report = grade_submission(
+                    copy,
+                    seed=upload.seed,
+                    workers=workers,
+                    policy=IsolationPolicy.ALLOW_FALLBACK,
+                    config=config,
+                )
+            except (
+                Exception
+            ) as error:  # results.json must exist whatever happens, or Gradescope shows nothing
+                graded = failed_run(
+                    f"The autograder failed (not your fault; please tell your instructor): "
+                    f"{type(error).__name__}: {error}"
+                )
+            else:
+                graded = results(report, upload=upload)
     if graded.extra_data is None:
         graded = graded.model_copy(update={"extra_data": seed_record(upload)})
     target = root / "results" / "results.json"
     target.parent.mkdir(parents=True, exist_ok=True)
     target.write_text(graded.to_json(), encoding="utf-8")
     return graded
+
+
+def _private_copy(picked: Path | str, submission: Path, private: Path) -> Path | str:
+    """The chosen upload file, read once without following a link anywhere below ``submission``, as a
+    copy in the grader's private folder (what is graded); or why it cannot be graded."""
+    if isinstance(picked, str):
+        return picked
+    from grader.grading import READ_LIMIT
+
+    try:
+        data = read_untrusted(picked, limit=READ_LIMIT, root=submission)
+    except UnsafeFile as error:
+        return str(error)
+    copy = private / picked.name
+    copy.write_bytes(data)
+    return copy
 
 
 def upload_seed_of(archive_path: Path, metadata_path: Path) -> UploadSeed:
@@ -238,11 +303,12 @@ def regrade_upload(
         (root / "source").mkdir()
         config = root / "source" / "assignment.toml"
         config.write_text(bundle_config(archive_path), encoding="utf-8")
-        if submission.is_dir():
-            shutil.copytree(submission, root / "submission")
+        # Links are copied as links (never followed), so the regrade refuses them as the bundle did.
+        if submission.is_dir() and not submission.is_symlink():
+            shutil.copytree(submission, root / "submission", symlinks=True)
         else:
             (root / "submission").mkdir()
-            shutil.copy2(submission, root / "submission" / submission.name)
+            shutil.copy2(submission, root / "submission" / submission.name, follow_symlinks=False)
         graded = run_autograder(root, upload=upload, config=config, workers=workers)
         shutil.copy2(root / "results" / "results.json", out)
     return graded

@@ -14,11 +14,14 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from grader.errors import GradescopeError
 from grader.seeds import held_out_seed, upload_seed
+from grader.untrusted_file import UnsafeFile, read_untrusted
 
 METADATA_FILE = "submission_metadata.json"
 """Gradescope's description of the upload being graded, in the autograder's root."""
 METADATA_LIMIT_BYTES = 64 * 2**20
 """Read no more of the metadata (it embeds every earlier upload's results.json)."""
+SECRET_LIMIT_BYTES = 4096
+"""A bundle's secret is 64 hex digits and a newline."""
 
 
 class GradescopeUser(BaseModel):
@@ -111,8 +114,28 @@ def seed_for_upload(root: Path, *, secret_file: Path) -> UploadSeed:
     recorded for the instructor.
     """
     try:
-        secret = secret_file.read_text(encoding="ascii")
+        secret = read_secret(secret_file)
         identity = read_metadata(root / METADATA_FILE).identity()
         return UploadSeed(upload_seed(secret, identity), "derived", identity)
     except (GradescopeError, OSError, UnicodeDecodeError, ValueError) as error:
         return UploadSeed(held_out_seed(), "fresh", note=str(error))
+
+
+def read_secret(path: Path) -> str:
+    """The bundle's seed secret, read before any file of the upload is touched, and left readable by its
+    owner alone (student code runs as another uid, and bubblewrap and Landlock do not show the file).
+
+    Raises:
+        GradescopeError: The secret is a link, not a regular file, too large or unreadable.
+    """
+    try:
+        data = read_untrusted(path, limit=SECRET_LIMIT_BYTES, one_name=False)
+    except UnsafeFile as error:
+        raise GradescopeError(f"the bundle's seed secret cannot be used: {error}") from error
+    if len(data) > SECRET_LIMIT_BYTES:
+        raise GradescopeError(
+            f"{path} is larger than {SECRET_LIMIT_BYTES:,} bytes; expected the bundle's secret"
+        )
+    if path.stat().st_mode & 0o077:
+        path.chmod(0o600)
+    return data.decode("ascii")

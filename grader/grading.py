@@ -14,7 +14,9 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from grader.collector import Collector, GradingListener, OnResult, Silent, Submission
-from grader.notebook import build_module, is_notebook
+from grader.editions import EDITIONS
+from grader.editions.detection import detect_source, edition_note
+from grader.notebook import MAX_NOTEBOOK_BYTES, build_module, is_notebook
 from grader.notebook.cells import write_cells
 from grader.plan import GradingPlan
 from grader.plugin import SessionPlan
@@ -24,7 +26,11 @@ from grader.sandbox.host import usable_cpus
 from grader.sandbox.isolation.scope import sandbox_scope
 from grader.sandbox.runner import require_isolation
 from grader.session import run_session
-from grader.validation import FileVerdict, check_source
+from grader.untrusted_file import UnsafeFile, read_untrusted
+from grader.validation import MAX_SUBMISSION_BYTES, FileVerdict, check_source
+
+READ_LIMIT = max(MAX_SUBMISSION_BYTES, MAX_NOTEBOOK_BYTES)
+"""Bytes of a submission the parent reads (one more shows it is over; the file's verdict says by how much)."""
 
 
 def default_workers() -> int:
@@ -109,8 +115,11 @@ def grade_files(
     with tempfile.TemporaryDirectory(prefix="gymgrade-modules-") as modules_dir:
         prepared: dict[Path, tuple[bytes | None, Submission | FileVerdict]] = {}
         for index, path in enumerate(files):
-            data = _read(path)
-            prepared[path] = (data, _prepare(path, data, Path(modules_dir) / str(index), plan))
+            read = _read(path)
+            prepared[path] = (
+                read if isinstance(read, bytes) else None,
+                _prepare(path, read, Path(modules_dir) / str(index), plan),
+            )
         graded = sum(1 for _, submission in prepared.values() if isinstance(submission, Submission))
         worker_count = min(workers or default_workers(), max(graded * len(plan.problems), 1))
         collector = Collector(
@@ -139,15 +148,24 @@ def grade_files(
     return collector.reports_of(paths)
 
 
-def _prepare(path: Path, data: bytes | None, module_dir: Path, plan: GradingPlan) -> Submission | FileVerdict:
-    """The file the sandbox imports for a submission: the file itself, or the module built from a
-    notebook (in ``module_dir``); a verdict when it cannot be graded."""
-    if data is None:
-        return FileVerdict(
-            "error", f"{path.name} could not be read: check that the file exists and is readable."
-        )
+def _prepare(
+    path: Path, data: bytes | FileVerdict, module_dir: Path, plan: GradingPlan
+) -> Submission | FileVerdict:
+    """The file the sandbox imports for a submission, in ``module_dir`` (the grader's own folder): a copy of
+    the bytes read once, or the module built from a notebook; a verdict when it cannot be graded.
+
+    The student's file is never read again after `_read`: a file swapped or linked in meanwhile, or a
+    ``<name>.cells.json`` planted beside it, is not what is graded."""
+    if isinstance(data, FileVerdict):
+        return data
     if not is_notebook(path.name):
-        return check_source(data, path.name) or Submission(path, data, path)
+        verdict = check_source(data, path.name)
+        if verdict is not None:
+            return verdict
+        module_dir.mkdir()
+        module = module_dir / path.name
+        module.write_bytes(data)
+        return Submission(path, data, module, edition_note=_edition_note(data, path.name, plan))
     built = build_module(data, path.name, plan.problems)
     if isinstance(built, FileVerdict):
         return built
@@ -155,11 +173,20 @@ def _prepare(path: Path, data: bytes | None, module_dir: Path, plan: GradingPlan
     module_dir.mkdir()
     module.write_text(built.source, encoding="utf-8")
     write_cells(module, built.cells)
-    return Submission(path, data, module, built)
+    note = _edition_note(built.source.encode("utf-8"), path.name, plan)
+    return Submission(path, data, module, built, edition_note=note)
 
 
-def _read(path: Path) -> bytes | None:
+def _edition_note(source: bytes, name: str, plan: GradingPlan) -> str | None:
+    """What the report tells a file written for another edition's problems than the plan's (read with
+    `ast`, never run): it is graded as the assignment's edition and told so."""
+    graded = EDITIONS.get(plan.edition)
+    return None if graded is None else edition_note(graded, detect_source(source, name))
+
+
+def _read(path: Path) -> bytes | FileVerdict:
+    """The submission's bytes, read once without following links (`grader.untrusted_file`)."""
     try:
-        return path.read_bytes()
-    except OSError:
-        return None
+        return read_untrusted(path, limit=READ_LIMIT)
+    except UnsafeFile as error:
+        return FileVerdict("error", str(error))

@@ -215,6 +215,11 @@ class Report(BaseModel):
         description="The edition of the lab graded (grader/editions/). "
         "Absent in reports older than editions, all graded in the first, 'classic'.",
     )
+    edition_note: str | None = Field(
+        default=None,
+        description="Said to a file that looks written for an edition asking other problems than the one graded (the assignment's): "  # noqa: E501
+        "which edition it shows and why; None otherwise.",
+    )
     gymnasium_version: str = Field(description="Gymnasium version the episodes were replayed with.")
     grader_version: str = Field(description="gymgrade version.")
     isolation: Isolation = Field(default=None, description="What the sandbox could enforce for this grading.")

@@ -48,7 +48,10 @@ GRADER_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "testing",
         ),
     ),
-    ("plain data", ("report", "notebook", "stats", "seeds", "gradescope_upload", "validation", "errors")),
+    (
+        "plain data",
+        ("report", "notebook", "stats", "seeds", "gradescope_upload", "untrusted_file", "validation", "errors"),
+    ),
     ("untrusted execution", ("sandbox",)),
     ("the lab's dialects", ("compat",)),
 )

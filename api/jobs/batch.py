@@ -25,10 +25,11 @@ from api.settings import BrokerSettings
 from grader.collector import Collector, GradingListener, Silent, Submission
 from grader.config import config_from_data
 from grader.errors import ConfigError, ExecutorUnavailable
-from grader.grading import grade_files
+from grader.grading import READ_LIMIT, grade_files
 from grader.plan import GradingPlan
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
+from grader.untrusted_file import UnsafeFile, read_untrusted
 
 logger = logging.getLogger(__name__)
 
@@ -132,8 +133,8 @@ class CeleryExecutor:
         pending: dict[str, Path] = {}
         for index, path in enumerate(paths):
             try:
-                data = path.read_bytes()
-            except OSError:  # reported as unreadable without any grading: no need for the cluster
+                data = read_untrusted(path, limit=READ_LIMIT)
+            except UnsafeFile:  # a link or unreadable: refused without any grading, no need for the cluster
                 grade_files([path], plan, seed=seed, workers=1, policy=self.policy, listener=listener)
                 continue
             key = str(index)

@@ -54,7 +54,8 @@ def run_job(
     # (json.py, grader.py...) can shadow a module of the trusted process that drives the sandbox.
     submission = workdir / "submission" / grading_file_name(job.filename)
     submission.parent.mkdir()
-    submission.write_bytes(job.content)
+    with submission.open("xb") as created:  # a new file in a new folder: nothing to follow
+        created.write(job.content)
     config = None
     if job.config_toml is not None:
         config = workdir / "assignment.toml"

@@ -135,8 +135,8 @@ class BlackjackCheck:
         budget = games_budget(settings.games_per_call, GAME_STEPS)
         return [Call("blackjack", (n,), budget=budget) for n in settings.thresholds]
 
-    @noting_post_terminal_steps
     @paused_gc
+    @noting_post_terminal_steps
     @judged_when_all_returned
     def judge(self, settings: BlackjackConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge every call's rule, game count, returned rate and exact win probability."""

@@ -32,8 +32,8 @@ class CarCheck:
         """The configured number of car() calls."""
         return one_game_calls("car", settings.calls, EPISODE_STEPS)
 
-    @noting_post_terminal_steps
     @paused_gc
+    @noting_post_terminal_steps
     def judge(self, settings: CarConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned lengths against the replays, then the goal and the mean against the bar."""
         runs = judge_lengths("car", settings.game_rules(), records)

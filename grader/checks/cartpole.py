@@ -33,8 +33,8 @@ class CartpoleCheck:
         """The configured number of cartpole() calls."""
         return one_game_calls("cartpole", settings.calls, EPISODE_STEPS)
 
-    @noting_post_terminal_steps
     @paused_gc
+    @noting_post_terminal_steps
     def judge(self, settings: CartpoleConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the returned lengths against the replays, then mean and minimum against the bar."""
         runs = judge_lengths("cartpole", settings.game_rules(), records)

@@ -48,8 +48,8 @@ class RandomBlackjackCheck:
         games = settings.games
         return [Call("random_blackjack", (games,), budget=games_budget(games, GAME_STEPS))]
 
-    @noting_post_terminal_steps
     @paused_gc
+    @noting_post_terminal_steps
     @judged_when_all_returned
     def judge(self, settings: RandomBlackjackConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge the call against its replayed games and the exact random-policy win probability."""

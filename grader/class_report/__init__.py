@@ -7,13 +7,41 @@ writes both files.
 
 from __future__ import annotations
 
+import importlib
 import json
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from grader.class_report.entries import ClassEntry, EntryStatus
-from grader.class_report.html import CSP, render_class_html
-from grader.class_report.summary import ClassSummary, class_summary, diagnosis_key, diagnosis_text, summarise
+
+if TYPE_CHECKING:
+    from grader.class_report.html import CSP, render_class_html
+    from grader.class_report.summary import (
+        ClassSummary,
+        class_summary,
+        diagnosis_key,
+        diagnosis_text,
+        summarise,
+    )
+
+_LAZY = {
+    "CSP": "grader.class_report.html",
+    "render_class_html": "grader.class_report.html",
+    "ClassSummary": "grader.class_report.summary",
+    "class_summary": "grader.class_report.summary",
+    "diagnosis_key": "grader.class_report.summary",
+    "diagnosis_text": "grader.class_report.summary",
+    "summarise": "grader.class_report.summary",
+}
+"""Names loaded on first use: the page and its figures (matplotlib, Jinja) are not imported by what needs only
+``grader.class_report.text`` (the gradebooks, every page's filters, the terminal lines)."""
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "CSP",
@@ -54,6 +82,9 @@ def write_class_report(page: Path, entries: Sequence[ClassEntry], *, title: str 
         raise ValueError(
             f"--html {page}: expected an .html file name (the JSON summary is written beside it as {target.name}); name the page e.g. class.html"  # noqa: E501
         )
+    from grader.class_report.html import render_class_html
+    from grader.class_report.summary import summarise
+
     summary = summarise(entries, title=title)
     page.parent.mkdir(parents=True, exist_ok=True)
     page.write_text(render_class_html(entries, summary=summary), encoding="utf-8")

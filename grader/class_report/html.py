@@ -2,8 +2,8 @@
 
 No script, no network: images are ``data:`` URIs and the only style is the page's own, pinned by hash,
 under the one policy of ``grader.render.csp``. Every string from a student or a roster is escaped by
-the template and shown through ``display_text`` (bounded, no controls or bidi overrides, inside
-``<bdi>``); links to the students' reports are relative paths checked by ``safe_href``.
+the template and shown through the page filters of ``grader.class_report.text`` (bounded, no controls or
+bidi overrides, inside ``<bdi>``); links to the students' reports are relative paths checked by ``safe_href``.
 """
 
 from __future__ import annotations
@@ -13,7 +13,6 @@ from collections.abc import Sequence
 from grader.class_report.entries import ClassEntry
 from grader.class_report.figures import class_figures
 from grader.class_report.summary import ClassSummary, summarise
-from grader.class_report.text import MAX_NAME_CHARS, MAX_NOTE_CHARS, display_identity, display_text
 from grader.figures import Figure
 from grader.render.csp import content_security_policy
 from grader.render.page import page_environment
@@ -23,7 +22,6 @@ DIAGNOSES_SHOWN = 20
 """Diagnosis groups on the page (most common first); class.json lists more."""
 IDENTITIES_SHOWN = 60
 """Students named under one diagnosis on the page; class.json names them all."""
-IDENTITY_SHOWN_CHARS = 80
 STYLE = (
     "body{font-family:system-ui,sans-serif;max-width:60rem;margin:2rem auto;padding:0 1rem;color:#222}"
     ".meta{color:#555;font-size:.9rem}figure{margin:1rem 0}img{max-width:100%}"
@@ -37,9 +35,6 @@ STYLE = (
 CSP = content_security_policy(STYLE)
 
 _environment = page_environment()
-_environment.filters["identity"] = lambda text: display_identity(text, IDENTITY_SHOWN_CHARS)
-_environment.filters["name"] = lambda text: display_text(text, MAX_NAME_CHARS)
-_environment.filters["note"] = lambda text: display_text(text, MAX_NOTE_CHARS)
 
 
 def render_class_html(

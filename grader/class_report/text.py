@@ -1,15 +1,23 @@
-"""Hostile text made safe to show: identities, names and feedback bounded, controls and bidi overrides inert.
+"""Hostile text made safe to show: the one place that says how every output neutralises what a student chose.
 
-Escaping for HTML is the template's (Jinja autoescape); what is left is what escaping cannot do: a name
-of a million characters, a right-to-left override that turns ``evil.exe\u202egpj.py`` around, a newline
-in an identity. These functions bound a string and show such characters as U+FFFD; the summary's JSON
-keeps each identity as given (bounded the same way, so no file grows with one hostile string), and its
-encoder escapes every non-ASCII character.
+Identities, names, file names and feedback come from downloads, rosters and student code. Escaping for
+HTML is the template's (Jinja autoescape) and JSON's is its encoder's; what is left is what escaping cannot
+do: a name of a million characters, a right-to-left override that turns ``evil.exe\u202egpj.py`` around, a
+newline that forges a line, an escape sequence that retitles a terminal, a cell a spreadsheet runs.
+
+- one line to show (terminal lines, pages): ``display_text`` and ``display_identity`` bound a string and
+  show controls and bidi overrides as U+FFFD; pages get them as the Jinja filters ``PAGE_FILTERS``
+  (``grader.render.page.page_environment`` installs them in every page);
+- text kept whole (CSV cells): ``inert`` shows controls (but newline and tab) and bidi overrides as U+FFFD,
+  ``safe_cell`` also neutralises a formula start;
+- JSON: identities kept as given (bounded the same way, so no file grows with one hostile string), its
+  encoder escaping every non-ASCII character.
 """
 
 from __future__ import annotations
 
 import unicodedata
+from collections.abc import Callable
 from urllib.parse import quote, urlsplit
 
 MAX_IDENTITY_CHARS = 256
@@ -19,6 +27,10 @@ MAX_DIAGNOSIS_CHARS = 400
 """Characters of a diagnosis' normalised feedback kept (its key) and shown."""
 MAX_NOTE_CHARS = 300
 MAX_HREF_CHARS = 2_000
+IDENTITY_SHOWN_CHARS = 80
+"""Characters of an identity a page or a terminal line shows (JSON keeps up to ``MAX_IDENTITY_CHARS``)."""
+MAX_LINE_CHARS = 2_000
+"""Characters of a reason or note a terminal line shows."""
 ELLIPSIS = "…"
 
 HIDDEN = "\ufffd"
@@ -59,6 +71,13 @@ def display_text(text: str, limit: int) -> str:
     return _cleaned(text, limit, HIDDEN_CATEGORIES)
 
 
+def terminal_line(text: str) -> str:
+    """A printed line that holds names a student chose: its leading indentation kept, the rest as
+    ``display_text`` (``MAX_LINE_CHARS``), so no name can retitle or clear the terminal or start a line."""
+    indent = text[: len(text) - len(text.lstrip(" "))]
+    return indent + display_text(text, MAX_LINE_CHARS)
+
+
 def display_identity(text: str, limit: int) -> str:
     """An identity to show: as ``display_text``, and every invisible format character (zero-width space,
     joiners, soft hyphen, byte order mark) also shown as ``\ufffd``, so two identities that differ only
@@ -82,6 +101,49 @@ def _cleaned(text: str, limit: int, hidden: frozenset[str]) -> str:
     return bounded(single if len(rough) == len(text) else single + ELLIPSIS, limit)
 
 
+INERT_CATEGORIES = frozenset({"Cc", "Cs"})
+"""Controls and surrogates: shown as ``HIDDEN`` even in text kept whole (newline and tab excepted)."""
+KEPT_CONTROLS = frozenset("\n\t")
+FORMULA_STARTS = frozenset("=+-@")
+"""A spreadsheet runs a cell as a formula when, after leading blanks and invisible characters, it starts with
+one of these, or with a character NFKC-equal to one (fullwidth ``＝``, small ``﹦``, superscript ``⁺``)."""
+
+
+def inert(text: str) -> str:
+    """``text`` kept whole (lines and length), every control but newline and tab, every surrogate and every
+    bidi override shown as ``\ufffd``: what a CSV cell or a multi-line text holds of a hostile string."""
+    if text.isprintable():  # every character replaced below is unprintable: the common case costs one scan
+        return text
+    return "".join(
+        HIDDEN
+        if character not in KEPT_CONTROLS
+        and (character in BIDI_CONTROLS or unicodedata.category(character) in INERT_CATEGORIES)
+        else character
+        for character in text
+    )
+
+
+def safe_cell(value: object) -> str:
+    """A spreadsheet cell's text: ``inert``, with an apostrophe before a start that a spreadsheet would run
+    (``=``, ``+``, ``-``, ``@``, a leading tab or carriage return, any of them after blanks, or their
+    fullwidth and small forms).
+
+    Numbers we write ourselves (``-0.5`` never happens: scores are >= 0) pass through as text unchanged.
+    """
+    text = "" if value is None else str(value)
+    return "'" + inert(text) if _runs_as_formula(text) else inert(text)
+
+
+def _runs_as_formula(text: str) -> bool:
+    if text.startswith(("\t", "\r")):
+        return True
+    for character in text[:1_000]:
+        if character.isspace() or unicodedata.category(character) in ("Cc", "Cf"):
+            continue
+        return unicodedata.normalize("NFKC", character)[:1] in FORMULA_STARTS
+    return False
+
+
 def safe_href(href: str | None) -> str | None:
     """A relative link to a student's report, percent-encoded, or None when it is not a plain relative path.
 
@@ -102,3 +164,16 @@ def safe_href(href: str | None) -> str | None:
     if parts.scheme or parts.netloc or parts.query or parts.fragment or ":" in href.split("/")[0]:
         return None
     return quote(href, safe="/")
+
+
+PAGE_FILTERS: dict[str, Callable[[str], str]] = {
+    "identity": lambda text: display_identity(text, IDENTITY_SHOWN_CHARS),
+    "document": lambda text: display_identity(text, MAX_IDENTITY_CHARS),
+    "name": lambda text: display_text(text, MAX_NAME_CHARS),
+    "note": lambda text: display_text(text, MAX_NOTE_CHARS),
+    "line": lambda text: display_text(text, MAX_LINE_CHARS),
+    "code": inert,
+}
+"""What every page shows of hostile text, by Jinja filter (``{{ row.identity|identity }}``, ``{{ line|code }}``):
+an identity (80 characters), a compared document's name (a student's identity or a reference file's path,
+256), a name, a note, a longer line of text, a line of code kept whole."""

@@ -10,7 +10,15 @@ Public API (pure but for reading the download and writing zips into a scratch fo
     download.unattributed, download.refused    # Skipped(where, reason), never guessed
 """
 
-from grader.classroom.discovery import discover, discover_all, layout_named, recognise
+from grader.classroom.discovery import (
+    ReadDownload,
+    discover,
+    discover_all,
+    layout_named,
+    read_all,
+    recognise,
+    submissions_of_all,
+)
 from grader.classroom.graded_file import LAB_FILE_NAMES, GradedFileRule
 from grader.classroom.layouts import LAYOUTS
 from grader.classroom.model import ClassDownload, Member, Skipped, Submission, SubmittedFile
@@ -23,11 +31,14 @@ __all__ = [
     "GradedFileRule",
     "Limits",
     "Member",
+    "ReadDownload",
     "Skipped",
     "Submission",
     "SubmittedFile",
     "discover",
     "discover_all",
     "layout_named",
+    "read_all",
     "recognise",
+    "submissions_of_all",
 ]

@@ -1,6 +1,7 @@
 """Gradebooks people upload: ``grades.csv`` and the import formats of Canvas, Gradescope and GitHub
-Classroom, built as pure functions of the class's rows. Every cell a spreadsheet would evaluate
-(leading ``= + - @``, tab, carriage return) is neutralised with a leading apostrophe."""
+Classroom, built as pure functions of the class's rows. Every cell goes through
+``grader.class_report.text.safe_cell``: controls and bidi overrides inert, and a leading apostrophe where a
+spreadsheet would evaluate it (``= + - @`` after any blanks, their fullwidth forms, a tab, a carriage return)."""
 
 from __future__ import annotations
 
@@ -9,22 +10,11 @@ import io
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
+from grader.class_report.text import safe_cell
 from grader.classroom.errors import GradebookError
 from grader.classroom.model import ClassDownload, Member, Submission
 from grader.classroom.roster import Roster, RosterEntry
 from grader.report import Report
-
-FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
-
-
-def safe_cell(value: object) -> str:
-    """A cell's text, with an apostrophe before a start that would make a spreadsheet evaluate it.
-
-    Numbers we write ourselves (``-0.5`` never happens: scores are >= 0) pass through as text unchanged.
-    """
-    text = "" if value is None else str(value)
-    return "'" + text if text.startswith(FORMULA_STARTS) else text
-
 
 @dataclass(frozen=True)
 class GradeRow:
@@ -36,6 +26,9 @@ class GradeRow:
         report: The report of its graded file, None when not graded (nothing submitted, no file chosen).
         roster: Their roster entry, None without a roster or when they are not on it.
         note: What a person should know ("no submission", "not on the roster", the grader's error).
+        refused_claim: Its identity matches a roster student another submission matched first: it is in
+            ``grades.csv`` with a note, never in an LMS gradebook (two rows for one student there would
+            give one of them the other's score).
     """
 
     member: Member
@@ -43,6 +36,7 @@ class GradeRow:
     report: Report | None
     roster: RosterEntry | None
     note: str
+    refused_claim: bool = False
 
     @property
     def name(self) -> str:
@@ -68,41 +62,90 @@ def class_rows(
     Returns:
         Rows sorted by the student's identity.
     """
-    rows: list[GradeRow] = []
-    seen: set[int] = set()
     counted = _counted_submissions(download)
-    for submission in download.submissions:
+    students = [
+        (member, submission)
+        for submission in download.submissions
+        for member in submission.members
+        if counted[member.identity] is submission
+    ]
+    claims = _roster_claims(students, roster)
+    rows: list[GradeRow] = []
+    for member, submission in students:
         report = reports.get(submission.identity)
-        for member in submission.members:
-            if counted[member.identity] is not submission:
-                continue
-            entry = roster.find(member.identity) if roster else None
-            if entry is not None:
-                seen.add(id(entry))
-            notes = []
-            if submission.graded_file is None:
-                notes.append(f"nothing graded: {submission.why}")
-            elif report is None:
-                notes.append("not graded yet")
-            elif report.submission_error or report.grader_errors:
-                notes.append(report.submission_error or "; ".join(report.grader_errors))
-            if roster is not None and entry is None:
-                notes.append("not on the roster")
-            others = [
-                other.identity
-                for other in download.submissions
-                if other is not submission and member in other.members
-            ]
-            if others:
-                notes.append(f"also in {', '.join(others)}: the latest submission counts")
-            rows.append(GradeRow(member, submission, report, entry, "; ".join(notes)))
+        entry, claimed_by, _ = claims.get(member.identity, (None, None, member.identity))
+        notes = []
+        if submission.graded_file is None:
+            notes.append(f"nothing graded: {submission.why}")
+        elif report is None:
+            notes.append("not graded yet")
+        elif report.submission_error or report.grader_errors:
+            notes.append(report.submission_error or "; ".join(report.grader_errors))
+        if claimed_by is not None and roster is not None:
+            column = roster.key_column(submission.source, member.identity)
+            notes.append(
+                f"refused: {member.identity} matches roster student {claimed_by.name or claimed_by.identity} "
+                f"({column} {claimed_by.get(column or '')}), "
+                f"whom {_claimant(claims, claimed_by)} matched first; "
+                "left out of every LMS gradebook: rename the folder or correct the roster"
+            )
+        elif roster is not None and entry is None:
+            notes.append("not on the roster")
+        others = [
+            other.identity
+            for other in download.submissions
+            if other is not submission and member in other.members
+        ]
+        if others:
+            notes.append(f"also in {', '.join(others)}: the latest submission counts")
+        rows.append(
+            GradeRow(
+                member, submission, report, entry, "; ".join(notes), refused_claim=claimed_by is not None
+            )
+        )
+    matched = {id(entry) for entry, claimed_by, _ in claims.values() if entry is not None}
     for entry in roster.entries if roster else []:
-        if id(entry) not in seen:
+        if id(entry) not in matched:
             rows.append(
                 GradeRow(Member(entry.identity, entry.name, entry.email), None, None, entry, "no submission")
             )
     rows.sort(key=lambda row: row.member.identity)
     return rows
+
+
+Claim = tuple[RosterEntry | None, RosterEntry | None, str]
+"""A student's roster match: (their entry, or None; the entry they claimed but another matched first, or
+None; their identity)."""
+
+
+def _roster_claims(students: Sequence[tuple[Member, Submission]], roster: Roster | None) -> dict[str, Claim]:
+    """Each student's roster entry, one student per entry: an identity equal to the entry's key as written
+    claims it before one equal only after `roster_key`'s normalisation; then identities in order. A second
+    claim is refused (recorded as the entry claimed, none matched)."""
+    if roster is None:
+        return {}
+    found = []
+    for member, submission in students:
+        entry = roster.find(member.identity, submission.source)
+        column = roster.key_column(submission.source, member.identity)
+        exact = entry is not None and column is not None and entry.get(column) == member.identity
+        found.append((not exact, member.identity, entry))
+    claims: dict[str, Claim] = {}
+    holder: dict[int, str] = {}
+    for _, identity, entry in sorted(found, key=lambda item: (item[0], item[1])):
+        if entry is None:
+            claims[identity] = (None, None, identity)
+        elif id(entry) in holder:
+            claims[identity] = (None, entry, identity)
+        else:
+            holder[id(entry)] = identity
+            claims[identity] = (entry, None, identity)
+    return claims
+
+
+def _claimant(claims: Mapping[str, Claim], entry: RosterEntry) -> str:
+    """The identity whose claim on ``entry`` was kept."""
+    return next(identity for identity, (held, _, _) in claims.items() if held is entry)
 
 
 def _counted_submissions(download: ClassDownload) -> dict[str, Submission]:
@@ -206,7 +249,7 @@ def canvas_csv(rows: Sequence[GradeRow], assignment: Assignment) -> str:
     column = f"{assignment.title} ({assignment.lms_id})"
     points = assignment.points if assignment.points is not None else _max_points(rows)
     lines: list[list[object]] = [["    Points Possible", "", "", "", "", _number(points)]]
-    for row in rows:
+    for row in _lms_rows(rows):
         canvas_id = canvas_user_id(row)
         if not canvas_id:
             continue
@@ -228,7 +271,7 @@ def gradescope_csv(rows: Sequence[GradeRow], problems: Sequence[str]) -> str:
     """Scores in the columns of Gradescope's own score export (``Name, SID, Email, Total Score, Max Points,
     Status``, one per problem), so they import where a Gradescope export's scores do."""
     lines = []
-    for row in rows:
+    for row in _lms_rows(rows):
         scores = {result.id: result.score for result in row.report.problems} if row.report else {}
         lines.append(
             [
@@ -257,9 +300,14 @@ def github_classroom_csv(rows: Sequence[GradeRow]) -> str:
             _number(row.report.score) if row.report else "",
             _number(row.report.max_score if row.report else points),
         ]
-        for row in rows
+        for row in _lms_rows(rows)
     ]
     return _write(["github_username", "roster_identifier", "points_awarded", "points_available"], lines)
+
+
+def _lms_rows(rows: Sequence[GradeRow]) -> list[GradeRow]:
+    """The rows an LMS gradebook may hold: not those whose claim on a roster student was refused."""
+    return [row for row in rows if not row.refused_claim]
 
 
 def _max_points(rows: Sequence[GradeRow]) -> float | None:

@@ -53,6 +53,7 @@ class Submission:
         submitted_at: When it was submitted, where the source says.
         late: Whether the source marks it late (None: the source does not say).
         source: The layout's name.
+        refused: Its files refused for safety (``why`` names the first few and counts the rest).
     """
 
     identity: str
@@ -64,6 +65,7 @@ class Submission:
     submitted_at: datetime | None = None
     late: bool | None = None
     source: str = ""
+    refused: tuple[Skipped, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,34 @@ ID_COLUMNS = (
 """Columns whose values name a student, in order of preference for the row's identity."""
 
 
+KEY_COLUMNS: dict[str, tuple[str, ...]] = {
+    "plain": ("username", "login", "sis login id", "student id", "student_id", "sid", "user"),
+    "canvas": ("id",),
+    "github-classroom": ("github_username",),
+    "gradescope": ("sid", "student id", "student_id"),
+    "moodle": ("participant id", "id"),
+    "nbgrader": ("student id", "student_id", "username", "id"),
+    "blackboard": ("username", "user", "login", "sis login id"),
+}
+"""The roster column a layout's identities are matched on (the first the roster has): one key per layout,
+never any column, so that one student's id cannot equal another column of another student's row (a GitHub
+username that is someone's roster identifier). Plain folders are named by the instructor, most often by login:
+its list is logins first. A roster with none of a layout's columns is matched on its first `ID_COLUMNS`
+column; an identity with an ``@`` matches the email column (`EMAIL_LAYOUTS`)."""
+EMAIL_COLUMNS = ("email", "email address")
+EMAIL_LAYOUTS = ("gradescope", "plain")
+"""Layouts whose identities may be emails (Gradescope's submitters without an SID, folders named by email):
+an identity with an ``@`` matches the email column there."""
+_ASCII_UPPER = str.maketrans("ABCDEFGHIJKLMNOPQRSTUVWXYZ", "abcdefghijklmnopqrstuvwxyz")
+
+
+def roster_key(identity: str) -> str:
+    """An id as the course systems compare it: ASCII letters case-insensitively (GitHub usernames, logins,
+    emails), everything else exactly. Unicode case folding is not applied: a Kelvin sign (U+212A) is not a K
+    to any of them, so ``\u212aim`` never matches ``kim``."""
+    return identity.strip().translate(_ASCII_UPPER)
+
+
 @dataclass(frozen=True)
 class RosterEntry:
     """A student on the roster.
@@ -34,29 +62,38 @@ class RosterEntry:
     email: str
     fields: dict[str, str]
 
-    @property
-    def keys(self) -> frozenset[str]:
-        """Every id the roster gives them, case-folded: any of them joins a submission to them."""
-        return frozenset(self.fields[column].casefold() for column in ID_COLUMNS if self.fields.get(column))
-
     def get(self, column: str) -> str:
         """A column's value ("" when absent)."""
         return self.fields.get(column, "")
 
 
 class Roster:
-    """The students of a roster, found by any of their ids."""
+    """The students of a roster, found by the one column a layout's identities are matched on."""
 
-    def __init__(self, entries: list[RosterEntry]) -> None:
+    def __init__(self, entries: list[RosterEntry], columns: tuple[str, ...] = ()) -> None:
         self.entries = entries
-        self._by_key: dict[str, RosterEntry] = {}
-        for entry in entries:
-            for key in entry.keys:
-                self._by_key.setdefault(key, entry)
+        self.columns = columns or tuple(dict.fromkeys(c for entry in entries for c in entry.fields))
+        self._by_column: dict[str, dict[str, RosterEntry]] = {}
 
-    def find(self, identity: str) -> RosterEntry | None:
-        """The student whose ids include ``identity`` (case-insensitively), None when none does."""
-        return self._by_key.get(identity.casefold())
+    def key_column(self, layout: str, identity: str = "") -> str | None:
+        """The column identities of ``layout`` are matched on (None: the roster has no id column)."""
+        by_email = "@" in identity and layout in EMAIL_LAYOUTS
+        wanted = EMAIL_COLUMNS if by_email else KEY_COLUMNS.get(layout, ())
+        return next((column for column in (*wanted, *ID_COLUMNS) if column in self.columns), None)
+
+    def find(self, identity: str, layout: str = "plain") -> RosterEntry | None:
+        """The student whose value in the layout's key column is ``identity`` (`roster_key` of both), None
+        when none is. Of two rows with the same key, the first counts."""
+        column = self.key_column(layout, identity)
+        if column is None:
+            return None
+        if column not in self._by_column:
+            index: dict[str, RosterEntry] = {}
+            for entry in self.entries:
+                if entry.get(column):
+                    index.setdefault(roster_key(entry.get(column)), entry)
+            self._by_column[column] = index
+        return self._by_column[column].get(roster_key(identity))
 
 
 def parse_roster(text: str, *, source: str = "roster") -> Roster:
@@ -93,7 +130,7 @@ def parse_roster(text: str, *, source: str = "roster") -> Roster:
         )
         email = fields.get("email") or fields.get("email address") or ""
         entries.append(RosterEntry(identity, name, email, fields))
-    return Roster(entries)
+    return Roster(entries, tuple(headers))
 
 
 def read_roster(path: Path) -> Roster:

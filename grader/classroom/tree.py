@@ -58,6 +58,20 @@ class Entry:
 
 
 @dataclass
+class Budget:
+    """What the downloads of one command have used of `Limits` so far: one budget for every download it
+    reads (several targets together), so that the limits hold "in all".
+
+    Attributes:
+        files: Files and zip entries taken.
+        extracted_bytes: Bytes written into scratch from zips.
+    """
+
+    files: int = 0
+    extracted_bytes: int = 0
+
+
+@dataclass
 class Tree:
     """The regular files of a download (zips opened), with what was refused and how much was ignored."""
 
@@ -65,7 +79,12 @@ class Tree:
     entries: list[Entry] = field(default_factory=list)
     refused: list[Skipped] = field(default_factory=list)
     ignored: int = 0
-    extracted_bytes: int = 0
+    budget: Budget = field(default_factory=Budget)
+
+    def take(self, entry: Entry) -> None:
+        """Add a file of the download, counted against the budget."""
+        self.entries.append(entry)
+        self.budget.files += 1
 
 
 def ignorable(name: str) -> bool:
@@ -73,24 +92,28 @@ def ignorable(name: str) -> bool:
     return name.startswith(".") or name == "__MACOSX" or name == "__pycache__"
 
 
-def read_tree(root: Path, scratch: Path | None, limits: Limits | None = None) -> Tree:
+def read_tree(
+    root: Path, scratch: Path | None, limits: Limits | None = None, budget: Budget | None = None
+) -> Tree:
     """Every regular file under ``root`` (a folder or a zip), zips opened into ``scratch``.
 
     Args:
         root: The class folder, or a zip as downloaded.
         scratch: A folder (created, should be empty) that zips are read into; None refuses every zip.
         limits: Size and count bounds.
+        budget: What other downloads of the same command used already (shared, updated); a fresh one
+            when None.
 
     Returns:
         The files, sorted by path, and the refusals.
     """
     limits = limits or Limits()
-    tree = Tree(root=root)
+    tree = Tree(root=root, budget=budget if budget is not None else Budget())
     if root.is_symlink():
         tree.refused.append(Skipped(root.name, "a symbolic link: pass the folder or file itself"))
         return tree
     if root.is_file() and root.suffix.lower() != ".zip":
-        tree.entries.append(Entry(root.name, root))
+        tree.take(Entry(root.name, root))
         return tree
     if root.is_file():
         if scratch is None:
@@ -142,7 +165,7 @@ def _walk(tree: Tree, folder: Path, prefix: str, scratch: Path | None, limits: L
             tree.refused.append(
                 Skipped(relative, f"{info.st_size:,} bytes, over the {limits.max_file_bytes:,} limit")
             )
-        elif len(tree.entries) >= limits.max_files:
+        elif tree.budget.files >= limits.max_files:
             tree.refused.append(Skipped(relative, f"over the {limits.max_files:,}-file limit of a download"))
         elif item.name.lower().endswith(".zip") and scratch is not None:
             _expand_zip(
@@ -154,7 +177,7 @@ def _walk(tree: Tree, folder: Path, prefix: str, scratch: Path | None, limits: L
                 depth=1,
             )
         else:
-            tree.entries.append(Entry(relative, Path(item.path)))
+            tree.take(Entry(relative, Path(item.path)))
 
 
 def _link_target(path: str) -> str:
@@ -174,7 +197,7 @@ def _expand_zip(tree: Tree, archive: Path, prefix: str, dest: Path, limits: Limi
             members = bundle.infolist()
             dest.mkdir(parents=True, exist_ok=True)
             for number, member in enumerate(members):
-                if len(tree.entries) >= limits.max_files and not member.is_dir():
+                if tree.budget.files >= limits.max_files and not member.is_dir():
                     left = sum(1 for rest in members[number:] if not rest.is_dir())
                     tree.refused.append(
                         Skipped(
@@ -244,7 +267,7 @@ def _extract_member(
             )
         )
         return
-    if tree.extracted_bytes + member.file_size > limits.max_total_bytes:
+    if tree.budget.extracted_bytes + member.file_size > limits.max_total_bytes:
         tree.refused.append(
             Skipped(where, f"the download's zips expand past {limits.max_total_bytes:,} bytes")
         )
@@ -256,12 +279,12 @@ def _extract_member(
         tree.refused.append(Skipped(where, "its data is larger than its header says (a zip bomb?)"))
         target.unlink(missing_ok=True)
         return
-    tree.extracted_bytes += written
+    tree.budget.extracted_bytes += written
     relative = prefix + "/".join(parts)
     if parts[-1].lower().endswith(".zip"):
         _expand_zip(tree, target, f"{relative}/", dest / f"{number}.d", limits, depth + 1)
     else:
-        tree.entries.append(Entry(relative, target))
+        tree.take(Entry(relative, target))
 
 
 def _copy_bounded(bundle: zipfile.ZipFile, member: zipfile.ZipInfo, target: Path, limit: int) -> int | None:

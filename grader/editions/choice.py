@@ -83,6 +83,22 @@ def choose_edition(flag: str | None, config: Path | None, submission: Path | Non
     )
 
 
+def service_edition(name: str | None) -> EditionChoice:
+    """The edition every upload to the service is graded as: `GYMGRADE_EDITION`, else the first edition
+    (as every configuration naming none). Never detected from an upload: a student does not choose what
+    they are graded on.
+
+    Raises:
+        UnknownEdition: The setting names no edition.
+    """
+    if name is None:
+        first = EDITIONS[DEFAULT_EDITION]
+        reason = f"GYMGRADE_EDITION is unset: the first edition (GYMGRADE_EDITION={RL1.name} grades today's)"
+        return EditionChoice(first, default_config(first), reason)
+    chosen = edition_of(name, where="GYMGRADE_EDITION")
+    return EditionChoice(chosen, default_config(chosen), f"GYMGRADE_EDITION={chosen.name}")
+
+
 def default_config(edition: Edition) -> Path | None:
     """The configuration an edition is graded with when none is given (None: the bundled one)."""
     return None if edition.default_config == BUNDLED_CONFIG else edition.default_config

@@ -1,23 +1,29 @@
 """Which edition a submission was written for, read statically from its source (never run) in the parent.
 
-The source is untrusted: it is read up to a bound, parsed with `ast` only (nothing is executed or imported),
-and a file that cannot be read or parsed simply shows no marker. The rules, newest edition first, each with
-the reason the command line prints:
+The source is untrusted: it is read up to a bound without following links, parsed with `ast` only (nothing
+is executed or imported), and a file that cannot be read or parsed simply shows no marker. A notebook's code
+cells come from the bounded reader (`grader.notebook.read_notebook`: its JSON is never parsed here).
+
+The rules, newest edition first, each with the reason the command line prints:
 
 1. a function only the current edition asks for (`epsilon_decay`, `qlearn`, `sarsa0`, `compare`), or a
    `taxi` with two required parameters: `rl1`;
 2. `cartpole`/`car` with a `render` parameter, or `import gymnasium`: `volume2`;
 3. `import gym_toytext`, or gym 0.26's five-value `step` / two-value `reset` unpacking: `gym026`;
-4. otherwise the first edition, `classic`.
+4. `import gym` with none of the above: `classic`;
+5. otherwise the file shows no edition (`Detection.shown` is False: an empty file, one that cannot be read or
+   parsed, one defining a shared function and importing no gym); it is taken as the first edition, `classic`,
+   but a class's choice does not count it.
 
 Editions 1-3 grade the same problems (the compatibility layer runs every gym API), so telling them apart
-only names the edition; rule 1 changes what is graded.
+only names the edition; rule 1 changes what is graded. Detection chooses the edition of a student's own
+`check`; grading for a gradebook grades the edition the instructor chose, and `edition_note` tells a file
+written for other problems so.
 """
 
 from __future__ import annotations
 
 import ast
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,19 +32,21 @@ from grader.editions.gym026 import GYM026
 from grader.editions.pack import Edition
 from grader.editions.rl1 import RL1
 from grader.editions.volume2 import VOLUME2
-from grader.validation import MAX_SUBMISSION_BYTES
-
-MAX_NOTEBOOK_BYTES = 32 * MAX_SUBMISSION_BYTES
-"""A notebook's outputs (plots) make it larger than its code; beyond this it is not read for detection."""
-MAX_CELLS = 10_000
+from grader.notebook import MAX_NOTEBOOK_BYTES, is_notebook, read_notebook
+from grader.untrusted_file import UnsafeFile, read_untrusted
+from grader.validation import MAX_SUBMISSION_BYTES, FileVerdict
 
 
 @dataclass(frozen=True)
 class Detection:
-    """The edition a submission was detected as, and why (one sentence a person reads)."""
+    """The edition a submission was detected as, and why (one sentence a person reads).
+
+    `shown` is False for a file that shows no edition's mark (it is then taken as the first edition).
+    """
 
     edition: Edition
     reason: str
+    shown: bool = True
 
 
 @dataclass(frozen=True)
@@ -50,11 +58,20 @@ class _Function:
 
 def detect_edition(path: Path) -> Detection:
     """The edition of a `.py` or `.ipynb` submission, from the functions it defines and what it imports."""
-    trees = _parse(path)
-    if trees is None:
-        return Detection(
-            CLASSIC, f"{path.name} could not be read as Python, so no later edition's mark was found"
-        )
+    return _detected(_parse(path), path.name)
+
+
+def detect_source(source: bytes, name: str) -> Detection:
+    """The edition of Python source already read (a `.py` file's bytes, or the module built from a
+    notebook's cells), bounded as `detect_edition` bounds a file."""
+    if len(source) > MAX_SUBMISSION_BYTES:
+        return _detected(None, name)
+    return _detected(_parsed([source]), name)
+
+
+def _detected(trees: list[ast.Module] | None, name: str) -> Detection:
+    if trees is None or not trees:
+        return Detection(CLASSIC, f"{name} could not be read as Python, so it shows no edition", shown=False)
     functions = {
         node.name: _signature(node)
         for tree in trees
@@ -91,21 +108,48 @@ def detect_edition(path: Path) -> Detection:
         return Detection(
             GYM026, "it imports gym and unpacks the five values of gym 0.26's step (or reset's two)"
         )
-    return Detection(CLASSIC, "it shows no mark of a later edition (their functions, render flags or APIs)")
+    if "gym" in imports:
+        return Detection(
+            CLASSIC,
+            "it imports gym and shows no mark of a later edition (their functions, render flags or APIs)",
+        )
+    return Detection(
+        CLASSIC,
+        "it shows no edition: it imports no gym and defines none of a later edition's functions or render flags",  # noqa: E501
+        shown=False,
+    )
+
+
+def edition_note(graded: Edition, found: Detection) -> str | None:
+    """What a report tells a file written for other problems than the edition graded (None: it is not).
+
+    Editions grading the same problems (1-3) are not told: the compatibility layer runs each one's API.
+    """
+    if not found.shown or found.edition.registry is graded.registry:
+        return None
+    return (
+        f"This file looks written for edition {found.edition.number} ({found.edition.name}, "
+        f"{found.edition.title}): {found.reason}. Your assignment is edition {graded.number} ({graded.name}, "
+        f"{graded.title}), so it was graded on that edition's problems; check the assignment's template."
+    )
 
 
 def _parse(path: Path) -> list[ast.Module] | None:
-    limit = MAX_NOTEBOOK_BYTES if path.suffix == ".ipynb" else MAX_SUBMISSION_BYTES
+    notebook = is_notebook(path.name)
+    limit = MAX_NOTEBOOK_BYTES if notebook else MAX_SUBMISSION_BYTES
     try:
-        with path.open("rb") as handle:
-            data = handle.read(limit + 1)
-    except OSError:
+        data = read_untrusted(path, limit=limit)
+    except UnsafeFile:
         return None
     if len(data) > limit:
         return None
-    sources = _notebook_cells(data) if path.suffix == ".ipynb" else [data]
+    sources = _notebook_cells(data, path.name) if notebook else [data]
     if sources is None or sum(len(source) for source in sources) > MAX_SUBMISSION_BYTES:
         return None
+    return _parsed(sources)
+
+
+def _parsed(sources: list[bytes]) -> list[ast.Module]:
     trees: list[ast.Module] = []
     for source in sources:
         try:
@@ -115,25 +159,14 @@ def _parse(path: Path) -> list[ast.Module] | None:
     return trees
 
 
-def _notebook_cells(data: bytes) -> list[bytes] | None:
-    try:
-        notebook = json.loads(data)
-    except (ValueError, RecursionError, MemoryError):
-        return None
-    cells = notebook.get("cells") if isinstance(notebook, dict) else None
-    if not isinstance(cells, list) or len(cells) > MAX_CELLS:
+def _notebook_cells(data: bytes, name: str) -> list[bytes] | None:
+    read = read_notebook(data, name)
+    if isinstance(read, FileVerdict):
         return None
     sources: list[bytes] = []
-    for cell in cells:
-        if not isinstance(cell, dict) or cell.get("cell_type") != "code":
-            continue
-        source = cell.get("source")
-        text = (
-            "".join(part for part in source if isinstance(part, str)) if isinstance(source, list) else source
-        )
-        if isinstance(text, str):
-            lines = [line for line in text.splitlines() if not line.lstrip().startswith(("%", "!"))]
-            sources.append("\n".join(lines).encode("utf-8", "replace"))
+    for cell in read.cells:
+        lines = [line for line in cell.source.splitlines() if not line.lstrip().startswith(("%", "!"))]
+        sources.append("\n".join(lines).encode("utf-8", "replace"))
     return sources
 
 

@@ -1,10 +1,11 @@
-"""The edition of a class graded without `--edition` or a configuration: detected per submission.
+"""The edition of a class graded without `--edition` or a configuration: the one its files all show.
 
-Each submission's graded file is read statically (`grader.editions.detection`, never run). A class is graded
-as one edition, so that its gradebook has one set of columns: the edition whose problems most submissions
-were written for (editions grading the same problems count together; a tie goes to the newer edition). Every
-submission's detected edition and its reason are said; a submission written for other problems than the
-class's is named with what to do.
+What a student is graded on is the instructor's assignment, never a majority of the class's files: each
+submission's graded file is read statically (`grader.editions.detection`, never run), files that show no
+edition (empty, unreadable, a shared function without imports) are left out, and the class is graded as the
+edition the others show only when they all ask the same problems (editions 1-3 grade the same problems and
+agree). Otherwise `ClassEditions.disagreement` says which editions were found and whose files are behind
+each, and the command stops before grading so that the instructor names the assignment's edition.
 """
 
 from __future__ import annotations
@@ -14,74 +15,98 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from grader.editions import EDITIONS
+from grader.editions import DEFAULT_EDITION, EDITIONS
 from grader.editions.choice import EditionChoice, default_config
 from grader.editions.detection import Detection, detect_edition
+from grader.editions.rl1 import RL1
+
+MAX_NAMED = 20
+"""Identities named per edition in a disagreement (the rest are counted)."""
 
 
 @dataclass(frozen=True)
 class ClassEditions:
-    """The edition a class is graded as, and each submission's own detection.
+    """The edition a class is graded as (or why none can be chosen), and each submission's own detection.
 
     Attributes:
         choice: The class's edition, its configuration (None: the bundled one) and why.
         detected: Each submission's detection, by identity (in the order given).
+        disagreement: Why no edition is chosen (files showing editions of different problems), with the
+            editions found and whose files are behind each; None when `choice` grades the class.
     """
 
     choice: EditionChoice
     detected: Mapping[str, Detection]
+    disagreement: str | None = None
 
     def lines(self) -> list[str]:
         """What `gymgrade grade` prints: the class's edition, then one line per submission."""
-        graded = self.choice.edition
         lines = [self.choice.line]
         for identity, found in self.detected.items():
-            line = f"  {identity}: {found.edition.name}: {found.reason}"
-            if found.edition.registry is not graded.registry:
-                line += (
-                    f"; graded as {graded.name} with the class (it asks other problems): "
-                    f"grade it alone with --edition {found.edition.name} if that is its assignment"
-                )
-            lines.append(line)
+            shown = found.edition.name if found.shown else "no edition"
+            lines.append(f"  {identity}: {shown}: {found.reason}")
         return lines
 
 
 def class_editions(files: Mapping[str, Path]) -> ClassEditions:
-    """Detect each submission's edition and choose the class's.
+    """Detect each submission's edition and choose the class's, or say why none can be chosen.
 
     Args:
         files: Each submission's graded file, by identity.
 
     Returns:
-        The class's edition (the first edition for a class with no file) and every detection.
+        The class's edition: the one every file showing an edition asks the problems of (of several names
+        for the same problems, the most common, a tie to the newer); the first edition when no file shows
+        one. With files showing editions of different problems, `disagreement` is set.
     """
     detected = {identity: detect_edition(path) for identity, path in files.items()}
-    order = list(EDITIONS.values())
-    by_problems: Counter[int] = Counter()
-    for found in detected.values():
-        by_problems[_first_with_problems(found.edition.registry)] += 1
-    if not by_problems:
-        first = order[0]
-        return ClassEditions(EditionChoice(first, None, "no submission to detect an edition from"), detected)
-    most = max(by_problems.values())
-    winner = max((index for index, count in by_problems.items() if count == most))
-    registry = order[winner].registry
-    names = Counter(found.edition.name for found in detected.values() if found.edition.registry is registry)
-    named = max(names, key=lambda name: (names[name], order.index(EDITIONS[name])))
+    shown = {identity: found for identity, found in detected.items() if found.shown}
+    unshown = len(detected) - len(shown)
+    if not shown:
+        first = EDITIONS[DEFAULT_EDITION]
+        reason = (
+            f"no --edition and no configuration, and none of the {len(detected)} files shows an edition: "
+            f"the first edition (--edition {RL1.name} grades today's)"
+        )
+        return ClassEditions(EditionChoice(first, None, reason), detected)
+    problem_sets = {id(found.edition.registry) for found in shown.values()}
+    order = list(EDITIONS)
+    names = Counter(found.edition.name for found in shown.values())
+    named = max(names, key=lambda name: (names[name], order.index(name)))
     edition = EDITIONS[named]
-    counts = ", ".join(
-        f"{name} {count}"
-        for name, count in Counter(found.edition.name for found in detected.values()).most_common()
+    counts = ", ".join(f"{name} {count}" for name, count in names.most_common())
+    left_out = f"; {unshown} showing no edition not counted" if unshown else ""
+    if len(problem_sets) == 1:
+        reason = (
+            "no --edition and no configuration; "
+            f"every file that shows an edition asks its problems ({counts} of {len(detected)}{left_out})"
+        )
+        return ClassEditions(EditionChoice(edition, default_config(edition), reason), detected)
+    reason = f"no --edition and no configuration, and the files disagree ({counts}{left_out})"
+    return ClassEditions(
+        EditionChoice(edition, default_config(edition), reason), detected, _disagreement(shown, unshown)
     )
-    reason = (
-        f"detected per submission (no --edition, no configuration): {counts} of {len(detected)}; "
-        f"the class is graded as the edition most submissions were written for"
-    )
-    return ClassEditions(EditionChoice(edition, default_config(edition), reason), detected)
 
 
-def _first_with_problems(registry: object) -> int:
-    """The index of the newest edition grading the same problems as `registry` (editions sharing problems
-    count together)."""
-    order = list(EDITIONS.values())
-    return max(index for index, edition in enumerate(order) if edition.registry is registry)
+def _disagreement(shown: Mapping[str, Detection], unshown: int) -> str:
+    """Which editions the files show, whose files are behind each, and what to do."""
+    by_edition: dict[str, list[str]] = {}
+    for identity, found in shown.items():
+        by_edition.setdefault(found.edition.name, []).append(identity)
+    order = list(EDITIONS)
+    parts = []
+    for name in sorted(by_edition, key=order.index):
+        who = by_edition[name]
+        listed = ", ".join(who[:MAX_NAMED]) + (
+            f" and {len(who) - MAX_NAMED} more" if len(who) > MAX_NAMED else ""
+        )
+        parts.append(f"{name} ({EDITIONS[name].title}, {len(who)}): {listed}")
+    left_out = f" ({unshown} files showing no edition are not counted)" if unshown else ""
+    choices = " or ".join(f"--edition {name}" for name in sorted(by_edition, key=order.index))
+    return (
+        f"the class's files were written for editions that ask different problems{left_out}: "
+        f"{'; '.join(parts)}. What a student is graded on is the assignment's edition, not the files': "
+        "nothing was graded; "
+        f'pass the assignment\'s edition ({choices}) or a configuration naming it (edition = "..."); '
+        "a file written for another edition is then graded as the assignment and told so"
+    )

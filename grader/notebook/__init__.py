@@ -3,7 +3,7 @@ memory (see `grader.notebook.building` for what is kept, `grader.notebook.bounde
 
 from __future__ import annotations
 
-from grader.notebook.bounded import build_module
+from grader.notebook.bounded import build_module, read_notebook
 from grader.notebook.models import NotebookModule, NotebookSummary, SkippedCode, UnboundGlobal
 from grader.notebook.reading import MAX_NOTEBOOK_BYTES
 
@@ -24,4 +24,5 @@ __all__ = [
     "UnboundGlobal",
     "build_module",
     "is_notebook",
+    "read_notebook",
 ]

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from grader.notebook import rules
 from grader.notebook.ipython import transform_cell
 from grader.notebook.models import NotebookModule, NotebookSummary, SkippedCode, UnboundGlobal
-from grader.notebook.reading import Cell, read_cells
+from grader.notebook.reading import Cell, NotebookCells, read_cells
 from grader.notebook.rules import Kind, Scope
 from grader.validation import FileVerdict, check_source
 
@@ -100,6 +100,13 @@ def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) ->
     read = read_cells(data, name)
     if isinstance(read, FileVerdict):
         return read
+    return build_from_cells(read, name, graded)
+
+
+def build_from_cells(
+    read: NotebookCells, name: str, graded: Collection[str] | None = ()
+) -> NotebookModule | FileVerdict:
+    """`build_module` of a notebook whose code cells are read already (`grader.notebook.reading`)."""
     builder = _Builder(name, graded=graded)
     for cell in read.cells:
         _add_cell(builder, cell)

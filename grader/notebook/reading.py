@@ -15,6 +15,9 @@ held to the ``.py`` limit once extracted."""
 MAX_CODE_CHARS = 2_000_000
 """Characters of code (all code cells together) the grader reads: twice the ``.py`` limit, as skipped
 demo cells do not count towards that."""
+MAX_CELLS = 10_000
+"""Cells (of any kind) a notebook may have: a lab notebook has well under a hundred; millions of empty
+ones would make every later step slow."""
 MAX_IGNORED_DETAIL = 200
 PYTHON_LANGUAGES = ("python", "ipython")
 
@@ -97,6 +100,12 @@ def read_cells(data: bytes, name: str) -> NotebookCells | FileVerdict:
     raw_cells = _raw_cells(notebook, ignored)
     if isinstance(raw_cells, str):
         return FileVerdict("error", f"{name} is not a readable notebook: {raw_cells}. {_RESAVE}")
+    if len(raw_cells) > MAX_CELLS:
+        return FileVerdict(
+            "error",
+            f"{name} has {len(raw_cells):,} cells; a notebook may have at most {MAX_CELLS:,}. "
+            "Delete the cells that are not part of your solution (or submit your code as a .py file) and submit again.",  # noqa: E501
+        )
     cells: list[Cell] = []
     for number, raw in enumerate(raw_cells, start=1):
         if not isinstance(raw, dict):

@@ -114,6 +114,8 @@ def results(
         f"gymgrade {report.grader_version}, gymnasium {report.gymnasium_version}.",
         f"Edition: {edition_name(report.edition)}.",
     ]
+    if report.edition_note:
+        lines.append(report.edition_note)
     if report.notebook is not None:
         lines += notebook_lines(report.notebook)
     if report.submission_error is not None:

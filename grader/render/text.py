@@ -34,6 +34,8 @@ def summary(report: Report) -> str:
         f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
     )
     lines.append(f"Edition: {edition_name(report.edition)}")
+    if report.edition_note:
+        lines.append(report.edition_note)
     lines.append(
         f"Practice seed {report.seed}: your instructor grades on different, unseen starts (a held-out seed), so code that only does well from these starts will fail there."  # noqa: E501
     )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import tempfile
 from collections.abc import Sequence
@@ -81,7 +82,9 @@ def run_similarity_command(args: argparse.Namespace) -> int:
     template = load_template(tuple(args.template) if args.template else BUNDLED)
     cache = None if args.no_cache else IndexCache(args.cache or default_cache_dir())
     with tempfile.TemporaryDirectory(prefix="gymgrade-similarity-") as scratch:
-        sources = submissions_from(args.class_dir, layout=args.layout, scratch=Path(scratch))
+        sources = submissions_from(
+            args.class_dir, layout=args.layout, sections=args.sections, scratch=Path(scratch)
+        )
         report = write_similarity(
             sources, args.out, args.reference, template=template, cache=cache, reports=args.reports
         )
@@ -128,12 +131,17 @@ def write_similarity(
     with (out / CSV_FILE).open("w", encoding="utf-8", newline="") as stream:
         stream.write(render_csv(report))
     (out / HTML_FILE).write_text(render_html(report, outcome.lines_of), encoding="utf-8")
-    (out / JSON_FILE).write_text(report.model_dump_json(indent=2) + "\n", encoding="utf-8")
+    # ASCII, every other character escaped (as class.json): a bidi override in a name never reorders a terminal
+    (out / JSON_FILE).write_text(json.dumps(report.model_dump(mode="json"), indent=2) + "\n", encoding="utf-8")
     return report
 
 
 def summarise(report: SimilarityReport, out: Path, stream: Any) -> None:
-    """Print what was compared, the notes, every file left out and what was written."""
+    """Print what was compared, the notes, every file left out and what was written (each name and reason
+    one inert line: ``grader.class_report.text.terminal_line``)."""
+    from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
+    from grader.class_report.text import terminal_line as shown
+
     print(
         f"Compared {len(report.students)} students"
         + (
@@ -147,7 +155,8 @@ def summarise(report: SimilarityReport, out: Path, stream: Any) -> None:
         file=stream,
     )
     for note in report.notes:
-        print(f"  {note}", file=stream)
+        print(f"  {shown(note)}", file=stream)
     for left_out in report.unreadable:
-        print(f"  left out {left_out.file} ({left_out.identity}): {left_out.reason}", file=stream)
+        who = display_identity(left_out.identity, IDENTITY_SHOWN_CHARS)
+        print(f"  left out {shown(left_out.file)} ({who}): {shown(left_out.reason)}", file=stream)
     print(f"Wrote {out / CSV_FILE}, {out / HTML_FILE} and {out / JSON_FILE}.", file=stream)

@@ -1,20 +1,15 @@
-"""``similarity.csv``: one row per flagged pair, safe to open in a spreadsheet."""
+"""``similarity.csv``: one row per flagged pair, safe to open in a spreadsheet (every cell through
+``grader.class_report.text.safe_cell``, as the gradebooks')."""
 
 from __future__ import annotations
 
 import csv
 import io
 
+from grader.class_report.text import safe_cell
 from grader.similarity.report import SimilarityReport
 
 COLUMNS = ("a", "b", "score", "shared_fragments", "longest_fragment_lines", "evidence")
-FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
-"""A spreadsheet runs a cell starting with one of these as a formula; names and comments are untrusted."""
-
-
-def neutralised(cell: str) -> str:
-    """The cell, with a leading apostrophe when a spreadsheet would run it as a formula (CSV injection)."""
-    return "'" + cell if cell.startswith(FORMULA_STARTS) else cell
 
 
 def render_csv(report: SimilarityReport) -> str:
@@ -25,12 +20,12 @@ def render_csv(report: SimilarityReport) -> str:
     for pair in report.pairs:
         writer.writerow(
             [
-                neutralised(pair.a),
-                neutralised(pair.b),
+                safe_cell(pair.a),
+                safe_cell(pair.b),
                 f"{pair.score:.4f}",
                 str(pair.shared_fragments),
                 str(pair.longest_fragment_lines),
-                neutralised(" | ".join(pair.evidence)),
+                safe_cell(" | ".join(pair.evidence)),
             ]
         )
     return buffer.getvalue()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -99,7 +99,7 @@ def run_similarity(
         for start in range(0, len(jobs), BATCH):
             batch = jobs[start : start + BATCH]
             for (identity, _, paths), document in zip(
-                batch, _documents(batch, template, cache, unreadable, pool), strict=True
+                batch, _documents(batch, template, cache, unreadable, pool, workers), strict=True
             ):
                 if document is not None:
                     documents.append(document)
@@ -107,7 +107,8 @@ def run_similarity(
     finally:
         if pool is not None:
             pool.shutdown()
-    report = build_report(documents, unreadable, behaviour, template.names, notes)
+    cache_notes = cache.notes if cache is not None else []
+    report = build_report(documents, unreadable, behaviour, template.names, [*notes, *cache_notes])
     return Outcome(report, files)
 
 
@@ -121,17 +122,24 @@ def _documents(
     cache: IndexCache | None,
     unreadable: list[UnreadableFile],
     pool: ProcessPoolExecutor | None,
+    readers: int,
 ) -> list[Document | None]:
-    """Read a batch of documents, index the files not cached (in the pool, if any), and build them."""
+    """Read a batch of documents (``readers`` at a time), index the files not cached (in the pool, if
+    any), and build them."""
     texts: list[list[SourceText]] = []
     indexed: dict[tuple[int, int], IndexedFile] = {}
     missing: list[tuple[int, int, SourceText]] = []
-    for number, (identity, is_reference, paths) in enumerate(jobs):
-        readable, failures = read_files(paths)
+    # A notebook is read by a bounded child process (grader.notebook): `readers` threads wait for those
+    # children, one document each.
+    with ThreadPoolExecutor(readers) as threads:
+        reads = list(threads.map(read_files, [paths for _, _, paths in jobs]))
+    for number, ((identity, is_reference, _), (readable, failures)) in enumerate(
+        zip(jobs, reads, strict=True)
+    ):
         unreadable.extend(_listed(identity, failure) for failure in failures)
         texts.append(readable)
         for position, source in enumerate(readable):
-            entry = cache.get(source.text) if cache is not None and is_reference else None
+            entry = cache.get(source.text, identity) if cache is not None and is_reference else None
             if entry is None:
                 missing.append((number, position, source))
             else:

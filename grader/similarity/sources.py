@@ -11,15 +11,18 @@ setup file), the graded file first; docs/similarity.md says why not the graded f
 from __future__ import annotations
 
 import ast
-import json
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from grader.classroom import ClassDownload, GradedFileRule, discover
 from grader.classroom.graded_file import is_candidate
-from grader.notebook import MAX_NOTEBOOK_BYTES
+from grader.classroom.model import Skipped
+from grader.notebook import MAX_NOTEBOOK_BYTES, read_notebook
 from grader.similarity.errors import ClassDirectoryError
 from grader.similarity.report import UnreadableFile
+from grader.untrusted_file import UnsafeFile, read_untrusted
+from grader.validation import FileVerdict
 
 SOURCE_SUFFIXES = (".py", ".ipynb")
 MAX_COMPARED_BYTES = 200_000
@@ -27,6 +30,8 @@ MAX_COMPARED_BYTES = 200_000
 (the grader itself accepts up to ``grader.validation.MAX_SUBMISSION_BYTES``)."""
 MAX_FILES_PER_SUBMISSION = 20
 """A student's folder may hold helpers beside the lab file; files beyond this many are listed, not read."""
+MAX_REFUSED_LISTED = 20
+"""Refused files listed per student (and for nobody); the rest are counted in one line."""
 IGNORED_PARTS = ("__pycache__", ".ipynb_checkpoints", "__MACOSX")
 UNATTRIBUTED = "(not attributed)"
 """The identity column of a file no student can be named for."""
@@ -86,6 +91,7 @@ def submissions_from(
     path: Path,
     *,
     layout: str | None = None,
+    sections: int | None = None,
     scratch: Path | None = None,
     rule: GradedFileRule | None = None,
 ) -> ClassSources:
@@ -94,6 +100,8 @@ def submissions_from(
     Args:
         path: The download: a folder, a zip as the LMS gave it, or one file.
         layout: A ``grader.classroom.LAYOUTS`` name (``--layout``); recognised from the download when None.
+        sections: Plain folders: levels of section folders (``--sections``); None: from the download's
+            shape.
         scratch: Where zips are extracted (the caller removes it after the report is written); zips are
             listed as refused when None.
         rule: How the graded file (compared first) is chosen; by default as `gymgrade grade` chooses it
@@ -113,7 +121,7 @@ def submissions_from(
 
         rule = GradedFileRule(functions=GradingPlan.load(None, None).problems)
     try:
-        download = discover(path, layout=layout, rule=rule, scratch=scratch)
+        download = discover(path, layout=layout, sections=sections, rule=rule, scratch=scratch)
     except FileNotFoundError as error:
         raise ClassDirectoryError(str(error)) from None
     return sources_of(download)
@@ -125,17 +133,9 @@ def sources_of(download: ClassDownload) -> ClassSources:
     sources = ClassSources(layout=download.layout)
     claimed: set[str] = set()
     for submission in download.submissions:
-        # discovery names a student's refused files in its reason (``where: reason``): list them as theirs
-        mine = [
-            skipped for skipped in download.refused if f"{skipped.where}: {skipped.reason}" in submission.why
-        ]
+        mine = submission.refused
         claimed.update(skipped.where for skipped in mine)
-        sources.skipped += [
-            UnreadableFile(
-                identity=submission.identity, file=skipped.where, reason=f"refused: {skipped.reason}."
-            )
-            for skipped in mine
-        ]
+        sources.skipped += _refused_listed(submission.identity, mine)
         candidates = [file for file in submission.files if is_candidate(file.original_name)]
         if submission.graded_file is not None and submission.graded_file in candidates:
             candidates.remove(submission.graded_file)
@@ -157,11 +157,9 @@ def sources_of(download: ClassDownload) -> ClassSources:
                     reason=f"nothing to compare: {submission.why}.",
                 )
             )
-    sources.skipped += [
-        UnreadableFile(identity=REFUSED, file=skipped.where, reason=f"refused: {skipped.reason}.")
-        for skipped in download.refused
-        if skipped.where not in claimed
-    ]
+    sources.skipped += _refused_listed(
+        REFUSED, [skipped for skipped in download.refused if skipped.where not in claimed]
+    )
     sources.skipped += [
         UnreadableFile(
             identity=UNATTRIBUTED,
@@ -171,6 +169,25 @@ def sources_of(download: ClassDownload) -> ClassSources:
         for skipped in download.unattributed
     ]
     return sources
+
+
+def _refused_listed(identity: str, refused: Sequence[Skipped]) -> list[UnreadableFile]:
+    """The refused files of one student (or of nobody) as listed: the first ``MAX_REFUSED_LISTED``, then
+    one line counting the rest (a zip of 80,000 links is one student's 21 lines)."""
+    listed = [
+        UnreadableFile(identity=identity, file=skipped.where, reason=f"refused: {skipped.reason}.")
+        for skipped in refused[:MAX_REFUSED_LISTED]
+    ]
+    if len(refused) > MAX_REFUSED_LISTED:
+        more = len(refused) - MAX_REFUSED_LISTED
+        listed.append(
+            UnreadableFile(
+                identity=identity,
+                file=f"{more:,} more refused files",
+                reason="refused like those above; `gymgrade grade` on the download lists each of them.",
+            )
+        )
+    return listed
 
 
 def _not_candidate(relative: str) -> str:
@@ -199,10 +216,9 @@ def references_from(path: Path) -> list[tuple[str, Path]]:
 
 
 def read_source(path: Path) -> SourceText | Unreadable:
-    """Read one submitted file as Python text, bounded in size, never executing or importing it."""
-    if path.is_symlink():
-        return Unreadable(path, f"{path.name} is a symbolic link: only regular files are read, left out.")
-    if path.is_dir():
+    """Read one submitted file as Python text, bounded in size, never executing or importing it, never
+    following a link; a notebook's code cells come from the bounded reader (`grader.notebook`)."""
+    if path.is_dir() and not path.is_symlink():
         return Unreadable(path, f"{path.name} holds no .py or .ipynb file: nothing to compare.")
     if not _has_source_suffix(path):
         return Unreadable(
@@ -212,10 +228,9 @@ def read_source(path: Path) -> SourceText | Unreadable:
     notebook = path.suffix.lower() == ".ipynb"
     limit = MAX_NOTEBOOK_BYTES if notebook else MAX_COMPARED_BYTES
     try:
-        with path.open("rb") as stream:
-            data = stream.read(limit + 1)
-    except OSError as error:
-        return Unreadable(path, f"{path.name} could not be read ({error.strerror or error}).")
+        data = read_untrusted(path, limit=limit)
+    except UnsafeFile as error:
+        return Unreadable(path, f"{error} Left out.")
     if len(data) > limit:
         return Unreadable(
             path, f"{path.name} is larger than {limit:,} bytes: too large to be a lab solution, left out."
@@ -224,44 +239,30 @@ def read_source(path: Path) -> SourceText | Unreadable:
         return Unreadable(path, f"{path.name} is empty: nothing to compare.")
     if b"\0" in data:
         return Unreadable(path, f"{path.name} is binary (it contains NUL bytes), not Python text: left out.")
+    if notebook:  # read (its UTF-8 too) by the bounded reader: the parent never decodes it whole
+        return _notebook_code(path, data)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         return Unreadable(
             path, f"{path.name} is not UTF-8 text (byte {error.start} cannot be decoded): left out."
         )
-    if notebook:
-        return _notebook_code(path, text)
     return SourceText(path, text)
 
 
-def _notebook_code(path: Path, text: str) -> SourceText | Unreadable:
-    try:
-        notebook = json.loads(text)
-    except (json.JSONDecodeError, RecursionError) as error:
-        return Unreadable(
-            path, f"{path.name} is not a readable notebook: not valid JSON ({str(error)[:120]})."
-        )
-    cells = notebook.get("cells") if isinstance(notebook, dict) else None
-    if not isinstance(cells, list):
-        return Unreadable(
-            path, f'{path.name} is JSON but not a Jupyter notebook (no "cells" list): left out.'
-        )
+def _notebook_code(path: Path, data: bytes) -> SourceText | Unreadable:
+    read = read_notebook(data, path.name)
+    if isinstance(read, FileVerdict):
+        return Unreadable(path, f"left out: {read.message}")
     chunks: list[str] = []
     notes: list[str] = []
-    for number, cell in enumerate(cells, start=1):
-        if not isinstance(cell, dict) or cell.get("cell_type") != "code":
-            continue
-        source = cell.get("source", "")
-        if isinstance(source, list):
-            source = "".join(part for part in source if isinstance(part, str))
-        if isinstance(source, str) and source.strip():
-            lines = [_without_magic(line) for line in source.splitlines()]
-            if not _parses("\n".join(lines)):
-                # one broken cell (a half-typed line) must not hide the rest of the notebook
-                notes.append(f"{path.name}: cell {number} is not valid Python and was not compared.")
-                lines = [""] * len(lines)
-            chunks.append("\n".join(lines))
+    for cell in read.cells:
+        lines = [_without_magic(line) for line in cell.source.splitlines()]
+        if not _parses("\n".join(lines)):
+            # one broken cell (a half-typed line) must not hide the rest of the notebook
+            notes.append(f"{path.name}: cell {cell.number} is not valid Python and was not compared.")
+            lines = [""] * len(lines)
+        chunks.append("\n".join(lines))
     code = "\n\n".join(chunks)
     if len(code.encode()) > MAX_COMPARED_BYTES:
         return Unreadable(

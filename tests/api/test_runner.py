@@ -169,26 +169,59 @@ def taxi(q_table, q_table_decay):
 '''
 
 
+CLASSIC_TAXI_ONLY = b'''"""Last year\'s classic solution, handed in to a course of today\'s edition."""
+import gym
+
+
+def taxi(q_table):
+    raise NotImplementedError
+'''
+
+
 @pytest.mark.parametrize(
-    ("edition", "graded", "expected"),
+    ("edition", "upload", "graded", "expected", "told"),
     [
-        (None, "rl1", {"epsilon_decay": "passed", "taxi": "missing", "cartpole": "missing"}),
-        ("classic", "classic", {"taxi": "missing", "cartpole": "missing"}),
+        (None, RL1_EPSILON_ONLY, "classic", {"taxi": "missing", "cartpole": "missing"}, "edition 4 (rl1"),
+        (
+            "rl1",
+            CLASSIC_TAXI_ONLY,
+            "rl1",
+            {"epsilon_decay": "missing", "cartpole": "missing"},
+            "edition 1 (classic",
+        ),
+        ("rl1", RL1_EPSILON_ONLY, "rl1", {"epsilon_decay": "passed", "taxi": "missing"}, None),
+        (
+            "classic",
+            RL1_EPSILON_ONLY,
+            "classic",
+            {"taxi": "missing", "cartpole": "missing"},
+            "edition 4 (rl1",
+        ),
     ],
-    ids=["detected-per-upload", "named-by-the-service"],
+    ids=[
+        "unset-is-the-first-edition",
+        "a-classic-file-in-an-rl1-course",
+        "rl1-in-rl1",
+        "named-by-the-service",
+    ],
 )
-def test_the_real_grader_grades_the_uploads_edition(
+def test_the_real_grader_grades_the_services_edition_never_the_uploads(
     sessions: sessionmaker[Session],
     make_settings: SettingsFactory,
     edition: str | None,
+    upload: bytes,
     graded: str,
     expected: dict[str, str],
+    told: str | None,
 ) -> None:
+    # Hostile: a file written for another edition does not choose what it is graded on; it is told so.
     real = {"grader": "grader.grading:grade_submission", "allow_weak_isolation": True, "grading_workers": 1}
     settings = make_settings(**real, edition=edition)
-    row = _grade(sessions, settings, RL1_EPSILON_ONLY, filename="gymnasium.py")
+    row = _grade(sessions, settings, upload, filename="gymnasium.py")
     assert row.status == "done", row.error
     assert row.report is not None and row.report["edition"] == graded
     statuses = {problem["id"]: problem["status"] for problem in row.report["problems"]}
     assert {problem: statuses.get(problem) for problem in expected} == expected
     assert ("epsilon_decay" in statuses) == (graded == "rl1")
+    note = row.report["edition_note"]
+    assert (note is None) if told is None else (f"This file looks written for {told}" in note), note

@@ -169,3 +169,15 @@ def test_without_a_broker_url_nothing_distributed_is_configured(monkeypatch: pyt
     monkeypatch.setenv("GYMGRADE_DEVELOPMENT", "1")
     monkeypatch.setenv("GYMGRADE_BROKER_URL", "")
     assert Settings().broker_url is None
+
+
+def test_an_edition_no_pack_has_is_refused_when_the_service_starts(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.setenv("GYMGRADE_EDITION", "rl9")
+    with pytest.raises(ValidationError) as raised:
+        Settings()
+    assert "GYMGRADE_EDITION: unknown edition 'rl9'; expected one of classic, gym026, volume2, rl1" in str(
+        raised.value
+    )
+    monkeypatch.setenv("GYMGRADE_EDITION", "rl1")
+    assert Settings().edition == "rl1"

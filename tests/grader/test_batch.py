@@ -12,7 +12,7 @@ import pytest
 from grading_support import write_config
 
 import grader
-from grader.batch import GRADES_FILE, grade_many, report_names, write_grades
+from grader.batch import GRADES_FILE, MAX_STEM_CHARS, grade_many, identity_stem, report_names, write_grades
 from grader.collector import GradingListener
 from grader.errors import BatchInterrupted
 from grader.plan import GradingPlan
@@ -199,3 +199,53 @@ def test_a_report_listing_grader_errors_is_graded_again(tmp_path: Path, inputs: 
     outcome = grade_many(inputs, out, seed=4, only=ONLY, executor=executor)
     assert executor.asked == [["carol.py"]]
     assert outcome.reasons[inputs[2]] == "its last grading failed (grader error)"
+
+
+# Report names a student chose: bounded, stable, distinct; a report that cannot be written is that student's.
+
+LONG_NAMES = ["1" + "é" * 80, "1" + "é" * 79 + "e", "x" * 150, "x" * 151, "y" * 100_000, "%" * 60]
+
+
+@pytest.mark.parametrize(
+    "identity", LONG_NAMES, ids=["161-bytes", "its-neighbour", "150", "151", "100k", "percent"]
+)
+def test_a_long_identity_gets_a_bounded_stable_report_name(identity: str) -> None:
+    stem = identity_stem(identity)
+    assert len(stem) <= MAX_STEM_CHARS + 3
+    assert stem.isascii() and "/" not in stem
+    assert identity_stem(identity) == stem, "the same name in every run, so a re-run resumes"
+
+
+def test_long_identities_never_share_a_report_name() -> None:
+    stems = [identity_stem(identity) for identity in LONG_NAMES]
+    assert len(set(stems)) == len(stems)
+    assert identity_stem("x" * 150) == "x" * 150, "a stem that fits is kept whole, as before"
+    kept_whole = identity_stem("x" * 150)
+    hashed = identity_stem("x" * 151)
+    assert len(hashed) > MAX_STEM_CHARS >= len(kept_whole), "no name kept whole can equal a hashed one"
+
+
+def test_a_161_byte_folder_name_is_graded_and_resumed(tmp_path: Path, inputs: list[Path]) -> None:
+    names = {inputs[0]: "1" + "é" * 80, inputs[1]: "bob", inputs[2]: "carol"}
+    out = tmp_path / "out"
+    first = grade_many(inputs, out, seed=4, only=ONLY, executor=FakeExecutor(), names=names)
+    assert [report.grader_errors for report in first.reports] == [[], [], []]
+    executor = FakeExecutor()
+    second = grade_many(inputs, out, seed=4, only=ONLY, executor=executor, names=names)
+    assert (executor.asked, second.reused) == ([], inputs)
+
+
+def test_a_report_that_cannot_be_written_is_that_students_grader_error(
+    tmp_path: Path, inputs: list[Path]
+) -> None:
+    out = tmp_path / "out"
+    (out / "bob.json").mkdir(parents=True)  # a folder where bob's report goes: the rename fails
+    outcome = grade_many(inputs, out, seed=4, only=ONLY, executor=FakeExecutor())
+    assert [report.grader_errors for report in outcome.reports] == [
+        [],
+        ["its report could not be written to bob.json (Is a directory); its scores are in the gradebook, and the next run grades it again"],  # noqa: E501
+        [],
+    ]
+    assert _rows(out) == ["alice", "bob", "carol"]
+    assert sorted(path.name for path in out.glob("*.json")) == ["alice.json", "bob.json", "carol.json"]
+    assert (out / "carol.json").is_file() and (out / "bob.json").is_dir()

@@ -67,6 +67,23 @@ def test_check_explains_what_is_missing_and_exits_1(
     )
 
 
+def test_check_of_a_symbolic_link_says_so_and_reads_nothing_of_its_target(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    secret = tmp_path / "secret.txt"
+    secret.write_text("def epsilon_decay(n):\n    return 'hunter2'\n")  # an rl1 mark, if it were read
+    (tmp_path / "opengym.py").symlink_to(secret)
+    assert (
+        cli.main(["check", str(tmp_path / "opengym.py"), "--only", "random_blackjack"]) == cli.EXIT_NOT_FULL
+    )
+    captured = capsys.readouterr()
+    assert (
+        f"opengym.py is a symbolic link (to {secret}): links are never followed, so it was not read. "
+        "Submit the file itself, not a link to it." in captured.out
+    )
+    assert "Edition: classic" in captured.err and "epsilon_decay" not in captured.err, "detection read it"
+
+
 QUICK_FIND_QVALUES = (
     "import numpy as np\n\n\ndef find_qvalues(env):\n    print('training a table')\n"
     "    return np.zeros((500, 6))\n"
@@ -371,3 +388,26 @@ def test_a_broken_executor_entry_point_is_refused_with_a_remedy(
         "gymgrade grade: the batch executor 'cluster' could not be loaded (ImportError: No module named "
         "'celery'); reinstall the package providing it (pip install -e '.[distributed]')"
     ) in capsys.readouterr().err
+
+
+def test_the_class_summary_shows_each_name_a_student_chose_as_one_inert_line(tmp_path: Path) -> None:
+    """Hostile: folder and file names with escape sequences, BEL, a C1 control, a right-to-left override and
+    a newline that would forge a `refused alice` line are printed inert, one line per student."""
+    import zipfile
+
+    from grader.classroom import discover
+
+    klass = tmp_path / "class"
+    names = ["\x1b]0;owned\x07\x1b[2Jmallory", "\x9b31mtrudy", "\u202eecila", "eve\n  refused alice: forged"]
+    for name in names:
+        (klass / name).mkdir(parents=True)
+        (klass / name / "opengym.py").write_text("def blackjack(n):\n    return 0\n")
+    with zipfile.ZipFile(klass / "eve\n  refused alice: forged" / "more.zip", "w") as bundle:
+        bundle.writestr("../\x1b[2J.py", "x = 1\n")
+    printed = cli.class_summary(discover(klass, scratch=tmp_path / "scratch"))
+    lines = printed.split("\n")
+    assert len(lines) == 1 + len(names) + 1, printed
+    assert not any(line.startswith("  refused alice") for line in lines)
+    assert [character for character in printed if character in "\x1b\x07\x9b\u202e\r"] == []
+    assert "  \ufffd]0;owned\ufffd\ufffd[2Jmallory: " in printed
+    assert "  refused eve refused alice: forged/more.zip/../\ufffd[2J.py: a name climbing out" in printed

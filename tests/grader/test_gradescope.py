@@ -197,15 +197,101 @@ def test_a_file_that_cannot_be_graded_says_why_in_the_output() -> None:
          "ideally named opengym.py; found a.py, b.py. Submit exactly one such file."),
         ([], "Expected one Python file (.py) or Jupyter notebook (.ipynb) with your functions, ideally "
          "named opengym.py; found no .py or .ipynb file. Submit exactly one such file."),
+        (["helper.py", "opengym.py -> /etc/hostname"], "opengym.py is a symbolic link (to /etc/hostname): "
+         "links are never followed, so it was not read. Submit the file itself, not a link to it."),
+        (["lab/opengym.py", "old -> lab"], "lab/opengym.py"),
+        (["a.py", "b.py", "old -> lab"], "Expected one Python file (.py) or Jupyter notebook (.ipynb) with "
+         "your functions, ideally named opengym.py; found a.py, b.py. Submit exactly one such file. old is a "
+         "symbolic link (to lab): links are never followed, so it was not read. Submit the file itself, not "
+         "a link to it."),
     ],
-    ids=["one-file", "notebook-beside-checkpoint", "lab-name-among-several", "ambiguous", "nothing"],
+    ids=["one-file", "notebook-beside-checkpoint", "lab-name-among-several", "ambiguous", "nothing",
+         "lab-name-is-a-link", "folder-link-not-walked", "folder-link-named"],
 )  # fmt: skip
 def test_the_graded_file_is_chosen_or_the_student_told(tmp_path: Path, files: list[str], picked: str) -> None:
     for name in files:
+        name, _, target = name.partition(" -> ")
         (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
-        (tmp_path / name).write_text("x = 1\n")
+        if target:
+            (tmp_path / name).symlink_to(target)
+        else:
+            (tmp_path / name).write_text("x = 1\n")
     choice = pick_submission(tmp_path)
-    assert (choice.name if isinstance(choice, Path) else choice) == picked
+    assert (choice.relative_to(tmp_path).as_posix() if isinstance(choice, Path) else choice) == picked
+
+
+def test_an_upload_is_walked_only_so_deep(tmp_path: Path) -> None:
+    deep = tmp_path.joinpath(*["d"] * 40)
+    deep.mkdir(parents=True)
+    (deep / "opengym.py").write_text("x = 1\n")
+    choice = pick_submission(tmp_path)
+    assert isinstance(choice, str) and choice.endswith(f"{'d/' * 32}d is deeper than 32 folders: not read.")
+
+
+NAME_LIKE_SECRET = "ab" * 32
+"""A secret that parses as a Python name: run as a student's code, a NameError would print it."""
+
+
+def _linked_upload(root: Path, kind: str) -> None:
+    """A Gradescope root whose upload reaches for the bundle's secret: a symbolic link to it, a hard link,
+    or a folder link to the bundle's source folder."""
+    (root / "source").mkdir(parents=True)
+    secret = root / "source" / SECRET_FILE
+    secret.write_text(NAME_LIKE_SECRET + "\n")
+    secret.chmod(0o644)  # as an unzip may leave it: the grader makes it private before grading
+    (root / METADATA_FILE).write_text(json.dumps(metadata(3001, "2026-11-26T09:00:00.000000-08:00", 9)))
+    upload = root / "submission"
+    upload.mkdir()
+    if kind == "symlink":
+        (upload / "opengym.py").symlink_to(secret)
+    elif kind == "relative-symlink":
+        (upload / "opengym.py").symlink_to(Path("..") / "source" / SECRET_FILE)
+    elif kind == "hard-link":
+        os.link(secret, upload / "opengym.py")
+    else:
+        (upload / "lab").symlink_to(root / "source", target_is_directory=True)
+        (upload / "notes.txt").write_text("my solution is in lab/\n")
+
+
+LINKED = [
+    ("symlink", "opengym.py is a symbolic link (to {root}/source/seed_secret): links are never followed, so it was not read. Submit the file itself, not a link to it."),  # noqa: E501
+    ("relative-symlink", "opengym.py is a symbolic link (to ../source/seed_secret): links are never followed"),  # noqa: E501
+    ("hard-link", "opengym.py is a hard link (2 names for one file, possibly outside the submission): it was not read. Submit a copy of the file itself."),  # noqa: E501
+    ("folder-link", "Expected one Python file (.py) or Jupyter notebook (.ipynb) with your functions, ideally named opengym.py; found no .py or .ipynb file. Submit exactly one such file. lab is a symbolic link (to {root}/source): links are never followed"),  # noqa: E501
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("kind", "message"), LINKED, ids=[case[0] for case in LINKED])
+def test_an_upload_linking_to_the_secret_is_refused_and_the_secret_stays_private(
+    tmp_path: Path, kind: str, message: str
+) -> None:
+    root = tmp_path / "autograder"
+    _linked_upload(root, kind)
+    secret_file = root / "source" / SECRET_FILE
+    assert main(["gradescope-run", "--root", str(root), "--secret-file", str(secret_file)]) == 0
+    text = (root / "results" / "results.json").read_text()
+    data = json.loads(text)
+    GradescopeResults.model_validate(data)
+    assert NAME_LIKE_SECRET not in text, "not a byte of the secret in any result, visible or not"
+    assert data["score"] == 0 and data["output"].startswith(message.format(root=root))
+    assert data["extra_data"]["gymgrade"]["seed_source"] == "derived", "read before the upload, link or not"
+    assert secret_file.stat().st_mode & 0o077 == 0, "unreadable to the sandbox's uid"
+
+
+def test_a_regrade_copies_an_uploads_links_as_links(gradescope: Path, tmp_path: Path) -> None:
+    secret = tmp_path / "instructor_secret.txt"
+    secret.write_text(NAME_LIKE_SECRET + "\n")
+    upload = tmp_path / "upload"
+    upload.mkdir()
+    (upload / "opengym.py").symlink_to(secret)
+    metadata_path = tmp_path / "meta.json"
+    metadata_path.write_text(json.dumps(metadata(3002, "2026-11-26T09:05:00.000000-08:00", 9)))
+    out = tmp_path / "results.json"
+    arguments = ["--bundle", str(gradescope), "--metadata", str(metadata_path), "--out", str(out)]
+    for submission in (upload, upload / "opengym.py"):
+        assert main(["gradescope-seed", *arguments, "--submission", str(submission)]) == 0
+        assert NAME_LIKE_SECRET not in out.read_text()
+        assert json.loads(out.read_text())["output"].startswith("opengym.py is a symbolic link (to ")
 
 
 def test_check_prints_valid_gradescope_results(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -334,6 +420,26 @@ def test_two_uploads_get_different_starts_and_a_recorded_one_regrades_identicall
     # Where the seed repeats (one seed per bundle, as before), the same tapes get full marks.
     assert main([*arguments, "--submission", str(attack), "--out", str(tmp_path / "same-seed.json")]) == 0
     assert _cartpole(json.loads((tmp_path / "same-seed.json").read_text()))["status"] == "passed"
+
+
+@pytest.mark.slow
+def test_student_code_that_opens_the_secret_by_its_path_reads_nothing(
+    gradescope: Path, tmp_path: Path
+) -> None:
+    root = tmp_path / "root"
+    reader = tmp_path / "opengym.py"
+    reader.write_text(
+        "from pathlib import Path\n"
+        "try:\n"
+        f"    FOUND = 'read: ' + Path({str(root / 'source' / SECRET_FILE)!r}).read_text()\n"
+        "except OSError as error:\n"
+        "    FOUND = f'refused: {type(error).__name__}'\n\n\n"
+        "def cartpole():\n"
+        "    raise ValueError(FOUND)\n"
+    )
+    data = _upload(gradescope, root, reader, metadata(3003, "2026-11-26T09:10:00.000000-08:00", 9))
+    assert SECRET not in json.dumps(data)
+    assert "ValueError: refused: " in _cartpole(data)["output"], _cartpole(data)["output"]
 
 
 @pytest.mark.slow

@@ -67,6 +67,25 @@ def test_bad_files_get_a_clear_verdict_for_every_problem(
     assert Report.model_validate_json(report.to_json()) == report
 
 
+@pytest.mark.parametrize("kind", ["symbolic", "hard"])
+def test_a_linked_submission_is_refused_without_reading_its_target(tmp_path: Path, kind: str) -> None:
+    secret = tmp_path / "secret.txt"
+    secret.write_text("hunter2\n")
+    path = tmp_path / "opengym.py"
+    if kind == "symbolic":
+        path.symlink_to(secret)
+        message = (
+            f"opengym.py is a symbolic link (to {secret}): links are never followed, so it was not read."
+        )
+    else:
+        os.link(secret, path)
+        message = "opengym.py is a hard link (2 names for one file, possibly outside the submission)"
+    report = grade_submission(path)
+    assert report.submission_error is not None and report.submission_error.startswith(message)
+    assert {problem.status for problem in report.problems} == {"error"} and report.score == 0
+    assert "hunter2" not in report.to_json()
+
+
 def test_unknown_problem_ids_are_refused() -> None:
     with pytest.raises(ValueError, match="unknown problem blackjak; expected ids among random_blackjack"):
         grade_submission(CLASSIC_COMPLETE, only=["blackjak"])

@@ -5,6 +5,8 @@ from __future__ import annotations
 import csv
 import json
 import signal
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -403,3 +405,119 @@ def test_thousands_of_skipped_lines_are_listed_up_to_a_cap_and_counted() -> None
     assert module.summary.skipped[-1].reason == (
         "this and 1,999 more statements left out (not listed one by one)"
     )
+
+
+def _empty_objects_notebook(size: int = 19_900_000) -> tuple[bytes, int]:
+    """Issue 33's hostile sample: a valid notebook (the lab's own) padded with millions of empty JSON objects
+    among its cells, each costing the parser ~25 times its 3 bytes; and its number of cells."""
+    text = (NOTEBOOKS / "classic_complete.ipynb").read_text(encoding="utf-8")
+    at = text.index('"cells": [') + len('"cells": [')
+    filler = (size - len(text)) // 3
+    return (text[:at] + "{}," * filler + text[at:]).encode(), filler + len(json.loads(text)["cells"])
+
+
+class _Decodes:
+    """Counts every JSON decoding in this process (json.loads and json.load go through it)."""
+
+    def __init__(self, monkeypatch: pytest.MonkeyPatch) -> None:
+        self.calls = 0
+        original = json.JSONDecoder.decode
+
+        def counted(decoder: json.JSONDecoder, text: str, *args: Any) -> Any:
+            self.calls += 1
+            return original(decoder, text, *args)
+
+        monkeypatch.setattr(json.JSONDecoder, "decode", counted)
+
+
+def test_a_notebook_is_parsed_once_in_the_reader_and_never_in_the_parent(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from grader.editions.detection import detect_edition
+    from grader.similarity.sources import SourceText, read_source
+
+    path = tmp_path / "opengym.ipynb"
+    path.write_bytes((NOTEBOOKS / "taxi_global_table.ipynb").read_bytes() + b"\n")  # new bytes: not kept yet
+    decodes = _Decodes(monkeypatch)
+    children: list[list[str]] = []
+    run = bounded.subprocess.run
+
+    def counted_run(arguments: list[str], **options: Any) -> Any:
+        children.append(arguments)
+        return run(arguments, **options)
+
+    monkeypatch.setattr(bounded.subprocess, "run", counted_run)
+    assert detect_edition(path).edition.name == "classic"
+    assert isinstance(read_source(path), SourceText)
+    module = build_module(path.read_bytes(), path.name, ["taxi"])
+    assert isinstance(module, NotebookModule)
+    assert decodes.calls == 0, "the parent decoded JSON"
+    requests = [json.loads(arguments[-1]) for arguments in children]
+    assert [(request["mode"], request.get("input")) for request in requests] == [
+        ("read", None),
+        ("module", "read"),
+    ]
+
+
+@pytest.mark.parametrize("sample", sorted(path.name for path in NOTEBOOKS.glob("*.ipynb")))
+def test_a_module_built_from_kept_cells_is_the_module_built_from_the_file(sample: str) -> None:
+    data = (NOTEBOOKS / sample).read_bytes()
+    fresh = bounded.build_module(data + b" ", sample, ["cartpole", "taxi"])  # new bytes: read by the child
+    read = bounded.read_notebook(data + b"  ", sample)
+    from_kept = bounded.build_module(data + b"  ", sample, ["cartpole", "taxi"])  # the kept cells
+    assert not isinstance(read, FileVerdict)
+    assert from_kept == fresh
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/status").is_file(), reason="reads VmHWM from /proc (Linux)")
+def test_a_notebook_of_millions_of_empty_objects_is_refused_and_the_parent_stays_small(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "mallory.ipynb"
+    data, cells = _empty_objects_notebook()
+    path.write_bytes(data)
+    measured = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import re, sys\nfrom pathlib import Path\n"
+            "from grader.editions.detection import detect_edition\n"
+            "from grader.notebook import build_module\nfrom grader.similarity.sources import read_source\n"
+            # VmHWM: the process's own peak since its exec (ru_maxrss counts its parent's size at the fork)
+            "def peak():\n"
+            "    return int(re.search(r'VmHWM:\\s+(\\d+) kB', Path('/proc/self/status').read_text())[1])\n"
+            "path = Path(sys.argv[1])\nbefore = peak()\n"
+            "print(detect_edition(path).reason)\nprint(read_source(path).reason)\n"
+            "print(build_module(path.read_bytes(), path.name, ['cartpole']).message)\n"
+            "print((peak() - before) // 1024)\n",
+            str(path),
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.splitlines()
+    refusal = (
+        f"mallory.ipynb has {cells:,} cells; a notebook may have at most 10,000. Delete the cells that are "
+        "not part of your solution (or submit your code as a .py file) and submit again."
+    )
+    assert measured[:3] == [
+        "mallory.ipynb could not be read as Python, so it shows no edition",
+        f"left out: {refusal}",
+        refusal,
+    ]
+    # Parsed in the parent, these objects took ~495 MiB there (bench/notebook_memory.py); read by the
+    # bounded child, the parent holds the file's 20 MB bytes and the child's short reply.
+    assert int(measured[3]) < 100, f"the parent grew by {measured[3]} MiB"
+
+
+def test_the_kept_readings_drop_the_least_recently_used_past_their_budget() -> None:
+    from grader.notebook.reading import Cell, NotebookCells
+
+    kept = bounded._Kept(characters=10)
+    for name in ("a", "b", "c"):
+        kept.put((b"digest", name), NotebookCells([Cell(1, None, "x" * 4)], []))
+    assert kept.get((b"digest", "a")) is None, "12 characters: the oldest went"
+    assert kept.get((b"digest", "b")) is not None  # now the most recently used: c goes next
+    kept.put((b"digest", "d"), FileVerdict("missing", "dddd"))
+    assert [key[1] for key in kept.entries] == ["b", "d"] and kept.size == 8

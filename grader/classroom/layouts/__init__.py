@@ -29,13 +29,34 @@ LAYOUTS: dict[str, Layout] = {
 
 
 def add_layout_option(parser: argparse.ArgumentParser) -> None:
-    """Give a command that reads a class download the ``--layout`` option (one of `LAYOUTS`)."""
+    """Give a command that reads a class download the ``--layout`` option (one of `LAYOUTS`) and plain
+    folders' ``--sections N``."""
     parser.add_argument(
         "--layout",
         choices=tuple(LAYOUTS),
         default=None,
         help="the download's layout (default: recognised from its names; see docs/instructors.md)",
     )
+    parser.add_argument(
+        "--sections",
+        type=_levels,
+        default=None,
+        metavar="N",
+        help="plain folders: N levels of section folders hold the students' folders; "
+        "0: the top folders are the students; by default decided from the download's shape as a whole",
+    )
+
+
+def _levels(text: str) -> int:
+    try:
+        levels = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a number of folder levels (0, 1, 2...), found {text!r}"
+        ) from None
+    if not 0 <= levels <= 32:
+        raise argparse.ArgumentTypeError(f"expected 0 to 32 levels of section folders, found {levels}")
+    return levels
 
 
 __all__ = ["LAYOUTS", "Group", "Grouping", "Layout", "add_layout_option"]

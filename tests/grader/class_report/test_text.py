@@ -11,7 +11,9 @@ from grader.class_report.text import (
     bounded,
     display_identity,
     display_text,
+    inert,
     safe_href,
+    terminal_line,
 )
 
 
@@ -103,3 +105,33 @@ def test_only_plain_relative_links_survive_and_they_are_percent_encoded(
     href: str | None, safe: str | None
 ) -> None:
     assert safe_href(href) == safe
+
+
+@pytest.mark.parametrize(
+    ("text", "kept"),
+    [
+        ("two\nlines\tand a tab", "two\nlines\tand a tab"),
+        ("Zoë Ñúñez 王小明", "Zoë Ñúñez 王小明"),
+        ("ali\x1b]0;owned\x07ce", f"ali{HIDDEN}]0;owned{HIDDEN}ce"),
+        ("\x9b31mx\r", f"{HIDDEN}31mx{HIDDEN}"),
+        ("\u202eecila", f"{HIDDEN}ecila"),
+        ("lone \ud800 surrogate", f"lone {HIDDEN} surrogate"),
+    ],
+    ids=["newline-and-tab", "unicode", "escape-and-bell", "c1-and-cr", "rtl-override", "surrogate"],
+)
+def test_inert_keeps_text_whole_but_controls_and_overrides(text: str, kept: str) -> None:
+    assert inert(text) == kept
+    assert len(inert(text)) == len(text)
+
+
+@pytest.mark.parametrize(
+    ("line", "printed"),
+    [
+        ("  alice: rl1: imports gymnasium", "  alice: rl1: imports gymnasium"),
+        ("  eve\n  refused alice: forged", "  eve refused alice: forged"),
+        ("\x1b[2J\x1b]0;owned\x07mallory", f"{HIDDEN}[2J{HIDDEN}]0;owned{HIDDEN}mallory"),
+    ],
+    ids=["plain", "forged-line", "clear-and-retitle"],
+)
+def test_a_terminal_line_keeps_its_indent_and_nothing_a_name_could_do(line: str, printed: str) -> None:
+    assert terminal_line(line) == printed

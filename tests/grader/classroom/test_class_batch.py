@@ -246,3 +246,57 @@ def test_hostile_folder_names_stay_data(tmp_path: Path) -> None:
     assert students == sorted(expected, key=lambda student: student.lstrip("'"))
     reports = sorted(path.name for path in (tmp_path / "out").glob("*.json"))
     assert "line%0Abreak.json" in reports and all("/" not in name for name in reports)
+
+
+def test_a_class_zip_with_a_161_byte_name_and_escaping_entries_grades_and_resumes(tmp_path: Path) -> None:
+    """Hostile: a student folder named by a digit and 80 `é` (161 bytes, 481 once percent-encoded) and
+    entries named ``../x``, ``/tmp/x`` and ``C:/x``: every honest student is graded, the long name's report
+    is written under a bounded name, no refused entry becomes a row, and a re-run grades nothing."""
+    import zipfile
+
+    long_name = "1" + "é" * 80
+    archive = tmp_path / "class.zip"
+    with zipfile.ZipFile(archive, "w") as bundle:
+        for name in (long_name, "alice", "bob"):
+            bundle.writestr(f"{name}/opengym.py", "def blackjack(n):\n    return 0\n")
+        for escaping in ("../x.py", "/tmp/x.py", "C:/x.py"):
+            bundle.writestr(escaping, "x = 1\n")
+    executor = FakeExecutor()
+    rows = _batch(archive, tmp_path / "out", executor)
+    assert sorted(row["student"] for row in rows) == sorted([long_name, "alice", "bob"])
+    assert all(row["note"] == "" for row in rows), rows
+    stems = sorted(path.stem for path in (tmp_path / "out").glob("*.json"))
+    assert stems == sorted(["alice", "bob", identity_stem(long_name)])
+    assert _batch(archive, tmp_path / "out", executor) == rows
+    assert len(executor.asked) == 1, "the re-run found every report, the long name's included"
+
+
+def test_a_class_zip_is_extracted_once_whatever_edition_it_is_graded_as(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Hostile shape (scaled down): a zip of many 1 MiB entries of zeros used to be extracted twice when the
+    # class's edition asked other functions than the first edition's, doubling what it wrote to /tmp.
+    import zipfile
+
+    from grader.classroom import discovery
+    from grader.editions import EDITIONS
+
+    monkeypatch.setattr(cli, "find_executor", lambda policy: FakeExecutor())
+    reads: list[Path] = []
+    real_read_tree = discovery.read_tree
+
+    def counting(root: Path, *args: object) -> object:
+        reads.append(root)
+        return real_read_tree(root, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(discovery, "read_tree", counting)
+    archive = tmp_path / "class.zip"
+    with zipfile.ZipFile(archive, "w", zipfile.ZIP_DEFLATED) as bundle:
+        for student in ("alice", "bob"):
+            bundle.writestr(f"{student}/opengym.py", EDITIONS["rl1"].reference.read_bytes())
+            for number in range(3):
+                bundle.writestr(f"{student}/zeros{number}.bin", b"\0" * 2**20)
+    argv = ["grade", str(archive), "--out", str(tmp_path / "out"), "--only", "epsilon_decay", "--seed", "3"]
+    assert cli.main(argv) == 0
+    assert "Edition: rl1" in capsys.readouterr().err
+    assert reads == [archive], "read once: grouped again by the rl1 functions without extracting again"

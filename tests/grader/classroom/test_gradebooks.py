@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from grader.class_report.text import safe_cell
 from grader.classroom import GradedFileRule, discover
 from grader.classroom.errors import GradebookError, RosterError
 from grader.classroom.gradebooks import (
@@ -18,7 +19,6 @@ from grader.classroom.gradebooks import (
     github_classroom_csv,
     grades_csv,
     gradescope_csv,
-    safe_cell,
 )
 from grader.classroom.roster import parse_roster, read_roster
 from grader.report import ProblemResult, Report
@@ -62,8 +62,16 @@ def _csv(text: str) -> list[dict[str, str]]:
 @pytest.mark.parametrize(
     ("value", "cell"),
     [("=1+2", "'=1+2"), ("+cmd", "'+cmd"), ("-2+3", "'-2+3"), ("@SUM(A1)", "'@SUM(A1)"), ("\tx", "'\tx"),
-     ("\rx", "'\rx"), ("alice", "alice"), ("0042", "0042"), (1.5, "1.5"), (None, "")],
-    ids=["equals", "plus", "minus", "at", "tab", "cr", "plain", "leading-zeros", "number", "none"],
+     ("\rx", "'\ufffdx"), ("alice", "alice"), ("0042", "0042"), (1.5, "1.5"), (None, ""),
+     (" =1+2", "' =1+2"), ("\u3000 \u00a0@x", "'\u3000 \u00a0@x"), ("\uff1dcmd|' /C calc'!A0", "'\uff1dcmd|' /C calc'!A0"),
+     ("\ufe66x", "'\ufe66x"), ("\uff0b1", "'\uff0b1"), ("\uff0d1", "'\uff0d1"), ("\uff20SUM(A1)", "'\uff20SUM(A1)"),
+     ("\u200b=1", "'\u200b=1"), ("a =1", "a =1"), ("  ", "  "), ("Zoë Ng", "Zoë Ng"),
+     ("ali\x1b]0;owned\x07ce", "ali\ufffd]0;owned\ufffdce"), ("\u202eecila", "\ufffdecila"),
+     ("two\nlines\tand tab", "two\nlines\tand tab")],
+    ids=["equals", "plus", "minus", "at", "tab", "cr", "plain", "leading-zeros", "number", "none",
+         "space-then-equals", "wide-spaces-then-at", "fullwidth-equals", "small-equals", "fullwidth-plus",
+         "fullwidth-minus", "fullwidth-at", "zero-width-then-equals", "equals-inside", "blank", "unicode-name",
+         "terminal-escape", "rtl-override", "newline-and-tab-kept"],
 )  # fmt: skip
 def test_cells_a_spreadsheet_would_evaluate_are_neutralised(value: object, cell: str) -> None:
     assert safe_cell(value) == cell
@@ -199,11 +207,86 @@ def test_a_roster_without_students_is_refused_with_what_was_expected(text: str, 
         parse_roster(text)
 
 
-def test_a_roster_matches_ids_case_insensitively_and_keeps_leading_zeros() -> None:
+def test_a_roster_matches_one_key_per_layout_and_keeps_leading_zeros() -> None:
     roster = parse_roster("Name,Email,Student ID\r\nAda,Ada@Uni.edu,00123\r\n")
     entry = roster.find("00123")
-    assert entry is not None and entry.identity == "00123" and roster.find("ada@uni.edu") is entry
+    assert entry is not None and entry.identity == "00123"
     assert roster.find("123") is None
+    assert roster.find("Ada", "plain") is None, "only the layout's key column, never the name"
+    assert roster.find("ADA@uni.edu", "gradescope") is entry, "Gradescope's email identities match the email"
+    assert roster.find("ada@uni.edu", "plain") is entry, "so do folders named by email"
+    assert roster.find("ada@uni.edu", "canvas") is None, "a Canvas identity is a user id"
+
+
+def _folders(root: Path, names: dict[str, bytes]) -> Path:
+    for name, source in names.items():
+        (root / name).mkdir(parents=True)
+        (root / name / "opengym.py").write_bytes(source)
+    return root
+
+
+def _rows_by_identity(download, roster, scores: dict[str, float]):  # type: ignore[no-untyped-def]
+    reports = {s.identity: _report(s.identity, scores[s.identity]) for s in download.submissions}
+    return {row.member.identity: row for row in class_rows(download, reports, roster)}
+
+
+@pytest.mark.parametrize(
+    ("folder", "claimed"),
+    [("\u212aim", False), ("KIM", True)],
+    ids=["kelvin-sign-for-a-k", "ascii-case"],
+)
+def test_a_folder_named_like_a_roster_student_never_gets_their_row(
+    tmp_path: Path, folder: str, claimed: bool
+) -> None:
+    # Hostile: a folder whose name folds onto Kim's must not put a second row with Kim's id into the LMS.
+    download = discover(_folders(tmp_path / "class", {"kim": b"x = 1\n", folder: b"x = 2\n"}), rule=RULE)
+    roster = parse_roster("ID,Student,SIS Login ID\r\n501,Kim,kim\r\n")
+    rows = _rows_by_identity(download, roster, {"kim": 2.0, folder: 0.0})
+    assert rows["kim"].roster is not None and rows["kim"].roster.get("id") == "501" and rows["kim"].note == ""
+    assert rows[folder].roster is None and rows[folder].refused_claim is claimed
+    if claimed:
+        assert rows[folder].note == (
+            "refused: KIM matches roster student Kim (sis login id kim), whom kim matched first; left out of "
+            "every LMS gradebook: rename the folder or correct the roster"
+        )
+    else:
+        assert rows[folder].note == "not on the roster"
+    text = canvas_csv(list(rows.values()), Assignment("Lab 1", "88"))
+    assert canvas_import(text, {"501"}, {"88": 2.0}) == {("501", "88"): 2.0}, "one row for Kim, Kim's score"
+    grades = {row["student"]: row for row in _csv(grades_csv(list(rows.values()), PROBLEMS))}
+    assert set(grades) == {"kim", folder}, "grades.csv keeps every submission, with the note"
+
+
+def test_a_github_username_equal_to_another_students_roster_identifier_claims_nobody(
+    tmp_path: Path,
+) -> None:
+    # Hostile: the GitHub user "alice" is not Alice (her username is alice-gh, "alice" her roster identifier).
+    root = tmp_path / "lab-1-submissions"
+    download = discover(_folders(root, {"lab-1-alice-gh": b"x = 1\n", "lab-1-alice": b"x = 2\n"}), rule=RULE)
+    assert download.layout == "github-classroom"
+    roster = parse_roster("identifier,github_username,github_id,name\r\nalice,alice-gh,7,Alice\r\n")
+    rows = _rows_by_identity(download, roster, {"alice-gh": 2.0, "alice": 0.0})
+    assert rows["alice-gh"].roster is not None and rows["alice-gh"].name == "Alice"
+    assert rows["alice"].roster is None and rows["alice"].note == "not on the roster"
+    github = _csv(github_classroom_csv(list(rows.values())))
+    assert [(row["github_username"], row["roster_identifier"], row["points_awarded"]) for row in github] == [
+        ("alice", "", "0"),
+        ("alice-gh", "alice", "2"),
+    ]
+
+
+def test_a_second_claim_on_a_roster_row_is_left_out_of_every_lms_gradebook(tmp_path: Path) -> None:
+    root = tmp_path / "lab-1-submissions"
+    download = discover(_folders(root, {"lab-1-octo": b"x = 1\n", "lab-1-OCTO": b"x = 2\n"}), rule=RULE)
+    roster = parse_roster("identifier,github_username,github_id,name\r\ns1,octo,7,Octo\r\n")
+    rows = _rows_by_identity(download, roster, {"octo": 2.0, "OCTO": 0.0})
+    assert rows["OCTO"].refused_claim and rows["OCTO"].note.startswith(
+        "refused: OCTO matches roster student Octo (github_username octo), whom octo matched first"
+    )
+    github = _csv(github_classroom_csv(list(rows.values())))
+    assert [(row["github_username"], row["points_awarded"]) for row in github] == [("octo", "2")]
+    gradescope = _csv(gradescope_csv(list(rows.values()), PROBLEMS))
+    assert [row["SID"] for row in gradescope] == ["octo"]
 
 
 def test_a_student_in_two_submissions_gets_one_row_from_the_latest(tmp_path: Path) -> None:

@@ -107,3 +107,33 @@ def test_entry_names_never_reach_the_file_system(tmp_path: Path) -> None:
     tree = read_tree(archive, tmp_path / "scratch")
     (entry,) = tree.entries
     assert entry.relative.endswith(".py") and len(entry.path.name) < 20
+
+
+MIB_OF_ZEROS = b"\0" * 2**20
+"""An entry of exactly 1 MiB: below the ratio check's size, so only the total budget bounds many of them."""
+
+
+def _scratch_bytes(scratch: Path) -> int:
+    return sum(path.stat().st_size for path in scratch.rglob("*") if path.is_file())
+
+
+def test_every_download_of_a_command_shares_one_budget(tmp_path: Path) -> None:
+    # Hostile (scaled down from 1,100 entries of 1 MiB against 1 GiB): each zip fits the budget alone,
+    # together they do not, so the command writes no more than the budget in all.
+    from grader.classroom.discovery import read_all
+
+    zips = [
+        _zip(
+            tmp_path / "in" / f"part{number}.zip",
+            [(f"s{number}{k}/x{k}.bin", MIB_OF_ZEROS) for k in range(3)],
+        )
+        for number in range(2)
+    ]
+    limits = Limits(max_total_bytes=4 * 2**20)
+    reads = read_all(zips, scratch=tmp_path / "scratch", limits=limits)
+    refused = [skipped for read in reads for skipped in read.tree.refused]
+    assert [skipped.reason for skipped in refused] == [
+        f"the download's zips expand past {4 * 2**20:,} bytes"
+    ] * 2
+    assert sum(len(read.tree.entries) for read in reads) == 4
+    assert _scratch_bytes(tmp_path / "scratch") == 4 * 2**20

@@ -28,21 +28,24 @@ def test_each_reference_is_detected_as_its_edition_or_an_edition_grading_the_sam
 
 
 @pytest.mark.parametrize(
-    ("source", "edition", "reason"),
+    ("source", "edition", "reason", "shown"),
     [
         (
             "def epsilon_decay(i, n, a=1.0, b=1e-6):\n    pass\n",
             "rl1",
             "it defines epsilon_decay(i, n, a, b)",
+            True,
         ),
-        ("def taxi(q, q2):\n    pass\n", "rl1", "its taxi(q, q2) takes two tables"),
-        ("def taxi(q, q2=None):\n    pass\n", "classic", "no mark of a later edition"),
-        ("def cartpole(render=False):\n    pass\n", "volume2", "its cartpole(render=...) take"),
-        ("import gymnasium as gym\n", "volume2", "imports gymnasium"),
-        ("import gym\nobs, r, te, tr, info = env.step(0)\n", "gym026", "five values"),
-        ("import gym\nobs, info = env.reset()\n", "gym026", "five values"),
-        ("import gym\nobs, r, done, info = env.step(0)\n", "classic", "no mark of a later edition"),
-        ("def cartpole(:\n", "classic", "no mark of a later edition"),
+        ("def taxi(q, q2):\n    pass\n", "rl1", "its taxi(q, q2) takes two tables", True),
+        ("def taxi(q, q2=None):\n    pass\n", "classic", "it shows no edition: it imports no gym", False),
+        ("def cartpole(render=False):\n    pass\n", "volume2", "its cartpole(render=...) take", True),
+        ("import gymnasium as gym\n", "volume2", "imports gymnasium", True),
+        ("import gym\nobs, r, te, tr, info = env.step(0)\n", "gym026", "five values", True),
+        ("import gym\nobs, info = env.reset()\n", "gym026", "five values", True),
+        ("import gym\nobs, r, done, info = env.step(0)\n", "classic", "no mark of a later edition", True),
+        ("def cartpole(:\n", "classic", "could not be read as Python, so it shows no edition", False),
+        ("", "classic", "it shows no edition", False),
+        ("def random_blackjack(n):\n    return 0.5\n", "classic", "it shows no edition", False),
     ],
     ids=[
         "epsilon_decay",
@@ -54,14 +57,17 @@ def test_each_reference_is_detected_as_its_edition_or_an_edition_grading_the_sam
         "reset2",
         "classic_step",
         "syntax_error",
+        "empty",
+        "one_shared_function",
     ],
 )
-def test_rules_and_their_reasons(tmp_path: Path, source: str, edition: str, reason: str) -> None:
+def test_rules_and_their_reasons(tmp_path: Path, source: str, edition: str, reason: str, shown: bool) -> None:
     path = tmp_path / "opengym.py"
     path.write_text(source, encoding="utf-8")
     detection = detect_edition(path)
     assert detection.edition.name == edition
     assert reason in detection.reason
+    assert detection.shown is shown
 
 
 def test_a_notebook_is_read_cell_by_cell_skipping_magics_and_broken_cells(tmp_path: Path) -> None:

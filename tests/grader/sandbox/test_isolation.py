@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import errno
+import importlib.util
 import signal
 import socket
 import subprocess
@@ -313,6 +314,21 @@ def test_the_harness_tree_holds_only_the_harness_and_the_compat_layer() -> None:
         name.split("/")[3] for name in files if name.startswith("lib/grader/sandbox/") and name.count("/") > 3
     } == {"child"}
     assert not any("reference" in name or name.endswith(".toml") for name in files)
+
+
+def test_the_harness_tree_carries_bytecode_the_child_interpreter_accepts() -> None:
+    # The child runs with -B in a read-only tree: what it does not find compiled it compiles at every start.
+    lib = harness_tree() / "lib" / "grader"
+    sources = sorted([*(lib / "sandbox" / "child").rglob("*.py"), *(lib / "compat").rglob("*.py")])
+    assert sources
+    for source in sources:
+        header = Path(importlib.util.cache_from_source(str(source))).read_bytes()[:16]
+        stat = source.stat()
+        # What Python checks before it uses a cached file: magic, flags 0 (time stamp), mtime, size.
+        assert header[:4] == importlib.util.MAGIC_NUMBER, source
+        assert int.from_bytes(header[4:8], "little") == 0, source
+        assert int.from_bytes(header[8:12], "little") == int(stat.st_mtime) & 0xFFFFFFFF, source
+        assert int.from_bytes(header[12:16], "little") == stat.st_size & 0xFFFFFFFF, source
 
 
 def test_import_hooks_of_the_site_directories_are_hidden_from_the_child() -> None:

@@ -143,3 +143,35 @@ def test_grading_reports_add_shared_wrong_results_as_evidence(tmp_path: Path) ->
     shared = rows[frozenset(("h06_functional", "h09_counter"))]
     assert shared["evidence"].count("the same wrong result on") == 3
     assert not any("h07_terse" in pair for pair in rows)
+
+
+HOSTILE_NAMES = {
+    "rtl": "\u202eecila",
+    "escape": "\x1b]0;owned\x07\x1b[2Jmallory",
+    "c1": "\x9b31mtrudy",
+    "newline": "eve\n  refused alice",
+}
+
+
+def test_names_that_reorder_retitle_or_forge_lines_are_inert_in_every_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Hostile: identities with a right-to-left override, escape sequences, a C1 control and a newline copy
+    one another's code; the page, the CSV, the JSON and the printed summary show them inert."""
+    klass = tmp_path / "class"
+    klass.mkdir()
+    for name in HOSTILE_NAMES.values():
+        (klass / f"{name}.py").write_text((CORPUS / "class" / "h07_terse.py").read_text(encoding="utf-8"))
+    (klass / "\u202ebroken.py").write_bytes(b"def f(:\n")
+    assert main(["similarity", str(klass), "--out", str(tmp_path / "out"), "--no-cache"]) == 0
+    printed = capsys.readouterr().out
+    page = (tmp_path / "out" / "similarity.html").read_text(encoding="utf-8")
+    table = (tmp_path / "out" / "similarity.csv").read_text(encoding="utf-8")
+    summary = (tmp_path / "out" / "similarity.json").read_text(encoding="utf-8")
+    unsafe = ["\x1b", "\x07", "\x9b", "\u202e"]
+    for output in (printed, page, table, summary):
+        assert [character for character in unsafe if character in output] == []
+    assert "<bdi>\ufffdecila</bdi>" in page, "shown as written, never turned around into 'alice'"
+    assert "\n  refused alice" not in printed and "eve refused alice" in page
+    assert summary.isascii() and "\\u202eecila" in summary, "the JSON keeps the identity, escaped"
+    assert "left out \ufffdbroken.py (\ufffdbroken): \ufffdbroken.py is not valid Python" in printed

@@ -23,7 +23,7 @@ BAD_FILES: dict[str, tuple[bytes, str]] = {
     "empty.py": (b"  \n\n", "is empty"),
     "deep.py": (b"x = " + b"[" * 5000 + b"]" * 5000 + b"\n", "is not valid Python"),
     "not_json.ipynb": (b"{ this is not json", "not valid JSON"),
-    "no_cells.ipynb": (json.dumps({"nbformat": 4, "metadata": {}}).encode(), 'no "cells" list'),
+    "no_cells.ipynb": (json.dumps({"nbformat": 4, "metadata": {}}).encode(), "is JSON but not a Jupyter notebook"),
     "only_markdown.ipynb": (
         json.dumps({"nbformat": 4, "cells": [{"cell_type": "markdown", "source": "hi"}]}).encode(),
         "has no code cells",
@@ -152,3 +152,28 @@ def test_a_symbolic_link_is_listed_and_never_followed(tmp_path: Path) -> None:
     assert [(entry.identity, entry.file, entry.reason) for entry in report.unreadable] == [
         ("ivy", "ivy.py", "refused: a symbolic link (to /dev/zero): links are never followed.")
     ]
+
+
+def test_thousands_of_refused_entries_are_listed_up_to_a_cap_and_counted(tmp_path: Path) -> None:
+    """Hostile: one student's zip of 3,000 link entries is read in linear time and listed in 21 lines."""
+    import zipfile
+
+    from grader.similarity.sources import MAX_REFUSED_LISTED
+
+    folder = tmp_path / "class"
+    for name, text in (("ana", GOOD), ("ben", COPY)):
+        (folder / name).mkdir(parents=True)
+        (folder / name / "opengym.py").write_text(text, encoding="utf-8")
+    with zipfile.ZipFile(folder / "ben" / "links.zip", "w") as bundle:
+        for number in range(3_000):
+            link = zipfile.ZipInfo(f"l{number}.py")
+            link.external_attr = 0o120777 << 16
+            bundle.writestr(link, "/etc/passwd")
+        bundle.writestr("../outside.py", "x = 1\n")
+    sources = submissions_from(folder, scratch=tmp_path / "scratch")
+    bens = [skipped for skipped in sources.skipped if skipped.identity == "ben"]
+    assert len(bens) == MAX_REFUSED_LISTED + 1
+    assert bens[-1].file == "2,981 more refused files"
+    assert sources.identities == ["ana", "ben"], "the refused entries make no student of their own"
+    report = run_similarity(sources, workers=1).report
+    assert [(pair.a, pair.b) for pair in report.pairs] == [("ana", "ben")]
