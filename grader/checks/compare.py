@@ -9,8 +9,8 @@ greedy actions they all are (a row's maximisers), so the episodes reveal which t
 returned pair must be the two replayed means, Q-learning's first, and each mean must lie within its z-test
 tolerance of the exact greedy return of the table its episodes reveal (`reference.oracles`).
 
-Without `run_cells` the function cannot be graded in isolation (it reads globals nothing sets): the problem
-is `skipped`, worth 0 points, with a note saying how to grade it.
+`run_cells` is on by default; an instructor who turns it off gets compare() `skipped`, worth 0 points, with a
+note saying why (the function cannot be graded in isolation: it reads globals nothing else sets).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ RANDOM_SHARE = 0.25
 """More non-greedy actions than this share of a half's steps reads as random play."""
 NOT_GRADABLE = (
     "Not graded: compare() takes no arguments and reads the tables your notebook's own training cells made, so it cannot be graded in isolation; it is worth 0 points in this assignment. "  # noqa: E501
-    "Instructors: set run_cells = true in [problems.compare] to run the notebook's cells in the sandbox (bounded by cells_seconds) before calling compare() (docs/editions.md)."  # noqa: E501
+    "Instructors: this assignment's [problems.compare] says run_cells = false; the default, run_cells = true, runs the notebook's cells in the sandbox (bounded by cells_seconds) before calling compare() (docs/editions.md)."  # noqa: E501
 )
 
 
@@ -48,9 +48,9 @@ class CompareConfig(PlayedProblemConfig):
     """The settings of `compare()` (edition rl1)."""
 
     run_cells: bool = Field(
-        default=False,
-        description="Run the notebook's code cells in the sandbox (in order, as Run All does) before calling compare(); "  # noqa: E501
-        "false: compare() is not gradable in isolation and worth 0 points whatever `points` says.",
+        default=True,
+        description="Run the notebook's code cells in the sandbox (in order, as Run All does) before calling compare() (the default); "  # noqa: E501
+        "false turns it off: compare() is not gradable in isolation, so it is skipped and worth 0 points whatever `points` says.",
     )
     cells_seconds: float = Field(
         default=900.0,
@@ -70,7 +70,7 @@ class CompareConfig(PlayedProblemConfig):
     @model_validator(mode="before")
     @classmethod
     def _not_gradable_is_worth_nothing(cls, data: Any) -> Any:
-        if isinstance(data, dict) and not data.get("run_cells", False):
+        if isinstance(data, dict) and not data.get("run_cells", True):
             return {**data, "points": 0.0}
         return data
 

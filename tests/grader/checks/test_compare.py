@@ -37,9 +37,15 @@ def test_the_plan_runs_the_cells_with_their_own_limit_then_records_compare() -> 
     assert (compare.function, compare.seconds, compare.record_episodes) == ("compare", None, True)
 
 
-def test_without_run_cells_compare_is_not_gradable_and_worth_nothing() -> None:
+def test_the_default_configuration_runs_the_cells_for_its_points() -> None:
     settings = load_config(RL1.default_config).problems["compare"]
     assert isinstance(settings, CompareConfig)
+    assert (settings.run_cells, settings.points) == (True, 1.0)
+    assert CompareConfig.model_fields["run_cells"].default is True
+
+
+def test_without_run_cells_compare_is_not_gradable_and_worth_nothing() -> None:
+    settings = _settings(run_cells=False)
     assert (settings.run_cells, settings.points) == (False, 0.0)
     assert PROBLEM.check.plan(settings, {}) == []
     verdict = PROBLEM.check.judge(settings, [])
