@@ -41,7 +41,7 @@ from grader.sandbox import IsolationPolicy  # noqa: E402
 
 NOTEBOOK = ROOT / "submissions" / "editions" / "rl1_template_honest.ipynb"
 
-PLAIN_RUNNER = '''
+PLAIN_RUNNER = """
 import json, sys, time
 import gymnasium
 spec = gymnasium.spec("Taxi-v4")
@@ -55,7 +55,7 @@ for source in cells:
     exec(compile(source, "<cell>", "exec"), namespace)
     seconds.append(time.perf_counter() - started)
 print(json.dumps({"cells": len(cells), "seconds": seconds}))
-'''
+"""
 
 
 def code_cells(notebook: Path) -> list[str]:
@@ -93,7 +93,12 @@ def plain_run(notebook: Path, directory: Path) -> dict[str, float]:
     if done.returncode != 0:
         raise SystemExit(f"the plain run failed (exit {done.returncode}): {done.stderr[-3000:]}")
     ran = json.loads(done.stdout.strip().splitlines()[-1])
-    return {"wall": wall, "cpu": _children_cpu() - cpu, "cells": ran["cells"], "cells_wall": sum(ran["seconds"])}
+    return {
+        "wall": wall,
+        "cpu": _children_cpu() - cpu,
+        "cells": ran["cells"],
+        "cells_wall": sum(ran["seconds"]),
+    }
 
 
 def graded_run(notebook: Path, seed: int) -> dict[str, object]:
@@ -117,7 +122,9 @@ def graded_run(notebook: Path, seed: int) -> dict[str, object]:
 
 def main() -> None:
     """Measure both, print each and the ratio."""
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--notebook", type=Path, default=NOTEBOOK)
     parser.add_argument("--seed", type=int, default=1)
     arguments = parser.parse_args()
@@ -126,13 +133,13 @@ def main() -> None:
         plain = plain_run(arguments.notebook, Path(temporary))
     print(
         f"plain Run All: {plain['wall']:.1f} s wall, {plain['cpu']:.1f} s CPU "
-        f"({plain['cells']:.0f} code cells, {plain['cells_wall']:.1f} s in the cells); load {os.getloadavg()}",
+        f"({plain['cells']:.0f} code cells, {plain['cells_wall']:.1f} s in the cells); load {os.getloadavg()}",  # noqa: E501
         flush=True,
     )
     graded = graded_run(arguments.notebook, arguments.seed)
     print(
         f"graded compare (rl1 default configuration, 1 worker): {graded['status']}, problem wall "
-        f"{graded['problem_wall']:.1f} s (cells {graded['cells_seconds']} s, compare() {graded['compare_seconds']} s), "
+        f"{graded['problem_wall']:.1f} s (cells {graded['cells_seconds']} s, compare() {graded['compare_seconds']} s), "  # noqa: E501
         f"file wall {graded['file_wall']:.1f} s; load {os.getloadavg()}",
         flush=True,
     )

@@ -50,7 +50,7 @@ class CompareConfig(PlayedProblemConfig):
     run_cells: bool = Field(
         default=True,
         description="Run the notebook's code cells in the sandbox (in order, as Run All does) before calling compare() (the default); "  # noqa: E501
-        "false turns it off: compare() is not gradable in isolation, so it is skipped and worth 0 points whatever `points` says.",
+        "false turns it off: compare() is not gradable in isolation, so it is skipped and worth 0 points whatever `points` says.",  # noqa: E501
     )
     cells_seconds: float = Field(
         default=900.0,
