@@ -2,7 +2,9 @@
 
 ``ClassEntry`` is its input (one per student, from any layout or roster); ``class_summary`` and
 ``render_class_html`` are pure functions of the entries; ``write_class_report`` is the thin shell that
-writes both files.
+writes both files. The page's modules (Jinja, matplotlib) load when the page is first asked for, so the
+package's plain-text helpers (`grader.class_report.text`, used by every output of a single report) cost
+nothing to import.
 """
 
 from __future__ import annotations
@@ -10,9 +12,9 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from grader.class_report.entries import ClassEntry, EntryStatus
-from grader.class_report.html import CSP, render_class_html
 from grader.class_report.summary import ClassSummary, class_summary, diagnosis_key, diagnosis_text, summarise
 
 __all__ = [
@@ -28,6 +30,18 @@ __all__ = [
     "summary_path",
     "write_class_report",
 ]
+
+
+_PAGE_NAMES = ("CSP", "render_class_html")
+
+
+def __getattr__(name: str) -> Any:
+    """`CSP` and `render_class_html`, imported from `grader.class_report.html` when first used."""
+    if name in _PAGE_NAMES:
+        from grader.class_report import html
+
+        return getattr(html, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def summary_path(page: Path) -> Path:
@@ -54,6 +68,8 @@ def write_class_report(page: Path, entries: Sequence[ClassEntry], *, title: str 
         raise ValueError(
             f"--html {page}: expected an .html file name (the JSON summary is written beside it as {target.name}); name the page e.g. class.html"  # noqa: E501
         )
+    from grader.class_report.html import render_class_html
+
     summary = summarise(entries, title=title)
     page.parent.mkdir(parents=True, exist_ok=True)
     page.write_text(render_class_html(entries, summary=summary), encoding="utf-8")

@@ -9,6 +9,7 @@ encoder escapes every non-ASCII character.
 
 from __future__ import annotations
 
+import re
 import unicodedata
 from urllib.parse import quote, urlsplit
 
@@ -57,6 +58,30 @@ def display_text(text: str, limit: int) -> str:
         The cleaned, bounded text (HTML escaping is still the template's job).
     """
     return _cleaned(text, limit, HIDDEN_CATEGORIES)
+
+
+def display_block(text: str) -> str:
+    """Multi-line text to show as it is (a traceback, what a program printed, a feedback): as
+    ``display_text`` for every control but the line break and the tab (ESC, BEL, a lone carriage return,
+    DEL and the C1 controls), every bidi override and every surrogate, private-use or unassigned character,
+    each shown as ``\ufffd``; lines, tabs and every other character kept, a CRLF read as a line break. Not
+    bounded: reports bound their feedback and output where they are made.
+
+    What the text summary of `gymgrade check` prints and what Gradescope's results carry pass through it,
+    so no escape sequence a student's code printed or raised reaches a terminal or a page.
+    """
+    if text.isascii() and not _ASCII_CONTROLS.search(text):
+        return text
+    return "".join(
+        character if character in _KEPT_IN_BLOCKS
+        else HIDDEN if character in BIDI_CONTROLS or unicodedata.category(character) in HIDDEN_CATEGORIES
+        else character
+        for character in text.replace("\r\n", "\n")
+    )  # fmt: skip
+
+
+_KEPT_IN_BLOCKS = frozenset("\n\t")
+_ASCII_CONTROLS = re.compile("[\x00-\x08\x0b-\x1f\x7f]")
 
 
 def display_identity(text: str, limit: int) -> str:
