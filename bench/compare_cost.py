@@ -10,7 +10,10 @@ A/B in one run, on the same machine, one after the other:
   (`grader/editions/rl1.toml`: `run_cells = true`), one worker: the problem's wall time (a sandbox child,
   the notebook's cells run in it, then compare() recorded, its 2 000 episodes replayed and judged).
 
-The ratio graded / plain is the figure `bench/RESULTS.md` records (target at most 1.0). The default notebook
+The ratio graded / plain is the figure `bench/RESULTS.md` records (target at most 1.0), in wall time and in
+CPU time (the processes' own CPU, which a machine shared with other work does not inflate as it does wall
+time: the session's reaped children, its xdist worker and the sandbox child under it, against the plain
+process's). The default notebook
 is `submissions/editions/rl1_template_honest.ipynb`, written from the course's template with the lab's own
 cells (`qlearn("Taxi-v3")`, `qlearn("Taxi-v3", decay=True)`, `sarsa0("Taxi-v3", decay=True)` at N = 70 000,
 the demos of problems 1-4, `print(compare())`). The plain run takes about 10 minutes; run it in the
@@ -106,12 +109,15 @@ def graded_run(notebook: Path, seed: int) -> dict[str, object]:
     plan = GradingPlan.load(RL1.default_config, ["compare"])
     settings = plan.assignment.problems["compare"]
     assert getattr(settings, "run_cells", False), "rl1's default configuration must run the cells"
-    started = time.perf_counter()
+    cpu, started = _children_cpu(), time.perf_counter()
     (report,) = grade_files([notebook], plan, seed=seed, workers=1, policy=IsolationPolicy.ALLOW_FALLBACK)
     wall = time.perf_counter() - started
+    own = resource.getrusage(resource.RUSAGE_SELF)
     (result,) = report.problems
     return {
         "file_wall": wall,
+        "children_cpu": _children_cpu() - cpu,
+        "own_cpu": own.ru_utime + own.ru_stime,
         "problem_wall": result.timings.wall_seconds if result.timings else float("nan"),
         "status": result.status,
         "cells_seconds": result.measurements.get("cells_seconds"),
@@ -140,11 +146,16 @@ def main() -> None:
     print(
         f"graded compare (rl1 default configuration, 1 worker): {graded['status']}, problem wall "
         f"{graded['problem_wall']:.1f} s (cells {graded['cells_seconds']} s, compare() {graded['compare_seconds']} s), "  # noqa: E501
-        f"file wall {graded['file_wall']:.1f} s; load {os.getloadavg()}",
+        f"file wall {graded['file_wall']:.1f} s; CPU of the session's processes {graded['children_cpu']:.1f} s "  # noqa: E501
+        f"(reaped children: workers and sandbox children), this process {graded['own_cpu']:.1f} s in all; "
+        f"load {os.getloadavg()}",
         flush=True,
     )
     print(f"feedback: {graded['feedback']}")
-    print(f"ratio compare problem / plain Run All: {float(graded['problem_wall']) / plain['wall']:.2f}")  # type: ignore[arg-type]
+    print(
+        f"ratio compare problem / plain Run All: {float(graded['problem_wall']) / plain['wall']:.2f} (wall)"
+    )  # type: ignore[arg-type]
+    print(f"ratio session CPU / plain CPU: {float(graded['children_cpu']) / plain['cpu']:.2f}")  # type: ignore[arg-type]
 
 
 if __name__ == "__main__":

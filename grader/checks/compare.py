@@ -30,7 +30,7 @@ from grader.checks.taxi import EPISODE_STEPS
 from grader.checks.values import as_number, describe
 from grader.notebook.cells import RAN_CELLS, SCRIPT_CELL
 from grader.problem_config import PlayedProblemConfig, Probability
-from grader.sandbox.outcome import RUN_CELLS, Call, FunctionInfo, OutcomeStatus, PlainValue
+from grader.sandbox.outcome import IMPORT_TIMEOUT, RUN_CELLS, Call, FunctionInfo, OutcomeStatus, PlainValue
 from grader.stats import mean_tolerance
 from reference.oracles import greedy_policy_return
 
@@ -157,11 +157,30 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
         return Verdict(
             "failed", 0.0, f"{preface}: {early.feedback}.{hint}", {**early.measurements, **measurements}
         )
+    if early is not None and compare.status is OutcomeStatus.EXCEPTION and not tables:
+        script = bool(ran) and ran[0][0] == SCRIPT_CELL
+        return Verdict(
+            "failed",
+            0.0,
+            f"{preface}. {_NO_TABLES_SCRIPT if script else _NO_TABLES_NOTEBOOK}. {early.feedback}",
+            {**early.measurements, **measurements},
+        )
     if early is not None:
         return Verdict(
             early.status, 0.0, f"{preface}: {early.feedback}", {**early.measurements, **measurements}
         )
     return _judge_compare(settings, records[1], tables, preface, measurements)
+
+
+_TRAINING = '`q_table_decay, _ = qlearn("Taxi-v3", decay=True)` and `sarsa_table_decay = sarsa0("Taxi-v3", decay=True)`'  # noqa: E501
+_NO_TABLES_SCRIPT = (
+    "Run as a script, your file left no Taxi Q-table for compare() to play: compare() plays the tables the notebook's training cells make (the lab's Problem 7), and a .py file has no cells. "  # noqa: E501
+    f'Train them where a script runs them, under `if __name__ == "__main__":` (as the notebook\'s cells do: {_TRAINING}), or submit the notebook'  # noqa: E501
+)
+_NO_TABLES_NOTEBOOK = (
+    "Your notebook's cells left no Taxi Q-table for compare() to play: compare() plays the tables the notebook's training cells make (the lab's Problem 7). "  # noqa: E501
+    f"Train them in cells before compare() is called ({_TRAINING}), then Restart & Run All"
+)
 
 
 def _judge_compare(
@@ -356,6 +375,9 @@ def _close(returned: tuple[float, float], expected: tuple[float, float]) -> bool
 def _cells_failed(settings: CompareConfig, status: OutcomeStatus, message: str) -> Verdict:
     """A cell that raised, ran out of time or crashed the child: that is compare()'s result."""
     measurements: dict[str, PlainValue] = {"cells_outcome": str(status.value)}
+    if status is OutcomeStatus.TIMEOUT and message.startswith(IMPORT_TIMEOUT):
+        # The file itself did not import in time (training at its top level): no cell ran.
+        return Verdict("timeout", 0.0, message, measurements)
     if status is OutcomeStatus.TIMEOUT:
         return Verdict(
             "timeout",

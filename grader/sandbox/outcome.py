@@ -16,6 +16,7 @@ from grader.sandbox.limits import CallBudget
 
 __all__ = [
     "ENV_NAME_OR_OBJECT",
+    "IMPORT_TIMEOUT",
     "PROVIDED",
     "RUN_CELLS",
     "Call",
@@ -33,6 +34,9 @@ the parent; the plans use them from here."""
 
 if TYPE_CHECKING:
     from grader.sandbox.episode_log import EpisodeLog
+
+IMPORT_TIMEOUT = "importing your file took more than"
+"""How the message of a call begins when the submission did not import within its limit (the runner's)."""
 
 PlainValue: TypeAlias = Any
 """None, bool, int, float, str, lists and str-keyed dicts of these, or a numeric numpy array."""

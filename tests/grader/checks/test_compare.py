@@ -134,3 +134,32 @@ def test_a_forged_cells_value_is_read_defensively(seed: int) -> None:
     verdict = _judge(students.honest, seed, cells=forged)
     assert verdict.status == "failed"
     assert "left no Taxi Q-table" in verdict.feedback
+
+
+def _untrained(cell: int) -> Any:
+    def cells(_lab: Any, *_args: Any, **_kwargs: Any) -> dict[str, Any]:
+        return {"cells": [{"cell": cell, "seconds": 0.5}], "tables": []}
+
+    return cells
+
+
+def _reads_missing_globals(_lab: Any) -> Any:
+    raise NameError("name 'q_table_decay' is not defined")
+
+
+@pytest.mark.parametrize(
+    ("cell", "words"),
+    [
+        (0, "Run as a script, your file left no Taxi Q-table for compare() to play"),
+        (3, "Your notebook's cells left no Taxi Q-table for compare() to play"),
+    ],
+    ids=["module", "notebook"],
+)
+def test_a_submission_that_trains_no_table_fails_saying_where_to_train(
+    cell: int, words: str, seed: int
+) -> None:
+    verdict = _judge(_reads_missing_globals, seed, cells=_untrained(cell))
+    assert verdict.status == "failed"
+    assert "compare() raised NameError: name 'q_table_decay' is not defined" in verdict.feedback
+    assert words in verdict.feedback
+    assert 'sarsa_table_decay = sarsa0("Taxi-v3", decay=True)' in verdict.feedback

@@ -30,7 +30,6 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     "blackjack": {"thresholds": [12]},
     "cartpole": {"calls": 20},
     "car": {"calls": 20},
-    "compare": {"run_cells": True, "cells_seconds": 300.0},
 }
 
 
