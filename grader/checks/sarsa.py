@@ -141,8 +141,8 @@ def env_form(records: Sequence[CallRecord]) -> tuple[str, str]:
         for event in record.outcome.compat_events:
             if event.kind == ENV_OBJECT_PASSED:
                 return "object", (
-                    f"The grader called sarsa0 with an environment object, gym.make({TAXI.name!r}): called with the name "  # noqa: E501
-                    f"{TAXI.name!r}, as the template's `env = gym.make(env)` expects, it failed before making or playing it"  # noqa: E501
+                    f"The grader called sarsa0 with an environment object, gym.make({TAXI.name!r}): "
+                    f"called with the name {TAXI.name!r}, as the template's `env = gym.make(env)` expects, it failed before making or playing it"  # noqa: E501
                 )
     return "name", (
         f"The grader called sarsa0 with the environment's name, {TAXI.name!r}, as the template's `env = gym.make(env)` expects"  # noqa: E501

@@ -88,4 +88,4 @@ RL1 = Edition(
         ),
     ),
 )
-"""The current edition: problems 1-7 graded (sarsa0; compare() after the notebook's cells); qlearn not graded."""
+"""The current edition: problems 1-7 graded (compare() after the notebook's cells); qlearn not graded."""

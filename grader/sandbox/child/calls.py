@@ -209,7 +209,7 @@ def _outcome(
             and not isinstance(attempt.error, MemoryError)
             and _fell_on_the_name(request, recorder)
         ):
-            first = attempt
+            first, error = attempt, attempt.error
             recorder.begin_call(request.seed, record=request.record, budget=request.budget)
             _name_envs(recorder, request)
             attempt = _attempt(function, request, as_objects=True)
@@ -217,7 +217,7 @@ def _outcome(
                 attempt = first  # the object got no further than the name: the name's error stands
                 recorder.begin_call(request.seed, record=request.record, budget=request.budget)
             else:
-                _report_object_form(name, request, first)
+                _report_object_form(name, request, error)
     finally:
         for provided in request.provided:
             if provided in replaced:
@@ -310,15 +310,14 @@ def _fell_on_the_name(request: CallRequest, recorder: Recorder) -> bool:
     return replaceable and not (recorder.made_by_name or recorder.resets or recorder.steps)
 
 
-def _report_object_form(name: str, request: CallRequest, first: _Attempt) -> None:
+def _report_object_form(name: str, request: CallRequest, error: BaseException) -> None:
     for argument in _env_arguments(request):
         if argument.form == ENV_NAME_OR_OBJECT:
             compat_events.record(
                 compat_events.ENV_OBJECT_PASSED,
                 argument.env_id,
-                f"{name}() was called with the environment's name {argument.env_id!r}, as the template's "
-                f"`env = gym.make(env)` expects, and raised {describe_exception(first.error)} before making "  # type: ignore[arg-type]
-                f"or playing it; it was called again with an environment object, gym.make({argument.env_id!r})",  # noqa: E501
+                f"{name}() was called with the environment's name {argument.env_id!r}, as the template's `env = gym.make(env)` expects, and raised {describe_exception(error)} before making or playing it; "  # noqa: E501
+                f"it was called again with an environment object, gym.make({argument.env_id!r})",
             )
 
 
