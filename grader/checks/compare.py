@@ -56,7 +56,7 @@ class CompareConfig(PlayedProblemConfig):
         default=1800.0,
         gt=0.0,
         description="Wall-clock limit of running the cells (their training runs included); call_seconds bounds compare() itself. "  # noqa: E501
-        "The lab's cells take about 4 minutes of CPU; the limit leaves room for a machine shared with other gradings.",  # noqa: E501
+        "The lab's cells take about 7 minutes of CPU; the limit leaves room for a machine shared with other gradings.",  # noqa: E501
     )
     episodes_per_table: int = Field(
         default=1000,
