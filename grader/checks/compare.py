@@ -9,8 +9,8 @@ greedy actions they all are (a row's maximisers), so the episodes reveal which t
 returned pair must be the two replayed means, Q-learning's first, and each mean must lie within its z-test
 tolerance of the exact greedy return of the table its episodes reveal (`reference.oracles`).
 
-Without `run_cells` the function cannot be graded in isolation (it reads globals nothing sets): the problem
-is `skipped`, worth 0 points, with a note saying how to grade it.
+`run_cells` is on by default; an instructor who turns it off gets compare() `skipped`, worth 0 points, with a
+note saying why (the function cannot be graded in isolation: it reads globals nothing else sets).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from grader.checks.taxi import EPISODE_STEPS
 from grader.checks.values import as_number, describe
 from grader.notebook.cells import RAN_CELLS, SCRIPT_CELL
 from grader.problem_config import PlayedProblemConfig, Probability
-from grader.sandbox.outcome import RUN_CELLS, Call, FunctionInfo, OutcomeStatus, PlainValue
+from grader.sandbox.outcome import IMPORT_TIMEOUT, RUN_CELLS, Call, FunctionInfo, OutcomeStatus, PlainValue
 from grader.stats import mean_tolerance
 from reference.oracles import greedy_policy_return
 
@@ -40,7 +40,7 @@ RANDOM_SHARE = 0.25
 """More non-greedy actions than this share of a half's steps reads as random play."""
 NOT_GRADABLE = (
     "Not graded: compare() takes no arguments and reads the tables your notebook's own training cells made, so it cannot be graded in isolation; it is worth 0 points in this assignment. "  # noqa: E501
-    "Instructors: set run_cells = true in [problems.compare] to run the notebook's cells in the sandbox (bounded by cells_seconds) before calling compare() (docs/editions.md)."  # noqa: E501
+    "Instructors: this assignment's [problems.compare] says run_cells = false; the default, run_cells = true, runs the notebook's cells in the sandbox (bounded by cells_seconds) before calling compare() (docs/editions.md)."  # noqa: E501
 )
 
 
@@ -48,14 +48,15 @@ class CompareConfig(PlayedProblemConfig):
     """The settings of `compare()` (edition rl1)."""
 
     run_cells: bool = Field(
-        default=False,
-        description="Run the notebook's code cells in the sandbox (in order, as Run All does) before calling compare(); "  # noqa: E501
-        "false: compare() is not gradable in isolation and worth 0 points whatever `points` says.",
+        default=True,
+        description="Run the notebook's code cells in the sandbox (in order, as Run All does) before calling compare() (the default); "  # noqa: E501
+        "false turns it off: compare() is not gradable in isolation, so it is skipped and worth 0 points whatever `points` says.",  # noqa: E501
     )
     cells_seconds: float = Field(
-        default=900.0,
+        default=1800.0,
         gt=0.0,
-        description="Wall-clock limit of running the cells (their training runs included); call_seconds bounds compare() itself.",  # noqa: E501
+        description="Wall-clock limit of running the cells (their training runs included); call_seconds bounds compare() itself. "  # noqa: E501
+        "The lab's cells take about 7 minutes of CPU; the limit leaves room for a machine shared with other gradings.",  # noqa: E501
     )
     episodes_per_table: int = Field(
         default=1000,
@@ -70,7 +71,7 @@ class CompareConfig(PlayedProblemConfig):
     @model_validator(mode="before")
     @classmethod
     def _not_gradable_is_worth_nothing(cls, data: Any) -> Any:
-        if isinstance(data, dict) and not data.get("run_cells", False):
+        if isinstance(data, dict) and not data.get("run_cells", True):
             return {**data, "points": 0.0}
         return data
 
@@ -157,11 +158,30 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
         return Verdict(
             "failed", 0.0, f"{preface}: {early.feedback}.{hint}", {**early.measurements, **measurements}
         )
+    if early is not None and compare.status is OutcomeStatus.EXCEPTION and not tables:
+        script = bool(ran) and ran[0][0] == SCRIPT_CELL
+        return Verdict(
+            "failed",
+            0.0,
+            f"{preface}. {_NO_TABLES_SCRIPT if script else _NO_TABLES_NOTEBOOK}. {early.feedback}",
+            {**early.measurements, **measurements},
+        )
     if early is not None:
         return Verdict(
             early.status, 0.0, f"{preface}: {early.feedback}", {**early.measurements, **measurements}
         )
     return _judge_compare(settings, records[1], tables, preface, measurements)
+
+
+_TRAINING = '`q_table_decay, _ = qlearn("Taxi-v3", decay=True)` and `sarsa_table_decay = sarsa0("Taxi-v3", decay=True)`'  # noqa: E501
+_NO_TABLES_SCRIPT = (
+    "Run as a script, your file left no Taxi Q-table for compare() to play: compare() plays the tables the notebook's training cells make (the lab's Problem 7), and a .py file has no cells. "  # noqa: E501
+    f'Train them where a script runs them, under `if __name__ == "__main__":` (as the notebook\'s cells do: {_TRAINING}), or submit the notebook'  # noqa: E501
+)
+_NO_TABLES_NOTEBOOK = (
+    "Your notebook's cells left no Taxi Q-table for compare() to play: compare() plays the tables the notebook's training cells make (the lab's Problem 7). "  # noqa: E501
+    f"Train them in cells before compare() is called ({_TRAINING}), then Restart & Run All"
+)
 
 
 def _judge_compare(
@@ -356,6 +376,9 @@ def _close(returned: tuple[float, float], expected: tuple[float, float]) -> bool
 def _cells_failed(settings: CompareConfig, status: OutcomeStatus, message: str) -> Verdict:
     """A cell that raised, ran out of time or crashed the child: that is compare()'s result."""
     measurements: dict[str, PlainValue] = {"cells_outcome": str(status.value)}
+    if status is OutcomeStatus.TIMEOUT and message.startswith(IMPORT_TIMEOUT):
+        # The file itself did not import in time (training at its top level): no cell ran.
+        return Verdict("timeout", 0.0, message, measurements)
     if status is OutcomeStatus.TIMEOUT:
         return Verdict(
             "timeout",

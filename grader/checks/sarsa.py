@@ -1,16 +1,21 @@
 """Edition rl1, problem 7: `sarsa0(env, alpha, gamma, epsilon, N, decay)`, verified by replaying its updates.
 
 The grader calls `sarsa0` twice with its own hyper-parameters and a small N (a constant epsilon, then
-`decay=True`), passing a Taxi env it makes and records. Every step is replayed, so the grader knows each
-(s, a, r, s', a'); it recomputes SARSA(0) from the zero table over those transitions and compares the
-returned table cell by cell (`grader.checks.sarsa_updates`). A mismatch names the first wrong update and
-the mistake that explains the whole table. The actions must be epsilon-greedy on the table as it was when
-chosen: the count of non-greedy actions is tested against epsilon (or, with `decay=True`, against the
-student's own `epsilon_decay(i, N)`, so a wrong decay is counted only in problem 5) with Bernstein's
-inequality at a stated false-fail probability.
+`decay=True`). `env` is the environment's name, `"Taxi-v3"`, as the course's template documents it
+(`env (str): environment name`, first line `env = gym.make(env)`) and the notebook's cells call it; the env
+the function makes by that name is recorded (with the time limit below). A sarsa0 changed to take an env
+object fails on the name before it makes or plays anything: it is then called again with an env object the
+child makes and records (`EnvArgument` of form `name_or_object`), and the feedback says which form was used.
+Every step is replayed, so the grader knows each (s, a, r, s', a'); it recomputes SARSA(0) from the zero
+table over those transitions and compares the returned table cell by cell (`grader.checks.sarsa_updates`).
+A mismatch names the first wrong update and the mistake that explains the whole table. The actions must be
+epsilon-greedy on the table as it was when chosen: the count of non-greedy actions is tested against
+epsilon (or, with `decay=True`, against the student's own `epsilon_decay(i, N)`, so a wrong decay is counted
+only in problem 5) with Bernstein's inequality at a stated false-fail probability.
 
-The env passed has no 200-step limit (its limit lies beyond the call's step budget), so the lab's loop on
-`terminated` and a loop that also stops on `truncated` play exactly the same episodes: both are honest.
+The env (made by name or passed) has no 200-step limit (its limit lies beyond the call's step budget), so
+the lab's loop on `terminated` and a loop that also stops on `truncated` play exactly the same episodes:
+both are honest.
 """
 
 from __future__ import annotations
@@ -38,10 +43,19 @@ from grader.checks.sarsa_updates import (
     recompute,
 )
 from grader.checks.values import as_number, describe
+from grader.compat.events import ENV_OBJECT_PASSED
 from grader.games import TAXI, Game, GameRules
 from grader.problem_config import Probability, ProblemConfig
 from grader.sandbox.limits import CallBudget
-from grader.sandbox.outcome import PROVIDED, Call, EnvArgument, FunctionInfo, OutcomeStatus, PlainValue
+from grader.sandbox.outcome import (
+    ENV_NAME_OR_OBJECT,
+    PROVIDED,
+    Call,
+    EnvArgument,
+    FunctionInfo,
+    OutcomeStatus,
+    PlainValue,
+)
 
 TAXI_SHAPE = (500, 6)
 PENALTY_REWARD = -10.0
@@ -101,7 +115,8 @@ class SarsaConfig(ProblemConfig):
     )
 
     def game_rules(self) -> GameRules:
-        """Taxi-v3 as the grader makes it for the call: its time limit beyond the call's step budget."""
+        """Taxi-v3 as made for the call (by the function from the name, or by the child): its time limit
+        beyond the call's step budget."""
         return GameRules(TAXI.name, (_taxi_game(self.env_steps),))
 
     @property
@@ -115,7 +130,22 @@ def _taxi_game(limit: int) -> Game:
         TAXI.name,
         TAXI.gymnasium_ids,
         {**TAXI.rules, "max_episode_steps": limit},
-        description=f"the {TAXI.name} env passed to sarsa0 (time limit {limit})",
+        description=f"the {TAXI.name} env of the call (made from the name passed to sarsa0; time limit {limit})",  # noqa: E501
+    )
+
+
+def env_form(records: Sequence[CallRecord]) -> tuple[str, str]:
+    """How sarsa0 got its env: ("name", ...) as the template has it, or ("object", ...) after failing on the
+    name; the second item says so in a sentence."""
+    for record in records:
+        for event in record.outcome.compat_events:
+            if event.kind == ENV_OBJECT_PASSED:
+                return "object", (
+                    f"The grader called sarsa0 with an environment object, gym.make({TAXI.name!r}): "
+                    f"called with the name {TAXI.name!r}, as the template's `env = gym.make(env)` expects, it failed before making or playing it"  # noqa: E501
+                )
+    return "name", (
+        f"The grader called sarsa0 with the environment's name, {TAXI.name!r}, as the template's `env = gym.make(env)` expects"  # noqa: E501
     )
 
 
@@ -159,7 +189,7 @@ class SarsaCheck:
                     for episode in range(1, run.episodes + 1)
                 ]
             arguments = (
-                EnvArgument(TAXI.name, settings.env_steps),
+                EnvArgument(TAXI.name, settings.env_steps, ENV_NAME_OR_OBJECT),
                 settings.alpha,
                 settings.gamma,
                 settings.epsilon,
@@ -197,10 +227,13 @@ class SarsaCheck:
                 f" The decay=True call is not counted: your epsilon_decay returned something that is not a number and sarsa0 failed with it ({message}); "  # noqa: E501
                 "epsilon_decay is graded in problem 5."
             )
+        form_key, form = env_form(sarsa_records)
         early = outcome_verdict(sarsa_records)
-        if early is not None:
+        if early is not None and early.status == "missing":
             return early
-        measurements: dict[str, PlainValue] = {}
+        if early is not None:
+            return Verdict(early.status, early.fraction, f"{early.feedback} ({form}.)", early.measurements)
+        measurements: dict[str, PlainValue] = {"env_form": form_key}
         passes = []
         runs = _runs(settings)
         for run, record in zip(runs, sarsa_records, strict=False):
@@ -208,14 +241,17 @@ class SarsaCheck:
             verdict = _judge_run(settings, run, record, schedule, measurements)
             if verdict is not None:
                 return Verdict(
-                    verdict.status, verdict.fraction, verdict.feedback + schedule_note, measurements
+                    verdict.status,
+                    verdict.fraction,
+                    f"{verdict.feedback}{schedule_note} ({form}.)",
+                    measurements,
                 )
             passes.append(run)
         explained = "; ".join(_passed_text(run, measurements) for run in passes)
         return Verdict(
             "passed",
             1.0,
-            f"sarsa0: every update of your table is SARSA(0)'s on the transitions you played, and you explored as epsilon-greedy does ({explained}).{schedule_note}",  # noqa: E501
+            f"sarsa0: every update of your table is SARSA(0)'s on the transitions you played, and you explored as epsilon-greedy does ({explained}).{schedule_note} {form}.",  # noqa: E501
             measurements,
         )
 

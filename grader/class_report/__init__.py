@@ -2,7 +2,9 @@
 
 ``ClassEntry`` is its input (one per student, from any layout or roster); ``class_summary`` and
 ``render_class_html`` are pure functions of the entries; ``write_class_report`` is the thin shell that
-writes both files.
+writes both files. The page's modules (Jinja, matplotlib) load when the page is first asked for, so the
+package's plain-text helpers (`grader.class_report.text`, used by every output of a single report) cost
+nothing to import.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ def __getattr__(name: str) -> Any:
     if name in _LAZY:
         return getattr(importlib.import_module(_LAZY[name]), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "CSP",

@@ -16,6 +16,7 @@ newline that forges a line, an escape sequence that retitles a terminal, a cell 
 
 from __future__ import annotations
 
+import re
 import unicodedata
 from collections.abc import Callable
 from urllib.parse import quote, urlsplit
@@ -76,6 +77,30 @@ def terminal_line(text: str) -> str:
     ``display_text`` (``MAX_LINE_CHARS``), so no name can retitle or clear the terminal or start a line."""
     indent = text[: len(text) - len(text.lstrip(" "))]
     return indent + display_text(text, MAX_LINE_CHARS)
+
+
+def display_block(text: str) -> str:
+    """Multi-line text to show as it is (a traceback, what a program printed, a feedback): as
+    ``display_text`` for every control but the line break and the tab (ESC, BEL, a lone carriage return,
+    DEL and the C1 controls), every bidi override and every surrogate, private-use or unassigned character,
+    each shown as ``\ufffd``; lines, tabs and every other character kept, a CRLF read as a line break. Not
+    bounded: reports bound their feedback and output where they are made.
+
+    What the text summary of `gymgrade check` prints and what Gradescope's results carry pass through it,
+    so no escape sequence a student's code printed or raised reaches a terminal or a page.
+    """
+    if text.isascii() and not _ASCII_CONTROLS.search(text):
+        return text
+    return "".join(
+        character if character in _KEPT_IN_BLOCKS
+        else HIDDEN if character in BIDI_CONTROLS or unicodedata.category(character) in HIDDEN_CATEGORIES
+        else character
+        for character in text.replace("\r\n", "\n")
+    )  # fmt: skip
+
+
+_KEPT_IN_BLOCKS = frozenset("\n\t")
+_ASCII_CONTROLS = re.compile("[\x00-\x08\x0b-\x1f\x7f]")
 
 
 def display_identity(text: str, limit: int) -> str:
@@ -174,6 +199,6 @@ PAGE_FILTERS: dict[str, Callable[[str], str]] = {
     "line": lambda text: display_text(text, MAX_LINE_CHARS),
     "code": inert,
 }
-"""What every page shows of hostile text, by Jinja filter (``{{ row.identity|identity }}``, ``{{ line|code }}``):
-an identity (80 characters), a compared document's name (a student's identity or a reference file's path,
+"""What every page shows of hostile text, by Jinja filter (``{{ row.identity|identity }}``,
+``{{ line|code }}``): an identity (80 characters), a compared document's name (a student's identity or a reference file's path,
 256), a name, a note, a longer line of text, a line of code kept whole."""

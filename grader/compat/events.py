@@ -12,6 +12,9 @@ LEGACY_SEED_CALL = "legacy_seed_call"
 RENAMED_ID = "renamed_id"
 SEED_REPLACED = "seed_replaced"
 API_DETECTED = "api_detected"
+ENV_OBJECT_PASSED = "env_object"
+"""Not the lab's API but the grader's call: a function given an environment's name failed on it before
+making or playing anything, so it was called again with an env object (`EnvArgument`'s `name_or_object`)."""
 
 KINDS = (
     STEP_BEFORE_RESET,
@@ -22,6 +25,7 @@ KINDS = (
     RENAMED_ID,
     SEED_REPLACED,
     API_DETECTED,
+    ENV_OBJECT_PASSED,
 )
 
 

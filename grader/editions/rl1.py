@@ -1,9 +1,10 @@
 """Edition 4, "Reinforcement Learning 1: Gymnasium" (2024 onwards), the one taught today.
 
 Problems 1-4 are the shared declarations of `grader.problems`; `epsilon_decay` and the two-table
-`taxi(q_table, q_table_decay)` are this edition's own, and `sarsa0`, verified by replaying its updates
-(`grader.checks.sarsa`). `compare()` is graded when the configuration runs the notebook's cells
-(`run_cells`, else it is skipped, worth 0: `grader.checks.compare`).
+`taxi(q_table, q_table_decay)` are this edition's own, and `sarsa0` (given the environment's name, as the
+course's template has it), verified by replaying its updates (`grader.checks.sarsa`). `compare()` is graded
+after the notebook's cells ran in the sandbox (`run_cells`, on by default; off, it is skipped, worth 0:
+`grader.checks.compare`).
 """
 
 from grader.checks.compare import CompareCheck, CompareConfig
@@ -83,8 +84,8 @@ RL1 = Edition(
         (
             "qlearn",
             "provided by the template; taxi gets the grader's own tables, so no verdict needs it; "
-            "it runs only inside the notebook's cells when compare() is graded with run_cells",
+            "it runs only inside the notebook's cells, before compare()",
         ),
     ),
 )
-"""The current edition: problems 1-7 graded (sarsa0; compare() with `run_cells`); qlearn in `not_graded`."""
+"""The current edition: problems 1-7 graded (compare() after the notebook's cells); qlearn not graded."""

@@ -1,15 +1,19 @@
 """Gradescope's ``results.json`` for one report: a test per problem, the summary and the isolation as output.
 
 Gradescope's specification (https://gradescope-autograders.readthedocs.io/en/latest/specs/) is declared
-once, as the pydantic models below, so what gymgrade writes is checked against it when it is built.
+once, as the pydantic models below, so what gymgrade writes is checked against it when it is built. Every
+`output` passes through `grader.class_report.text.display_block` as the models are built, as the text
+summary does: a control character (ESC, BEL...) of a student's exception message or printed output is shown
+as U+FFFD, never handed to Gradescope's page.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
+from grader.class_report.text import display_block
 from grader.gradescope_upload import UploadSeed
 from grader.render.text import edition_name, isolation_lines, notebook_lines
 from grader.report import SHOWN_AT_ONCE, Report, errors_shown, withheld_ids
@@ -18,6 +22,8 @@ if TYPE_CHECKING:
     from grader.config import AssignmentConfig
 
 Visibility = Literal["hidden", "after_due_date", "after_published", "visible"]
+ShownText = Annotated[str, AfterValidator(display_block)]
+"""Text Gradescope shows: controls (but line breaks and tabs) and bidi overrides inert."""
 OUTPUT_KEPT_NOTE = (
     "What your code printed is kept for your instructor, not shown here; "
     "run gymgrade check on your own machine to see it."
@@ -40,7 +46,7 @@ class GradescopeTest(BaseModel):
     score: float
     max_score: float
     status: Literal["passed", "failed"]
-    output: str
+    output: ShownText
     visibility: Visibility = "visible"
 
 
@@ -54,7 +60,7 @@ class GradescopeResults(BaseModel):
         default=None,
         description="Seconds, as Gradescope's schema gives it (an integer); left out while a problem is withheld.",  # noqa: E501
     )
-    output: str
+    output: ShownText
     output_format: Literal["text", "md", "html", "simple_format", "ansi"] = "text"
     visibility: Visibility = "visible"
     stdout_visibility: Visibility = "hidden"

@@ -1,13 +1,16 @@
 """The text summary `gymgrade check` prints: every verdict's feedback, the total, the isolation.
 
 Its pieces (`notebook_lines`, `isolation_lines`) are also what the Gradescope output and the HTML report
-say of the notebook and the sandbox.
+say of the notebook and the sandbox. The summary is shown through `grader.class_report.text.display_block`
+(the Gradescope output too): control characters a student's code raised or printed (ESC, BEL...) are shown
+as U+FFFD, never sent to the terminal.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from grader.class_report.text import display_block
 from grader.notebook import NotebookSummary
 from grader.report import IsolationSummary, Report
 
@@ -41,7 +44,7 @@ def summary(report: Report) -> str:
     )
     lines += isolation_lines(report.isolation)
     lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
-    return "\n".join(lines)
+    return display_block("\n".join(lines))
 
 
 def edition_name(name: str) -> str:

@@ -10,11 +10,13 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 from pydantic import BaseModel, ConfigDict, Field
 
 from grader.sandbox.child.cells import RUN_CELLS
-from grader.sandbox.child.frames import EnvArgument
+from grader.sandbox.child.frames import ENV_NAME_OR_OBJECT, EnvArgument
 from grader.sandbox.child.provided import PROVIDED
 from grader.sandbox.limits import CallBudget
 
 __all__ = [
+    "ENV_NAME_OR_OBJECT",
+    "IMPORT_TIMEOUT",
     "PROVIDED",
     "RUN_CELLS",
     "Call",
@@ -25,12 +27,16 @@ __all__ = [
     "ParameterInfo",
     "PlainValue",
 ]
-"""`RUN_CELLS` (the call that runs a notebook's cells), `EnvArgument` (an env the child makes for a call) and
+"""`RUN_CELLS` (the call that runs a notebook's cells), `EnvArgument` (an env passed to a call by name or
+as an object the child makes; `ENV_NAME_OR_OBJECT`, the name first) and
 `PROVIDED` (the grader's definitions a call may bind) are declared by the child, which imports nothing of
 the parent; the plans use them from here."""
 
 if TYPE_CHECKING:
     from grader.sandbox.episode_log import EpisodeLog
+
+IMPORT_TIMEOUT = "importing your file took more than"
+"""How the message of a call begins when the submission did not import within its limit (the runner's)."""
 
 PlainValue: TypeAlias = Any
 """None, bool, int, float, str, lists and str-keyed dicts of these, or a numeric numpy array."""

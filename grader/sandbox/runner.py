@@ -21,7 +21,7 @@ from grader.sandbox.isolation.launch import build_launch
 from grader.sandbox.isolation.layer import IsolationReport
 from grader.sandbox.limits import IsolationPolicy, Limits
 from grader.sandbox.messages import ImportErrorMessage, ResultMessage, first_message, result_message
-from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus
+from grader.sandbox.outcome import IMPORT_TIMEOUT, Call, CallOutcome, FunctionInfo, OutcomeStatus
 from grader.sandbox.process import ChildProcess, FrameEnd, FrameWait
 from grader.sandbox.termination import Ending, classify_exit, forged_message
 from grader.sandbox.text import clean_plain
@@ -296,7 +296,7 @@ class Sandbox:
             child.kill_tree()
             return Ending(
                 OutcomeStatus.TIMEOUT,
-                f"importing your file took more than {self.limits.import_seconds:g} seconds; "
+                f"{IMPORT_TIMEOUT} {self.limits.import_seconds:g} seconds; "
                 'move long-running code into functions or under `if __name__ == "__main__":`',
             )
         if wait.end is FrameEnd.CLOSED:

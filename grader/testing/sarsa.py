@@ -1,8 +1,11 @@
 """Simulated `sarsa0(env, alpha, gamma, epsilon, N, decay)` students (edition rl1): honest ones and mistakes.
 
-Each is called as ``function(lab, env_argument, alpha, gamma, epsilon, N, decay)`` by
-`grader.testing.simulation`; it makes the env the grader passes with `lab.make` (logged like the sandbox's
-recorder) and draws its randomness from `lab.random` and the env's action space.
+Each is called as ``function(lab, env, alpha, gamma, epsilon, N, decay)`` by `grader.testing.simulation`,
+`env` being what the sandbox passes: the environment's name first (`"Taxi-v3"`). Template-shaped learners
+begin as the course's template does, ``env = gym.make(env)`` (`lab.make`, logged like the sandbox's
+recorder); an object-form learner (`takes="object"`) uses `env` as an env, fails on the name and is called
+again with an env object, as in the sandbox. They draw their randomness from `lab.random` and the env's
+action space.
 """
 
 from __future__ import annotations
@@ -12,7 +15,6 @@ from typing import Any
 
 import numpy as np
 
-from grader.sandbox.child.frames import EnvArgument
 from grader.testing.simulation import Lab
 
 
@@ -21,8 +23,9 @@ def epsilon_decay(lab: Lab, episode: int, n: int, start: float = 1.0, end: float
     return start - (episode - 1) * (start - end) / n
 
 
-def _env(lab: Lab, env: EnvArgument) -> Any:
-    return lab.make(env.env_id, max_episode_steps=env.max_episode_steps)
+def _env(lab: Lab, env: Any, takes: str) -> Any:
+    """The env a learner plays: `gym.make(env)` for the template's name, else `env` as it is."""
+    return lab.make(env) if takes == "name" else env
 
 
 def _first_argmax(row: Any, lab: Lab) -> int:
@@ -52,16 +55,17 @@ def learner(
     keeps_first_table: bool = False,
     schedule: Callable[..., float] = epsilon_decay,
     dtype: Any = np.float64,
+    takes: str = "name",
 ) -> Callable[..., Any]:
     """A SARSA(0) learner on the lab's skeleton, with one of the typical departures switched on."""
     kept: list[Any] = []
 
     def sarsa0(
-        lab: Lab, env_argument: EnvArgument, alpha: float, gamma: float, epsilon: float, n: int, decay: bool
+        lab: Lab, env_argument: Any, alpha: float, gamma: float, epsilon: float, n: int, decay: bool
     ) -> Any:
         if fixed is not None:
             alpha, gamma = fixed
-        env = _env(lab, env_argument)
+        env = _env(lab, env_argument, takes)
         for _ in range(runs):
             q_table = np.zeros((env.observation_space.n, env.action_space.n), dtype=dtype)
             penalties = 0
@@ -115,9 +119,11 @@ HONEST: dict[str, Callable[..., Any]] = {
     "stops_on_truncated": learner(stop_on_truncated=True),
     "float32_table": learner(dtype=np.float32),
     "float32_lists": learner(dtype=np.float32, returns="lists", argmax=_random_argmax),
+    "object_form": learner(takes="object"),
 }
-"""Honest learners: the lab's loop, the table alone returned, ties broken at random, a stop on truncated, a
-float32 table (as an array, and as lists)."""
+"""Honest learners, template-shaped (`env = gym.make(env)` from the name): the lab's loop, the table alone
+returned, ties broken at random, a stop on truncated, a float32 table (as an array, and as lists); and one
+changed to take an env object (called again with one after failing on the name)."""
 
 MISTAKES: dict[str, tuple[Callable[..., Any], str]] = {
     "q_learning": (learner(target="max"), "which is Q-learning"),

@@ -27,10 +27,19 @@ import numpy as np
 
 from grader.checks.base import CallRecord
 from grader.compat import resolve_env_id
+from grader.compat.events import ENV_OBJECT_PASSED
 from grader.sandbox.child.episode_fields import EPISODE_COLUMNS, EPISODE_FIELDS
+from grader.sandbox.child.frames import ENV_NAME_OR_OBJECT, ENV_OBJECT, EnvArgument
 from grader.sandbox.child.seeding import SeedStream, Stream, space_seed
 from grader.sandbox.episode_log import EpisodeLog
-from grader.sandbox.outcome import Call, CallOutcome, FunctionInfo, OutcomeStatus, ParameterInfo
+from grader.sandbox.outcome import (
+    Call,
+    CallOutcome,
+    CompatEventRecord,
+    FunctionInfo,
+    OutcomeStatus,
+    ParameterInfo,
+)
 from grader.sandbox.replay import Replay, replay_episode
 
 StudentFunction = Callable[..., Any]
@@ -146,10 +155,27 @@ class Lab:
         self.call_seed = call_seed
         self.envs: list[LabEnv] = []
         self.episodes: list[_Episode] = []
+        self.named_envs: dict[str, int | None] = {}
+        self.made_by_name = False
 
     def make(self, env_id: str, **kwargs: Any) -> LabEnv:
-        """Make a logged env; the lab's ids resolve as in the sandbox (`Taxi-v2` raises)."""
+        """Make a logged env; the lab's ids resolve as in the sandbox (`Taxi-v2` raises). An id the call
+        passed by name gets the argument's time limit unless one is given, as the sandbox's recorder does."""
+        if isinstance(env_id, str) and env_id in self.named_envs:
+            self.made_by_name = True
+            if kwargs.get("max_episode_steps") is None:
+                kwargs = {**kwargs, "max_episode_steps": self.named_envs[env_id]}
         return LabEnv(self, env_id, kwargs)
+
+    def passed(self, argument: Any, *, as_objects: bool) -> Any:
+        """What a function receives for a call's argument, as in the sandbox child: an `EnvArgument` as
+        its name (noted, so an env made by it gets its limit) or as an env made here."""
+        if type(argument) is not EnvArgument:
+            return argument
+        if argument.form != ENV_OBJECT and not as_objects:
+            self.named_envs[argument.env_id] = argument.max_episode_steps
+            return argument.env_id
+        return self.make(argument.env_id, max_episode_steps=argument.max_episode_steps)
 
     def reset_seed(self, student_seed: int | None) -> int:
         """The seed a reset uses: the next grader seed (a student's seed is replaced, as in the sandbox)."""
@@ -173,33 +199,62 @@ def simulate_call(
             "fast Blackjack episodes cannot be replayed from their seeds; use fast=False to replay"
         )
     lab = Lab(call_seed, fast=fast)
+    events: list[CompatEventRecord] = []
     started = time.perf_counter()
     try:
-        value = function(lab, *call.args, **dict(call.kwargs))
+        value = _called(function, lab, call, as_objects=False)
     except Exception as error:
-        outcome = CallOutcome(
-            call,
-            OutcomeStatus.EXCEPTION,
-            None,
-            [],
-            [],
-            "",
-            "",
-            f"{call.function}() raised {type(error).__name__}: {error}",
-            time.perf_counter() - started,
-            call_seed,
+        replaceable = any(
+            type(argument) is EnvArgument and argument.form == ENV_NAME_OR_OBJECT
+            for argument in (*call.args, *dict(call.kwargs).values())
         )
-        return CallRecord(outcome, [])
+        failure = error
+        value = None
+        if replaceable and not (lab.made_by_name or lab.episodes):  # as the child: again with objects
+            lab = Lab(call_seed, fast=fast)
+            try:
+                value = _called(function, lab, call, as_objects=True)
+                failure = None
+            except Exception as again:
+                failure = again if lab.episodes else error
+            if failure is not error:
+                events.append(
+                    CompatEventRecord(
+                        kind=ENV_OBJECT_PASSED,
+                        env_id=next(a.env_id for a in call.args if type(a) is EnvArgument),
+                        detail=f"{call.function}() raised {type(error).__name__}: {error} on the name",
+                    )
+                )
+        if failure is not None:
+            outcome = CallOutcome(
+                call,
+                OutcomeStatus.EXCEPTION,
+                None,
+                [],
+                events,
+                "",
+                "",
+                f"{call.function}() raised {type(failure).__name__}: {failure}",
+                time.perf_counter() - started,
+                call_seed,
+            )
+            return CallRecord(outcome, [])
     wall_time = time.perf_counter() - started
     episodes = lab.episodes if call.record_episodes else []
     logs = [episode.log() for episode in episodes]
-    outcome = CallOutcome(call, OutcomeStatus.OK, value, logs, [], "", "", "", wall_time, call_seed)
+    outcome = CallOutcome(call, OutcomeStatus.OK, value, logs, events, "", "", "", wall_time, call_seed)
     replays = (
         [replay_episode(log) for log in logs]
         if replay
         else [episode.replay_as_played() for episode in episodes]
     )
     return CallRecord(outcome, replays)
+
+
+def _called(function: StudentFunction, lab: Lab, call: Call, *, as_objects: bool) -> Any:
+    args = [lab.passed(argument, as_objects=as_objects) for argument in call.args]
+    kwargs = {key: lab.passed(argument, as_objects=as_objects) for key, argument in dict(call.kwargs).items()}
+    return function(lab, *args, **kwargs)
 
 
 def simulate_calls(

@@ -5,7 +5,10 @@
 <Date>
 
 Edition 4 of the lab, written for gymgrade from the edition's description: qlearn is provided, every
-problem (epsilon_decay, taxi with two tables, sarsa0, compare) is still to be written.
+problem (epsilon_decay, taxi with two tables, sarsa0, compare) is still to be written. As in the course's
+notebook, the learners take the environment's name and make it themselves (`env = gym.make(env)`), and
+compare() plays the tables the training code trains; in a .py file that code goes under
+`if __name__ == "__main__":` (the end of this file), which the grader runs as a script before compare().
 """
 
 import random
@@ -87,7 +90,7 @@ def qlearn(env, alpha=0.1, gamma=0.6, epsilon=0.1, N=70_000, decay=False):
     """Train a Q-table with Q-learning (provided).
 
     Parameters:
-        env: the environment (made with gym.make)
+        env (str): the environment's name (a gym id such as "Taxi-v3")
         alpha (float): learning rate
         gamma (float): discount factor
         epsilon (float): exploration rate (the first one when decaying)
@@ -98,6 +101,7 @@ def qlearn(env, alpha=0.1, gamma=0.6, epsilon=0.1, N=70_000, decay=False):
         (ndarray): the Q-table, one row per state
         (int): the number of penalties (rewards of -10) taken while training
     """
+    env = gym.make(env)
     q_table = np.zeros((env.observation_space.n, env.action_space.n))
     penalties = 0
     for i in range(1, N + 1):
@@ -143,7 +147,7 @@ def sarsa0(env, alpha=0.1, gamma=0.6, epsilon=0.1, N=70_000, decay=False):
     """Train a Q-table with SARSA(0).
 
     Parameters:
-        env: the environment (made with gym.make)
+        env (str): the environment's name (a gym id such as "Taxi-v3")
         alpha (float): learning rate
         gamma (float): discount factor
         epsilon (float): exploration rate (the first one when decaying)
@@ -164,3 +168,11 @@ def compare():
         (float): the mean total reward with the SARSA table
     """
     raise NotImplementedError("Problem 7 incomplete")
+
+
+if __name__ == "__main__":
+    # The notebook's training cells: the tables compare() plays.
+    q_table, _ = qlearn("Taxi-v3")
+    q_table_decay, _ = qlearn("Taxi-v3", decay=True)
+    sarsa_table_decay = sarsa0("Taxi-v3", decay=True)
+    print(compare())

@@ -13,6 +13,7 @@ import json
 import os
 import subprocess
 import sys
+import unicodedata
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -302,6 +303,35 @@ def test_check_prints_valid_gradescope_results(tmp_path: Path, capsys: pytest.Ca
     GradescopeResults.model_validate(data)
     assert data["score"] == 0 and [test["status"] for test in data["tests"]] == ["failed"]
     assert "opengym.ipynb is not a readable notebook" in data["output"]
+
+
+def _controls(text: str) -> list[str]:
+    """The control characters (but line breaks and tabs) in `text`."""
+    return [
+        character for character in text if unicodedata.category(character) == "Cc" and character not in "\n\t"
+    ]
+
+
+def test_control_characters_a_student_raised_and_printed_are_inert(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The hostile sample prints and raises ESC sequences and BELs: results.json (for Gradescope) and the text
+    summary show each as U+FFFD, the report keeps them as the student wrote them."""
+    sample = SUBMISSIONS / "hostile" / "control_characters.py"
+    report_file = tmp_path / "report.json"
+    main(["check", str(sample), "--only", "random_blackjack", "--output", str(report_file)])
+    text = capsys.readouterr().out
+    report = Report.model_validate_json(report_file.read_text(encoding="utf-8"))
+    (problem,) = report.problems
+    assert "\x1b[2J\x07" in problem.feedback and "\x07" in problem.output  # the report holds them as raised
+    data = json.loads(results(report).to_json())
+    outputs = [data["output"], *(test["output"] for test in data["tests"])]
+    assert [_controls(output) for output in outputs] == [[] for _ in outputs]
+    assert "ValueError: bad \ufffd[2J\ufffd value \ufffd[31mred\ufffd[0m" in data["tests"][0]["output"]
+    assert "ring\ufffd the bell, \ufffd[31mred" in _printed(data)
+    assert _controls(text) == [] and "ValueError: bad \ufffd[2J\ufffd value" in text
+    for line in ("Traceback (most recent call last):", "Score: 0 / 1"):
+        assert line in text.splitlines() or any(line in shown for shown in text.splitlines())
 
 
 def test_each_bundle_draws_its_own_secret_and_keeps_it_private(tmp_path: Path) -> None:

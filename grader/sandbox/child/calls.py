@@ -18,7 +18,13 @@ from grader.compat import register_envs, resolve_env_id
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.cells import RUN_CELLS, run_cells
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
-from grader.sandbox.child.frames import EnvArgument, decode_value, encode_value
+from grader.sandbox.child.frames import (
+    ENV_NAME_OR_OBJECT,
+    ENV_OBJECT,
+    EnvArgument,
+    decode_value,
+    encode_value,
+)
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
 from grader.sandbox.child.log_block import NO_EPISODES, log_block
 from grader.sandbox.child.provided import PROVIDED
@@ -105,7 +111,7 @@ def run_call(
     max_frame = limits.max_bytes
     compat_events.drain()
     recorder.begin_call(request.seed, record=request.record, budget=request.budget)
-    result = _outcome(module, request, submission, max_frame)
+    result = _outcome(module, request, submission, max_frame, recorder)
     episodes = recorder.finish_call()
     if recorder.exceeded is not None and result["status"] not in ("missing_function", "bad_signature"):
         result = _status(
@@ -164,7 +170,9 @@ def _budget_message(function: str, recorder: Recorder) -> str:
     )
 
 
-def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_frame: int) -> dict[str, Any]:
+def _outcome(
+    module: ModuleType, request: CallRequest, submission: Path, max_frame: int, recorder: Recorder
+) -> dict[str, Any]:
     name = request.function
     function = functools.partial(run_cells, module) if name == RUN_CELLS else vars(module).get(name)
     if function is None:
@@ -190,41 +198,48 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
         )
     if mismatch:
         return _status("bad_signature", mismatch)
-    try:
-        args = [_made(arg) for arg in request.args]
-        kwargs = {key: _made(arg) for key, arg in request.kwargs.items()}
-    except Exception as error:  # the grader's own env could not be made: not the student's doing
-        return _status(
-            "sandbox_error", f"the grader could not make the environment it passes to {name}(): {error}"
-        )
+    _name_envs(recorder, request)
     namespace = vars(module)
     replaced = {provided: namespace[provided] for provided in request.provided if provided in namespace}
     namespace.update({provided: PROVIDED[provided] for provided in request.provided})
-    started = time.perf_counter()
     try:
-        value = function(*args, **kwargs)
-    except MemoryError:
-        return _status(
-            "memory_limit",
-            f"{name}() ran out of memory (it used more than the grader allows)",
-            wall_time=time.perf_counter() - started,
-        )
-    except SystemExit:
-        raise
-    except BaseException as error:  # KeyboardInterrupt or a BaseException subclass raised by the student
-        return _status(
-            "exception",
-            f"{name}() raised {describe_exception(error)}",
-            traceback=student_traceback(error, submission),
-            wall_time=time.perf_counter() - started,
-        )
+        attempt = _attempt(function, request, as_objects=False)
+        if (
+            attempt.error is not None
+            and not isinstance(attempt.error, MemoryError)
+            and _fell_on_the_name(request, recorder)
+        ):
+            first, error = attempt, attempt.error
+            recorder.begin_call(request.seed, record=request.record, budget=request.budget)
+            _name_envs(recorder, request)
+            attempt = _attempt(function, request, as_objects=True)
+            if attempt.error is not None and not (recorder.resets or recorder.steps):
+                attempt = first  # the object got no further than the name: the name's error stands
+                recorder.begin_call(request.seed, record=request.record, budget=request.budget)
+            else:
+                _report_object_form(name, request, error)
     finally:
         for provided in request.provided:
             if provided in replaced:
                 namespace[provided] = replaced[provided]
             else:
                 namespace.pop(provided, None)
-    wall_time = time.perf_counter() - started
+    if attempt.status is not None:
+        return attempt.status
+    if isinstance(attempt.error, MemoryError):
+        return _status(
+            "memory_limit",
+            f"{name}() ran out of memory (it used more than the grader allows)",
+            wall_time=attempt.wall_time,
+        )
+    if attempt.error is not None:
+        return _status(
+            "exception",
+            f"{name}() raised {describe_exception(attempt.error)}",
+            traceback=student_traceback(attempt.error, submission),
+            wall_time=attempt.wall_time,
+        )
+    value, wall_time = attempt.value, attempt.wall_time
     try:
         encoded = encode_value(value, f"the value returned by {name}()", max_bytes=max_frame)
     except InvalidValueError as error:
@@ -241,6 +256,78 @@ def _outcome(module: ModuleType, request: CallRequest, submission: Path, max_fra
             "memory_limit", f"{name}() returned more data than fits in memory", wall_time=wall_time
         )
     return {**_status("ok", ""), "value": encoded, "wall_time": wall_time}
+
+
+@dataclass
+class _Attempt:
+    """One call of the student's function: its value, or the exception it raised, or a ready status."""
+
+    value: Any = None
+    error: BaseException | None = None
+    wall_time: float = 0.0
+    status: dict[str, Any] | None = None
+
+
+def _attempt(function: Any, request: CallRequest, *, as_objects: bool) -> _Attempt:
+    """Call `function` with the request's arguments (env arguments as names, or as objects)."""
+    try:
+        args = [_passed(arg, as_objects) for arg in request.args]
+        kwargs = {key: _passed(arg, as_objects) for key, arg in request.kwargs.items()}
+    except Exception as error:  # the grader's own env could not be made: not the student's doing
+        return _Attempt(
+            status=_status(
+                "sandbox_error",
+                f"the grader could not make the environment it passes to {request.function}(): {error}",
+            )
+        )
+    started = time.perf_counter()
+    try:
+        value = function(*args, **kwargs)
+    except SystemExit:
+        raise
+    except BaseException as error:  # KeyboardInterrupt or a BaseException subclass raised by the student
+        return _Attempt(error=error, wall_time=time.perf_counter() - started)
+    return _Attempt(value=value, wall_time=time.perf_counter() - started)
+
+
+def _env_arguments(request: CallRequest) -> list[EnvArgument]:
+    return [arg for arg in (*request.args, *request.kwargs.values()) if type(arg) is EnvArgument]
+
+
+def _name_envs(recorder: Recorder, request: CallRequest) -> None:
+    """Tell the recorder the names the call passes: an env made by one gets the argument's time limit."""
+    for argument in _env_arguments(request):
+        if argument.form != ENV_OBJECT:
+            target = resolve_env_id(argument.env_id)
+            recorder.named_envs[argument.env_id] = argument.max_episode_steps
+            recorder.named_envs[target.gymnasium_id] = argument.max_episode_steps
+
+
+def _fell_on_the_name(request: CallRequest, recorder: Recorder) -> bool:
+    """Whether the call may be made again with env objects: it passed a name it may replace, and failed
+    before making an env by that name, resetting or stepping any env."""
+    replaceable = any(argument.form == ENV_NAME_OR_OBJECT for argument in _env_arguments(request))
+    return replaceable and not (recorder.made_by_name or recorder.resets or recorder.steps)
+
+
+def _report_object_form(name: str, request: CallRequest, error: BaseException) -> None:
+    for argument in _env_arguments(request):
+        if argument.form == ENV_NAME_OR_OBJECT:
+            compat_events.record(
+                compat_events.ENV_OBJECT_PASSED,
+                argument.env_id,
+                f"{name}() was called with the environment's name {argument.env_id!r}, as the template's `env = gym.make(env)` expects, and raised {describe_exception(error)} before making or playing it; "  # noqa: E501
+                f"it was called again with an environment object, gym.make({argument.env_id!r})",
+            )
+
+
+def _passed(argument: Any, as_objects: bool) -> Any:
+    """What the function receives for one argument: an `EnvArgument` as its name or as an env object."""
+    if type(argument) is not EnvArgument:
+        return argument
+    if argument.form != ENV_OBJECT and not as_objects:
+        return argument.env_id
+    return _made(argument)
 
 
 def _made(argument: Any) -> Any:

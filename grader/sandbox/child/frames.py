@@ -5,8 +5,9 @@ Values travel as JSON with two tagged forms: ``{"$float": "nan" | "inf" | "-inf"
 floats and ``{"$ndarray": {"dtype": "<f8", "shape": [...], "data": base64}}`` for numeric numpy
 arrays (raw bytes read back with `numpy.frombuffer`, never pickle). Only exact built-in types are
 accepted: a subclass of `float` with rigged comparisons is refused, not converted. A call's arguments may
-also hold ``{"$env": {"id": ..., "max_episode_steps": ...}}`` (`EnvArgument`): an environment the child
-makes for the call (the learners of edition rl1 take `env`); no return value or episode log may.
+also hold ``{"$env": {"id": ..., "max_episode_steps": ..., "form": ...}}`` (`EnvArgument`): an environment
+the child passes to the call by name or makes for it (the learners of edition rl1 take `env`); no return
+value or episode log may.
 """
 
 from __future__ import annotations
@@ -55,20 +56,35 @@ ARRAY_DTYPES = frozenset(
 """The dtypes (`dtype.str`) an array may have on the wire: bool, int, uint and float, either byte order."""
 
 
+ENV_OBJECT = "object"
+"""`EnvArgument.form`: the child makes the env (through the recorder) and passes the object."""
+ENV_NAME = "name"
+"""`EnvArgument.form`: the child passes the id (a str); the env the function makes by that name during the
+call gets `max_episode_steps` and is recorded like any other (the lab's `env = gym.make(env)`)."""
+ENV_NAME_OR_OBJECT = "name_or_object"
+"""`EnvArgument.form`: the name first; when the call fails on it before making or playing any env, it is
+made again with the env object (a student who changed the function to take one), and a compat event of
+kind `env_object` says so."""
+ENV_FORMS = (ENV_OBJECT, ENV_NAME, ENV_NAME_OR_OBJECT)
+
+
 @dataclass(frozen=True)
 class EnvArgument:
-    """An argument the child replaces by an environment it makes and records like the student's own.
+    """An argument the child replaces by an environment's name or by an env it makes and records.
 
     Attributes:
-        env_id: The id to make (a lab id such as ``"Taxi-v3"`` is resolved as the compat layer does).
-        max_episode_steps: The time limit of the env made; None keeps the registered one.
+        env_id: The id (a lab id such as ``"Taxi-v3"`` is resolved as the compat layer does).
+        max_episode_steps: The time limit of the env made (by the child, or by the function from the
+            name); None keeps the registered one.
+        form: One of `ENV_FORMS`: how the env reaches the function.
     """
 
     env_id: str
     max_episode_steps: int | None = None
+    form: str = ENV_OBJECT
 
     def __repr__(self) -> str:
-        return f"gym.make({self.env_id!r})"
+        return repr(self.env_id) if self.form != ENV_OBJECT else f"gym.make({self.env_id!r})"
 
 
 @contextlib.contextmanager
@@ -228,7 +244,13 @@ class _Encoder:
         if kind in _NUMPY_SCALARS:
             return self.encode(_NUMPY_SCALARS[kind](value), where, depth)
         if kind is EnvArgument:
-            return {ENV_TAG: {"id": value.env_id, "max_episode_steps": value.max_episode_steps}}
+            return {
+                ENV_TAG: {
+                    "id": value.env_id,
+                    "max_episode_steps": value.max_episode_steps,
+                    "form": value.form,
+                }
+            }
         raise _invalid(self.what, where, _found(value) + "; " + PLAIN_TYPES_HINT + _conversion_hint(value))
 
     def _encode_dict(self, value: dict[Any, Any], where: str, depth: int) -> dict[str, Any]:
@@ -282,14 +304,16 @@ class _Decoder:
 
 
 def _decode_env(spec: Any, what: str, where: str) -> EnvArgument:
-    if type(spec) is not dict or spec.keys() != {"id", "max_episode_steps"}:
-        raise _invalid(what, where, "an env argument needs exactly id and max_episode_steps")
-    env_id, limit = spec["id"], spec["max_episode_steps"]
+    if type(spec) is not dict or spec.keys() != {"id", "max_episode_steps", "form"}:
+        raise _invalid(what, where, "an env argument needs exactly id, max_episode_steps and form")
+    env_id, limit, form = spec["id"], spec["max_episode_steps"], spec["form"]
+    if type(form) is not str or form not in ENV_FORMS:
+        raise _invalid(what, where, f"an env argument's form must be one of {', '.join(ENV_FORMS)}")
     if type(env_id) is not str or not 0 < len(env_id) <= MAX_ENV_ID:
         raise _invalid(what, where, f"an env id must be a string of 1 to {MAX_ENV_ID} characters")
     if limit is not None and (type(limit) is not int or not 0 < limit < 2**62):
         raise _invalid(what, where, f"max_episode_steps {limit!r} is not a positive int or null")
-    return EnvArgument(env_id, limit)
+    return EnvArgument(env_id, limit, form)
 
 
 def _encode_array(array: np.ndarray, what: str, where: str) -> dict[str, Any]:

@@ -37,9 +37,15 @@ def test_the_plan_runs_the_cells_with_their_own_limit_then_records_compare() -> 
     assert (compare.function, compare.seconds, compare.record_episodes) == ("compare", None, True)
 
 
-def test_without_run_cells_compare_is_not_gradable_and_worth_nothing() -> None:
+def test_the_default_configuration_runs_the_cells_for_its_points() -> None:
     settings = load_config(RL1.default_config).problems["compare"]
     assert isinstance(settings, CompareConfig)
+    assert (settings.run_cells, settings.points) == (True, 1.0)
+    assert CompareConfig.model_fields["run_cells"].default is True
+
+
+def test_without_run_cells_compare_is_not_gradable_and_worth_nothing() -> None:
+    settings = _settings(run_cells=False)
     assert (settings.run_cells, settings.points) == (False, 0.0)
     assert PROBLEM.check.plan(settings, {}) == []
     verdict = PROBLEM.check.judge(settings, [])
@@ -60,7 +66,7 @@ def test_honest_play_passes_and_says_what_ran(function: Any, seed: int) -> None:
     verdict = _judge(function, seed)
     assert verdict.status == "passed", verdict.feedback
     assert verdict.feedback.startswith(
-        "Ran your notebook's 4 code cells in the sandbox in 2.0 s (limit 900 s)"
+        "Ran your notebook's 4 code cells in the sandbox in 2.0 s (limit 1800 s)"
     )
     assert "`q_table_decay` (from qlearn(decay=True, N=70000))" in verdict.feedback
     assert verdict.measurements[RAN_CELLS] is True
@@ -128,3 +134,32 @@ def test_a_forged_cells_value_is_read_defensively(seed: int) -> None:
     verdict = _judge(students.honest, seed, cells=forged)
     assert verdict.status == "failed"
     assert "left no Taxi Q-table" in verdict.feedback
+
+
+def _untrained(cell: int) -> Any:
+    def cells(_lab: Any, *_args: Any, **_kwargs: Any) -> dict[str, Any]:
+        return {"cells": [{"cell": cell, "seconds": 0.5}], "tables": []}
+
+    return cells
+
+
+def _reads_missing_globals(_lab: Any) -> Any:
+    raise NameError("name 'q_table_decay' is not defined")
+
+
+@pytest.mark.parametrize(
+    ("cell", "words"),
+    [
+        (0, "Run as a script, your file left no Taxi Q-table for compare() to play"),
+        (3, "Your notebook's cells left no Taxi Q-table for compare() to play"),
+    ],
+    ids=["module", "notebook"],
+)
+def test_a_submission_that_trains_no_table_fails_saying_where_to_train(
+    cell: int, words: str, seed: int
+) -> None:
+    verdict = _judge(_reads_missing_globals, seed, cells=_untrained(cell))
+    assert verdict.status == "failed"
+    assert "compare() raised NameError: name 'q_table_decay' is not defined" in verdict.feedback
+    assert words in verdict.feedback
+    assert 'sarsa_table_decay = sarsa0("Taxi-v3", decay=True)' in verdict.feedback

@@ -13,6 +13,7 @@ from grader.checks.base import Verdict
 from grader.checks.sarsa import SarsaConfig, returned_table
 from grader.config import load_config
 from grader.editions.rl1 import RL1
+from grader.sandbox.outcome import ENV_NAME_OR_OBJECT, EnvArgument
 from grader.testing import sarsa as students
 from grader.testing.simulation import Lab, simulate_calls
 
@@ -38,6 +39,32 @@ def test_honest_learners_pass(name: str, seed: int) -> None:
     verdict = _judge(students.HONEST[name], seed)
     assert verdict.status == "passed", verdict.feedback
     assert "every update of your table is SARSA(0)'s" in verdict.feedback
+    form = "object" if name == "object_form" else "name"
+    assert verdict.measurements["env_form"] == form
+    assert FORM_WORDS[form] in verdict.feedback
+
+
+FORM_WORDS = {
+    "name": "The grader called sarsa0 with the environment's name, 'Taxi-v3', as the template's `env = gym.make(env)` expects.",  # noqa: E501
+    "object": "The grader called sarsa0 with an environment object, gym.make('Taxi-v3')",
+}
+
+
+def test_the_plan_passes_the_environments_name_first() -> None:
+    call = PROBLEM.check.plan(_settings(), {})[0]
+    (env,) = [argument for argument in call.args if isinstance(argument, EnvArgument)]
+    assert (env.env_id, env.form, repr(env)) == ("Taxi-v3", ENV_NAME_OR_OBJECT, "'Taxi-v3'")
+
+
+def test_a_template_shaped_learner_that_fails_after_making_the_env_keeps_the_names_error(seed: int) -> None:
+    def broken(lab: Lab, env: Any, *args: Any) -> Any:
+        env = lab.make(env)
+        raise ValueError("after gym.make")
+
+    verdict = _judge(broken, seed)
+    assert verdict.status == "error"
+    assert "ValueError: after gym.make" in verdict.feedback
+    assert FORM_WORDS["name"] in verdict.feedback
 
 
 @pytest.mark.parametrize(("name", "mistake"), students.MISTAKES.items(), ids=list(students.MISTAKES))

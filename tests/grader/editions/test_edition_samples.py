@@ -30,7 +30,9 @@ OVERRIDES: dict[str, dict[str, Any]] = {
     "blackjack": {"thresholds": [12]},
     "cartpole": {"calls": 20},
     "car": {"calls": 20},
-    "compare": {"run_cells": True, "cells_seconds": 300.0},
+    # The template-shaped honest samples run the lab's own cells (N = 70 000, minutes); a loaded test machine
+    # gets twice the default limit, which changes no verdict of these samples.
+    "compare": {"cells_seconds": 3600.0},
 }
 
 
