@@ -50,8 +50,8 @@ def add_worker_command(subparsers: argparse._SubParsersAction[argparse.ArgumentP
 
 
 def _settings_or_none() -> Settings | None:
-    # Imported here: every `gymgrade` command builds this parser, and the settings' imports (pydantic-settings,
-    # the service's errors) cost a `gymgrade check` about 45 ms before its grading starts.
+    # Imported here: every `gymgrade` command builds this parser, and the settings' imports
+    # (pydantic-settings, the service's errors) cost a `gymgrade check` about 45 ms before its grading starts.
     from pydantic import ValidationError
 
     from api.errors import GraderUnavailable

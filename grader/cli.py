@@ -730,7 +730,8 @@ def class_page_clash(page: Path, identities: Sequence[str], out_dir: Path) -> st
     from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
 
     reports = {
-        out_dir / f"{identity_stem(identity)}.json": f"student {display_identity(identity, IDENTITY_SHOWN_CHARS)}"
+        out_dir / f"{identity_stem(identity)}.json": "student "
+        + display_identity(identity, IDENTITY_SHOWN_CHARS)
         for identity in identities
     }
     return page_clash_of_reports(page, reports, out_dir)

@@ -50,7 +50,10 @@ GRADER_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ),
     (
         "plain data",
-        ("report", "notebook", "stats", "seeds", "gradescope_upload", "untrusted_file", "validation", "errors"),
+        (
+            "report", "notebook", "stats", "seeds", "gradescope_upload", "untrusted_file", "validation",
+            "errors",
+        ),
     ),
     ("untrusted execution", ("sandbox",)),
     ("the lab's dialects", ("compat",)),

@@ -200,5 +200,5 @@ PAGE_FILTERS: dict[str, Callable[[str], str]] = {
     "code": inert,
 }
 """What every page shows of hostile text, by Jinja filter (``{{ row.identity|identity }}``,
-``{{ line|code }}``): an identity (80 characters), a compared document's name (a student's identity or a reference file's path,
-256), a name, a note, a longer line of text, a line of code kept whole."""
+``{{ line|code }}``): an identity (80 characters), a compared document's name (a student's identity or a
+reference file's path, 256), a name, a note, a longer line of text, a line of code kept whole."""

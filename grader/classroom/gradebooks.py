@@ -1,7 +1,8 @@
 """Gradebooks people upload: ``grades.csv`` and the import formats of Canvas, Gradescope and GitHub
 Classroom, built as pure functions of the class's rows. Every cell goes through
-``grader.class_report.text.safe_cell``: controls and bidi overrides inert, and a leading apostrophe where a
-spreadsheet would evaluate it (``= + - @`` after any blanks, their fullwidth forms, a tab, a carriage return)."""
+``grader.class_report.text.safe_cell``: controls and bidi overrides inert, and a leading apostrophe where
+a spreadsheet would evaluate it (``= + - @`` after any blanks, their fullwidth forms, a tab, a carriage
+return)."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from grader.classroom.errors import GradebookError
 from grader.classroom.model import ClassDownload, Member, Submission
 from grader.classroom.roster import Roster, RosterEntry
 from grader.report import Report
+
 
 @dataclass(frozen=True)
 class GradeRow:

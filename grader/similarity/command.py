@@ -131,8 +131,10 @@ def write_similarity(
     with (out / CSV_FILE).open("w", encoding="utf-8", newline="") as stream:
         stream.write(render_csv(report))
     (out / HTML_FILE).write_text(render_html(report, outcome.lines_of), encoding="utf-8")
-    # ASCII, every other character escaped (as class.json): a bidi override in a name never reorders a terminal
-    (out / JSON_FILE).write_text(json.dumps(report.model_dump(mode="json"), indent=2) + "\n", encoding="utf-8")
+    # ASCII, every other character escaped (as class.json): a bidi override in a name never reorders a
+    # terminal
+    document = json.dumps(report.model_dump(mode="json"), indent=2)
+    (out / JSON_FILE).write_text(document + "\n", encoding="utf-8")
     return report
 
 

@@ -63,15 +63,17 @@ def _csv(text: str) -> list[dict[str, str]]:
     ("value", "cell"),
     [("=1+2", "'=1+2"), ("+cmd", "'+cmd"), ("-2+3", "'-2+3"), ("@SUM(A1)", "'@SUM(A1)"), ("\tx", "'\tx"),
      ("\rx", "'\ufffdx"), ("alice", "alice"), ("0042", "0042"), (1.5, "1.5"), (None, ""),
-     (" =1+2", "' =1+2"), ("\u3000 \u00a0@x", "'\u3000 \u00a0@x"), ("\uff1dcmd|' /C calc'!A0", "'\uff1dcmd|' /C calc'!A0"),
-     ("\ufe66x", "'\ufe66x"), ("\uff0b1", "'\uff0b1"), ("\uff0d1", "'\uff0d1"), ("\uff20SUM(A1)", "'\uff20SUM(A1)"),
+     (" =1+2", "' =1+2"), ("\u3000 \u00a0@x", "'\u3000 \u00a0@x"),
+     ("\uff1dcmd|' /C calc'!A0", "'\uff1dcmd|' /C calc'!A0"),
+     ("\ufe66x", "'\ufe66x"), ("\uff0b1", "'\uff0b1"), ("\uff0d1", "'\uff0d1"),
+     ("\uff20SUM(A1)", "'\uff20SUM(A1)"),
      ("\u200b=1", "'\u200b=1"), ("a =1", "a =1"), ("  ", "  "), ("Zoë Ng", "Zoë Ng"),
      ("ali\x1b]0;owned\x07ce", "ali\ufffd]0;owned\ufffdce"), ("\u202eecila", "\ufffdecila"),
      ("two\nlines\tand tab", "two\nlines\tand tab")],
     ids=["equals", "plus", "minus", "at", "tab", "cr", "plain", "leading-zeros", "number", "none",
          "space-then-equals", "wide-spaces-then-at", "fullwidth-equals", "small-equals", "fullwidth-plus",
-         "fullwidth-minus", "fullwidth-at", "zero-width-then-equals", "equals-inside", "blank", "unicode-name",
-         "terminal-escape", "rtl-override", "newline-and-tab-kept"],
+         "fullwidth-minus", "fullwidth-at", "zero-width-then-equals", "equals-inside", "blank",
+         "unicode-name", "terminal-escape", "rtl-override", "newline-and-tab-kept"],
 )  # fmt: skip
 def test_cells_a_spreadsheet_would_evaluate_are_neutralised(value: object, cell: str) -> None:
     assert safe_cell(value) == cell

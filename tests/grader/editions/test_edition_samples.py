@@ -55,7 +55,13 @@ class Sample:
 
 
 SAMPLES = [
-    Sample(entry["file"], entry["edition"], entry["status"], entry.get("feedback", {}), entry.get("suite_episodes"))
+    Sample(
+        entry["file"],
+        entry["edition"],
+        entry["status"],
+        entry.get("feedback", {}),
+        entry.get("suite_episodes"),
+    )
     for entry in tomllib.loads(VERDICTS.read_text(encoding="utf-8"))["sample"]
 ]
 

@@ -23,7 +23,10 @@ BAD_FILES: dict[str, tuple[bytes, str]] = {
     "empty.py": (b"  \n\n", "is empty"),
     "deep.py": (b"x = " + b"[" * 5000 + b"]" * 5000 + b"\n", "is not valid Python"),
     "not_json.ipynb": (b"{ this is not json", "not valid JSON"),
-    "no_cells.ipynb": (json.dumps({"nbformat": 4, "metadata": {}}).encode(), "is JSON but not a Jupyter notebook"),
+    "no_cells.ipynb": (
+        json.dumps({"nbformat": 4, "metadata": {}}).encode(),
+        "is JSON but not a Jupyter notebook",
+    ),
     "only_markdown.ipynb": (
         json.dumps({"nbformat": 4, "cells": [{"cell_type": "markdown", "source": "hi"}]}).encode(),
         "has no code cells",
