@@ -120,12 +120,11 @@ def cost(q_episodes: int, sarsa_episodes: int, workers: int) -> None:
             wall, report = _grade(notebook, _config(directory, run_cells), workers)
             compare = next(result for result in report.problems if result.id == "compare")
             others = sum(r.timings.wall_seconds for r in report.problems if r.id != "compare")
-            measured = compare.measurements
-            cells, called = measured.get("cells_seconds", "-"), measured.get("compare_seconds", "-")
+            student = compare.timings.student_seconds if compare.timings else float("nan")
             print(
                 f"  run_cells={run_cells}: {wall:.1f} s wall for the file; "
                 f"compare {compare.status} {compare.score}/{compare.max_score} in "
-                f"{compare.timings.wall_seconds:.1f} s (cells {cells} s, compare() {called} s); "
+                f"{compare.timings.wall_seconds:.1f} s (in the cells and compare() {student:.1f} s); "
                 f"the other {len(report.problems) - 1} problems {others:.1f} s summed; "
                 + ", ".join(f"{r.id} {r.status}" for r in report.problems)
             )

@@ -200,11 +200,30 @@ def _deleted_when_the_session_starts(path: Path) -> Iterator[None]:
         yield
 
 
+@contextlib.contextmanager
+def _imported_copy_deleted_when_the_session_starts() -> Iterator[None]:
+    """Delete the files the session imports (the grader's private copies of the submissions, made after
+    the files were read and validated) as the session starts."""
+    import grader.grading
+
+    start = grader.grading.run_session
+
+    def delete_then_start(session: SessionPlan, *args: Any, **kwargs: Any) -> SessionEnd:
+        for module in session.submissions:
+            module.unlink()
+        return start(session, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(grader.grading, "run_session", delete_then_start)
+        yield
+
+
 def _vanished_report(plan: GradingPlan, tmp_path: Path) -> Report:
-    """The report of a file deleted after it was validated, before its check ran (a grader failure)."""
+    """The report of a file whose imported copy vanished after it was validated, before its check ran (a
+    grader failure: the student's own file is read once, and never again)."""
     vanished = tmp_path / "vanished.py"
     vanished.write_text("import math\n")
-    with _deleted_when_the_session_starts(vanished):
+    with _imported_copy_deleted_when_the_session_starts():
         [report] = grade_files([vanished], plan, seed=0, workers=1, policy=IsolationPolicy.ALLOW_FALLBACK)
     return report
 

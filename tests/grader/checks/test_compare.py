@@ -66,7 +66,7 @@ def test_honest_play_passes_and_says_what_ran(function: Any, seed: int) -> None:
     verdict = _judge(function, seed)
     assert verdict.status == "passed", verdict.feedback
     assert verdict.feedback.startswith(
-        "Ran your notebook's 4 code cells in the sandbox in 2.0 s (limit 1800 s)"
+        "Ran your notebook's 4 code cells in the sandbox (within the limit of 1800 s), then called compare()"
     )
     assert "`q_table_decay` (from qlearn(decay=True, N=70000))" in verdict.feedback
     assert verdict.measurements[RAN_CELLS] is True
