@@ -164,9 +164,13 @@ def _labelling(
 
 
 def _is_table(value: Any) -> bool:
+    # The type first: a module's lazy `__getattr__` (the light IPython's, matplotlib's) is never asked for
+    # `shape`, which would import what the cells never used.
+    if type(value).__module__ != "numpy":
+        return False
     shape = getattr(value, "shape", None)
     kind = getattr(getattr(value, "dtype", None), "kind", None)
-    return type(value).__module__ == "numpy" and shape == TABLE_SHAPE and kind in ("f", "i", "u")
+    return shape == TABLE_SHAPE and kind in ("f", "i", "u")
 
 
 def _tables(namespace: dict[str, Any], learned: dict[int, dict[str, Any]], kept: list[Any]) -> list[Any]:
