@@ -8,8 +8,9 @@
    per problem, the child's start and the student's import, the student's own time, the transfer, the
    replay and the judging. The calls the grader made are recorded.
 2. Runs exactly those calls plainly and serially in one fresh process (`grader.compat.activate()`, the
-   submission imported, each function called with the grader's arguments; no sandbox, no recording, no
-   replay: what an in-process grader such as Otter costs at least), alternated with `gymgrade check` of
+   submission imported, each function called with the grader's arguments, compare()'s cells call run as
+   Run All runs the cells; no sandbox, no recording, no replay: what an in-process grader such as Otter
+   costs at least), alternated with `gymgrade check` of
    the same file on `--workers` workers (default: all cores), `--rounds` times each, in one run. Prints
    the ratio gymgrade / plain (goal <= 1.0) and the grader's overhead as a share of the student's time
    (goal <= 10%), from the report's `timings`.
@@ -85,6 +86,7 @@ def plain_child(calls_file: Path, submission: Path, child_envs: bool = False) ->
     (`grader.sandbox.child.envs.cheaper`), so the run differs from the grading only by the grader's own work.
     """
     import grader.compat
+    from grader.sandbox.child.cells import RUN_CELLS
 
     started, cpu = time.perf_counter(), time.process_time()
     grader.compat.activate()
@@ -105,7 +107,10 @@ def plain_child(calls_file: Path, submission: Path, child_envs: bool = False) ->
         args = tuple(_plain_argument(value) for value in logged_args)
         began = time.perf_counter()
         with contextlib.redirect_stdout(quiet):
-            getattr(module, function)(*args, **kwargs)
+            if function == RUN_CELLS:
+                _run_cells_plainly(module, *args, **kwargs)
+            else:
+                getattr(module, function)(*args, **kwargs)
         per_function[function] = per_function.get(function, 0.0) + time.perf_counter() - began
         quiet.seek(0)
         quiet.truncate()
@@ -118,6 +123,21 @@ def plain_child(calls_file: Path, submission: Path, child_envs: bool = False) ->
         "per_function": per_function,
     }
     print(json.dumps(summary))
+
+
+def _run_cells_plainly(module: Any, cells: list[dict[str, Any]], then: str | None = None) -> None:
+    """The grader's cells call (compare()'s), as Run All runs them: each cell in the module's namespace,
+    a script with ``__name__ == "__main__"``; no labelling of tables, no limits."""
+    namespace = vars(module)
+    for entry in cells:
+        script, name = bool(entry["script"]), namespace.get("__name__")
+        filename = module.__file__ if script else f"<notebook cell {entry['cell']}>"
+        if script:
+            namespace["__name__"] = "__main__"
+        try:
+            exec(compile(str(entry["source"]), filename, "exec"), namespace)
+        finally:
+            namespace["__name__"] = name
 
 
 def _route_lab_ids(child_envs: bool = False) -> None:
