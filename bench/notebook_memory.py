@@ -17,7 +17,6 @@ import argparse
 import json
 import os
 import platform
-import re
 import subprocess
 import sys
 import tempfile
@@ -25,8 +24,9 @@ from datetime import date
 from pathlib import Path
 from typing import Any
 
+from results_section import replace_section
+
 ROOT = Path(__file__).resolve().parents[1]
-RESULTS = ROOT / "bench" / "RESULTS.md"
 HEADING = "## Fifth round: notebook memory"
 HONEST = {
     "alice.ipynb": ROOT / "submissions" / "notebooks" / "classic_complete.ipynb",
@@ -167,12 +167,7 @@ def main() -> None:
     text = "\n".join(lines)
     print(text)
     if arguments.write:
-        current = RESULTS.read_text(encoding="utf-8")
-        pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.S | re.M)
-        updated = (
-            pattern.sub(text + "\n", current) if pattern.search(current) else current.rstrip() + "\n\n" + text
-        )
-        RESULTS.write_text(updated, encoding="utf-8")
+        replace_section(HEADING, text + "\n")
 
 
 if __name__ == "__main__":
