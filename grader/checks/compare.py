@@ -139,7 +139,7 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
     # No wall time here (the problem's timings carry it): the verdict is the same for the same bytes and seed.
     preface = (
         f"Ran your notebook's {len(ran)} code cell{'' if len(ran) == 1 else 's'} in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
-        if not (ran and ran[0][0] == SCRIPT_CELL)
+        if not (ran and ran[0] == SCRIPT_CELL)
         else f"Ran your file as a script in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
     )
     measurements: dict[str, PlainValue] = {"cells_run": len(ran), "notebook_tables": len(tables)}
@@ -153,7 +153,7 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
             "failed", 0.0, f"{preface}: {early.feedback}.{hint}", {**early.measurements, **measurements}
         )
     if early is not None and compare.status is OutcomeStatus.EXCEPTION and not tables:
-        script = bool(ran) and ran[0][0] == SCRIPT_CELL
+        script = bool(ran) and ran[0] == SCRIPT_CELL
         return Verdict(
             "failed",
             0.0,
@@ -269,16 +269,16 @@ def _judge_compare(
     return Verdict("passed", 1.0, f"{preface}: {story}, and returned those two means.", measurements)
 
 
-def _cells_value(value: PlainValue) -> tuple[list[tuple[int, float]], list[NotebookTable]]:
-    """The cells call's value, validated (it comes from the student's process)."""
-    ran: list[tuple[int, float]] = []
+def _cells_value(value: PlainValue) -> tuple[list[int], list[NotebookTable]]:
+    """The cells call's value, validated (it comes from the student's process): the numbers of the cells
+    that ran (their seconds are the problem's timings, not the verdict's) and the tables they left."""
+    ran: list[int] = []
     tables: list[NotebookTable] = []
     if not isinstance(value, dict):
         return ran, tables
     for entry in value.get("cells", []) if isinstance(value.get("cells"), list) else []:
         if isinstance(entry, dict) and type(entry.get("cell")) is int:
-            seconds = as_number(entry.get("seconds"))
-            ran.append((entry["cell"], float(seconds) if seconds is not None else 0.0))
+            ran.append(entry["cell"])
     for entry in value.get("tables", []) if isinstance(value.get("tables"), list) else []:
         if not isinstance(entry, dict):
             continue
