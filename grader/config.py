@@ -151,6 +151,14 @@ def assignment_file_model(registry: Registry) -> type[BaseModel]:
         __doc__="The TOML file as written.",
         problems=(tables, Field(description="One table per problem.")),
         sandbox=(SandboxConfig, Field(description="Resource limits of the sandbox.")),
+        late=(
+            dict[str, Any] | None,
+            Field(
+                default=None,
+                description="The late policy of the class's gradebooks (read by grader/classroom/late.py); "
+                "no grading depends on it.",
+            ),
+        ),
         edition=(
             str,
             Field(

@@ -21,3 +21,11 @@ class RosterError(ClassroomError):
 
 class GradebookError(ClassroomError):
     """Raised when a gradebook lacks what it needs (e.g. Canvas without an assignment id)."""
+
+
+class OverridesError(ClassroomError):
+    """Raised when an overrides file cannot be read or names what the class has not (every fault listed)."""
+
+
+class LatePolicyError(ClassroomError):
+    """Raised when the configuration's ``[late]`` table, or a file of submission times, is not as expected."""
