@@ -326,7 +326,7 @@ def _submission(
         why = f"{why}; refused {_refusals(refused)}"
     late = group.late
     if late is None and due is not None and group.submitted_at is not None:
-        late = _aware(group.submitted_at) > _aware(due)
+        late = _aware(group.submitted_at, due) > _aware(due, due)
     return Submission(
         identity=group.identity,
         display_name=_display(group.members, group.identity),
@@ -341,5 +341,6 @@ def _submission(
     )
 
 
-def _aware(moment: datetime) -> datetime:
-    return moment if moment.tzinfo is not None else moment.replace(tzinfo=UTC)
+def _aware(moment: datetime, due: datetime) -> datetime:
+    """A time a source gives without a zone (Blackboard's file names) is read in the due time's zone."""
+    return moment if moment.tzinfo is not None else moment.replace(tzinfo=due.tzinfo or UTC)

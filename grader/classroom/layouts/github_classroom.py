@@ -2,7 +2,9 @@
 ``{assignment-slug}-submissions/{assignment-prefix}-{github-username}/...``.
 
 The student is the GitHub username: the repository folder's name after the assignment prefix (the slug,
-or the prefix every repository folder shares). The classroom roster joins usernames to names.
+or the prefix every repository folder shares). The classroom roster joins usernames to names. The time is
+the committer time of the repository's checked-out commit (``grader.classroom.git_commit``), when its
+``.git`` folder is there to read.
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ from __future__ import annotations
 import os
 from collections import defaultdict
 
+from grader.classroom.git_commit import commit_time
 from grader.classroom.layouts.protocol import Group, Grouping, top_names
 from grader.classroom.model import Member, Skipped
 from grader.classroom.tree import Entry, Tree
@@ -74,5 +77,7 @@ class GitHubClassroomLayout:
             username = entry.parts[skip][len(prefix) :]
             files[username].append((entry, "/".join(entry.parts[skip + 1 :])))
         for username, found in sorted(files.items()):
-            grouping.groups.append(Group((Member(username),), found))
+            entry = found[0][0]
+            repository = entry.path.parents[len(entry.parts) - skip - 2]
+            grouping.groups.append(Group((Member(username),), found, submitted_at=commit_time(repository)))
         return grouping
