@@ -99,8 +99,7 @@ def late_policy_of(data: Mapping[str, Any], *, where: str) -> LatePolicy | None:
             location = ".".join(str(part) for part in item["loc"]) or LATE_TABLE
             lines.append(f"  {LATE_TABLE}.{location}: {item['msg']} (found {item.get('input')!r})")
         lines.append(
-            "Write due as an ISO 8601 time with its zone (2026-03-01T23:59:00-05:00) and the penalties as "
-            "shares between 0 and 1 (0.1 is a tenth of the assignment's maximum)."
+            "Write due as an ISO 8601 time with its zone (2026-03-01T23:59:00-05:00) and the penalties as shares between 0 and 1 (0.1 is a tenth of the assignment's maximum)."  # noqa: E501
         )
         raise LatePolicyError("\n".join(lines)) from None
 
@@ -179,8 +178,7 @@ def lateness(
         moment,
         days,
         penalty,
-        f"{days} day{'s' if days != 1 else ''} late (submitted {moment.isoformat()}, due {due.isoformat()}"
-        f"{', extended' if extended else ''}): {penalty:g} points taken{capped}",
+        f"{days} day{'s' if days != 1 else ''} late (submitted {moment.isoformat()}, due {due.isoformat()}{', extended' if extended else ''}): {penalty:g} points taken{capped}",  # noqa: E501
     )
 
 

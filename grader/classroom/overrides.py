@@ -105,7 +105,9 @@ def parse_overrides(data: bytes, *, where: str) -> list[Override]:
     except csv.Error as error:
         raise OverridesError(f"{where} is not a CSV file ({error}): save it as CSV") from None
     if not rows:
-        raise OverridesError(f"{where} is empty: expected a header {','.join(COLUMNS)} and a row per override")
+        raise OverridesError(
+            f"{where} is empty: expected a header {','.join(COLUMNS)} and a row per override"
+        )
     header = [cell.strip().lower() for cell in rows[0]]
     missing = [column for column in COLUMNS if column not in header]
     if missing:
@@ -225,9 +227,7 @@ def check_overrides(
     return Overrides(by_student)
 
 
-def read_overrides(
-    path: Path, *, students: Collection[str], maxima: Mapping[str, float]
-) -> Overrides:
+def read_overrides(path: Path, *, students: Collection[str], maxima: Mapping[str, float]) -> Overrides:
     """`parse_overrides` and `check_overrides` of a file.
 
     Raises:

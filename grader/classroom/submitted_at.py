@@ -55,7 +55,9 @@ def parse_submitted_at(data: bytes, *, where: str) -> dict[str, datetime]:
             (every such row listed with its line).
     """
     if len(data) > MAX_TIMES_BYTES:
-        raise LatePolicyError(f"{where} is over {MAX_TIMES_BYTES:,} bytes: pass a CSV of student,submitted_at")
+        raise LatePolicyError(
+            f"{where} is over {MAX_TIMES_BYTES:,} bytes: pass a CSV of student,submitted_at"
+        )
     try:
         rows = list(csv.reader(io.StringIO(data.decode("utf-8-sig"), newline="")))
     except (UnicodeDecodeError, csv.Error) as error:
@@ -66,8 +68,7 @@ def parse_submitted_at(data: bytes, *, where: str) -> dict[str, datetime]:
     if student is None or time is None:
         found = ",".join(display_text(cell, 40) for cell in (rows[0][:8] if rows else [])) or "(nothing)"
         raise LatePolicyError(
-            f"{where} has no {'student' if student is None else 'time'} column: expected student,submitted_at "
-            f"(or a Canvas submissions CSV's user_id,submitted_at, or Moodle's grading worksheet), found {found}"
+            f"{where} has no {'student' if student is None else 'time'} column: expected student,submitted_at (or a Canvas submissions CSV's user_id,submitted_at, or Moodle's grading worksheet), found {found}"  # noqa: E501
         )
     times: dict[str, datetime] = {}
     faults: list[str] = []
@@ -81,14 +82,17 @@ def parse_submitted_at(data: bytes, *, where: str) -> dict[str, datetime]:
             continue
         moment = parse_time(when)
         if moment is None:
-            faults.append(f"line {line}: {display_text(when, 60)!r} is not a time: write e.g. 2026-03-01T23:59:00-05:00")  # noqa: E501
+            faults.append(
+                f"line {line}: {display_text(when, 60)!r} is not a time: write e.g. 2026-03-01T23:59:00-05:00"
+            )
             continue
         times[who] = moment
     if faults:
         more = len(faults) - MAX_FAULTS_SHOWN
         listed = "\n".join(f"  {fault}" for fault in faults[:MAX_FAULTS_SHOWN])
         raise LatePolicyError(
-            f"{where}: refused:\n{listed}" + (f"\n  ... and {more:,} more" if more > 0 else "")
+            f"{where}: refused:\n{listed}"
+            + (f"\n  ... and {more:,} more" if more > 0 else "")
             + "\nCorrect these rows and run the command again."
         )
     return times

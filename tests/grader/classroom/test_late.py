@@ -73,7 +73,9 @@ def test_the_note_says_days_times_and_the_cap() -> None:
     ],
     ids=["unknown", "marked-on-time", "marked-late-hours-unknown", "marked-late-with-extension"],
 )  # fmt: skip
-def test_a_late_mark_without_hours(student: str, marked: bool | None, days: int, penalty: float, note: str) -> None:
+def test_a_late_mark_without_hours(
+    student: str, marked: bool | None, days: int, penalty: float, note: str
+) -> None:
     found = lateness(POLICY, student, submitted_at=None, marked_late=marked, max_score=7.0)
     assert (found.days, found.penalty, found.note) == (days, penalty, note)
 
@@ -88,7 +90,7 @@ def _config(tmp_path: Path, late: str) -> Path:
 def test_the_late_table_is_read_from_the_configuration_and_changes_no_grading(tmp_path: Path) -> None:
     path = _config(
         tmp_path,
-        "[late]\ndue = 2026-03-01T23:59:00-05:00\npenalty_per_day = 0.1\nmax_penalty = 0.3\ngrace_minutes = 15\n"
+        "[late]\ndue = 2026-03-01T23:59:00-05:00\npenalty_per_day = 0.1\nmax_penalty = 0.3\ngrace_minutes = 15\n"  # noqa: E501
         '[late.extensions]\nalice = "2026-03-04T23:59:00-05:00"\n',
     )
     assert read_late_policy(path) == POLICY

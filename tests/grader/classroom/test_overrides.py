@@ -30,7 +30,7 @@ def test_an_honest_file_is_read_exactly() -> None:
     found = _read(
         "\ufeffStudent,Problem,Points,Reason,name\r\n"
         "alice,car,1,ran out of time on the cluster; checked by hand,Alice\r\n"
-        "0042,total,1.5,\"excused, see email\",\r\n"
+        '0042,total,1.5,"excused, see email",\r\n'
         "\r\n"
         "bob,random_blackjack,0.5,partial,\r\n"
     )
@@ -103,7 +103,7 @@ def test_every_fault_is_listed_and_many_are_counted() -> None:
 @pytest.mark.parametrize(
     ("data", "message"),
     [
-        (b"", "overrides.csv is empty: expected a header student,problem,points,reason and a row per override"),
+        (b"", "overrides.csv is empty: expected a header student,problem,points,reason and a row per override"),  # noqa: E501
         (b"who,what\nalice,car\n", "overrides.csv has no column student, problem, points, reason: expected the header student,problem,points,reason, found who,what"),  # noqa: E501
         (b"student,problem,points,reason\nal\xffce,car,1,x\n", "overrides.csv is not UTF-8 text (byte 32): save it as CSV UTF-8 with the columns student,problem,points,reason"),  # noqa: E501
         (b"x" * (MAX_OVERRIDES_BYTES + 1), f"overrides.csv is {MAX_OVERRIDES_BYTES + 1:,} bytes; an overrides file is at most {MAX_OVERRIDES_BYTES:,}: pass the CSV of student,problem,points,reason rows"),  # noqa: E501

@@ -43,7 +43,7 @@ def _times(layout: str, tmp_path: Path) -> dict[str, tuple[datetime | None, bool
         ("plain", "student000", None, None),
     ],
     ids=["gradescope-late", "gradescope-on-time", "nbgrader-timestamp", "blackboard-file-name",
-         "blackboard-on-time", "canvas-late-mark-no-hours", "canvas-no-mark", "moodle-none-in-the-download", "plain-none"],
+         "blackboard-on-time", "canvas-late-mark-no-hours", "canvas-no-mark", "moodle-none-in-the-download", "plain-none"],  # noqa: E501
 )  # fmt: skip
 def test_each_layouts_download_gives_its_time(
     layout: str, identity: str, submitted_at: datetime | None, late: bool | None, tmp_path: Path
@@ -56,7 +56,7 @@ def _git(repository: Path, *args: str, when: datetime) -> None:
     stamp = when.isoformat()
     environment = {**os.environ, "GIT_AUTHOR_DATE": stamp, "GIT_COMMITTER_DATE": stamp,
                    "GIT_AUTHOR_NAME": "s", "GIT_AUTHOR_EMAIL": "s@x", "GIT_COMMITTER_NAME": "s",
-                   "GIT_COMMITTER_EMAIL": "s@x", "GIT_CONFIG_GLOBAL": os.devnull, "GIT_CONFIG_NOSYSTEM": "1"}  # fmt: skip
+                   "GIT_COMMITTER_EMAIL": "s@x", "GIT_CONFIG_GLOBAL": os.devnull, "GIT_CONFIG_NOSYSTEM": "1"}  # fmt: skip  # noqa: E501
     subprocess.run(["git", "-C", str(repository), *args], check=True, capture_output=True, env=environment)
 
 
@@ -135,7 +135,7 @@ def test_a_tampered_git_folder_gives_no_time_and_reads_nothing_outside(tamper: s
         ("id,user_id,submitted_at,late\n9001,1105,2026-03-02T04:59:00Z,true\n9002,1106,,false\n",
          {"1105": datetime(2026, 3, 2, 4, 59, tzinfo=UTC)}),
         ("\ufeffIdentifier,Full name,Email address,Status,Last modified (submission)\r\n"
-         "Participant 81000,Student Number0,s0@uni.edu,Submitted for grading,\"Monday, 2 March 2026, 11:59 PM\"\r\n"
+         "Participant 81000,Student Number0,s0@uni.edu,Submitted for grading,\"Monday, 2 March 2026, 11:59 PM\"\r\n"  # noqa: E501
          "Participant 81001,Student Number1,s1@uni.edu,No submission,-\r\n",
          {"81000": datetime(2026, 3, 2, 23, 59)}),
     ],
