@@ -12,6 +12,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 from grader.class_report.text import safe_cell
+from grader.classroom.decisions import NO_DECISIONS, Decisions, FinalGrade, final_grade
 from grader.classroom.errors import GradebookError
 from grader.classroom.model import ClassDownload, Member, Submission
 from grader.classroom.roster import Roster, RosterEntry
@@ -31,6 +32,7 @@ class GradeRow:
         refused_claim: Its identity matches a roster student another submission matched first: it is in
             ``grades.csv`` with a note, never in an LMS gradebook (two rows for one student there would
             give one of them the other's score).
+        final: Their grade after the instructor's overrides and late policy (every gradebook's scores).
     """
 
     member: Member
@@ -39,6 +41,12 @@ class GradeRow:
     roster: RosterEntry | None
     note: str
     refused_claim: bool = False
+    final: FinalGrade | None = None
+
+    @property
+    def grade(self) -> FinalGrade:
+        """``final``, else the machine's grade as it is."""
+        return self.final or final_grade(self.member.identity, self.report, self.submission)
 
     @property
     def name(self) -> str:
@@ -52,7 +60,10 @@ class GradeRow:
 
 
 def class_rows(
-    download: ClassDownload, reports: Mapping[str, Report], roster: Roster | None = None
+    download: ClassDownload,
+    reports: Mapping[str, Report],
+    roster: Roster | None = None,
+    decisions: Decisions = NO_DECISIONS,
 ) -> list[GradeRow]:
     """A row per student: each member of each submission, and each roster student who submitted nothing.
 
@@ -60,6 +71,7 @@ def class_rows(
         download: What was found.
         reports: Reports by submission identity (finished ones; the others get no scores yet).
         roster: The class roster, if any.
+        decisions: The instructor's overrides and late policy (each row's ``final``).
 
     Returns:
         Rows sorted by the student's identity.
@@ -100,16 +112,32 @@ def class_rows(
         ]
         if others:
             notes.append(f"also in {', '.join(others)}: the latest submission counts")
+        final = final_grade(member.identity, report, submission, decisions)
+        notes += final.notes
         rows.append(
             GradeRow(
-                member, submission, report, entry, "; ".join(notes), refused_claim=claimed_by is not None
+                member,
+                submission,
+                report,
+                entry,
+                "; ".join(notes),
+                refused_claim=claimed_by is not None,
+                final=final,
             )
         )
     matched = {id(entry) for entry, claimed_by, _ in claims.values() if entry is not None}
     for entry in roster.entries if roster else []:
         if id(entry) not in matched:
+            final = final_grade(entry.identity, None, None, decisions)
             rows.append(
-                GradeRow(Member(entry.identity, entry.name, entry.email), None, None, entry, "no submission")
+                GradeRow(
+                    Member(entry.identity, entry.name, entry.email),
+                    None,
+                    None,
+                    entry,
+                    "; ".join(["no submission", *final.notes]),
+                    final=final,
+                )
             )
     rows.sort(key=lambda row: row.member.identity)
     return rows
@@ -183,17 +211,21 @@ def _write(header: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
     return stream.getvalue()
 
 
-def grades_csv(rows: Sequence[GradeRow], problems: Sequence[str]) -> str:
+def grades_csv(rows: Sequence[GradeRow], problems: Sequence[str], *, late_penalty: bool = False) -> str:
     """``grades.csv``: identity, name, email, group, graded file and why, time, late flag, sha256, seed,
-    a column per problem, total, max_score, note."""
+    a column per problem (the instructor's override where there is one), ``late_penalty`` when a late
+    policy is in force, total (after both), max_score, note (each override with the machine's verdict and
+    its reason, the late count)."""
     header = [
         "student", "name", "email", "group", "graded_file", "why", "submitted_at", "late", "sha256", "seed",
-        *problems, "total", "max_score", "note",
+        *problems, *(["late_penalty"] if late_penalty else []), "total", "max_score", "note",
     ]  # fmt: skip
     lines = []
     for row in rows:
-        submission, report = row.submission, row.report
-        scores = {result.id: result.score for result in report.problems} if report else {}
+        submission, report, grade = row.submission, row.report, row.grade
+        when = grade.lateness.submitted_at if grade.lateness else None
+        when = when or (submission.submitted_at if submission else None)
+        decided = report is not None or bool(grade.overridden)
         lines.append(
             [
                 row.member.identity,
@@ -202,15 +234,14 @@ def grades_csv(rows: Sequence[GradeRow], problems: Sequence[str]) -> str:
                 submission.identity if submission and len(submission.members) > 1 else "",
                 submission.graded_file.relative if submission and submission.graded_file else "",
                 submission.why if submission else "",
-                submission.submitted_at.isoformat() if submission and submission.submitted_at else "",
-                ""
-                if submission is None or submission.late is None
-                else ("late" if submission.late else "on time"),
+                when.isoformat() if when else "",
+                "" if grade.late is None else ("late" if grade.late else "on time"),
                 report.sha256 if report else "",
                 report.seed if report else "",
-                *(_number(scores.get(problem, 0.0)) if report else "" for problem in problems),
-                _number(report.score) if report else "",
-                _number(report.max_score) if report else "",
+                *(_number(grade.scores.get(problem, 0.0)) if decided else "" for problem in problems),
+                *([_number(grade.late_penalty) if grade.lateness else ""] if late_penalty else []),
+                _number(grade.total),
+                _number(grade.max_score) if decided else "",
                 row.note,
             ]
         )
@@ -263,7 +294,7 @@ def canvas_csv(rows: Sequence[GradeRow], assignment: Assignment) -> str:
                 roster.get("sis user id") if roster else "",
                 roster.get("sis login id") if roster else "",
                 roster.get("section") if roster else "",
-                _number(row.report.score) if row.report else "",
+                _number(row.grade.total),
             ]
         )
     return _write(["Student", "ID", "SIS User ID", "SIS Login ID", "Section", column], lines)
@@ -274,16 +305,17 @@ def gradescope_csv(rows: Sequence[GradeRow], problems: Sequence[str]) -> str:
     Status``, one per problem), so they import where a Gradescope export's scores do."""
     lines = []
     for row in _lms_rows(rows):
-        scores = {result.id: result.score for result in row.report.problems} if row.report else {}
+        grade = row.grade
+        decided = grade.total is not None
         lines.append(
             [
                 row.name,
                 row.member.identity,
                 row.email,
-                _number(row.report.score) if row.report else "",
-                _number(row.report.max_score) if row.report else "",
-                "Graded" if row.report else "Missing",
-                *(_number(scores.get(problem)) if row.report else "" for problem in problems),
+                _number(grade.total),
+                _number(grade.max_score) if decided else "",
+                "Graded" if decided else "Missing",
+                *(_number(grade.scores.get(problem)) if decided else "" for problem in problems),
             ]
         )
     return _write(["Name", "SID", "Email", "Total Score", "Max Points", "Status", *problems], lines)
@@ -299,8 +331,8 @@ def github_classroom_csv(rows: Sequence[GradeRow]) -> str:
         [
             (row.roster.get("github_username") if row.roster else "") or row.member.identity,
             row.roster.get("identifier") if row.roster else "",
-            _number(row.report.score) if row.report else "",
-            _number(row.report.max_score if row.report else points),
+            _number(row.grade.total),
+            _number(row.grade.max_score if row.grade.max_score is not None else points),
         ]
         for row in _lms_rows(rows)
     ]

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from grader.batch import GRADES_FILE, write_atomically
+from grader.classroom.decisions import NO_DECISIONS, Decisions
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment, GradeRow, class_rows, grades_csv
 from grader.classroom.model import ClassDownload
 from grader.classroom.roster import Roster
@@ -24,6 +25,7 @@ class ClassGradebook:
         roster: The roster, if any.
         formats: ``GRADEBOOKS`` names to write beside ``grades.csv``.
         assignment: Title, LMS id and points of the assignment.
+        decisions: The instructor's overrides and late policy, applied to every gradebook.
     """
 
     download: ClassDownload
@@ -33,12 +35,14 @@ class ClassGradebook:
     formats: Sequence[str] = ()
     assignment: Assignment = field(default_factory=Assignment)
     rows: list[GradeRow] | None = None
+    decisions: Decisions = NO_DECISIONS
 
     def __call__(self, out_dir: Path, reports: Mapping[Path, Report]) -> None:
         """Write every gradebook from the reports finished so far."""
         by_identity = {self.identities[path]: report for path, report in reports.items()}
-        self.rows = class_rows(self.download, by_identity, self.roster)
-        write_atomically(out_dir / GRADES_FILE, grades_csv(self.rows, self.problems))
+        self.rows = class_rows(self.download, by_identity, self.roster, self.decisions)
+        grades = grades_csv(self.rows, self.problems, late_penalty=self.decisions.late is not None)
+        write_atomically(out_dir / GRADES_FILE, grades)
         for name in self.formats:
             file_name, write = GRADEBOOKS[name]
             write_atomically(out_dir / file_name, write(self.rows, self.problems, self.assignment))
