@@ -16,7 +16,7 @@ import os
 import tempfile
 import time
 import urllib.parse
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
@@ -276,6 +276,7 @@ def grade_many(
     on_plan: Callable[[BatchOutcome], None] | None = None,
     names: Mapping[Path, str] | None = None,
     gradebook: GradebookWriter | None = None,
+    regrade: Collection[Path] | None = None,
 ) -> BatchOutcome:
     """Grade many submissions; keep ``<name>.json`` per submission and ``grades.csv`` in ``out_dir``.
 
@@ -298,9 +299,13 @@ def grade_many(
         names: Each file's student identity: it names the report (``<identity>.json``, the resume key) and
             the gradebook row; file stems (numbered when they repeat) when None.
         gradebook: Writes the gradebook(s) after each report; ``grades.csv`` by file when None.
+        regrade: Grade exactly these files, whatever their reports say; every other file's report in
+            ``out_dir`` is taken as it is (never graded, never rewritten; left out when there is none).
+            None: grade what is stale.
 
     Returns:
-        Every report in the order of ``paths``, and which files were reused or graded.
+        Every report in the order of ``paths`` (with ``regrade``, those that exist), and which files were
+        reused or graded.
 
     Raises:
         grader.errors.BatchInterrupted: Interrupted; the reports finished so far are in ``out_dir``.
@@ -310,6 +315,14 @@ def grade_many(
     outcome = BatchOutcome(reports=[], reused=[], graded=[])
     for path in paths:
         report_text = output.existing_text(path)
+        if regrade is not None:
+            if path in regrade:
+                outcome.graded.append(path)
+                outcome.reasons[path] = "regraded on request"
+            elif (kept := _parsed(report_text)) is not None:
+                output.reuse(path, kept)
+                outcome.reused.append(path)
+            continue
         reason = stale_reason(report_text, _read(path), seed=seed, plan=plan)
         if reason is None and report_text is not None:
             output.reuse(path, Report.model_validate_json(report_text))
@@ -330,8 +343,17 @@ def grade_many(
             raise BatchInterrupted(len(output.reports), len(paths)) from interruption
         finally:
             output.flush()
-    outcome.reports = [output.reports[path] for path in paths]
+    outcome.reports = [output.reports[path] for path in paths if path in output.reports]
     return outcome
+
+
+def _parsed(report_text: str | None) -> Report | None:
+    if report_text is None:
+        return None
+    try:
+        return Report.model_validate_json(report_text)
+    except ValidationError:
+        return None
 
 
 def recorded_seed(out_dir: Path) -> int | None:
