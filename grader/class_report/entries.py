@@ -13,6 +13,16 @@ that could not be graded at all (its report, when there is one, says why)."""
 
 
 @dataclass(frozen=True)
+class EntryOverride:
+    """A cell the instructor decided: the problem (or ``total``), their points, the machine's, and why."""
+
+    problem: str
+    points: float
+    machine: float | None
+    reason: str
+
+
+@dataclass(frozen=True)
 class ClassEntry:
     """One student (or group) of the class, as the class report sees them.
 
@@ -24,6 +34,10 @@ class ClassEntry:
         status: graded, missing or submission_error (see ``EntryStatus``).
         note: What to tell the instructor (why the submission could not be graded, which file was graded).
         report_href: Link to their own report, relative to the class page; None when there is none.
+        score: Their final score after the instructor's decisions (None: the report's score stands).
+        late_penalty: Points the late policy took (None: no late policy).
+        extended_to: Their own due time when they have an extension (ISO 8601).
+        overrides: The cells the instructor decided, the machine's verdict beside each.
     """
 
     identity: str
@@ -33,3 +47,7 @@ class ClassEntry:
     status: EntryStatus = "graded"
     note: str = ""
     report_href: str | None = None
+    score: float | None = None
+    late_penalty: float | None = None
+    extended_to: str | None = None
+    overrides: tuple[EntryOverride, ...] = ()

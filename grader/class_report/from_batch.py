@@ -12,8 +12,9 @@ from pathlib import Path
 
 from grader.batch import GRADES_FILE, identity_stem
 from grader.class_report import summary_path
-from grader.class_report.entries import ClassEntry, EntryStatus
+from grader.class_report.entries import ClassEntry, EntryOverride, EntryStatus
 from grader.classroom.gradebooks import GradeRow
+from grader.classroom.overrides import TOTAL
 
 
 def entries_from_rows(rows: Sequence[GradeRow], out_dir: Path, page: Path) -> list[ClassEntry]:
@@ -45,15 +46,29 @@ def entries_from_rows(rows: Sequence[GradeRow], out_dir: Path, page: Path) -> li
         if submission is not None and report is not None:
             target = (out_dir / f"{identity_stem(submission.identity)}.json").resolve()
             href = Path(os.path.relpath(target, folder)).as_posix()
+        grade = row.grade
+        lateness = grade.lateness
         entries.append(
             ClassEntry(
                 identity=row.member.identity,
                 name=row.name or None,
                 report=report,
-                late=bool(submission and submission.late),
+                late=bool(grade.late),
                 status=status,
                 note=row.note or (f"graded {graded}" if graded else ""),
                 report_href=href,
+                score=grade.total if grade.overridden or lateness else None,
+                late_penalty=lateness.penalty if lateness else None,
+                extended_to=lateness.due.isoformat() if lateness and lateness.extended else None,
+                overrides=tuple(
+                    EntryOverride(
+                        problem,
+                        override.points,
+                        grade.machine_total if problem == TOTAL else grade.machine.get(problem),
+                        override.reason,
+                    )
+                    for problem, override in grade.overridden.items()
+                ),
             )
         )
     return entries

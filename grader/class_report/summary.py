@@ -106,6 +106,17 @@ class Diagnosis(BaseModel):
     identities: list[str]
 
 
+class OverrideRow(BaseModel):
+    """A cell the instructor decided, beside the machine's verdict."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    problem: str = Field(description="A problem id, or total.")
+    points: float = Field(description="The instructor's points.")
+    machine: float | None = Field(description="The machine's points (None: nothing graded).")
+    reason: str
+
+
 class StudentRow(BaseModel):
     """One student as the class page lists them."""
 
@@ -114,11 +125,17 @@ class StudentRow(BaseModel):
     identity: str
     name: str | None
     status: EntryStatus
-    score: float | None
+    score: float | None = Field(description="The final score (after overrides and the late penalty).")
     max_score: float | None
     late: bool
     note: str
     report_href: str | None = Field(description="Relative, percent-encoded link; None when refused.")
+    machine_score: float | None = Field(default=None, description="The machine's score (None: no report).")
+    late_penalty: float | None = Field(
+        default=None, description="Points the late policy took (None: no policy)."
+    )
+    extended_to: str | None = Field(default=None, description="Their own due time, when extended.")
+    overrides: list[OverrideRow] = Field(default_factory=list, description="The instructor's decisions.")
 
 
 class ClassSummary(BaseModel):
@@ -132,6 +149,8 @@ class ClassSummary(BaseModel):
     graded: int
     missing: list[str] = Field(description="On the roster, no submission.")
     late: list[str]
+    overridden: list[str] = Field(default_factory=list, description="Students with an instructor's override.")
+    extended: list[str] = Field(default_factory=list, description="Students with their own due time.")
     submission_errors: list[StudentRow]
     scores: ScoreDistribution
     problems: list[ProblemPassRate]
@@ -183,6 +202,8 @@ def summarise(entries: Sequence[ClassEntry], *, title: str = "") -> ClassSummary
         graded=len(graded),
         missing=[_identity(entry) for entry in ordered if entry.status == "missing"],
         late=[_identity(entry) for entry in ordered if entry.late],
+        overridden=[_identity(entry) for entry in ordered if entry.overrides],
+        extended=[_identity(entry) for entry in ordered if entry.extended_to],
         submission_errors=[_row(entry) for entry in ordered if entry.status == "submission_error"],
         scores=_distribution(ordered),
         problems=_pass_rates(graded),
@@ -218,17 +239,37 @@ def _row(entry: ClassEntry) -> StudentRow:
         identity=_identity(entry),
         name=None if entry.name is None else bounded(entry.name, MAX_NAME_CHARS),
         status=entry.status,
-        score=None if report is None else report.score,
+        score=_score(entry),
         max_score=None if report is None else report.max_score,
         late=entry.late,
         note=bounded(note, MAX_NOTE_CHARS),
         report_href=safe_href(entry.report_href),
+        machine_score=None if report is None else report.score,
+        late_penalty=entry.late_penalty,
+        extended_to=entry.extended_to,
+        overrides=[
+            OverrideRow(
+                problem=override.problem,
+                points=override.points,
+                machine=override.machine,
+                reason=bounded(override.reason, MAX_NOTE_CHARS),
+            )
+            for override in entry.overrides
+        ],
     )
 
 
+def _score(entry: ClassEntry) -> float | None:
+    """The entry's final score: the instructor's decisions', else its report's."""
+    if entry.score is not None:
+        return entry.score
+    return None if entry.report is None else entry.report.score
+
+
 def _distribution(entries: Iterable[ClassEntry]) -> ScoreDistribution:
-    reports = [entry.report for entry in entries if entry.report is not None and entry.status != "missing"]
-    scores = [report.score for report in reports]
+    counted = [entry for entry in entries if entry.report is not None and entry.status != "missing"]
+    reports = [entry.report for entry in counted if entry.report is not None]
+    scores = [score for entry in counted if (score := _score(entry)) is not None]
     top = max((report.max_score for report in reports), default=0.0)
     return ScoreDistribution(
         count=len(scores),
@@ -237,9 +278,16 @@ def _distribution(entries: Iterable[ClassEntry]) -> ScoreDistribution:
         median=statistics.median(scores) if scores else None,
         min=min(scores, default=None),
         max=max(scores, default=None),
-        full_marks=sum(1 for report in reports if report.full_marks and report.problems),
+        full_marks=sum(1 for entry in counted if _full_marks(entry)),
         bins=_bins(scores, top),
     )
+
+
+def _full_marks(entry: ClassEntry) -> bool:
+    report = entry.report
+    if report is None or not report.problems:
+        return False
+    return report.full_marks if entry.score is None else entry.score >= report.max_score
 
 
 def _bins(scores: Sequence[float], top: float) -> list[ScoreBin]:

@@ -15,8 +15,8 @@ from grader.class_report.text import HIDDEN, MAX_DIAGNOSIS_CHARS
 from .support import OFF_BY_ONE, SHORT_POLE, STOOD_ON_N, all_passed, graded, report, result
 
 SUMMARY_KEYS = [
-    "format", "title", "students", "graded", "missing", "late", "submission_errors", "scores", "problems",
-    "diagnoses", "diagnoses_left_off", "entries",
+    "format", "title", "students", "graded", "missing", "late", "overridden", "extended", "submission_errors",
+    "scores", "problems", "diagnoses", "diagnoses_left_off", "entries",
 ]  # fmt: skip
 
 
@@ -251,7 +251,8 @@ def test_late_and_missing_students_are_listed_by_identity() -> None:
     ]
     assert summary["entries"][-1] == {
         "identity": "u400", "name": None, "status": "missing", "score": None, "max_score": None,
-        "late": False, "note": "", "report_href": None,
+        "late": False, "note": "", "report_href": None, "machine_score": None, "late_penalty": None,
+        "extended_to": None, "overrides": [],
     }  # fmt: skip
 
 

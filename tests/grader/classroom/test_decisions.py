@@ -148,3 +148,27 @@ def test_a_roster_student_without_a_submission_can_be_given_a_total() -> None:
     assert (grade.total, grade.max_score, grade.notes) == (
         1.5, 2.0, ("total overridden to 1.5 (machine: nothing graded): oral exam instead",),
     )  # fmt: skip
+
+
+def test_the_class_report_shows_overrides_penalties_and_extensions_as_such(tmp_path: Path) -> None:
+    from grader.class_report import render_class_html, summarise
+    from grader.class_report.from_batch import entries_from_rows
+
+    policy = POLICY.model_copy(update={"extensions": {"003101": DUE + timedelta(days=2)}})
+    text = OVERRIDES + "003101,car,1,<script>alert(1)</script>\n"
+    rows = _rows(tmp_path, text, late=policy, submitted_at={"000102": DUE + timedelta(hours=2)})
+    summary = summarise(entries_from_rows(rows, tmp_path / "out", tmp_path / "class.html"))
+    by_identity = {row.identity: row for row in summary.entries}
+    assert (summary.overridden, summary.extended) == (["000101", "000103", "003100", "003101"], ["003101"])
+    assert [(o.problem, o.points, o.machine) for o in by_identity["000103"].overrides] == [
+        ("total", 2.0, 1.0)
+    ]
+    assert (by_identity["000102"].score, by_identity["000102"].machine_score) == (0.5, 1.0)
+    assert by_identity["000102"].late_penalty == 0.5
+    assert by_identity["003101"].extended_to == "2026-03-03T23:59:00+00:00"
+    assert summary.scores.mean == pytest.approx((2 + 2 + 1.5 + 0.5 + 2 + 1) / 6)
+    page = render_class_html(
+        entries_from_rows(rows, tmp_path / "out", tmp_path / "class.html"), summary=summary
+    )
+    assert "<script>alert" not in page and "&lt;script&gt;alert(1)&lt;/script&gt;" in page
+    assert "(machine: 1)" in page and "(late: −0.5)" in page and "(due 2026-03-03T23:59:00+00:00)" in page
