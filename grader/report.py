@@ -198,6 +198,32 @@ class ProblemRun(BaseModel):
             return cleaned.model_dump_json()
 
 
+class InstructorOverride(BaseModel):
+    """A score the instructor set, beside the machine's."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    problem: str = Field(description="A problem id, or 'total' (the whole grade).")
+    points: float = Field(description="The instructor's points.")
+    machine: float | None = Field(description="What the machine gave (None: nothing was graded).")
+    reason: str = Field(description="Why, in the instructor's words.")
+
+
+class InstructorDecisions(BaseModel):
+    """The instructor's last word on one student's grade (``gymgrade grade --overrides`` and ``[late]``);
+    the machine's verdicts above it are unchanged."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    student: str = Field(
+        description="The student as the gradebook names them (a group's report has one each)."
+    )
+    overrides: list[InstructorOverride] = Field(default_factory=list, description="Scores set by hand.")
+    late_penalty: float | None = Field(default=None, description="Points the late policy took (None: none).")
+    late_note: str = Field(default="", description="How late, by which due time, and what was taken.")
+    final_score: float | None = Field(description="The grade after the overrides and the late penalty.")
+
+
 class Report(BaseModel):
     """The whole grade of one submission, serialised as the JSON the CLI prints and the service stores."""
 
@@ -242,6 +268,11 @@ class Report(BaseModel):
     timings: GradingTimings | None = Field(
         default=None, description="Where the grading's time went (not deterministic)."
     )
+    instructor: list[InstructorDecisions] = Field(
+        default_factory=list,
+        description="The instructor's overrides and late penalty, per student (written into a class's reports by gymgrade grade; "  # noqa: E501
+        "left out of the JSON when there are none).",
+    )
 
     @property
     def full_marks(self) -> bool:
@@ -253,11 +284,12 @@ class Report(BaseModel):
 
     def to_json(self) -> str:
         """The report as indented JSON, fields in declaration order (stable for identical reports)."""
-        return self.model_dump_json(indent=2)
+        return self.model_dump_json(indent=2, exclude=None if self.instructor else {"instructor"})
 
     def graded_view(self) -> dict[str, Any]:
-        """The report without its timing fields: identical for identical bytes and seed."""
-        data = self.model_dump(exclude=set(TIMING_FIELDS))
+        """The report without its timing fields and the instructor's decisions: identical for identical
+        bytes and seed."""
+        data = self.model_dump(exclude={*TIMING_FIELDS, "instructor"})
         for problem in data["problems"]:
             problem.pop("timings", None)
         return data

@@ -6,12 +6,13 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grader.batch import GRADES_FILE, write_atomically
+from grader.batch import GRADES_FILE, identity_stem, write_atomically
 from grader.classroom.decisions import NO_DECISIONS, Decisions
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment, GradeRow, class_rows, grades_csv
 from grader.classroom.model import ClassDownload
+from grader.classroom.overrides import TOTAL
 from grader.classroom.roster import Roster
-from grader.report import Report
+from grader.report import InstructorDecisions, InstructorOverride, Report
 
 
 @dataclass
@@ -36,6 +37,8 @@ class ClassGradebook:
     assignment: Assignment = field(default_factory=Assignment)
     rows: list[GradeRow] | None = None
     decisions: Decisions = NO_DECISIONS
+    decided: dict[str, list[InstructorDecisions]] = field(default_factory=dict)
+    """What each report file (by submission identity) last had written of the instructor's decisions."""
 
     def __call__(self, out_dir: Path, reports: Mapping[Path, Report]) -> None:
         """Write every gradebook from the reports finished so far."""
@@ -46,3 +49,45 @@ class ClassGradebook:
         for name in self.formats:
             file_name, write = GRADEBOOKS[name]
             write_atomically(out_dir / file_name, write(self.rows, self.problems, self.assignment))
+        self._write_decisions(out_dir, by_identity)
+
+    def _write_decisions(self, out_dir: Path, reports: Mapping[str, Report]) -> None:
+        """Put each student's overrides and late penalty into their report file (``instructor``), rewriting
+        a report only when what it holds of them changed; the machine's verdicts are left as they are."""
+        wanted: dict[str, list[InstructorDecisions]] = {}
+        for row in self.rows or []:
+            if row.submission is None or row.submission.identity not in reports:
+                continue
+            grade = row.grade
+            late = (
+                grade.lateness if grade.lateness and (grade.lateness.penalty or grade.lateness.note) else None
+            )
+            if not grade.overridden and late is None:
+                continue
+            wanted.setdefault(row.submission.identity, []).append(
+                InstructorDecisions(
+                    student=row.member.identity,
+                    overrides=[
+                        InstructorOverride(
+                            problem=problem,
+                            points=override.points,
+                            machine=grade.machine_total if problem == TOTAL else grade.machine.get(problem),
+                            reason=override.reason,
+                        )
+                        for problem, override in grade.overridden.items()
+                    ],
+                    late_penalty=late.penalty if late else None,
+                    late_note=late.note if late else "",
+                    final_score=grade.total,
+                )
+            )
+        for identity, report in reports.items():
+            decisions = wanted.get(identity, [])
+            if self.decided.get(identity, report.instructor) == decisions:
+                continue
+            try:
+                text = report.model_copy(update={"instructor": decisions}).to_json() + "\n"
+                write_atomically(out_dir / f"{identity_stem(identity)}.json", text)
+            except OSError:
+                continue  # the report's own write failed the same way: its row says so
+            self.decided[identity] = decisions

@@ -36,6 +36,7 @@ def summary(report: Report) -> str:
     lines.append(
         f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
     )
+    lines += instructor_lines(report)
     lines.append(f"Edition: {edition_name(report.edition)}")
     if report.edition_note:
         lines.append(report.edition_note)
@@ -45,6 +46,24 @@ def summary(report: Report) -> str:
     lines += isolation_lines(report.isolation)
     lines += [f"Grader error (not your fault): {error}" for error in report.grader_errors]
     return display_block("\n".join(lines))
+
+
+def instructor_lines(report: Report) -> list[str]:
+    """What the instructor decided of this grade: each override beside the grader's verdict, with its
+    reason, the late penalty, and the final score (one block per student of a group's report)."""
+    lines: list[str] = []
+    for decided in report.instructor:
+        whose = f" for {decided.student}" if len(report.instructor) > 1 else ""
+        for override in decided.overrides:
+            machine = "nothing graded" if override.machine is None else f"{override.machine:g}"
+            lines.append(
+                f"Your instructor set {override.problem}{whose} to {override.points:g} (the grader gave {machine}): {override.reason}"  # noqa: E501
+            )
+        if decided.late_note:
+            lines.append(f"Late{whose}: {decided.late_note}")
+        if decided.final_score is not None:
+            lines.append(f"Final score{whose}: {decided.final_score:g} / {report.max_score:g}")
+    return lines
 
 
 def edition_name(name: str) -> str:
