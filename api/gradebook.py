@@ -11,9 +11,11 @@ from typing import Any
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
-from api.models import JobStatus, Student, Submission
+from api.models import JobStatus, Override, Student, Submission
+from api.overrides import as_decided, counted_overrides, maxima_of
 from api.settings import GradebookPolicy
 from grader.class_report.text import safe_cell
+from grader.classroom.decisions import Decisions, FinalGrade, final_grade
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment, GradeRow
 from grader.classroom.model import Member
 from grader.classroom.roster import RosterEntry
@@ -69,20 +71,34 @@ def gradebook_export(
         )
     students, chosen = _chosen(session, policy)
     problem_ids = _problem_ids(row.report for row in chosen.values())
-    rows = [
-        GradeRow(
-            member=Member(student.name, student.name),
-            submission=None,
-            report=_report(chosen.get(student.id)),
-            roster=RosterEntry(
-                student.name, student.name, "", {"id": student.name, "username": student.name}
-            ),
-            note="",
+    counted = counted_overrides(session, chosen)
+    rows = []
+    for student in students:
+        picked = chosen.get(student.id)
+        report = _report(picked)
+        final = _final(student.name, picked, report, counted.get(student.id, {}))
+        rows.append(
+            GradeRow(
+                member=Member(student.name, student.name),
+                submission=None,
+                report=report,
+                roster=RosterEntry(
+                    student.name, student.name, "", {"id": student.name, "username": student.name}
+                ),
+                note="; ".join(final.notes),
+                final=final,
+            )
         )
-        for student in students
-    ]
     _, write = GRADEBOOKS[gradebook_format]
     return write(rows, problem_ids, assignment)
+
+
+def _final(name: str, picked: Any, report: Report | None, overrides: dict[str, Override]) -> FinalGrade:
+    """The student's grade after the instructor's overrides (the machine's when there are none)."""
+    decisions = Decisions(
+        overrides=as_decided(name, overrides), maxima=maxima_of(picked.report if picked else None)
+    )
+    return final_grade(name, report, None, decisions)
 
 
 def _report(picked: Any) -> Report | None:
@@ -107,23 +123,27 @@ def gradebook_csv(session: Session, policy: GradebookPolicy) -> str:
 
     Returns:
         CSV text: ``student, submission_id, submitted_at, sha256``, one column per problem (its score),
-        ``score, max_score``; students without a graded submission have empty cells.
+        ``score, max_score`` (after the instructor's overrides), ``note`` (each override with the machine's
+        verdict and its reason); students without a graded submission have empty cells.
     """
     students, chosen = _chosen(session, policy)
     problem_ids = _problem_ids(row.report for row in chosen.values())
+    counted = counted_overrides(session, chosen)
     output = io.StringIO()
     writer = csv.writer(output, lineterminator="\n")
     writer.writerow(
-        ["student", "submission_id", "submitted_at", "sha256", *problem_ids, "score", "max_score"]
+        ["student", "submission_id", "submitted_at", "sha256", *problem_ids, "score", "max_score", "note"]
     )
     for student in students:
         picked = chosen.get(student.id)
         if picked is None:
-            writer.writerow([safe_cell(student.name), "", "", "", *([""] * len(problem_ids)), "", ""])
+            writer.writerow([safe_cell(student.name), "", "", "", *([""] * len(problem_ids)), "", "", ""])
             continue
+        final = _final(student.name, picked, _report(picked), counted.get(student.id, {}))
         scores = {
             problem.get("id"): problem.get("score") for problem in (picked.report or {}).get("problems", [])
         }
+        scores.update(final.scores)
         writer.writerow(
             [
                 safe_cell(student.name),
@@ -131,8 +151,9 @@ def gradebook_csv(session: Session, policy: GradebookPolicy) -> str:
                 picked.created_at.isoformat(timespec="seconds"),
                 picked.sha256,
                 *(_number(scores.get(problem_id)) for problem_id in problem_ids),
-                _number(picked.score),
+                _number(final.total if final.overridden else picked.score),
                 _number(picked.max_score),
+                safe_cell("; ".join(final.notes)),
             ]
         )
     return output.getvalue()

@@ -67,3 +67,19 @@ class Submission(Base):
     max_score: Mapped[float | None] = mapped_column(Float, nullable=True)
 
     student: Mapped[Student] = relationship(back_populates="submissions")
+
+
+class Override(Base):
+    """An instructor's override of one student's score for a problem (or their ``total``), with its reason,
+    who made it and when. Every override is kept; for a student, problem and upload the latest counts."""
+
+    __tablename__ = "overrides"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    student_id: Mapped[int] = mapped_column(ForeignKey("students.id"), index=True)
+    submission_id: Mapped[int | None] = mapped_column(ForeignKey("submissions.id"), nullable=True)
+    problem: Mapped[str] = mapped_column(String(64))
+    points: Mapped[float] = mapped_column(Float)
+    reason: Mapped[str] = mapped_column(Text)
+    author: Mapped[str] = mapped_column(String(100))
+    created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)

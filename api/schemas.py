@@ -113,3 +113,39 @@ class ErrorBody(BaseModel):
         default=None,
         description="Only on 422 for a request that breaks the schema: each offending field, for programs.",
     )
+
+
+class OverrideCreate(BaseModel):
+    """An instructor's override of a student's score for one problem (or their total)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    problem: str = Field(
+        min_length=1,
+        max_length=64,
+        description="A problem id of the student's report, or `total`.",
+        examples=["car"],
+    )
+    points: float = Field(
+        ge=0.0, allow_inf_nan=False, description="The points given (at most what it is worth)."
+    )
+    reason: str = Field(min_length=1, max_length=1000, description="Why, shown beside the machine's verdict.")
+    submission_id: int | None = Field(
+        default=None,
+        ge=1,
+        le=2**31 - 1,
+        description="One upload's override (it counts while the gradebook shows that upload); none: the student's.",  # noqa: E501
+    )
+
+
+class OverrideView(BaseModel):
+    """A recorded override, with who made it and when."""
+
+    id: int
+    student: str
+    submission_id: int | None
+    problem: str
+    points: float
+    reason: str
+    author: str = Field(description="Who made it (the instructor).")
+    created_at: UtcDateTime

@@ -11,9 +11,10 @@ from sqlalchemy.orm import Session
 from api.auth import Principal, authenticate
 from api.deps import SESSION_COOKIE, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
 from api.disclosure import disclosure_for
-from api.errors import NotAuthenticated
+from api.errors import InvalidRequest, NotAuthenticated, StudentNotFound, SubmissionNotFound
 from api.gradebook import gradebook_csv
 from api.models import JobStatus
+from api.overrides import record_override
 from api.settings import Settings
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
@@ -116,6 +117,54 @@ def _submission(
 ) -> Response:
     view = detail(get_submission(session, caller, submission_id), disclosure_for(caller, settings))
     return _page(request, template, {"submission": view, "final": view.status in FINAL_STATUSES})
+
+
+@router.post("/ui/overrides")
+def override(
+    request: Request,
+    session: SessionDep,
+    settings: SettingsDep,
+    caller: PageCallerDep,
+    student: Annotated[str, Form()] = "",
+    problem: Annotated[str, Form()] = "",
+    points: Annotated[str, Form()] = "",
+    reason: Annotated[str, Form()] = "",
+    submission_id: Annotated[str, Form()] = "",
+) -> Response:
+    """The instructor's override form: kept with who and when, or the reason it was refused."""
+    signed_in = _signed_in(caller)
+    signed_in.require_instructor()
+    try:
+        value = float(points)
+        upload = int(submission_id) if submission_id.strip() else None
+    except ValueError:
+        return _home(request, session, signed_in, settings, f"points {points!r} is not a number", error=True)
+    try:
+        record_override(
+            session, student_name=student, problem=problem.strip(), points=value, reason=reason,
+            author=signed_in.name, submission_id=upload,
+        )  # fmt: skip
+    except (InvalidRequest, StudentNotFound, SubmissionNotFound) as refused:
+        return _home(request, session, signed_in, settings, str(refused), error=True)
+    return _home(request, session, signed_in, settings, f"{problem} of {student} set to {value:g}: {reason}")
+
+
+def _home(
+    request: Request,
+    session: Session,
+    caller: Principal,
+    settings: Settings,
+    message: str,
+    *,
+    error: bool = False,
+) -> Response:
+    disclosure = disclosure_for(caller, settings)
+    submissions = [summary(item, disclosure) for item in list_submissions(session, caller)]
+    context = {
+        "caller": caller, "submissions": submissions, "max_upload_bytes": settings.max_upload_bytes,
+        "override_message": message, "override_error": error,
+    }  # fmt: skip
+    return _page(request, "home.html", context, status_code=422 if error else 200)
 
 
 @router.get("/ui/gradebook.csv")

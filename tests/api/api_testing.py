@@ -148,3 +148,19 @@ class RedisServer:
         if self._databases >= 64:
             raise RuntimeError("more than 63 Redis databases asked for in one run")
         return f"redis://127.0.0.1:{self.port}/{self._databases}"
+
+
+def graded_upload(client: TestClient, token: str, scores: dict[str, float]) -> int:
+    """Upload a file as the student of ``token`` and complete its grading job with ``scores`` (each problem
+    out of 1), as a worker would; return the submission's id."""
+    response = client.post("/submissions", files={"file": ("opengym.py", b"x = 1\n")}, headers=bearer(token))
+    submission_id: int = response.json()["id"]
+    jobs = client.app.state.context.jobs  # type: ignore[attr-defined]
+    job = jobs.claim("test-worker")
+    if job is None or job.submission_id != submission_id:
+        raise RuntimeError(f"expected to claim submission {submission_id}, claimed {job}")
+    problems = [{"id": name, "score": score, "max_score": 1.0} for name, score in scores.items()]
+    report = {"score": sum(scores.values()), "max_score": float(len(scores)), "problems": problems}
+    if not jobs.complete(submission_id, "test-worker", report):
+        raise RuntimeError(f"could not complete submission {submission_id}")
+    return submission_id

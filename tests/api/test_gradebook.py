@@ -65,6 +65,7 @@ def test_one_row_per_student_by_policy(
         "cartpole",
         "score",
         "max_score",
+        "note",
     ]
 
 
@@ -79,6 +80,7 @@ def test_ungraded_submissions_are_not_in_the_gradebook(client: TestClient) -> No
             "sha256": "",
             "score": "",
             "max_score": "",
+            "note": "",
         }
     ]
 

@@ -1,0 +1,128 @@
+"""The instructor's overrides in the service: recorded with who and when, checked as ``gymgrade grade
+--overrides`` checks a file's rows (``grader.classroom.overrides``), applied by the gradebook.
+
+An override is a student's (``submission_id`` None: whatever upload the gradebook counts) or one upload's
+(it counts while that upload is the one the gradebook shows). Every override is kept; for a student,
+problem and upload the latest counts. What a problem is worth is read from the student's graded report.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from sqlalchemy import select
+from sqlalchemy.orm import Session
+
+from api.errors import InvalidRequest, SubmissionNotFound
+from api.models import JobStatus, Override, Student, Submission
+from api.students import find_student
+from grader.classroom.errors import OverridesError
+from grader.classroom.overrides import MAX_REASON_CHARS, TOTAL, Overrides, check_overrides
+from grader.classroom.overrides import Override as Cell
+
+
+def _graded(session: Session, student: Student, submission_id: int | None) -> Submission:
+    query = select(Submission).where(
+        Submission.student_id == student.id, Submission.status == JobStatus.DONE.value
+    )
+    if submission_id is not None:
+        query = query.where(Submission.id == submission_id)
+    found = session.scalars(query.order_by(Submission.id.desc())).first()
+    if found is None:
+        if submission_id is not None:
+            raise SubmissionNotFound(
+                f"no graded submission {submission_id} of {student.name}; list theirs with GET /submissions?student=..."  # noqa: E501
+            )
+        raise InvalidRequest(
+            f"{student.name} has no graded submission yet: an override needs one to know what each problem is worth",  # noqa: E501
+            [(["path", "name"], "no graded submission", "no_graded_submission")],
+        )
+    return found
+
+
+def maxima_of(report: Mapping[str, Any] | None) -> dict[str, float]:
+    """What each problem of a stored report is worth, by id."""
+    return {
+        str(problem.get("id")): float(problem.get("max_score") or 0.0)
+        for problem in (report or {}).get("problems", [])
+    }
+
+
+def record_override(
+    session: Session,
+    *,
+    student_name: str,
+    problem: str,
+    points: float,
+    reason: str,
+    author: str,
+    submission_id: int | None = None,
+) -> Override:
+    """Check and keep an override.
+
+    Raises:
+        StudentNotFound: No such student.
+        SubmissionNotFound: ``submission_id`` is not a graded upload of theirs.
+        InvalidRequest: An unknown problem, points outside what it is worth, or no reason (the message says
+            what was expected, as ``gymgrade grade --overrides`` does).
+    """
+    student = find_student(session, student_name)
+    graded = _graded(session, student, submission_id)
+    reason = reason.strip()
+    if not reason:
+        raise InvalidRequest(
+            "an override needs a reason: say why", [(["body", "reason"], "empty", "missing")]
+        )
+    cell = Cell(student.name, problem, points, reason[:MAX_REASON_CHARS], 1)
+    try:
+        check_overrides(
+            [cell], students=[student.name], maxima=maxima_of(graded.report), where="the override"
+        )
+    except OverridesError as error:
+        fault = str(error).splitlines()[1].strip().removeprefix("line 1: ")
+        raise InvalidRequest(
+            f"refused: {fault}",
+            [(["body", "problem" if "problem" in fault else "points"], fault, "value_error")],
+        ) from None
+    override = Override(
+        student_id=student.id,
+        submission_id=submission_id,
+        problem=problem,
+        points=points,
+        reason=cell.reason,
+        author=author,
+    )
+    session.add(override)
+    session.commit()
+    return override
+
+
+def list_overrides(session: Session, student_name: str) -> list[Override]:
+    """Every override of a student, oldest first."""
+    student = find_student(session, student_name)
+    return list(
+        session.scalars(select(Override).where(Override.student_id == student.id).order_by(Override.id))
+    )
+
+
+def counted_overrides(session: Session, chosen: Mapping[int, Any]) -> dict[int, dict[str, Override]]:
+    """The overrides that count for each student (by id), by problem: the latest of those made for the
+    student or for the upload the gradebook shows (``chosen``: student id -> its row, with ``id``)."""
+    counted: dict[int, dict[str, Override]] = {}
+    for override in session.scalars(select(Override).order_by(Override.id)):
+        shown = chosen.get(override.student_id)
+        if override.submission_id is not None and (shown is None or shown.id != override.submission_id):
+            continue
+        counted.setdefault(override.student_id, {})[override.problem] = override
+    return counted
+
+
+def as_decided(name: str, overrides: Mapping[str, Override]) -> Overrides:
+    """A student's counted overrides as ``grader.classroom`` reads them (their name as the student)."""
+    return Overrides(
+        {name: {problem: Cell(name, problem, o.points, o.reason, o.id) for problem, o in overrides.items()}}
+    )
+
+
+__all__ = ["TOTAL", "as_decided", "counted_overrides", "list_overrides", "maxima_of", "record_override"]
