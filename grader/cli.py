@@ -24,8 +24,11 @@ from grader.seeds import PRACTICE_SEED, held_out_seed
 
 if TYPE_CHECKING:
     from grader.batch import BatchExecutor
+    from grader.classroom.kept import InstructorData
     from grader.classroom.model import ClassDownload
     from grader.classroom.output import ClassGradebook
+    from grader.classroom.roster import Roster
+    from grader.plan import GradingPlan
 
 COMMAND_GROUP = "gymgrade.commands"
 EXECUTOR_GROUP = "gymgrade.executors"
@@ -128,12 +131,42 @@ def _add_class_options(grade: argparse.ArgumentParser) -> None:
         help="the LMS's assignment id (needed by --gradebook canvas)",
     )
     grade.add_argument(
+        "--overrides",
+        type=Path,
+        default=None,
+        metavar="CSV",
+        help="the instructor's overrides (student,problem,points,reason; problem an id or total), checked, then kept in --out for later runs",  # noqa: E501
+    )
+    grade.add_argument(
+        "--submitted-at",
+        type=Path,
+        default=None,
+        metavar="CSV",
+        help="submission times the download lacks (student,submitted_at; a Canvas submissions CSV; Moodle's grading worksheet), for the [late] policy",  # noqa: E501
+    )
+    grade.add_argument(
+        "--only-students",
+        type=_students,
+        default=None,
+        metavar="ID[,ID...]",
+        help="regrade only these students in an existing --out, at its recorded seed and configuration; nobody else's files change",  # noqa: E501
+    )
+    grade.add_argument(
         "--due",
         type=_moment,
         default=None,
         metavar="ISO-TIME",
         help="deadline (e.g. 2026-03-01T23:59-05:00): submissions whose source gives a time but no late mark are late after it",  # noqa: E501
     )
+
+
+def _students(text: str) -> list[str]:
+    chosen = [name.strip() for name in text.split(",") if name.strip()]
+    if not chosen:
+        raise argparse.ArgumentTypeError(
+            f"expected students as grades.csv's student column names them, comma-separated; found {text!r}"
+        )
+    return chosen
 
 
 def _moment(text: str) -> datetime:
@@ -482,6 +515,7 @@ def run_grade(args: argparse.Namespace) -> int:
     from grader.classroom import GradedFileRule, read_all, submissions_of_all
     from grader.classroom.errors import GradebookError
     from grader.classroom.gradebooks import Assignment
+    from grader.classroom.kept import chosen_submissions
     from grader.classroom.output import ClassGradebook
     from grader.classroom.roster import read_roster
     from grader.plan import GradingPlan
@@ -531,11 +565,47 @@ def run_grade(args: argparse.Namespace) -> int:
             if clash is not None:
                 print(f"gymgrade grade: {clash}", file=sys.stderr)
                 return EXIT_ERROR
-        gradebook = ClassGradebook(download, identities, plan.problems, roster, args.gradebook, assignment)
-        code = _grade_class(args, list(identities), identities, gradebook)
+        instructor = _instructor_data(args, download, roster, plan)
+        regrade = None
+        if args.only_students is not None:
+            chosen = chosen_submissions(download, args.only_students)
+            regrade = {path for path, identity in identities.items() if identity in chosen}
+        gradebook = ClassGradebook(
+            download,
+            identities,
+            plan.problems,
+            roster,
+            args.gradebook,
+            assignment,
+            decisions=instructor.decisions,
+        )
+        code = _grade_class(args, list(identities), identities, gradebook, regrade, instructor)
         if args.similarity and code != EXIT_INTERRUPTED:
             return _similarity_beside_grading(args, download) or code
         return code
+
+
+def _instructor_data(
+    args: argparse.Namespace, download: ClassDownload, roster: Roster | None, plan: GradingPlan
+) -> InstructorData:
+    """The instructor's overrides, late policy and given times for this class (kept in --out from earlier
+    runs unless given again), each line about them printed."""
+    from grader.class_report.text import terminal_line
+    from grader.classroom.gradebooks import class_rows
+    from grader.classroom.kept import load_instructor_data
+
+    students = sorted({row.member.identity for row in class_rows(download, {}, roster)})
+    data = load_instructor_data(
+        out_dir=args.out,
+        config=args.config,
+        overrides=args.overrides,
+        submitted_at=args.submitted_at,
+        students=students,
+        maxima=plan.points,
+    )
+    for line in data.lines:
+        print(terminal_line(line), file=sys.stderr, flush=True)
+    return data
 
 
 def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> tuple[str, ...] | None:
@@ -645,10 +715,17 @@ student's, and a reason in their row)."""
 
 
 def _grade_class(
-    args: argparse.Namespace, paths: list[Path], identities: dict[Path, str], gradebook: ClassGradebook
+    args: argparse.Namespace,
+    paths: list[Path],
+    identities: dict[Path, str],
+    gradebook: ClassGradebook,
+    regrade: set[Path] | None = None,
+    instructor: InstructorData | None = None,
 ) -> int:
     from grader.batch import BatchOutcome, grade_many
     from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
+    from grader.classroom.kept import regrade_refusal
+    from grader.plan import GradingPlan
 
     policy = IsolationPolicy.ALLOW_FALLBACK if args.allow_weak_isolation else IsolationPolicy.REQUIRE_FULL
     executor = find_executor(policy)
@@ -671,6 +748,21 @@ def _grade_class(
         bar.advance(f"{shown[path]}: {result.id} {result.status}")
 
     seed = choose_seed(args.seed, args.out)
+    if regrade is not None:
+        plan = GradingPlan.load(args.config, args.only)
+        others = [identity for path, identity in identities.items() if path not in regrade]
+        refusal = regrade_refusal(
+            args.out, others, seed=seed, config_sha256=plan.config_sha256, problems=plan.problems
+        )
+        if refusal is not None:
+            print(f"gymgrade grade: {refusal}", file=sys.stderr)
+            return EXIT_ERROR
+        print(
+            f"Regrading {len(regrade)} submissions; every other report in {args.out} is kept as it is.",
+            file=sys.stderr,
+        )
+    if instructor is not None:
+        instructor.write_kept(args.out)
     try:
         outcome = grade_many(
             paths,
@@ -685,6 +777,7 @@ def _grade_class(
             on_plan=planned,
             names=identities,
             gradebook=gradebook,
+            regrade=regrade,
         )
     except BatchInterrupted as interruption:
         print(

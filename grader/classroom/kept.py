@@ -178,3 +178,23 @@ def recorded_grading_differs(
         if tuple(result.id for result in report.problems) != tuple(problems):
             return f"{shown} was graded for {', '.join(r.id for r in report.problems)}: pass the same --only as the class's grading"  # noqa: E501
     return None
+
+
+def regrade_refusal(
+    out_dir: Path, others: Collection[str], *, seed: int, config_sha256: str, problems: Sequence[str]
+) -> str | None:
+    """Why ``--only-students`` cannot regrade into ``out_dir``: nothing graded there yet, or the other
+    students' reports (by identity) were graded on another seed, configuration or problems; None when it can.
+    """
+    from grader.batch import identity_stem
+
+    reports: dict[str, Report] = {}
+    for identity in others:
+        try:
+            text = (out_dir / f"{identity_stem(identity)}.json").read_text(encoding="utf-8")
+            reports[identity] = Report.model_validate_json(text)
+        except (OSError, UnicodeDecodeError, ValueError):
+            continue
+    if not reports and not (out_dir / "grades.csv").is_file():
+        return f"--only-students regrades students of a class already graded in {out_dir}, and nothing is graded there: run without --only-students first"  # noqa: E501
+    return recorded_grading_differs(reports, seed=seed, config_sha256=config_sha256, problems=problems)
