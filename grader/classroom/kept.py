@@ -16,7 +16,7 @@ from pathlib import Path
 from grader.batch import write_atomically
 from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
 from grader.classroom.decisions import Decisions
-from grader.classroom.errors import ClassroomError, LatePolicyError
+from grader.classroom.errors import ClassroomError, LatePolicyError, OverridesError
 from grader.classroom.late import read_late_policy
 from grader.classroom.model import ClassDownload
 from grader.classroom.overrides import MAX_OVERRIDES_BYTES, check_overrides, parse_overrides
@@ -29,11 +29,6 @@ KEPT_TIMES = "submitted_at.csv"
 
 class UnknownStudents(ClassroomError):
     """Raised when ``--only-students`` names someone the class does not have."""
-
-
-class RecordedGradingDiffers(ClassroomError):
-    """Raised when a regrade of some students would grade on another seed, configuration or problems than
-    the rest of the output directory was graded on."""
 
 
 @dataclass
@@ -58,7 +53,7 @@ class InstructorData:
 
 
 def _source(
-    given: Path | None, out_dir: Path, kept: str, limit: int, what: str
+    given: Path | None, out_dir: Path, kept: str, limit: int, refused: type[ClassroomError], what: str
 ) -> tuple[bytes, str, bool] | None:
     """The bytes to read (given, else kept in ``out_dir``), where they come from, and whether given."""
     path = given if given is not None else out_dir / kept
@@ -68,7 +63,7 @@ def _source(
         with path.open("rb") as stream:
             return stream.read(limit + 1), str(path), given is not None
     except OSError as error:
-        raise LatePolicyError(
+        raise refused(
             f"cannot read the {what} {path} ({error.strerror or error}): pass a readable CSV"
         ) from None
 
@@ -97,7 +92,7 @@ def load_instructor_data(
             late policy is invalid.
     """
     data = InstructorData(Decisions(maxima=dict(maxima), late=read_late_policy(config)))
-    found = _source(overrides, out_dir, KEPT_OVERRIDES, MAX_OVERRIDES_BYTES, "overrides file")
+    found = _source(overrides, out_dir, KEPT_OVERRIDES, MAX_OVERRIDES_BYTES, OverridesError, "overrides file")
     if found is not None:
         raw, where, given = found
         rows = parse_overrides(raw, where=where)
@@ -113,7 +108,7 @@ def load_instructor_data(
                 else " (kept from an earlier run; --overrides FILE replaces them)"
             )
         )
-    found = _source(submitted_at, out_dir, KEPT_TIMES, MAX_TIMES_BYTES, "submission times")
+    found = _source(submitted_at, out_dir, KEPT_TIMES, MAX_TIMES_BYTES, LatePolicyError, "submission times")
     if found is not None:
         raw, where, given = found
         times = parse_submitted_at(raw, where=where)

@@ -15,7 +15,6 @@ import io
 import math
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from grader.class_report.text import IDENTITY_SHOWN_CHARS, MAX_LINE_CHARS, display_identity, display_text
 from grader.classroom.errors import OverridesError
@@ -225,23 +224,6 @@ def check_overrides(
     if faults:
         raise _refuse(where, faults, "Correct these rows and run the command again.")
     return Overrides(by_student)
-
-
-def read_overrides(path: Path, *, students: Collection[str], maxima: Mapping[str, float]) -> Overrides:
-    """`parse_overrides` and `check_overrides` of a file.
-
-    Raises:
-        OverridesError: The file cannot be read or is refused (the message lists every fault).
-    """
-    try:
-        with path.open("rb") as stream:
-            data = stream.read(MAX_OVERRIDES_BYTES + 1)
-    except OSError as error:
-        raise OverridesError(
-            f"cannot read the overrides file {path} ({error.strerror or error}): pass a readable CSV"
-        ) from None
-    rows = parse_overrides(data, where=str(path))
-    return check_overrides(rows, students=students, maxima=maxima, where=str(path))
 
 
 def note_of(override: Override, machine: float | None) -> str:

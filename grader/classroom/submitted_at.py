@@ -15,9 +15,7 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Mapping
 from datetime import datetime
-from pathlib import Path
 
 from grader.class_report.text import display_text
 from grader.classroom.errors import LatePolicyError
@@ -96,19 +94,3 @@ def parse_submitted_at(data: bytes, *, where: str) -> dict[str, datetime]:
             + "\nCorrect these rows and run the command again."
         )
     return times
-
-
-def read_submitted_at(path: Path) -> Mapping[str, datetime]:
-    """`parse_submitted_at` of a file.
-
-    Raises:
-        LatePolicyError: The file cannot be read or is refused.
-    """
-    try:
-        with path.open("rb") as stream:
-            data = stream.read(MAX_TIMES_BYTES + 1)
-    except OSError as error:
-        raise LatePolicyError(
-            f"cannot read the submission times {path} ({error.strerror or error}): pass a readable CSV"
-        ) from None
-    return parse_submitted_at(data, where=str(path))

@@ -108,3 +108,8 @@ def _report(seed: int, digest: str, problems: tuple[str, ...]) -> Report:
 )  # fmt: skip
 def test_a_regrade_of_one_matches_the_recorded_grading(report: Report, reason: str | None) -> None:
     assert recorded_grading_differs({"bob": report}, seed=7, config_sha256="c1", problems=("car",)) == reason
+
+
+def test_a_missing_file_says_so(tmp_path: Path) -> None:
+    with pytest.raises(OverridesError, match=r"cannot read the overrides file .*nope\.csv \(No such file"):
+        _load(tmp_path / "out", overrides=tmp_path / "nope.csv")

@@ -3,8 +3,6 @@ range, no reason, too large) refused with every fault and its line, nothing neut
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from grader.classroom.errors import OverridesError
@@ -13,7 +11,6 @@ from grader.classroom.overrides import (
     Override,
     check_overrides,
     parse_overrides,
-    read_overrides,
 )
 
 STUDENTS = ("alice", "bob", "0042")
@@ -114,8 +111,3 @@ def test_a_file_that_is_not_an_overrides_csv_says_what_was_expected(data: bytes,
     with pytest.raises(OverridesError) as raised:
         parse_overrides(data, where="overrides.csv")
     assert str(raised.value) == message
-
-
-def test_a_missing_file_says_so(tmp_path: Path) -> None:
-    with pytest.raises(OverridesError, match=r"cannot read the overrides file .*nope\.csv \(No such file"):
-        read_overrides(tmp_path / "nope.csv", students=STUDENTS, maxima=MAXIMA)
