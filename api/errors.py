@@ -65,6 +65,10 @@ class StudentNotFound(ServiceError):
     """Raised when a named student does not exist."""
 
 
+class GradingInProgress(ServiceError):
+    """Raised when a regrade is asked of a submission that is queued or being graded already."""
+
+
 class StudentExists(ServiceError):
     """Raised when a student is created under a name that is already taken."""
 

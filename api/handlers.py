@@ -16,6 +16,7 @@ from starlette.exceptions import HTTPException
 from starlette.routing import Match, Mount
 
 from api.errors import (
+    GradingInProgress,
     InstructorOnly,
     InternalError,
     InvalidRequest,
@@ -47,6 +48,7 @@ HTTP_STATUS: dict[type[ServiceError], int] = {
     StudentNotFound: 404,
     MethodNotAllowed: 405,
     StudentExists: 409,
+    GradingInProgress: 409,
     LengthRequired: 411,
     UploadTooLarge: 413,
     InvalidRequest: 422,

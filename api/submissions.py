@@ -10,7 +10,7 @@ from sqlalchemy.orm import Session, joinedload
 
 from api.auth import Principal
 from api.disclosure import Disclosure, problem_view, report_view, withholds_any
-from api.errors import RateLimited, SubmissionNotFound
+from api.errors import GradingInProgress, RateLimited, SubmissionNotFound
 from api.jobs.job_queue import Dispatcher
 from api.models import JobStatus, Student, Submission, utcnow
 from api.schemas import SubmissionDetail, SubmissionSummary
@@ -73,6 +73,36 @@ def create_submission(
     session.commit()
     dispatcher.submitted(submission.id)
     return submission
+
+
+def regrade(session: Session, submissions: list[Submission], dispatcher: Dispatcher) -> list[int]:
+    """Queue graded (or failed) submissions again, each on its own recorded seed; their reports are replaced
+    when the workers finish, and the instructor's overrides stay (they are kept apart).
+
+    Raises:
+        GradingInProgress: One of them is queued or being graded already (nothing is queued then).
+    """
+    busy = [item for item in submissions if item.status in (JobStatus.QUEUED.value, JobStatus.RUNNING.value)]
+    if busy:
+        raise GradingInProgress(
+            f"submission {busy[0].id} is {busy[0].status} already: it is graded as soon as a worker is free; regrade it once it is done or failed"  # noqa: E501
+        )
+    for item in submissions:
+        item.status = JobStatus.QUEUED.value
+        item.attempts = 0
+        item.lease_owner = None
+        item.lease_expires_at = None
+        item.started_at = None
+        item.finished_at = None
+        item.progress = []
+        item.report = None
+        item.error = None
+        item.score = None
+        item.max_score = None
+    session.commit()
+    for item in submissions:
+        dispatcher.submitted(item.id)
+    return [item.id for item in submissions]
 
 
 def get_submission(session: Session, caller: Principal, submission_id: int) -> Submission:

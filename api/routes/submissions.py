@@ -6,8 +6,18 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, File, Query, Request, Response, UploadFile
 
-from api.deps import CallerDep, DisclosureDep, DispatcherDep, SessionDep, SettingsDep, StudentDep
+from api.deps import (
+    CallerDep,
+    DisclosureDep,
+    DispatcherDep,
+    InstructorDep,
+    SessionDep,
+    SettingsDep,
+    StudentDep,
+)
 from api.errors import (
+    GradingInProgress,
+    InstructorOnly,
     InvalidRequest,
     InvalidUpload,
     LengthRequired,
@@ -21,7 +31,7 @@ from api.errors import (
 )
 from api.handlers import error_responses
 from api.schemas import SubmissionAccepted, SubmissionDetail, SubmissionSummary
-from api.submissions import create_submission, detail, get_submission, list_submissions, summary
+from api.submissions import create_submission, detail, get_submission, list_submissions, regrade, summary
 from api.uploads import check_upload, upload_rules
 
 router = APIRouter(tags=["submissions"])
@@ -125,3 +135,42 @@ def document_upload_rules(openapi: dict[str, Any], max_upload_bytes: int) -> Non
     body_name = media["schema"]["$ref"].rsplit("/", 1)[-1]
     openapi["components"]["schemas"][body_name]["properties"]["file"].update(content)
     media["encoding"] = {"file": encoding}
+
+
+@router.post(
+    "/submissions/{submission_id}/regrade",
+    status_code=202,
+    response_model=SubmissionAccepted,
+    responses=error_responses(
+        NotAuthenticated, InstructorOnly, SubmissionNotFound, GradingInProgress, InvalidRequest
+    ),
+)
+def post_regrade(
+    request: Request,
+    response: Response,
+    submission_id: int,
+    session: SessionDep,
+    dispatcher: DispatcherDep,
+    instructor: InstructorDep,
+) -> SubmissionAccepted:
+    """Grade one upload again on its recorded seed (after a fix to the grader or the configuration); poll
+    GET /submissions/{id}. The instructor's overrides stay."""
+    regrade(session, [get_submission(session, instructor, submission_id)], dispatcher)
+    response.headers["Location"] = request.app.url_path_for("get_one_submission", submission_id=submission_id)
+    return SubmissionAccepted(id=submission_id)
+
+
+@router.post(
+    "/students/{name}/regrade",
+    status_code=202,
+    response_model=list[SubmissionAccepted],
+    responses=error_responses(
+        NotAuthenticated, InstructorOnly, StudentNotFound, GradingInProgress, InvalidRequest
+    ),
+)
+def post_student_regrade(
+    name: str, session: SessionDep, dispatcher: DispatcherDep, instructor: InstructorDep
+) -> list[SubmissionAccepted]:
+    """Grade every upload of one student again, each on its recorded seed; nobody else's is touched."""
+    ids = regrade(session, list_submissions(session, instructor, name), dispatcher)
+    return [SubmissionAccepted(id=submission_id) for submission_id in ids]
