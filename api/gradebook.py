@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import io
 from collections.abc import Iterable
+from datetime import UTC
 from typing import Any
 
 from sqlalchemy import select
@@ -13,11 +14,13 @@ from sqlalchemy.orm import Session
 
 from api.models import JobStatus, Override, Student, Submission
 from api.overrides import as_decided, counted_overrides, maxima_of
-from api.settings import GradebookPolicy
+from api.settings import GradebookPolicy, Settings
 from grader.class_report.text import safe_cell
 from grader.classroom.decisions import Decisions, FinalGrade, final_grade
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment, GradeRow
+from grader.classroom.late import LatePolicy, read_late_policy
 from grader.classroom.model import Member
+from grader.classroom.model import Submission as ClassSubmission
 from grader.classroom.roster import RosterEntry
 from grader.report import ProblemResult, Report
 
@@ -53,7 +56,11 @@ def _chosen(session: Session, policy: GradebookPolicy) -> tuple[list[Student], d
 
 
 def gradebook_export(
-    session: Session, policy: GradebookPolicy, gradebook_format: str, assignment: Assignment
+    session: Session,
+    policy: GradebookPolicy,
+    gradebook_format: str,
+    assignment: Assignment,
+    late: LatePolicy | None = None,
 ) -> str:
     """The gradebook in one of ``GRADEBOOK_FORMATS``: ``gymgrade`` is :func:`gradebook_csv`; the others are
     the LMS import CSVs of ``gymgrade grade --gradebook``, with each student's name as their identity (name
@@ -64,7 +71,7 @@ def gradebook_export(
         grader.classroom.errors.GradebookError: The format lacks what it needs (Canvas: the assignment id).
     """
     if gradebook_format == "gymgrade":
-        return gradebook_csv(session, policy)
+        return gradebook_csv(session, policy, late)
     if gradebook_format not in GRADEBOOKS:
         raise ValueError(
             f"unknown gradebook format {gradebook_format!r}: use one of {', '.join(GRADEBOOK_FORMATS)}"
@@ -76,7 +83,7 @@ def gradebook_export(
     for student in students:
         picked = chosen.get(student.id)
         report = _report(picked)
-        final = _final(student.name, picked, report, counted.get(student.id, {}))
+        final = _final(student.name, picked, report, counted.get(student.id, {}), late)
         rows.append(
             GradeRow(
                 member=Member(student.name, student.name),
@@ -93,12 +100,36 @@ def gradebook_export(
     return write(rows, problem_ids, assignment)
 
 
-def _final(name: str, picked: Any, report: Report | None, overrides: dict[str, Override]) -> FinalGrade:
-    """The student's grade after the instructor's overrides (the machine's when there are none)."""
+def late_policy_of(settings: Settings) -> LatePolicy | None:
+    """The late policy of ``GYMGRADE_LATE_POLICY`` (checked when the settings were made), None when unset."""
+    return read_late_policy(settings.late_policy) if settings.late_policy is not None else None
+
+
+def _final(
+    name: str,
+    picked: Any,
+    report: Report | None,
+    overrides: dict[str, Override],
+    late: LatePolicy | None = None,
+) -> FinalGrade:
+    """The student's grade after the instructor's overrides and the late policy, by the upload's time (the
+    machine's when there are neither)."""
     decisions = Decisions(
-        overrides=as_decided(name, overrides), maxima=maxima_of(picked.report if picked else None)
+        overrides=as_decided(name, overrides), late=late, maxima=maxima_of(picked.report if picked else None)
     )
-    return final_grade(name, report, None, decisions)
+    upload = None
+    if picked is not None:
+        upload = ClassSubmission(
+            identity=name,
+            display_name=name,
+            members=(),
+            files=(),
+            graded_file=None,
+            why="",
+            submitted_at=picked.created_at.replace(tzinfo=UTC),
+            source="service",
+        )
+    return final_grade(name, report, upload, decisions)
 
 
 def _report(picked: Any) -> Report | None:
@@ -114,12 +145,13 @@ def _report(picked: Any) -> Report | None:
     )
 
 
-def gradebook_csv(session: Session, policy: GradebookPolicy) -> str:
+def gradebook_csv(session: Session, policy: GradebookPolicy, late: LatePolicy | None = None) -> str:
     """Build the gradebook of every student.
 
     Args:
         session: A database session.
         policy: Which graded submission represents a student: the latest, or the best (latest among ties).
+        late: The late policy (``GYMGRADE_LATE_POLICY``); None: no penalties, no ``late_penalty`` column.
 
     Returns:
         CSV text: ``student, submission_id, submitted_at, sha256``, one column per problem (its score),
@@ -132,14 +164,25 @@ def gradebook_csv(session: Session, policy: GradebookPolicy) -> str:
     output = io.StringIO()
     writer = csv.writer(output, lineterminator="\n")
     writer.writerow(
-        ["student", "submission_id", "submitted_at", "sha256", *problem_ids, "score", "max_score", "note"]
+        [
+            "student",
+            "submission_id",
+            "submitted_at",
+            "sha256",
+            *problem_ids,
+            *(["late_penalty"] if late else []),
+            "score",
+            "max_score",
+            "note",
+        ]
     )
     for student in students:
         picked = chosen.get(student.id)
         if picked is None:
-            writer.writerow([safe_cell(student.name), "", "", "", *([""] * len(problem_ids)), "", "", ""])
+            blanks = [""] * (len(problem_ids) + (1 if late else 0))
+            writer.writerow([safe_cell(student.name), "", "", "", *blanks, "", "", ""])
             continue
-        final = _final(student.name, picked, _report(picked), counted.get(student.id, {}))
+        final = _final(student.name, picked, _report(picked), counted.get(student.id, {}), late)
         scores = {
             problem.get("id"): problem.get("score") for problem in (picked.report or {}).get("problems", [])
         }
@@ -151,7 +194,8 @@ def gradebook_csv(session: Session, policy: GradebookPolicy) -> str:
                 picked.created_at.isoformat(timespec="seconds"),
                 picked.sha256,
                 *(_number(scores.get(problem_id)) for problem_id in problem_ids),
-                _number(final.total if final.overridden else picked.score),
+                *([_number(final.late_penalty)] if late else []),
+                _number(final.total if final.overridden or late else picked.score),
                 _number(picked.max_score),
                 safe_cell("; ".join(final.notes)),
             ]

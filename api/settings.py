@@ -111,6 +111,11 @@ class Settings(BrokerSettings):
         description="The assignment's due date (ISO 8601; UTC when no offset is given): "
         "students see problems marked after_due_date from then on; unset, never.",
     )
+    late_policy: Path | None = Field(
+        default=None,
+        description="A TOML file with a [late] table, as the assignment configuration has it (due, penalty_per_day, max_penalty, grace_minutes, [late.extensions] by student name): "  # noqa: E501
+        "the gradebook takes late penalties by upload time; unset, none.",
+    )
     gradebook_policy: GradebookPolicy = Field(
         default=GradebookPolicy.LATEST, description="latest or best graded submission per student."
     )
@@ -160,6 +165,24 @@ class Settings(BrokerSettings):
         except UnknownEdition as error:
             raise ValueError(str(error)) from None
         return edition
+
+    @field_validator("late_policy")
+    @classmethod
+    def _readable_late_policy(cls, path: Path | None) -> Path | None:
+        if path is None:
+            return None
+        from grader.classroom.late import read_late_policy
+        from grader.errors import GraderError
+
+        try:
+            found = read_late_policy(path)
+        except GraderError as error:
+            raise ValueError(str(error)) from None
+        if found is None:
+            raise ValueError(
+                f"GYMGRADE_LATE_POLICY={path} has no [late] table: add one (due, penalty_per_day, ...) or unset it"  # noqa: E501
+            )
+        return path
 
     @field_validator("due_date")
     @classmethod

@@ -9,7 +9,7 @@ from fastapi.responses import Response
 
 from api.deps import InstructorDep, SessionDep, SettingsDep
 from api.errors import InstructorOnly, InvalidRequest, NotAuthenticated
-from api.gradebook import GRADEBOOK_FORMATS, gradebook_export
+from api.gradebook import GRADEBOOK_FORMATS, gradebook_export, late_policy_of
 from api.handlers import error_responses
 from grader.classroom.gradebooks import Assignment
 
@@ -41,7 +41,11 @@ def get_gradebook(
         raise InvalidRequest(message, [(["query", "assignment_id"], message, "missing")])
     return Response(
         gradebook_export(
-            session, settings.gradebook_policy, format, Assignment(assignment_title, assignment_id)
+            session,
+            settings.gradebook_policy,
+            format,
+            Assignment(assignment_title, assignment_id),
+            late_policy_of(settings),
         ),
         media_type="text/csv; charset=utf-8",
         headers={"Content-Disposition": 'attachment; filename="gradebook.csv"'},

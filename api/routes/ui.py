@@ -12,7 +12,7 @@ from api.auth import Principal, authenticate
 from api.deps import SESSION_COOKIE, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
 from api.disclosure import disclosure_for
 from api.errors import InvalidRequest, NotAuthenticated, StudentNotFound, SubmissionNotFound
-from api.gradebook import gradebook_csv
+from api.gradebook import gradebook_csv, late_policy_of
 from api.models import JobStatus
 from api.overrides import record_override
 from api.settings import Settings
@@ -172,7 +172,7 @@ def gradebook_download(session: SessionDep, settings: SettingsDep, caller: PageC
     """The gradebook for the signed-in instructor."""
     _signed_in(caller).require_instructor()
     return Response(
-        gradebook_csv(session, settings.gradebook_policy),
+        gradebook_csv(session, settings.gradebook_policy, late_policy_of(settings)),
         media_type="text/csv; charset=utf-8",
         headers={"Content-Disposition": 'attachment; filename="gradebook.csv"'},
     )

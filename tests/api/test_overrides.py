@@ -130,3 +130,48 @@ def test_the_instructors_page_overrides_and_says_why_it_refuses(make_settings: S
         refused = client.post("/ui/overrides", data={**form, "points": "7"})
         assert refused.status_code == 422 and "is outside 0..1" in refused.text
         assert _rows(client)["ada"]["score"] == "1"
+
+
+def test_the_late_policy_takes_penalties_by_upload_time(make_settings: SettingsFactory, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from datetime import UTC, datetime, timedelta
+
+    from api.models import Submission
+
+    policy = tmp_path / "late.toml"
+    due = datetime(2026, 3, 1, 23, 59, tzinfo=UTC)
+    policy.write_text(
+        f'[late]\ndue = {due.isoformat()}\npenalty_per_day = 0.25\n[late.extensions]\nbob = "{(due + timedelta(days=3)).isoformat()}"\n',  # noqa: E501
+        encoding="utf-8",
+    )
+    with TestClient(create_app(make_settings(late_policy=policy), run_workers=False)) as client:
+        ada, bob = add_student(client, "ada"), add_student(client, "bob")
+        uploads = {
+            name: graded_upload(client, token, {"random_blackjack": 1.0, "car": 1.0})
+            for name, token in (("ada", ada), ("bob", bob))
+        }
+        with client.app.state.context.sessions() as session:  # type: ignore[attr-defined]
+            for upload in uploads.values():  # both uploaded 1 day and 1 second after the class's due time
+                session.get(Submission, upload).created_at = (due + timedelta(days=1, seconds=1)).replace(
+                    tzinfo=None
+                )
+            session.commit()
+        rows = _rows(client)
+        assert {name: (row["late_penalty"], row["score"]) for name, row in rows.items()} == {
+            "ada": ("1", "1"),
+            "bob": ("0", "2"),
+        }
+        assert rows["ada"]["note"] == (
+        "2 days late (submitted 2026-03-02T23:59:01+00:00, due 2026-03-01T23:59:00+00:00): 1 points taken"
+    )
+        assert _rows(client, "gradescope")["ada"]["Total Score"] == "1"
+
+
+def test_a_late_policy_without_a_late_table_stops_the_service(
+    make_settings: SettingsFactory, tmp_path
+) -> None:  # type: ignore[no-untyped-def]
+    from pydantic import ValidationError
+
+    empty = tmp_path / "empty.toml"
+    empty.write_text("edition = 'classic'\n", encoding="utf-8")
+    with pytest.raises(ValidationError, match=r"has no \[late\] table: add one"):
+        make_settings(late_policy=empty)
