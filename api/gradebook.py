@@ -15,13 +15,13 @@ from sqlalchemy.orm import Session
 from api.models import JobStatus, Override, Student, Submission
 from api.overrides import as_decided, counted_overrides, maxima_of
 from api.settings import GradebookPolicy, Settings
-from grader.class_report.text import safe_cell
 from grader.classroom.decisions import Decisions, FinalGrade, final_grade
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment, GradeRow
 from grader.classroom.late import LatePolicy, read_late_policy
 from grader.classroom.model import Member
 from grader.classroom.model import Submission as ClassSubmission
 from grader.classroom.roster import RosterEntry
+from grader.render.neutral import safe_cell
 from grader.report import ProblemResult, Report
 
 GRADEBOOK_FORMATS = ("gymgrade", *GRADEBOOKS)

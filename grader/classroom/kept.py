@@ -13,14 +13,14 @@ from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grader.batch import write_atomically
-from grader.class_report.text import IDENTITY_SHOWN_CHARS, display_identity
 from grader.classroom.decisions import Decisions
 from grader.classroom.errors import ClassroomError, LatePolicyError, OverridesError
 from grader.classroom.late import read_late_policy
 from grader.classroom.model import ClassDownload
 from grader.classroom.overrides import MAX_OVERRIDES_BYTES, check_overrides, parse_overrides
 from grader.classroom.submitted_at import MAX_TIMES_BYTES, parse_submitted_at
+from grader.grading.batch import write_atomically
+from grader.render.neutral import IDENTITY_SHOWN_CHARS, display_identity
 from grader.report import Report
 
 KEPT_OVERRIDES = "overrides.csv"
@@ -181,7 +181,7 @@ def regrade_refusal(
     """Why ``--only-students`` cannot regrade into ``out_dir``: nothing graded there yet, or the other
     students' reports (by identity) were graded on another seed, configuration or problems; None when it can.
     """
-    from grader.batch import identity_stem
+    from grader.grading.batch import identity_stem
 
     reports: dict[str, Report] = {}
     for identity in others:

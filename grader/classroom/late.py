@@ -33,7 +33,7 @@ from typing import Any
 from pydantic import AwareDatetime, BaseModel, ConfigDict, Field, ValidationError
 
 from grader.classroom.errors import LatePolicyError
-from grader.config import DEFAULT_CONFIG_PATH, read_config_file
+from grader.lab.assignment import DEFAULT_CONFIG_PATH, read_config_file
 
 DAY = timedelta(days=1)
 LATE_TABLE = "late"

@@ -16,8 +16,8 @@ import math
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 
-from grader.class_report.text import IDENTITY_SHOWN_CHARS, MAX_LINE_CHARS, display_identity, display_text
 from grader.classroom.errors import OverridesError
+from grader.render.neutral import IDENTITY_SHOWN_CHARS, MAX_LINE_CHARS, display_identity, display_text
 
 TOTAL = "total"
 """The ``problem`` of an override of the student's whole grade (after any late penalty)."""

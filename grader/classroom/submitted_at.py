@@ -17,8 +17,8 @@ import csv
 import io
 from datetime import datetime
 
-from grader.class_report.text import display_text
 from grader.classroom.errors import LatePolicyError
+from grader.render.neutral import display_text
 
 MAX_TIMES_BYTES = 16 * 2**20
 STUDENT_COLUMNS = ("student", "user_id", "identifier", "id", "sid", "username")

@@ -161,8 +161,8 @@ def test_the_late_policy_takes_penalties_by_upload_time(make_settings: SettingsF
             "bob": ("0", "2"),
         }
         assert rows["ada"]["note"] == (
-        "2 days late (submitted 2026-03-02T23:59:01+00:00, due 2026-03-01T23:59:00+00:00): 1 points taken"
-    )
+            "2 days late (submitted 2026-03-02T23:59:01+00:00, due 2026-03-01T23:59:00+00:00): 1 points taken"
+        )
         assert _rows(client, "gradescope")["ada"]["Total Score"] == "1"
 
 

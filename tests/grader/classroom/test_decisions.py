@@ -151,8 +151,8 @@ def test_a_roster_student_without_a_submission_can_be_given_a_total() -> None:
 
 
 def test_the_class_report_shows_overrides_penalties_and_extensions_as_such(tmp_path: Path) -> None:
-    from grader.class_report import render_class_html, summarise
-    from grader.class_report.from_batch import entries_from_rows
+    from grader.classroom.report import render_class_html, summarise
+    from grader.classroom.report.from_batch import entries_from_rows
 
     policy = POLICY.model_copy(update={"extensions": {"003101": DUE + timedelta(days=2)}})
     text = OVERRIDES + "003101,car,1,<script>alert(1)</script>\n"

@@ -13,12 +13,13 @@ from pathlib import Path
 import pytest
 
 from grader import cli
+from grader.classroom import command
 from grader.report import Report
 
 from .downloads import BUILDERS, DUE
 from .test_class_batch import FakeExecutor, InterruptingExecutor
 
-BUNDLED = Path(__file__).resolve().parents[3] / "grader" / "assignment.toml"
+BUNDLED = Path(__file__).resolve().parents[3] / "grader" / "lab" / "assignment.toml"
 LATE = f"""
 [late]
 due = {DUE.isoformat()}
@@ -47,7 +48,7 @@ def _rows(path: Path) -> dict[str, dict[str, str]]:
 @pytest.fixture
 def executor(monkeypatch: pytest.MonkeyPatch) -> FakeExecutor:
     fake = FakeExecutor()
-    monkeypatch.setattr(cli, "find_executor", lambda policy: fake)
+    monkeypatch.setattr(command, "find_executor", lambda policy: fake)
     return fake
 
 
@@ -126,7 +127,7 @@ def test_a_canvas_class_with_overrides_and_a_late_policy(
 def test_overrides_survive_an_interrupted_batch_and_its_resumption(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from grader import batch
+    from grader.grading import batch
 
     monkeypatch.setattr(batch, "GRADEBOOK_INTERVAL", 3600.0)
     expected = BUILDERS["plain"](tmp_path / "download", 4)
@@ -134,9 +135,9 @@ def test_overrides_survive_an_interrupted_batch_and_its_resumption(
     overrides.write_text("student,problem,points,reason\nstudent003,total,0,plagiarism\n", encoding="utf-8")
     out = tmp_path / "out"
     argv = ["grade", str(expected.path), "--out", str(out), "--only", "random_blackjack", "--seed", "3"]
-    monkeypatch.setattr(cli, "find_executor", lambda policy: InterruptingExecutor(after=2))
+    monkeypatch.setattr(command, "find_executor", lambda policy: InterruptingExecutor(after=2))
     assert cli.main([*argv, "--overrides", str(overrides)]) == cli.EXIT_INTERRUPTED
-    monkeypatch.setattr(cli, "find_executor", lambda policy: FakeExecutor())
+    monkeypatch.setattr(command, "find_executor", lambda policy: FakeExecutor())
     assert cli.main(argv) == 0
     grades = _rows(out / "grades.csv")
     assert (grades["student003"]["total"], grades["student002"]["total"]) == ("0", "1")

@@ -10,7 +10,7 @@ import pytest
 
 from grader.classroom.errors import LatePolicyError
 from grader.classroom.late import LatePolicy, lateness, read_late_policy
-from grader.config import load_config
+from grader.lab.assignment import load_config
 
 EST = timezone(timedelta(hours=-5))
 DUE = datetime(2026, 3, 1, 23, 59, tzinfo=EST)
@@ -81,7 +81,9 @@ def test_a_late_mark_without_hours(
 
 
 def _config(tmp_path: Path, late: str) -> Path:
-    bundled = (Path(__file__).resolve().parents[3] / "grader" / "assignment.toml").read_text(encoding="utf-8")
+    bundled = (Path(__file__).resolve().parents[3] / "grader" / "lab" / "assignment.toml").read_text(
+        encoding="utf-8"
+    )
     path = tmp_path / "assignment.toml"
     path.write_text(bundled + "\n" + late, encoding="utf-8")
     return path

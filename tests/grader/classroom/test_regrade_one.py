@@ -6,14 +6,14 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from grader.batch import grade_many
 from grader.classroom import discover
 from grader.classroom.decisions import Decisions
 from grader.classroom.late import LatePolicy
 from grader.classroom.output import ClassGradebook
 from grader.classroom.overrides import check_overrides, parse_overrides
-from grader.config import load_config
-from grader.plan import GradingPlan
+from grader.grading.batch import grade_many
+from grader.grading.plan import GradingPlan
+from grader.lab.assignment import load_config
 from grader.render.html import render_html
 from grader.render.text import render_text
 from grader.report import Report
