@@ -14,12 +14,15 @@ from typing import Any
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
+from api.disclosure import Disclosure
 from api.errors import InvalidRequest, SubmissionNotFound
 from api.models import JobStatus, Override, Student, Submission
+from api.schemas import OverrideShown
 from api.students import find_student
 from grader.classroom.errors import OverridesError
 from grader.classroom.overrides import MAX_REASON_CHARS, TOTAL, Overrides, check_overrides
 from grader.classroom.overrides import Override as Cell
+from grader.report import withheld_ids
 
 
 def _graded(session: Session, student: Student, submission_id: int | None) -> Submission:
@@ -118,6 +121,21 @@ def counted_overrides(session: Session, chosen: Mapping[int, Any]) -> dict[int, 
     return counted
 
 
+def overrides_shown(session: Session, submission: Submission, disclosure: Disclosure) -> list[OverrideShown]:
+    """The overrides that count for ``submission`` (its student's and its own, the latest per problem), as
+    ``disclosure`` allows: none of a withheld problem, and no ``total`` while any problem is withheld."""
+    if submission.status != JobStatus.DONE.value:
+        return []
+    counted = counted_overrides(session, {submission.student_id: submission}).get(submission.student_id, {})
+    problems = (submission.report or {}).get("problems", [])
+    withheld = withheld_ids(problems, disclosure.shown)
+    return [
+        OverrideShown(problem=o.problem, points=o.points, reason=o.reason, created_at=o.created_at)
+        for problem, o in counted.items()
+        if problem not in withheld and not (problem == TOTAL and withheld)
+    ]
+
+
 def as_decided(name: str, overrides: Mapping[str, Override]) -> Overrides:
     """A student's counted overrides as ``grader.classroom`` reads them (their name as the student)."""
     return Overrides(
@@ -125,4 +143,12 @@ def as_decided(name: str, overrides: Mapping[str, Override]) -> Overrides:
     )
 
 
-__all__ = ["TOTAL", "as_decided", "counted_overrides", "list_overrides", "maxima_of", "record_override"]
+__all__ = [
+    "TOTAL",
+    "as_decided",
+    "counted_overrides",
+    "list_overrides",
+    "maxima_of",
+    "overrides_shown",
+    "record_override",
+]

@@ -66,6 +66,15 @@ class SubmissionSummary(BaseModel):
     finished_at: UtcDateTime | None = None
 
 
+class OverrideShown(BaseModel):
+    """An override as the student's submission shows it: the problem, the instructor's points and why."""
+
+    problem: str
+    points: float
+    reason: str
+    created_at: UtcDateTime
+
+
 class SubmissionDetail(SubmissionSummary):
     """A submission with its live progress and, once done, its report."""
 
@@ -83,6 +92,10 @@ class SubmissionDetail(SubmissionSummary):
         "Students see null seeds unless released, and problems withheld by their visibility (hidden, after_due_date before the due date) with status 'withheld', a note for feedback and a null score, as is then the total.",  # noqa: E501
     )
     error: str | None = Field(default=None, description="Why grading failed, when status is failed.")
+    overrides: list[OverrideShown] = Field(
+        default_factory=list,
+        description="The instructor's overrides that count for this upload, latest per problem (a student sees none of a withheld problem, and no total override while one is withheld).",  # noqa: E501
+    )
 
 
 class Health(BaseModel):

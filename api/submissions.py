@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from datetime import timedelta
 
 from sqlalchemy import func, select
@@ -13,7 +14,7 @@ from api.disclosure import Disclosure, problem_view, report_view, withholds_any
 from api.errors import GradingInProgress, RateLimited, SubmissionNotFound
 from api.jobs.job_queue import Dispatcher
 from api.models import JobStatus, Student, Submission, utcnow
-from api.schemas import SubmissionDetail, SubmissionSummary
+from api.schemas import OverrideShown, SubmissionDetail, SubmissionSummary
 from api.settings import SeedPolicy, Settings
 from api.students import find_student
 from api.uploads import CheckedUpload
@@ -156,8 +157,11 @@ def summary(submission: Submission, disclosure: Disclosure) -> SubmissionSummary
     )
 
 
-def detail(submission: Submission, disclosure: Disclosure) -> SubmissionDetail:
-    """A submission with its progress while running and its report once done, as ``disclosure`` allows."""
+def detail(
+    submission: Submission, disclosure: Disclosure, overrides: Sequence[OverrideShown] = ()
+) -> SubmissionDetail:
+    """A submission with its progress while running, its report once done and the instructor's overrides
+    that count for it (``api.overrides.overrides_shown``), as ``disclosure`` allows."""
     report = submission.report if submission.status == JobStatus.DONE.value else None
     return SubmissionDetail(
         **summary(submission, disclosure).model_dump(),
@@ -167,4 +171,5 @@ def detail(submission: Submission, disclosure: Disclosure) -> SubmissionDetail:
         progress=[problem_view(problem, disclosure) for problem in submission.progress],
         report=report_view(report, disclosure) if report is not None else None,
         error=submission.error,
+        overrides=list(overrides),
     )

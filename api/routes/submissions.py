@@ -30,6 +30,7 @@ from api.errors import (
     UploadTooLarge,
 )
 from api.handlers import error_responses
+from api.overrides import overrides_shown
 from api.schemas import SubmissionAccepted, SubmissionDetail, SubmissionSummary
 from api.submissions import create_submission, detail, get_submission, list_submissions, regrade, summary
 from api.uploads import check_upload, upload_rules
@@ -105,7 +106,8 @@ def get_one_submission(
     submission_id: int, session: SessionDep, caller: CallerDep, disclosure: DisclosureDep
 ) -> SubmissionDetail:
     """A submission's status, the problems finished so far, and its report once done."""
-    return detail(get_submission(session, caller, submission_id), disclosure)
+    submission = get_submission(session, caller, submission_id)
+    return detail(submission, disclosure, overrides_shown(session, submission, disclosure))
 
 
 @router.get(

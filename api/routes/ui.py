@@ -14,7 +14,7 @@ from api.disclosure import disclosure_for
 from api.errors import InvalidRequest, NotAuthenticated, StudentNotFound, SubmissionNotFound
 from api.gradebook import gradebook_csv, late_policy_of
 from api.models import JobStatus
-from api.overrides import record_override
+from api.overrides import overrides_shown, record_override
 from api.settings import Settings
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
@@ -115,7 +115,9 @@ def _submission(
     settings: Settings,
     submission_id: int,
 ) -> Response:
-    view = detail(get_submission(session, caller, submission_id), disclosure_for(caller, settings))
+    disclosure = disclosure_for(caller, settings)
+    submission = get_submission(session, caller, submission_id)
+    view = detail(submission, disclosure, overrides_shown(session, submission, disclosure))
     return _page(request, template, {"submission": view, "final": view.status in FINAL_STATUSES})
 
 

@@ -175,3 +175,33 @@ def test_a_late_policy_without_a_late_table_stops_the_service(
     empty.write_text("edition = 'classic'\n", encoding="utf-8")
     with pytest.raises(ValidationError, match=r"has no \[late\] table: add one"):
         make_settings(late_policy=empty)
+
+
+def test_the_student_sees_the_reason_on_their_submission_but_nothing_withheld(
+    make_settings: SettingsFactory,
+) -> None:
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        ada = add_student(client, "ada")
+        upload = graded_upload(client, ada, {"random_blackjack": 0.0, "car": 0.0})
+        with client.app.state.context.sessions() as session:  # type: ignore[attr-defined]
+            from api.models import Submission
+
+            row = session.get(Submission, upload)
+            report = dict(row.report)
+            report["problems"] = [
+                {**p, "visibility": "hidden" if p["id"] == "car" else "visible"} for p in report["problems"]
+            ]
+            row.report = report
+            session.commit()
+        for problem, reason in (("random_blackjack", "<i>checked by hand</i>"), ("car", "secret")):
+            assert _override(client, "ada", problem=problem, points=1, reason=reason).status_code == 201
+        assert _override(client, "ada", problem="total", points=2, reason="whole").status_code == 201
+        mine = client.get(f"/submissions/{upload}", headers=bearer(ada)).json()["overrides"]
+        assert [(item["problem"], item["reason"]) for item in mine] == [
+            ("random_blackjack", "<i>checked by hand</i>")
+        ]
+        everything = client.get(f"/submissions/{upload}", headers=instructor_headers()).json()["overrides"]
+        assert [item["problem"] for item in everything] == ["random_blackjack", "car", "total"]
+        client.cookies.set("gymgrade_token", ada)
+        page = client.get(f"/ui/submissions/{upload}").text
+        assert "&lt;i&gt;checked by hand&lt;/i&gt;" in page and "secret" not in page
