@@ -17,16 +17,17 @@ In detail:
   several. Both are `read_all(paths, layout=, sections=, scratch=, limits=) -> list[ReadDownload]` (each
   download read once, zips extracted once, all within one `tree.Budget` of `limits`) then
   `submissions_of_all(reads, rule=, due=)` (grouping and the graded-file choice, as often as needed without
-  reading again: `gymgrade grade` groups again by another edition's functions this way).
-  Pure but for reading the download and writing zip entries into `scratch` (zips are refused without it).
-  `ClassDownload(layout, root, submissions, unattributed: list[Skipped], refused: list[Skipped], ignored)`,
-  `Skipped(where, reason)`; `Submission(identity, display_name, members: tuple[Member, ...], files:
-  tuple[SubmittedFile, ...], graded_file: SubmittedFile | None, why, submitted_at, late, source)`,
-  `Member(identity, name, email)`, `SubmittedFile(path, relative, original_name)`. A group's identity is
-  its members' joined by `+`; a student whose every file was refused still gets a submission (no graded
-  file, `why` says so). `Submission.refused` holds the student's refused files (`why` names 5 and counts the
-  rest); a refused zip entry whose name climbs out or is absolute is attributed to the folder or zip holding
-  it (`discovery._holder`), never named for a student by its name (`../x` at the top is nobody's). Identities are strings as the source writes them (leading zeros kept).
+  reading again: `gymgrade grade` groups again by another edition's functions this way). Pure but for reading
+  the download and writing zip entries into `scratch` (zips are refused without it). `ClassDownload(layout,
+  root, submissions, unattributed: list[Skipped], refused: list[Skipped], ignored)`, `Skipped(where, reason)`;
+  `Submission(identity, display_name, members: tuple[Member, ...], files: tuple[SubmittedFile, ...],
+  graded_file: SubmittedFile | None, why, submitted_at, late, source)`, `Member(identity, name, email)`,
+  `SubmittedFile(path, relative, original_name)`. A group's identity is its members' joined by `+`; a student
+  whose every file was refused still gets a submission (no graded file, `why` says so). `Submission.refused`
+  holds the student's refused files (`why` names 5 and counts the rest); a refused zip entry whose name climbs
+  out or is absolute is attributed to the folder or zip holding it (`discovery._holder`), never named for a
+  student by its name (`../x` at the top is nobody's). Identities are strings as the source writes them
+  (leading zeros kept).
 - `tree.py`: the safe walk (`read_tree`): never follows links; refuses symlinks, hard links (`st_nlink > 1`),
   devices/FIFOs/sockets, oversize files; ignores hidden names, `__MACOSX`, `__pycache__`; opens zips
   (also nested, up to `Limits.max_zip_depth`) entry by entry into numbered files under `scratch` (entry
@@ -49,18 +50,18 @@ In detail:
   (`KEY_COLUMNS`: Canvas `id`, GitHub Classroom `github_username`, ...), exactly but for ASCII case
   (`roster_key`; no Unicode case folding: a Kelvin sign is not a K).
 - `gradebooks.py` (pure): `class_rows(download, reports_by_identity, roster) -> list[GradeRow]` (a row per
-  member, one per student: of several submissions the latest counts; roster students without one;
-  notes; a roster row is claimed once, an exact match first: a second claim is a row with
-  `refused_claim` and a note, which every LMS format leaves out), `grades_csv`, `canvas_csv`,
-  `gradescope_csv`, `github_classroom_csv`, `GRADEBOOKS` (the `--gradebook` registry); every cell through
-  `grader.render.neutral.safe_cell`. `output.ClassGradebook` is the `grader.grading.batch.GradebookWriter` that
-  `gymgrade grade` passes to `grade_many(..., names=identities, gradebook=...)`: reports are
-  `<identity_stem(identity)>.json` (the resume key: the identity percent-encoded, one over `MAX_STEM_CHARS`
-  (150) cut and ended by `~` and 20 hex digits of its SHA-256), gradebooks are rewritten at most every
-  `batch.GRADEBOOK_INTERVAL` s and when the batch ends or is interrupted.
+  member, one per student: of several submissions the latest counts; roster students without one; notes; a
+  roster row is claimed once, an exact match first: a second claim is a row with `refused_claim` and a note,
+  which every LMS format leaves out), `grades_csv`, `canvas_csv`, `gradescope_csv`, `github_classroom_csv`,
+  `GRADEBOOKS` (the `--gradebook` registry); every cell through `grader.render.neutral.safe_cell`.
+  `output.ClassGradebook` is the `grader.grading.batch.GradebookWriter` that `gymgrade grade` passes to
+  `grade_many(..., names=identities, gradebook=...)`: reports are `<identity_stem(identity)>.json` (the resume
+  key: the identity percent-encoded, one over `MAX_STEM_CHARS` (150) cut and ended by `~` and 20 hex digits of
+  its SHA-256), gradebooks are rewritten at most every `batch.GRADEBOOK_INTERVAL` s and when the batch ends or
+  is interrupted.
 - `gymgrade grade --html`: the class report's entries come from the rows the batch last wrote
-  (`grader.classroom.report.from_batch.entries_from_rows(ClassGradebook.rows, out_dir, page)`: a roster student
-  without a submission is `missing`, a submission with nothing gradable `submission_error`, links to
+  (`grader.classroom.report.from_batch.entries_from_rows(ClassGradebook.rows, out_dir, page)`: a roster
+  student without a submission is `missing`, a submission with nothing gradable `submission_error`, links to
   `<identity_stem>.json`); the page-clash check runs against the identity report files before grading.
 - `api/gradebook.py`'s `gradebook_export(session, policy, format, assignment)` serves the same formats
   (`GET /gradebook.csv?format=canvas&assignment_id=...`), each student's service name as identity.

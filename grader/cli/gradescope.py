@@ -6,21 +6,21 @@ are an output format: `grader.render.gradescope`.
 In detail:
 
 - `grader/render/gradescope.py`: `GradescopeResults`/`GradescopeTest` (pydantic, Gradescope's published
-  results.json schema); `results(report, *, visibility="visible", upload=None) -> GradescopeResults`
-  (pure; a test per problem, `status` passed/failed, feedback and output; the printed output and the
-  seed go in `hidden` tests and `extra_data`, and while a problem is withheld the results' top-level
-  visibility is raised to the withheld problem's, `execution_time` and that problem's grader errors are
-  dropped, and the summary is repeated in a visible test). `grader/cli/gradescope.py`: `pick_submission(dir) -> Path | str` (the one
+  results.json schema); `results(report, *, visibility="visible", upload=None) -> GradescopeResults` (pure; a
+  test per problem, `status` passed/failed, feedback and output; the printed output and the seed go in
+  `hidden` tests and `extra_data`, and while a problem is withheld the results' top-level visibility is raised
+  to the withheld problem's, `execution_time` and that problem's grader errors are dropped, and the summary is
+  repeated in a visible test). `grader/cli/gradescope.py`: `pick_submission(dir) -> Path | str` (the one
   `.py`/`.ipynb`, preferring `opengym.*`, or why none; the upload is walked without following links, and a
-  chosen name that is a symbolic or hard link, or a folder link on the way, is refused with the reason); `bundle(out, *, config, secret=None)` (the
-  autograder zip: `setup.sh`, `run_autograder`, the configuration and `seed_secret`, mode 0600);
-  `run_autograder(root, *, upload, config, workers)` (what the zip's `run_autograder` script runs through
-  `gymgrade gradescope-run`, passing `--secret-file`, never a seed; `GYMGRADE_AUTOGRADER_ROOT` and
-  `GYMGRADE_COMMAND` move it for tests; the chosen file is read once with `read_untrusted(path,
-  root=submission)`, every folder below the upload's root opened without following links too, and its
-  bytes graded from a copy in a private temporary folder, so nothing of the upload is read through a
-  link, even by the root grader); `upload_seed_of(zip, metadata)` and
-  `regrade_upload(zip, metadata, submission, out)` (CLI `gymgrade gradescope-seed`).
+  chosen name that is a symbolic or hard link, or a folder link on the way, is refused with the reason);
+  `bundle(out, *, config, secret=None)` (the autograder zip: `setup.sh`, `run_autograder`, the configuration
+  and `seed_secret`, mode 0600); `run_autograder(root, *, upload, config, workers)` (what the zip's
+  `run_autograder` script runs through `gymgrade gradescope-run`, passing `--secret-file`, never a seed;
+  `GYMGRADE_AUTOGRADER_ROOT` and `GYMGRADE_COMMAND` move it for tests; the chosen file is read once with
+  `read_untrusted(path, root=submission)`, every folder below the upload's root opened without following links
+  too, and its bytes graded from a copy in a private temporary folder, so nothing of the upload is read
+  through a link, even by the root grader); `upload_seed_of(zip, metadata)` and `regrade_upload(zip, metadata,
+  submission, out)` (CLI `gymgrade gradescope-seed`).
 - The autograder grades with `IsolationPolicy.ALLOW_FALLBACK` (Gradescope's containers lack the
   namespaces and cgroups bubblewrap and the cgroup layer need); the results' output names every missing
   layer.

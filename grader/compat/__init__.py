@@ -17,8 +17,8 @@ The layer's contract:
   `from gymnasium import make`), so the sandbox's recorder, which wraps `gymnasium.make`, sees every env.
 - `grader.compat.events.drain() -> list[CompatEvent]` (`CompatEvent(kind: str, env_id: str, detail: str)`,
   kinds: `step_before_reset`, `step_after_done`, `numpy_action`, `render_without_mode`, `legacy_seed_call`,
-  `renamed_id`, `seed_replaced`, `api_detected`): what the layer had to tolerate. Repeats are counted, not stored: one event per
-  (kind, env_id) per drain, its detail ending in "(N times)".
+  `renamed_id`, `seed_replaced`, `api_detected`): what the layer had to tolerate. Repeats are counted, not
+  stored: one event per (kind, env_id) per drain, its detail ending in "(N times)".
 - `python -m grader.compat SCRIPT.py` runs a script with the layer active.
 - **Both gym APIs**: `grader.compat.detection.detect_api(source) -> ApiDetection` (pure, `ast`)
   decides per function, then per module, whether code expects classic gym (`Api.CLASSIC`: `obs = reset()`,

@@ -13,12 +13,12 @@ How the lab's parts fit:
   the acceptance modules (`test_<id>.py`, `PROBLEM = PROBLEMS.acceptance_problem(__name__)`) and the
   report's titles and points.
   `tests/grader/lab/test_problems.py` fails on any other source that lists every id.
-- `grader/lab/assignment.py` loads `grader/lab/assignment.toml` for a registry (`load_config(path, registry=PROBLEMS)`):
-  `assignment_file_model(registry)` has one `[problems.<id>]` table per problem, parsed with its settings
-  model, whose `title`, `points` and `enabled` default to the registry's; a problem disabled by default may
-  be left out (built from its model's defaults). Each loaded settings object is bound to its problem
-  (`settings.problem_id`; `settings.game_rules()` is `allowed_games(problem.games, accepted_envs)` for played
-  problems, None otherwise). `AssignmentConfig.problem(id)` gives the settings as `ProblemConfig`;
+- `grader/lab/assignment.py` loads `grader/lab/assignment.toml` for a registry (`load_config(path,
+  registry=PROBLEMS)`): `assignment_file_model(registry)` has one `[problems.<id>]` table per problem, parsed
+  with its settings model, whose `title`, `points` and `enabled` default to the registry's; a problem disabled
+  by default may be left out (built from its model's defaults). Each loaded settings object is bound to its
+  problem (`settings.problem_id`; `settings.game_rules()` is `allowed_games(problem.games, accepted_envs)` for
+  played problems, None otherwise). `AssignmentConfig.problem(id)` gives the settings as `ProblemConfig`;
   `registry.problem(id).settings(assignment)` gives them typed (`Problem.settings`, the one narrowing;
   `PlanError` for another registry's). `config.registry` is the registry it was loaded with, and
   `model_dump_json()` (the report's `config_sha256`) includes every problem's own fields.
@@ -38,36 +38,36 @@ How the lab's parts fit:
   replayed observations leave and the total of guesses with an exact test
   (`checks.guessing_game.total_acceptance`: the n-fold convolution of the oracle's distribution).
 - `grader/lab/checks/` pure per-problem verdict logic; `grader/grading/cases/` one pytest module per problem
-  (`test_<id>.py` with `PROBLEM` and `test_<id>(problem_case, grade)`), run by pytest-xdist through the
-  plugin `grader/grading/plugin.py` in one **acceptance session per grading, in the calling process**
-  (`grader/grading/session.py`; see "The path of one grading").
-  `grader/lab/checks/base.py` is the contract: `CallRecord(outcome, replays)`, `Verdict(status, fraction,
-  feedback, measurements)`, `ProblemCheck[ConfigT]` with `.plan(settings: ConfigT, functions) ->
-  list[Call]` / `.judge(settings: ConfigT, records) -> Verdict` (a check never narrows its settings; the
-  games its episodes must be played in are `settings.game_rules()`), and the shared outcome mapping. Every planned `Call` carries a
-  `CallBudget` (`grader.lab.checks.integrity.games_budget`). `grader.grading.execution.run_problem` looks the problem up in
+  (`test_<id>.py` with `PROBLEM` and `test_<id>(problem_case, grade)`), run by pytest-xdist through the plugin
+  `grader/grading/plugin.py` in one **acceptance session per grading, in the calling process**
+  (`grader/grading/session.py`; see "The path of one grading"). `grader/lab/checks/base.py` is the contract:
+  `CallRecord(outcome, replays)`, `Verdict(status, fraction, feedback, measurements)`, `ProblemCheck[ConfigT]`
+  with `.plan(settings: ConfigT, functions) -> list[Call]` / `.judge(settings: ConfigT, records) -> Verdict`
+  (a check never narrows its settings; the games its episodes must be played in are `settings.game_rules()`),
+  and the shared outcome mapping. Every planned `Call` carries a `CallBudget`
+  (`grader.lab.checks.integrity.games_budget`). `grader.grading.execution.run_problem` looks the problem up in
   `config.registry`, makes the calls one by one; each outcome becomes a record through
-  `integrity.replay_call(outcome, settings.game_rules())`, which checks
-  env ids, arguments and reset options **before** anything is replayed (refused logs get
-  `replay.not_replayed(reason)` replays); after each record `integrity.settled_by(record, games)` says
-  whether the verdict can still change, and if not the remaining calls are not made (the verdict's
-  feedback and `calls_planned`/`calls_made` measurements say so). The integrity rules (the grader's
-  seeds, the lab's game, no options, played starts a fair sample of the dealt ones, real and finished
-  games) are `integrity_problem`; the selection test on dealt starts is `grader/lab/checks/starts.py`
-  (it values every start with `reference.oracles` or the reference policy and needs every call, so
-  unplayed resets never settle a verdict early); steps after a game ended are a note
-  (`integrity.noting_post_terminal_steps` on each played check's `judge`), and a call beyond its
-  `CallBudget` is a described `failed` (`base.outcome_verdict`). All are stated in `grader/lab/ASSIGNMENT.md`. The numbers behind every check are
-  explained in `grader/lab/ASSIGNMENT.md`.
+  `integrity.replay_call(outcome, settings.game_rules())`, which checks env ids, arguments and reset options
+  **before** anything is replayed (refused logs get `replay.not_replayed(reason)` replays); after each record
+  `integrity.settled_by(record, games)` says whether the verdict can still change, and if not the remaining
+  calls are not made (the verdict's feedback and `calls_planned`/`calls_made` measurements say so). The
+  integrity rules (the grader's seeds, the lab's game, no options, played starts a fair sample of the dealt
+  ones, real and finished games) are `integrity_problem`; the selection test on dealt starts is
+  `grader/lab/checks/starts.py` (it values every start with `reference.oracles` or the reference policy and
+  needs every call, so unplayed resets never settle a verdict early); steps after a game ended are a note
+  (`integrity.noting_post_terminal_steps` on each played check's `judge`), and a call beyond its `CallBudget`
+  is a described `failed` (`base.outcome_verdict`). All are stated in `grader/lab/ASSIGNMENT.md`. The numbers
+  behind every check are explained in `grader/lab/ASSIGNMENT.md`.
 
 **Where an edition's problems sit (no import circle, type-only imports included).** From the bottom:
 `grader/lab/ids.py` (`ProblemId`, standard library only) <- `grader/lab/games.py` (the `Game`s and the lab's
-`*_GAMES` tuples) <- `grader/lab/settings.py` (settings models; a loaded model is bound to its problem's
-id and games) <- `grader/lab/checks/*` <- `grader/lab/showcase.py` (`ShowcaseRule`s) and `grader/lab/plots.py`
-(plotters; matplotlib imported when a plot is drawn) <- `grader/lab/registry.py` (`Problem`, `Registry`;
-it reads settings through the `SettingsSource` protocol, never `grader.lab.assignment`) <- `grader/lab/problems.py` and
-the packs in `grader/lab/editions/` <- `grader/lab/assignment.py` <- everything that grades or renders. A problem's
-declaration holds everything about it: `Problem(id, title, points, config, check, enabled, games, showcase,
-plot)`; nothing outside it is keyed by problem id (`grader.render.figures` asks `config.registry.problem(id).plot`,
-`grader.grading.execution` passes `problem.showcase`, the loader binds `problem.games`).
+`*_GAMES` tuples) <- `grader/lab/settings.py` (settings models; a loaded model is bound to its problem's id
+and games) <- `grader/lab/checks/*` <- `grader/lab/showcase.py` (`ShowcaseRule`s) and `grader/lab/plots.py`
+(plotters; matplotlib imported when a plot is drawn) <- `grader/lab/registry.py` (`Problem`, `Registry`; it
+reads settings through the `SettingsSource` protocol, never `grader.lab.assignment`) <-
+`grader/lab/problems.py` and the packs in `grader/lab/editions/` <- `grader/lab/assignment.py` <- everything
+that grades or renders. A problem's declaration holds everything about it: `Problem(id, title, points, config,
+check, enabled, games, showcase, plot)`; nothing outside it is keyed by problem id (`grader.render.figures`
+asks `config.registry.problem(id).plot`, `grader.grading.execution` passes `problem.showcase`, the loader
+binds `problem.games`).
 """

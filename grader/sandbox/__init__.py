@@ -75,10 +75,11 @@ The interpreter inside the sandbox:
   that bwrap can remount read-only; a directory containing a system directory raises `SandboxLayoutError`.
   `file_system_argv` is shared by the children and the bubblewrap probe, which starts the interpreter in
   that file system and reports bwrap's message (paths without `/newroot`) when it cannot.
-- `grader/sandbox/doctor.py`: `diagnose(student_modules) -> Diagnosis` (probe, binds, one sandbox child importing
-  each module, timings) and `render(diagnosis)`; `gymgrade doctor [--config]` prints it (exit 0 = ready).
-- `grader.lab.assignment.STUDENT_MODULES` / `[sandbox] student_modules`: the modules students may import beyond the
-  stdlib, numpy and gym (installed by `pyproject.toml`'s dependencies); not part of `Limits`.
+- `grader/sandbox/doctor.py`: `diagnose(student_modules) -> Diagnosis` (probe, binds, one sandbox child
+  importing each module, timings) and `render(diagnosis)`; `gymgrade doctor [--config]` prints it (exit 0 =
+  ready).
+- `grader.lab.assignment.STUDENT_MODULES` / `[sandbox] student_modules`: the modules students may import
+  beyond the stdlib, numpy and gym (installed by `pyproject.toml`'s dependencies); not part of `Limits`.
 - `grader/sandbox/process.py` `CappedOutput`: a line rewritten with `\\r` keeps its last state (progress
   bars, `clear_output`), before the `output_bytes` cap.
 """

@@ -31,14 +31,15 @@ The wire format:
   runner reports as a forged frame (`INVALID_VALUE`).
 
 The episode's wire fields are declared once in `grader/sandbox/child/episode_fields.py` (stdlib only):
-`EPISODE_HEADER`, `EPISODE_COLUMNS`, `EPISODE_FIELDS`, and the frozen dataclass
-`EpisodeHeader` (env and reset fields) that the child's `EpisodeRecord` and the parent's `EpisodeLog`
-extend; and the columnar log's layout, `MADE_FIELDS`, `DENSE_FIELDS`, `SPARSE_FIELDS`, `LOG_FIELDS`,
-`ACTION_FORMS`. `grader/simulated_students/simulation.py` (whose episodes hold an `EpisodeLog`) uses them too;
-`check_declaration` and `check_log_declaration` refuse a drifted model or block at import.
-`RecordingEnv.step` counts and logs each step in its one frame into typed columns (`array('q')` actions,
-a list only after an action that is not an int64; `array('d')` rewards, a NaN for a reward that cannot
-be converted, which the replay then reports; `bytearray` flags). Costs: `bench/recorder_cost.py`; a class's: `bench/class_throughput.py`.
+`EPISODE_HEADER`, `EPISODE_COLUMNS`, `EPISODE_FIELDS`, and the frozen dataclass `EpisodeHeader` (env and reset
+fields) that the child's `EpisodeRecord` and the parent's `EpisodeLog` extend; and the columnar log's layout,
+`MADE_FIELDS`, `DENSE_FIELDS`, `SPARSE_FIELDS`, `LOG_FIELDS`, `ACTION_FORMS`.
+`grader/simulated_students/simulation.py` (whose episodes hold an `EpisodeLog`) uses them too;
+`check_declaration` and `check_log_declaration` refuse a drifted model or block at import. `RecordingEnv.step`
+counts and logs each step in its one frame into typed columns (`array('q')` actions, a list only after an
+action that is not an int64; `array('d')` rewards, a NaN for a reward that cannot be converted, which the
+replay then reports; `bytearray` flags). Costs: `bench/recorder_cost.py`; a class's:
+`bench/class_throughput.py`.
 """
 
 from __future__ import annotations
