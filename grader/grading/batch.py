@@ -11,7 +11,7 @@ In detail:
 - `grader/grading/batch.py` (resumable batches): `grade_many(paths, out_dir, *, seed, workers, only, policy,
   config, on_result, executor=None, on_plan=None, names=None, gradebook=None) -> BatchOutcome(reports, reused,
   graded, reasons)` writes each `<name>.json` (`names` maps a file to its identity; `gradebook` is a
-  `GradebookWriter`, see "grader/classroom/") (one rename, never half a file) and rewrites `grades.csv` as
+  `GradebookWriter`, see `grader.classroom`) (one rename, never half a file) and rewrites `grades.csv` as
   soon as that file's report exists, and reuses a report already in `out_dir` when `stale_reason(report_text,
   data, seed=, plan=)` is None: same sha256, seed, `config_sha256` (`GradingPlan.config_sha256`, the digest of
   the validated configuration, recorded in `Report.config_sha256`), problems and grader version, and no grader

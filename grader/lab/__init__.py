@@ -40,7 +40,7 @@ How the lab's parts fit:
 - `grader/lab/checks/` pure per-problem verdict logic; `grader/grading/cases/` one pytest module per problem
   (`test_<id>.py` with `PROBLEM` and `test_<id>(problem_case, grade)`), run by pytest-xdist through the plugin
   `grader/grading/plugin.py` in one **acceptance session per grading, in the calling process**
-  (`grader/grading/session.py`; see "The path of one grading"). `grader/lab/checks/base.py` is the contract:
+  (`grader/grading/session.py`; see `grader.grading`). `grader/lab/checks/base.py` is the contract:
   `CallRecord(outcome, replays)`, `Verdict(status, fraction, feedback, measurements)`, `ProblemCheck[ConfigT]`
   with `.plan(settings: ConfigT, functions) -> list[Call]` / `.judge(settings: ConfigT, records) -> Verdict`
   (a check never narrows its settings; the games its episodes must be played in are `settings.game_rules()`),

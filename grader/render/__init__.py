@@ -9,7 +9,8 @@ configuration):
   and the summary `gymgrade check` prints (`grader/render/text.py`);
 - JSON: `Report.to_json()` (`gymgrade check --json`, `--output`, every `gymgrade grade` report file;
   `grader/render/report_json.py`);
-- Gradescope's results.json: `grader.render.gradescope.results` (section "Gradescope");
+- Gradescope's results.json: `grader.render.gradescope.results` (the autograder itself:
+  `grader.cli.gradescope`);
 - the HTML report and its figures:
   - `grader/lab/showcase.py`: `showcase_episode(rule, records) -> EpisodeReplay | None` (pure; `rule` is the
     problem declaration's `showcase`, a `ShowcaseRule`), called by

@@ -21,18 +21,17 @@ The sandbox's contract, beyond the types the code declares:
   against its shape before base64 decoding. The `ready` frame is bounded likewise (16 MiB, 200 000).
   Over a limit is a forged frame (`INVALID_VALUE`), never a grader error; the child checks its own frame
   against the same limits and reports an honest overflow as `OUTPUT_TOO_LARGE`.
-- **Declared boundaries.** Everything the child sends is validated by declared pydantic
-  models in strict mode with no undeclared fields (`grader/sandbox/boundary.py`: `STRICT`, `one_of`
-  for unions that fail with one sentence, `at_most(n)` refusing a longer list or dict before any entry is
-  validated, `problem(ValidationError, where)` -> "the episode log: envs[0].env_kwargs: should be a valid
-  dictionary, found list [1]"). `grader/sandbox/messages.py`: `ReadyMessage`
-  (function table, at most `MAX_LISTED_NAMES` x `MAX_LISTED_PARAMETERS`), `ImportErrorMessage`,
-  `ResultMessage` (`ChildStatus`, `compat_events: list[CompatEventRecord]`, `wall_time` in [0, 1e9)),
-  whose string fields are cleaned as they validate; `value` is decoded by `decode_value`, `episodes` by
-  `episodes_from_plain` (the episodes' wire format: "Recording and replay"). A failed validation is a
-  forged frame (`INVALID_VALUE`) with that sentence.
-  pydantic was chosen over msgspec by `bench/boundaries.py` (bench/RESULTS.md; the bench measured the
-  per-episode layout and was retired with it: run it at commit 78f5685).
+- **Declared boundaries.** Everything the child sends is validated by declared pydantic models in strict mode
+  with no undeclared fields (`grader/sandbox/boundary.py`: `STRICT`, `one_of` for unions that fail with one
+  sentence, `at_most(n)` refusing a longer list or dict before any entry is validated,
+  `problem(ValidationError, where)` -> "the episode log: envs[0].env_kwargs: should be a valid dictionary,
+  found list [1]"). `grader/sandbox/messages.py`: `ReadyMessage` (function table, at most `MAX_LISTED_NAMES` x
+  `MAX_LISTED_PARAMETERS`), `ImportErrorMessage`, `ResultMessage` (`ChildStatus`, `compat_events:
+  list[CompatEventRecord]`, `wall_time` in [0, 1e9)), whose string fields are cleaned as they validate;
+  `value` is decoded by `decode_value`, `episodes` by `episodes_from_plain` (the episodes' wire format:
+  `grader.sandbox.child.log_block`). A failed validation is a forged frame (`INVALID_VALUE`) with that
+  sentence. pydantic was chosen over msgspec by `bench/boundaries.py` (bench/RESULTS.md; the bench measured
+  the per-episode layout and was retired with it: run it at commit 78f5685).
 - **Strings from the child** are cleaned once where they enter the parent (`grader/sandbox/text.py`:
   `clean_text(text, limit)` replaces lone surrogates and NULs with U+FFFD and caps with a note;
   `clean_plain` for values, env arguments and reset options): messages and tracebacks 20 000

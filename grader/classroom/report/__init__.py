@@ -26,7 +26,7 @@ In detail:
   that says it; safe_href keeps plain relative paths only, percent-encoded).
 - Shells: `write_class_report(page, entries)` (`__init__.py`) writes the page and `class.json` beside it.
   `gymgrade grade --html PATH` builds the entries with `from_batch.entries_from_rows(rows, out_dir, page)`
-  from the gradebook rows the batch last wrote (see "grader/classroom/");
+  from the gradebook rows the batch last wrote (see `grader.classroom`);
   `from_batch.entries_from_batch(paths, reports, out_dir, page)` builds them from a batch's files and
   reports alone (each report's file name as identity), for callers without a class download.
 """
