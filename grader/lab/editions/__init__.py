@@ -51,6 +51,17 @@ How an edition is carried, chosen and shown:
   first edition), chosen in the grading child `api/jobs/child.py` (`service_edition`, which logs the
   `Edition:` line); an upload's own edition is never used, its report's `edition_note` tells it. A batch
   job carries its configuration as before.
+
+The four editions of this lab: `classic` (1, the lab text; its registry is `grader.lab.problems.PROBLEMS`, so
+every configuration and report that names no edition keeps its meaning), `gym026` (2) and `volume2` (3) (the
+same problems: the compatibility layer runs their APIs; `cartpole()`/`car()` are called without arguments, so
+`render=False` keeps its default), and `rl1` (4, the current one: problems 1-4 are `PROBLEMS`' own
+declarations, reused, plus `epsilon_decay` and the two-table `taxi` (the same id as edition 1's `taxi`,
+another `Problem`: ids are unique within an edition), `sarsa0` and `compare()` (the notebook's cells run
+first, by default); `qlearn` is a provided function, listed in `not_graded`). Templates are
+`submissions/template.py` (classic) and `submissions/templates/<edition>.py`; references are
+`submissions/*_complete.py` and `submissions/editions/rl1_complete.py`; `rl1`'s default configuration is
+`grader/lab/editions/rl1.toml` (the others use the bundled `grader/lab/assignment.toml`).
 """
 
 from grader.lab.editions.classic import CLASSIC
