@@ -8,6 +8,16 @@ replaced by a note. So is everything summed over the problems, which would give 
 (a total minus the shown parts is the withheld part): the total score, the grading's time and its timings,
 and the grader's errors about a withheld problem. The stored report always keeps everything; these pure
 functions only shape the views.
+
+In detail:
+
+  precision of the learner's cells (`recompute(..., precision=)`): a table whose every cell is a float32
+  number is recomputed with `np.float32` cells, so NumPy rounds every update as it did in the child, and is
+  compared within `float32_table_tolerance`; any other table in float64 within `table_tolerance`. A later
+  learner (Q-learning, Expected SARSA, the MDP lab's iterations) adds a rule and a check on the same core.
+
+- Seeds: `SEED_POLICY=random` (default) stores `held_out_seed(2**31)` in each submission's row (the
+  column is a 32-bit integer); `fixed` uses `SEED` and is refused with the practice seed 0 outside
 """
 
 from __future__ import annotations

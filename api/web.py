@@ -1,4 +1,11 @@
-"""The Jinja2 environment of the web pages (autoescaping on) and the security headers they are sent with."""
+"""The Jinja2 environment of the web pages (autoescaping on) and the security headers they are sent with.
+
+The pages show each problem's figures through `page_figures` (`grader.render.figures.problem_figures`, the
+HTML report's figures, each problem drawn once and cached): a finished report's with its edition's
+configuration, and while a submission is being graded, each finished problem's with the first edition's
+(every edition plots its problems with the first edition's plotters and settings; `tests/api/test_web.py`
+holds them to it).
+"""
 
 from __future__ import annotations
 

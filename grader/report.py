@@ -1,4 +1,27 @@
-"""The grade report: what a submission earned per problem, why, and how the grading ran."""
+"""The grade report: what a submission earned per problem, why, and how the grading ran.
+
+In detail:
+
+- `grader/report.py`: pydantic `Report` (`format`, `submission`, `sha256`, `seed`, `config_sha256`, `edition`
+  (absent in older reports: `classic`), `gymnasium_version`, `grader_version`, `isolation`, `score`,
+  `max_score`, `submission_error`, `problems`, `notebook`, `grader_errors`, `execution_time`, `timings`) and
+  `ProblemResult` (`id`, `title`, `status`, `score`, `max_score`, `feedback`, `measurements`, `output`,
+  `compat_events`, `seed`, `visibility`, `replay`, `timings`); a problem's run in a worker is a
+  `ProblemRun(submission, result, isolation, internal_error)`. `ProblemRun.to_json()` is how a run crosses
+  from an acceptance test (an xdist worker) to the controller (`grader.grading.plugin.outcome_json`): it never
+  raises on student text (unencodable characters are replaced and that problem becomes `error`).
+  `Report.isolation` / `ProblemRun.isolation` are an `IsolationSummary(full, layers: [LayerSummary(name,
+  active, required, detail, remedy)], summary)` (`grader.grading.execution.isolation_summary`), or None when
+  no sandbox ran, stored as `{}`; `ProblemResult.compat_events` are `CompatEventRecord`s
+  (`grader.sandbox.outcome`). `ProblemResult.visibility` (`Visibility = Literal["visible", "after_due_date",
+  "hidden"]`, Gradescope's words, default `visible`) comes from the problem's `visibility` in the assignment
+  config and is set on every result (checked, rejected file, grader failure); the report itself always holds
+  everything.
+- `grader/report.py`: `withheld_ids(problems, shown)` and `errors_shown(grader_errors, withheld)` (pure),
+  used by Gradescope's results and by `api/disclosure.report_view`, which, while a problem is withheld,
+  also sets `score`, `execution_time` and `timings` to None. Student-visible views are tested byte for byte
+  against reports that differ only in the withheld problem.
+"""
 
 from __future__ import annotations
 

@@ -6,6 +6,14 @@ drawn at random (`held_out_seed`) and recorded in each report, so a regrade with
 database can record a fresh seed per upload (the Gradescope bundle), each upload's seed is derived from a
 secret and the upload's identity (`upload_seed`): different for every upload, unpredictable without the
 secret, and recomputed by whoever holds it.
+
+In detail:
+
+- `grader/seeds.py`: `PRACTICE_SEED = 0` (what `gymgrade check` plays on unless given `--seed`) and
+  `held_out_seed(limit=2**63)`, a `secrets` draw in [1, limit): what `gymgrade grade` uses without
+  `--seed` (printed, in every report and the `seed` column of `grades.csv`) and the service per submission.
+- `grader/seeds.py`: `new_secret()` (256-bit hex) and `upload_seed(secret, identity, limit=2**63)`:
+  HMAC-SHA256 of the identity (a sequence of strings, JSON-encoded) under the secret, in [1, limit). Pure.
 """
 
 from __future__ import annotations

@@ -1,4 +1,13 @@
-"""The `gymgrade` command line: `check` one file (students), `grade` a batch (instructors), and plugins."""
+"""The `gymgrade` command line: `check` one file (students), `grade` a batch (instructors), and plugins.
+
+In detail:
+
+- `grader/cli/__init__.py`: `gymgrade check`, `grade`, `gradescope-bundle`, `gradescope-run`,
+  `gradescope-seed`, `doctor` and `similarity` (`grader/classroom/similarity/command.py`); other subcommands
+  come from the entry-point group `gymgrade.commands` (each entry point is `add_command(subparsers) -> None`;
+  the subparser sets `handler=callable(args) -> int`). The service registers `serve` and `worker` this way, so
+  `grader` never imports `api`.
+"""
 
 from __future__ import annotations
 

@@ -2,6 +2,36 @@
 
 The results themselves (Gradescope's specification as pydantic models, and a report as those results)
 are an output format: `grader.render.gradescope`.
+
+In detail:
+
+- `grader/render/gradescope.py`: `GradescopeResults`/`GradescopeTest` (pydantic, Gradescope's published
+  results.json schema); `results(report, *, visibility="visible", upload=None) -> GradescopeResults` (pure; a
+  test per problem, `status` passed/failed, feedback and output; the printed output and the seed go in
+  `hidden` tests and `extra_data`, and while a problem is withheld the results' top-level visibility is raised
+  to the withheld problem's, `execution_time` and that problem's grader errors are dropped, and the summary is
+  repeated in a visible test). `grader/cli/gradescope.py`: `pick_submission(dir) -> Path | str` (the one
+  `.py`/`.ipynb`, preferring `opengym.*`, or why none; the upload is walked without following links, and a
+  chosen name that is a symbolic or hard link, or a folder link on the way, is refused with the reason);
+  `bundle(out, *, config, secret=None)` (the autograder zip: `setup.sh`, `run_autograder`, the configuration
+  and `seed_secret`, mode 0600); `run_autograder(root, *, upload, config, workers)` (what the zip's
+  `run_autograder` script runs through `gymgrade gradescope-run`, passing `--secret-file`, never a seed;
+  `GYMGRADE_AUTOGRADER_ROOT` and `GYMGRADE_COMMAND` move it for tests; the chosen file is read once with
+  `read_untrusted(path, root=submission)`, every folder below the upload's root opened without following links
+  too, and its bytes graded from a copy in a private temporary folder, so nothing of the upload is read
+  through a link, even by the root grader); `upload_seed_of(zip, metadata)` and `regrade_upload(zip, metadata,
+  submission, out)` (CLI `gymgrade gradescope-seed`).
+- The autograder grades with `IsolationPolicy.ALLOW_FALLBACK` (Gradescope's containers lack the
+  namespaces and cgroups bubblewrap and the cgroup layer need); the results' output names every missing
+  layer.
+- `grader/submission/gradescope_upload.py`: `SubmissionMetadata` (pydantic, the fields gymgrade reads of
+  `submission_metadata.json`: `id`, `created_at`, `users[].id`; `identity()`), `read_metadata(path)`
+  (bounded read, `GradescopeError` with the field at fault), `seed_for_upload(root, secret_file=) ->
+  UploadSeed(seed, source, identity, note)` (`upload_seed` of the identity; a fresh seed, never a fixed
+  one, when the secret or the metadata cannot be read). `read_secret` reads the secret (without following
+  a link) before any file of the upload is touched (`gymgrade gradescope-run` derives the seed first) and
+  leaves it mode 0600: student code runs as another uid, and bubblewrap and Landlock do not show
+  `/autograder` at all. What students see: `docs/gradescope.md`.
 """
 
 from __future__ import annotations

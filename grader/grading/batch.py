@@ -5,6 +5,22 @@ exists; the core writes it (atomically) and rewrites ``grades.csv``. Re-running 
 output directory reuses every report that still matches its file's bytes, seed and configuration, so an
 interrupted batch resumes where it stopped. The local executor runs pytest-xdist on this machine;
 others (the distributed one in ``api``) are found through the ``gymgrade.executors`` entry points.
+
+In detail:
+
+- `grader/grading/batch.py` (resumable batches): `grade_many(paths, out_dir, *, seed, workers, only, policy,
+  config, on_result, executor=None, on_plan=None, names=None, gradebook=None) -> BatchOutcome(reports, reused,
+  graded, reasons)` writes each `<name>.json` (`names` maps a file to its identity; `gradebook` is a
+  `GradebookWriter`, see `grader.classroom`) (one rename, never half a file) and rewrites `grades.csv` as
+  soon as that file's report exists, and reuses a report already in `out_dir` when `stale_reason(report_text,
+  data, seed=, plan=)` is None: same sha256, seed, `config_sha256` (`GradingPlan.config_sha256`, the digest of
+  the validated configuration, recorded in `Report.config_sha256`), problems and grader version, and no grader
+  errors. Interrupted, it raises `grader.errors.BatchInterrupted(finished, total)` (a `KeyboardInterrupt`).
+  Who grades is a `BatchExecutor` (`grade(paths, plan, *, seed, listener)`, each report handed to the
+  `GradingListener` as soon as it exists; a report that cannot be written becomes that file's grader error,
+  never the batch's): `LocalExecutor(workers, policy)` (chunks of `grade_files`, whose collector hands a
+  report over when a file's last check arrives) or one found through the entry-point group
+  `gymgrade.executors` (`factory(policy) -> BatchExecutor | None`; None when not configured, then local).
 """
 
 from __future__ import annotations

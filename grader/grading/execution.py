@@ -1,4 +1,23 @@
-"""Grade one problem of one submission: sandboxed calls, trusted replays, the check's verdict."""
+"""Grade one problem of one submission: sandboxed calls, trusted replays, the check's verdict.
+
+How a problem is run (`run_problem`):
+
+- **No student CPU where no verdict needs it.** `run_problem` hands a plan the submission's functions on
+  demand (`grader.grading.execution.FunctionsOnDemand`): the sandbox child starts (and imports the submission)
+  only when the plan reads them or the first call is made, so a plan without calls costs no child.
+  `find_qvalues` plans none unless its problem is worth points or `[problems.find_qvalues]` says `run =
+  "always"` (`FindQvaluesConfig.called`; default `run = "when_scored"`: `taxi(q_table)` gets the grader's
+  exact table, and a `taxi()` that trains its own table calls `find_qvalues` inside its own call); its verdict
+  is then `skipped` (0 of 0, feedback saying why and how to have it run). `skipped` is a status of `Verdict`
+  and `ProblemResult`: `Report.full_marks` and Gradescope's test status count it as nothing failed, progress
+  shows `[SKIPPED]`. One sandbox child per problem stays (not one per worker for all problems of a
+  submission): `bench/speed.py` measured the saving (a child start, import and teardown per problem: 1 to 3 s
+  each on the shared 2-core machine, isolation set-up a few hundredths of it; off the critical path, which is
+  the longest problem) against the cost: module-level state (a notebook's global env, Q-table or list) would
+  carry from one problem into the next, so a problem's report would depend on which problems xdist happened to
+  run before it in that worker; one child's life-long CPU limit, memory growth and restart after a fatal
+  outcome would be shared too.
+"""
 
 from __future__ import annotations
 

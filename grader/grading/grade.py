@@ -4,6 +4,24 @@
 be graded is refused with its report at once), runs one acceptance session over every (file, problem) case
 on pytest-xdist workers (`grader.grading.session`), and hands each case's outcome to one `Outcomes`, which
 builds each file's report the moment its last problem is graded and tells the caller's `GradingListener`.
+
+Its contract:
+
+- Each file is read once, without following links (`grader/submission/untrusted_file.py`, `read_untrusted`:
+  opened with `O_NOFOLLOW` where the system has it, else `lstat` before and `fstat` after; a hard link, a
+  FIFO, a folder is refused; read from the descriptor, at most `grading.READ_LIMIT` + 1 bytes), and the
+  sandbox imports a copy of those bytes in the grading's own temporary folder (or the module built from a
+  notebook), never the student's path again: a file swapped or linked in meanwhile, or a `<name>.cells.json`
+  planted beside it, is not what is graded.
+- Invalid files (a link, empty, not UTF-8, not Python, > 1 MB) return a `Report` with clear verdicts
+  (`report.submission_error`), never raise; a student's crash or timeout is a verdict. It raises only
+  `IsolationUnavailable` (`REQUIRE_FULL` on a machine that cannot isolate), `ConfigError` and `ValueError` (an
+  unknown id in `only`). A failure of the grader itself marks the problem `error` and is listed in
+  `report.grader_errors` (the service treats a non-empty list as a failed job). `config` is an assignment TOML
+  (default `grader/lab/assignment.toml`), `plan` one loaded already (then `config` and `only` are not read).
+  `on_progress` is called from the calling thread.
+- Deterministic: `report.graded_view()` (everything but `execution_time` and `timings`) is identical for
+  the same bytes and seed.
 """
 
 from __future__ import annotations

@@ -5,6 +5,23 @@ the collector keeps the runs of each file, tells its `GradingListener` each prob
 once a file's last problem is in, builds that file's report and hands it over (so a batch writes it at
 once). A file refused before anything ran, and the cases a session ended without, go through the same
 collector, so every report of a grading is built in one place (`build_report`).
+
+In detail:
+
+- **One collector** (`grader/grading/outcomes.py`): outcomes are typed: an acceptance test attaches
+  `grader.grading.plugin.CaseOutcome = ProblemRun | GraderFailure(kind: "isolation_unavailable" |
+  "grader_error", detail)` as JSON to its report (`user_properties`); the controller reads it in
+  `pytest_runtest_logreport` and turns a worker that died on a case into a `grader_error` for exactly that
+  case in `pytest_handlecrashitem` (the others still arrive; xdist replaces the worker). A case's first
+  outcome goes, in the calling thread, to `Outcomes.receive`, which keeps each file's runs, tells the caller's
+  `GradingListener` the result (`result(path, result)`: progress) and, with the file's last problem, builds
+  its report (`build_report`, `with_notebook`) and hands it over (`report(path, report)`). Files refused
+  before running (`Outcomes.reject`) and cases a session ended without (`Outcomes.close`: "the grading run
+  stopped (pytest exit code N): <the last lines pytest printed>") go through the same collector.
+  `IsolationUnavailable` fails closed before the session (`grader.sandbox.runner.require_isolation`, the check
+  `Sandbox` makes too) and is raised by `close` when a worker reported it. A batch's listener is its
+  `OutputDirectory` (writes the report, passes the result on to the progress bar); `grade_submission`'s is
+  `OnResult(on_progress)`.
 """
 
 from __future__ import annotations

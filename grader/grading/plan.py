@@ -4,6 +4,20 @@ A `GradingPlan` is made once, where a grading starts (`GradingPlan.load`: the TO
 selection checked), and travels as it is: to the acceptance session's workers as data (`to_data`, decoded
 by `from_data` with the same models), never as a path each process reads again. So every process of a
 grading checks with the configuration whose digest (`config_sha256`) its reports record.
+
+In detail:
+
+- **One plan, made once** (`grader/grading/plan.py`): `GradingPlan(assignment, problems, config)` holds the
+  validated `AssignmentConfig` (and through it the edition and its registry) and the problems graded;
+  `GradingPlan.load(config, only)` reads and validates the TOML and the selection once, where the grading
+  starts (`gymgrade check` renders the report with the same plan's configuration). Points, titles, visibility
+  and `config_sha256` derive from it. `grade_files` wraps it in a `grader.grading.plugin.SessionPlan` (the
+  plan, the files, the seed, the policy), which travels to the controller and every worker as data: one option
+  `--gymgrade-plan=JSON` holding the configuration's file tables (`config.config_data`), decoded with the same
+  models (`GradingPlan.from_data`, `config.config_from_data`); no worker reads a file again, so every process
+  grades with the configuration whose digest the reports record. `ProblemCase.node_id`
+  (`test_<id>.py::test_<id>[submission<index>]`, ASCII whatever the file is called) is the one declaration of
+  a case's id: the workers check every collected item against it, the controller keys every report by it.
 """
 
 from __future__ import annotations

@@ -6,6 +6,24 @@ handed to ``pytest.main`` as a plugin object, receives each case's report in the
 (``pytest_runtest_logreport``, and ``pytest_handlecrashitem`` for the case a worker died on) and hands its
 typed outcome over at once. Nothing pytest prints reaches the caller's stdout or stderr: it goes to a log
 whose tail explains a session that stopped early.
+
+In detail:
+
+- The session leaves the caller as it was: `session_environment` sets `GYMGRADE_SANDBOX_SCOPE`,
+  `PYTEST_DISABLE_PLUGIN_AUTOLOAD=1`, `PYTHONDONTWRITEBYTECODE=1` and removes `PYTEST_ADDOPTS`/
+  `PYTEST_PLUGINS` for the session only (workers inherit them), stops bytecode writing and restores
+  `sys.path`; `-c grader/grading/cases/pytest.ini --rootdir grader/grading/cases` keep the caller's pytest
+  settings out; `faulthandler`, `unraisableexception` and `threadexception` are off (process-wide
+  hooks; the last one's forced garbage collection cost ~1 s per session). Everything pytest prints goes
+  to a log, never to the caller's stdout or stderr (the callbacks still print normally). Sessions in
+  one process run one at a time (a lock); nested inside a running pytest (the project's own tests,
+  under xdist too) they work, and a batch reuses `grader.grading.cases.*` from `sys.modules`. The workers
+  get the `sys.path` the calling process had when xdist was imported (xdist's rule).
+- Ending: the controller SIGKILLs the workers at session finish (`stop_workers`, execnet's kill): once
+  every result is in, their interpreter exit (1-2 s under load) is not waited for. A `KeyboardInterrupt`
+  (Ctrl-C, or raised by a callback) stops the workers the same way and reaches the caller as
+  `KeyboardInterrupt` (pytest would return `ExitCode.INTERRUPTED`), so `grade_many` raises
+  `BatchInterrupted`; any other exception a callback raises is raised again after the session.
 """
 
 from __future__ import annotations

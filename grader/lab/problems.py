@@ -4,9 +4,9 @@ Everything that lists problems derives from `PROBLEMS`: the assignment configura
 (`grader.lab.assignment`), `--only`, the acceptance modules (`grader/grading/cases/test_<id>.py`), the
 report's titles and points, the games each problem accepts, the episode its report replays and its plot.
 Adding a problem is one entry here (or in an edition pack), its module in `grader/lab/checks/` (settings model
-+ check), its acceptance module and its `[problems.<id>]` table (ARCHITECTURE.md, "Adding an edition or a
-lab"). This registry is the first edition's (`grader.lab.editions.classic`); later editions reuse its
-declarations.
++ check), its acceptance module and its `[problems.<id>]` table (ARCHITECTURE.md, "Adding a problem, an
+edition or a lab"). This registry is the first edition's (`grader.lab.editions.classic`); later editions
+reuse its declarations.
 """
 
 from grader.lab.checks.blackjack import BlackjackCheck, BlackjackConfig

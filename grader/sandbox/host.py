@@ -8,6 +8,37 @@ is served the same way whatever it calls itself. An isolation layer names the fe
 (`needs`); the probe reports a layer whose features are missing as "not available on this system"
 without running it. How a child process is started and ended follows from the same facts
 (`grader.sandbox.process_model`).
+
+In detail:
+
+- `grader/sandbox/host.py` is the one place that reads the platform: `HOST.system` ("Linux", "macOS",
+  "Windows") and `HOST.features`, each found by asking for the capability (`POSIX_PROCESSES`: fork,
+  killpg, setsid, SIGKILL; `RESOURCE_LIMITS`; `USER_IDS`: geteuid and pwd; `LINUX_KERNEL`: Linux with
+  POSIX processes; `CPU_AFFINITY`; `WINDOWS_HANDLES`: msvcrt and _winapi), plus `usable_cpus()` and
+  `signal_number(name)` (None where a signal does not exist). Nothing else under `grader/` tests
+  `sys.platform` or imports `resource`/`pwd` at module level.
+- Each layer declares `needs: tuple[Feature, ...]` (cgroup, bubblewrap, seccomp, Landlock: `LINUX_KERNEL`;
+  privileges: `USER_IDS`; rlimits: `RESOURCE_LIMITS`) and `guards` (what it enforces); `probe_isolation`
+  reports a layer whose needs are missing as "not available on this system (<system> without
+  <feature>): <guards> not enforced" without probing it. The
+  bootstrap imports `resource` only for an rlimit step and sets no-new-privileges only when the parent
+  asks (`BootstrapSteps.no_new_privileges`, `rlimits_may_fail`: off Linux a refused limit is named on
+  the child's stderr).
+- `grader/sandbox/process_model.py` decides how a child is started, read and ended (`MODEL`): `posix`
+  (`pass_fds`, a new session, `killpg(SIGKILL)`, pipes waited on with `selectors`), `windows` (the
+  pipes as inheritable handles in `STARTUPINFO`'s handle list, `--handles` on the harness's command
+  line, `Popen.kill()`, pipes polled with PeekNamedPipe) and `inherited` (no `pass_fds` and no handles:
+  inheritable descriptors with `close_fds=False`, `Popen.kill()`; the Windows-shaped test runs use it).
+  `ChildProcess` (`process.py`) calls `start`, `end`, `read_available` and `pipe_selector` only;
+  `exists(pid)` asks whether a grader that left a harness tree still runs (Windows' `os.kill(pid, 0)`
+  would end it). On Windows the request pipe is written blocking (frames are sent to an idle child). The
+  child's environment adds `PYTHONUTF8=1` (and, on Windows, `SYSTEMROOT` and the like), so a student's
+  text is UTF-8 whatever the locale. The wall-clock limit per call is the parent's and holds on every
+  system; memory and CPU limits hold where the rlimits or cgroup layer is active, and the report's
+  isolation lines say when they are not.
+- `tests/grader/test_portable.py` runs `check` under interpreters shaped like Windows' and macOS'
+  CPython (`tests/grader/shaped_python/`) and compares statuses, scores and measurements with this
+  machine's; `.github/workflows/portable.yml` runs the same on real Windows and macOS runners.
 """
 
 from __future__ import annotations

@@ -4,6 +4,42 @@ A student can monkeypatch dynamics, wrappers or time limits in the child, or for
 none of that reaches this process. Checks judge `Replay`, never the `EpisodeLog`.
 Rewards are compared exactly (the same code on the same seed and actions gives the same floats;
 NaN equals NaN), terminated/truncated flags exactly.
+
+The child records every episode of a recording call; the parent replays each one in its own, unpatched
+gymnasium and judges the replay, never the log:
+
+- The recorder (`grader/sandbox/child/recorder.py`, child side) replaces `gymnasium.make` (every name it
+  is bound to), `numpy.random.default_rng` and `gymnasium.utils.seeding.np_random`, so unseeded
+  randomness comes from the call's seed streams; it sits outermost on each env, sees the gymnasium-API
+  `reset`/`step` (the compat `gym` shim wraps it in turn), reseeds every reset from the grader's stream
+  and logs the actions and what the student saw.
+- The child's games (`grader/sandbox/child/envs.py`): an env `gymnasium.make` returns whose game is exactly
+  gymnasium's `TaxiEnv` or `BlackjackEnv` is swapped in place (`envs.cheaper`, called by the recorder's
+  `make`) to a subclass of the same name that does the same step with fewer numpy calls: Taxi skips
+  `categorical_sample`'s arrays when there is one transition (it still draws the one number gymnasium
+  draws) and caches each state's action mask; Blackjack draws `deck[integers(0, 13)]`, which is what
+  `choice(deck)` draws. Each call returns what gymnasium's returns, type for type, and leaves the env's
+  state and generator as gymnasium's would (`tests/grader/sandbox/test_envs.py`, step by step against
+  gymnasium's classes, rainy and fickle Taxi and refused actions included); what the shortcuts do not
+  cover goes to gymnasium's own code. The parent never uses these classes: it replays in gymnasium's.
+- `grader/sandbox/replay.py`: `replay_episode(log: EpisodeLog) -> Replay` in the parent's own,
+  unpatched gymnasium env (ids resolved with `grader.compat.resolve_env_id`). `Replay` carries the
+  trusted `observations` (reset observation first), `rewards`, `terminated`, `truncated`, `length`
+  (steps until the first terminated/truncated), `steps_after_done`, and `mismatch: str | None` describing
+  the first disagreement with the student's log. Checks judge the replayed trajectory, never the log.
+  Also `finished` (the episode reached terminated/truncated), `env_spec` (the replayed env's gymnasium
+  `EnvSpec`, e.g. `max_episode_steps`, for checks that restrict ids/arguments), `matches`, `total_reward`.
+  `replay_episodes(logs)` gives the same results, batching CartPole, Taxi and Blackjack episodes
+  (`grader/sandbox/batched/`: `REPLAYERS`, bit-identical to gymnasium's scalar env; use it for many logs:
+  CartPole and Taxi advance all episodes in lockstep over arrays, `replayer.lockstep`; Blackjack plays
+  gymnasium's rules on plain lists; every batch's seeds are hashed at once, `draws.seeded_draws`, the
+  streams of `np_random(seed)` without building a Generator; a batch is used only when the scalar env
+  replays its longest, first and last episodes identically, and a batch of three or fewer is not played);
+  `verify_reset_seeds(logs_of_one_call, call_seed) -> str | None` checks the logged reset seeds against
+  the stream `grader.sandbox.child.seeding` prescribes (`derive_call_seed(seed, call_index)`,
+  `reset_seeds(call_seed, n)`: pure functions). Every reset, seeded by the student or not, takes the next
+  seed of the stream; a student's seed is only logged (`student_seed`, plain non-negative ints) and
+  reported as a `seed_replaced` compat event.
 """
 
 from __future__ import annotations

@@ -5,6 +5,30 @@
 writes both files. The page's modules (Jinja, matplotlib) load when the page is first asked for, so the
 package's plain-text helpers (`grader.render.neutral`, used by every output of a single report) cost
 nothing to import.
+
+In detail:
+
+- Input: `ClassEntry(identity, name, report: Report | None, late, status: graded | missing |
+  submission_error, note, report_href)` (`entries.py`), one per student whatever layout or roster they
+  came from. Everything below is a pure function of a sequence of entries, independent of their order.
+- `summary.py`: `summarise(entries) -> ClassSummary` (pydantic) and `class_summary(entries) -> dict` (its
+  JSON, `class.json`): score distribution (10 bins), per-problem pass rates (passed / graded submissions
+  that ran it), diagnoses, late, missing, submission errors, every student. A diagnosis is
+  `(problem, status, diagnosis_text(feedback, submission))`: the feedback with numbers (and lists of
+  them) as `#`, the report's file name as `<file>`, controls inert, 400 characters; its key is
+  `problem:status:` + 12 hex digits of the text's SHA-256 (reports have no diagnosis code; the checks
+  write one template per cause).
+- `figures.py`: the score histogram and pass-rate bars, drawn on the report's canvas and colours
+  (`grader.lab.plots.new_plot`) and encoded by `grader.render.figures.png_figure`. `html.py`:
+  `render_class_html(entries) -> str` (template `grader/render/templates/class_report.html`), CSP built by
+  `grader.render.csp.content_security_policy(style)`, the policy of every report page, for its own
+  stylesheet. How hostile text is shown, in every output, is `grader.render.neutral`'s (the one place
+  that says it; safe_href keeps plain relative paths only, percent-encoded).
+- Shells: `write_class_report(page, entries)` (`__init__.py`) writes the page and `class.json` beside it.
+  `gymgrade grade --html PATH` builds the entries with `from_batch.entries_from_rows(rows, out_dir, page)`
+  from the gradebook rows the batch last wrote (see `grader.classroom`);
+  `from_batch.entries_from_batch(paths, reports, out_dir, page)` builds them from a batch's files and
+  reports alone (each report's file name as identity), for callers without a class download.
 """
 
 from __future__ import annotations

@@ -11,6 +11,27 @@ tolerance of the exact greedy return of the table its episodes reveal (`referenc
 
 `run_cells` is on by default; an instructor who turns it off gets compare() `skipped`, worth 0 points, with a
 note saying why (the function cannot be graded in isolation: it reads globals nothing else sets).
+
+The data flows in one chain:
+
+- `grader.submission.notebook.building` keeps, besides the graded module, every code cell Run All would run,
+  as IPython reads it (`NotebookModule.cells`, computed in the bounded reader);
+  `grader.grading.grade._prepare` writes them beside the module
+  (`grader.submission.notebook.cells.write_cells`).
+- A check plans `Call(RUN_CELLS, seconds=...)` (its own wall-clock limit) before its own calls;
+  `grader.grading.execution.run_problem` fills in the argument (`runnable_cells`: the notebook's cells, or a
+  `.py` file whole as a script) because only it knows the submission.
+- In the child, `grader.sandbox.child.calls` runs a `RUN_CELLS` call with
+  `grader.sandbox.child.cells.run_cells`: the cells run in the module's globals (the same child then serves
+  the problem's calls), the first failing cell raises `NotebookCellError` (the outcome is an exception, so the
+  run stops there), and the value is plain data: each cell's time and the Taxi Q-tables left behind, labelled
+  by learner.
+- The check judges with that value and the replayed episodes of its own calls (`grader.lab.checks.compare`);
+  its result carries the `ran_notebook_cells` measurement, so `with_notebook` adds no "global only a
+  skipped statement sets" note to it. Cells that left no table and a compare() that then raises is
+  `failed`, saying where a `.py` (under `if __name__ == "__main__":`) or a notebook trains the tables; a
+  file that did not import within `import_seconds` (training at its top level) is `timeout` with the
+  runner's message (`grader.sandbox.outcome.IMPORT_TIMEOUT`).
 """
 
 from __future__ import annotations

@@ -16,6 +16,30 @@ only in problem 5) with Bernstein's inequality at a stated false-fail probabilit
 The env (made by name or passed) has no 200-step limit (its limit lies beyond the call's step budget), so
 the lab's loop on `terminated` and a loop that also stops on `truncated` play exactly the same episodes:
 both are honest.
+
+How a learner is verified by replaying its updates:
+
+- A call may pass an environment: `EnvArgument(env_id, max_episode_steps, form)`
+  (`grader/sandbox/child/frames.py`) travels as `{"$env": ...}` in a call's arguments only (a returned value
+  or an episode log holding the tag is refused). `form` says how it reaches the function
+  (`grader.sandbox.child.calls`): `object`, the child makes it through the recorder's `gymnasium.make`;
+  `name`, the function gets the id (a str) and the recorder gives an env made by that id (lab id or its
+  gymnasium id, `Recorder.named_envs`) the argument's time limit when the function names none, so the env the
+  student's `env = gym.make(env)` makes is logged and replayed like any other; `name_or_object` (sarsa0's, as
+  the course's template passes a name), the name first and, when the call raised before making an env by that
+  name or resetting or stepping any env, the call again with the env object (the recorder restarted with the
+  call's seed), reported as a compat event `env_object`; when the object gets no further (no reset or step),
+  the name's error stands. A lab id the grader names is resolved without a compat event.
+- A call may bind the grader's own definitions in place of the submission's globals for its duration:
+  `Call.provided` names them, `grader/sandbox/child/provided.py` (stdlib only) defines them (sarsa0 with the
+  lab's `epsilon_decay`, `decay_schedule = "grader"`); the child restores the student's afterwards.
+- `grader/lab/checks/sarsa.py` says which form was used (`env_form(records)`: the `env_object` event), in the
+  feedback and the `env_form` measurement. `grader/simulated_students/simulation.py` passes env arguments as
+  the child does (`Lab.passed`, the same retry), so the simulated learners are written as the template is.
+- `grader/lab/checks/sarsa_updates.py` is the pure core: transitions from trusted replays, SARSA(0) and
+  typical mistaken rules recomputed from the zero table, the greedy/non-greedy judgement of every action
+  against the table as it was, Bernstein's bound. `grader/lab/checks/sarsa.py` plans the calls, validates the
+  returned table
 """
 
 from __future__ import annotations

@@ -4,6 +4,64 @@ The contract is `grader.lab.editions.pack.Edition`; `edition_of(name)` finds a p
 one every configuration that names none grades (the first, so existing configurations and reports keep their
 meaning). Detection from a submission is `grader.lab.editions.detection`; the command line's choice between
 `--edition`, a configuration's `edition = "..."` and detection is `grader.lab.editions.choice`.
+
+How an edition is carried, chosen and shown:
+
+- **The edition travels inside the configuration.** A TOML's top-level `edition = "NAME"` (default
+  `classic`) picks the registry `load_config` validates its tables with (`AssignmentConfig.edition`,
+  `.registry`); `GradingPlan.load` loads it once and the plan carries it to every xdist worker
+  (`plugin.GradingSession`); a batch, Gradescope and the service load the same file, so nothing else
+  carries an edition. Problem ids are unique within an edition;
+  an acceptance module `test_<id>.py` looks its problem up in its edition's registry
+  (`RL1.registry.acceptance_problem(__name__)`), and `--only` accepts every edition's ids
+  (`grader.lab.editions.all_problem_ids()`), the plan refusing those its edition does not grade.
+- **Choosing** (`grader/lab/editions/choice.py`, called once by `gymgrade check`/`grade` before their
+  handlers): `--edition NAME` (with no `--config`: the pack's default configuration; with one: it must grade
+  the same problems, else `EditionConflict` says what to write), else the configuration's `edition`, else
+  detection (`check`: the file; `grade`: each file, below), else `classic`. The command prints `Edition: NAME
+  (title): why` on stderr. What a student is graded on is the instructor's choice: detection alone chooses
+  only for a student's own `check`; `service_edition(GYMGRADE_EDITION)` for the service (unset: `classic`,
+  never the upload's).
+- **Detection** (`grader/lab/editions/detection.py`) reads the submission in the parent (without following
+  links) with `ast` only, within bounds (1 MB of source; a notebook's code cells come from the bounded reader,
+  `grader.submission.notebook.read_notebook`, so its JSON is never parsed in the parent; a file that cannot be
+  read or parsed shows no mark): a function only `rl1` asks for (`epsilon_decay`, `qlearn`, `sarsa0`,
+  `compare`) or a two-table `taxi` -> `rl1`; a `render` flag on `cartpole`/`car` or `import gymnasium` ->
+  `volume2`; `gym_toytext` or gym 0.26's five-value `step` / two-value `reset` -> `gym026`; `import gym` ->
+  `classic`; else the file shows no edition (`Detection.shown` False: taken as `classic`, counted by no
+  class). Each reason names what it saw. `detect_source(bytes, name)` reads source already read;
+  `edition_note(graded, detection)` is what a report says (`Report.edition_note`) to a file written for other
+  problems than the edition graded: `grader.grading.grade` computes it for every graded file (a notebook from
+  the module built of its cells), so `check --edition`, `grade`, Gradescope and the service all tell it.
+
+- **The edition is in the report** (`Report.edition`; a report without it, written before editions, reads
+  as `classic`, `grader.report.FIRST_EDITION`). The text summary, the HTML report, the Gradescope output and
+  the service's page show it (`grader.render.text.edition_name`: `rl1 (Reinforcement Learning 1: Gymnasium)`);
+  figures are drawn with the report's edition's configuration (`grader.lab.editions.choice.edition_config`).
+- **A class without `--edition` or a configuration** (`gymgrade grade`,
+  `grader/lab/editions/per_submission.py`): every graded file is detected; files showing no edition are left
+  out; when the others all ask the same problems the class is graded as their edition (of several names, the
+  most common, a tie to the newer; none: `classic`), so its gradebook has one set of columns; `Edition: ...`
+  then one line per submission (`identity: edition: reason`). When they ask different problems,
+  `ClassEditions.disagreement` names each edition and whose files are behind it and `grade` stops before
+  grading (exit 2): a majority never decides. When the class's edition asks other functions than the first
+  edition's, the graded files are chosen again by its functions from the download already read
+  (`submissions_of_all`, nothing extracted again).
+- **The service** grades each upload as `GYMGRADE_EDITION` (validated when the settings load; unset: the
+  first edition), chosen in the grading child `api/jobs/child.py` (`service_edition`, which logs the
+  `Edition:` line); an upload's own edition is never used, its report's `edition_note` tells it. A batch
+  job carries its configuration as before.
+
+The four editions of this lab: `classic` (1, the lab text; its registry is `grader.lab.problems.PROBLEMS`, so
+every configuration and report that names no edition keeps its meaning), `gym026` (2) and `volume2` (3) (the
+same problems: the compatibility layer runs their APIs; `cartpole()`/`car()` are called without arguments, so
+`render=False` keeps its default), and `rl1` (4, the current one: problems 1-4 are `PROBLEMS`' own
+declarations, reused, plus `epsilon_decay` and the two-table `taxi` (the same id as edition 1's `taxi`,
+another `Problem`: ids are unique within an edition), `sarsa0` and `compare()` (the notebook's cells run
+first, by default); `qlearn` is a provided function, listed in `not_graded`). Templates are
+`submissions/template.py` (classic) and `submissions/templates/<edition>.py`; references are
+`submissions/*_complete.py` and `submissions/editions/rl1_complete.py`; `rl1`'s default configuration is
+`grader/lab/editions/rl1.toml` (the others use the bundled `grader/lab/assignment.toml`).
 """
 
 from grader.lab.editions.classic import CLASSIC

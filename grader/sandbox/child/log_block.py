@@ -5,6 +5,41 @@ concatenates them into one array per column for the whole call, so a 20 000-epis
 10 000-game Blackjack call sends about a dozen arrays instead of four per episode, and the parent
 validates one block (`grader.sandbox.episode_log.episodes_from_plain`) instead of one model per episode.
 The block is plain data for `grader.sandbox.child.frames.encode_value` (numpy arrays travel as base64).
+
+The wire format:
+
+- The wire format: a call's episodes travel as ONE columnar block (`grader/sandbox/child/log_block.py`
+  builds it from the recorder's typed columns; its keys are `LOG_FIELDS` of
+  `grader/sandbox/child/episode_fields.py`):
+  `envs`, the call's distinct made envs (`requested_id`, `env_id`, `env_kwargs`) and `made`, each
+  episode's index in it; `env_index` and `reset_seed` (uint64), one entry per episode; `student_seed` and
+  `reset_options` sparse, `{"episodes": [numbers], "values": [...]}` for the episodes that have one;
+  `lengths`, each episode's steps; the per-step columns `actions`, `rewards`, `terminated`, `truncated`
+  concatenated over the episodes (`sum(lengths)` entries each, smallest int dtype for integral rewards);
+  `action_form` says how actions travel: `int` (1-D int array: every action a plain int), `array` (one
+  array of shape (steps, *shape): every action a numpy array of one shape and dtype, a `Box` env's), or
+  `plain` (one list of plain values, decoded by `decode_value`). Arrays are `$ndarray` base64 tags; a call
+  with no episode sends `[]`. The parent's `WireLog` (strict pydantic TypedDict, checked against
+  `LOG_FIELDS` at import by `check_log_declaration`) validates the block; `episodes_from_plain` then
+  checks every array's dtype and announced shape, the episode and step counts against the call's
+  budget and the table's size BEFORE decoding any array; then decodes the per-episode arrays (lengths
+  >= 0 summing, in Python ints, to the step columns' length; `made` within the table; `env_index` in
+  [0, 2^31); seeds >= 0; sparse episode numbers strictly increasing and in range), then the step
+  arrays, one at a time, each split into its episodes' list slices as soon as it is decoded (flags
+  normalised to bool from their bytes), and builds the `EpisodeLog`s from them.
+  Every failure is an `InvalidEpisodeLogError` saying what was expected and what was found, which the
+  runner reports as a forged frame (`INVALID_VALUE`).
+
+The episode's wire fields are declared once in `grader/sandbox/child/episode_fields.py` (stdlib only):
+`EPISODE_HEADER`, `EPISODE_COLUMNS`, `EPISODE_FIELDS`, and the frozen dataclass `EpisodeHeader` (env and reset
+fields) that the child's `EpisodeRecord` and the parent's `EpisodeLog` extend; and the columnar log's layout,
+`MADE_FIELDS`, `DENSE_FIELDS`, `SPARSE_FIELDS`, `LOG_FIELDS`, `ACTION_FORMS`.
+`grader/simulated_students/simulation.py` (whose episodes hold an `EpisodeLog`) uses them too;
+`check_declaration` and `check_log_declaration` refuse a drifted model or block at import. `RecordingEnv.step`
+counts and logs each step in its one frame into typed columns (`array('q')` actions, a list only after an
+action that is not an int64; `array('d')` rewards, a NaN for a reward that cannot be converted, which the
+replay then reports; `bytearray` flags). Costs: `bench/recorder_cost.py`; a class's:
+`bench/class_throughput.py`.
 """
 
 from __future__ import annotations

@@ -1,4 +1,25 @@
-"""Isolation layers for sandboxed children: probed into an `IsolationReport`, applied by `build_launch`."""
+"""Isolation layers for sandboxed children: probed into an `IsolationReport`, applied by `build_launch`.
+
+How layers plug in:
+
+- **Isolation layers are plug-ins** (`grader/sandbox/isolation/`). Each layer is one module with a class
+  implementing `layer.Layer` (the contract, with `LaunchSpec`, in `layer.py`): `name`, `probe(outer:
+  IsolationReport) -> LayerReport` (what it enforces here, or why not and the remedy; `outer` holds the
+  reports of the layers listed before it, already switched off as `disable` asks: privileges and Landlock read
+  bubblewrap there; costly machine checks are cached per process) and `apply(spec: LaunchSpec)` (called only
+  while active). `registry.LAYERS` is the one ordered list, outermost first: cgroup, bubblewrap, seccomp,
+  privileges, rlimits, landlock; `probe_isolation(disable)` and `launch.build_launch` are loops over it, so
+  the report's order and each child's wrapping follow it. A layer adds its part to the `LaunchSpec`:
+  `wrappers` (command prefixes ending in `--`, built from the finished spec when composed: the cgroup join
+  shell, bwrap, setpriv), `environment` (added to the child's), `bootstrap` (the child-side steps
+  `bootstrap.py` runs before the harness: rlimits, Landlock rules, a seccomp descriptor), `launch.pass_fds`,
+  `launch.cgroup` (placement, OOM counts, killing the tree), `launch.signals_in_exit_status`, and at most one
+  private file system (`provide_view`; otherwise `child_view()` makes a scratch directory on the host).
+  Bubblewrap sets the child's environment with `--setenv` and installs the seccomp program itself
+  (`--seccomp`), taking that step from the bootstrap. Adding a layer is one module and one line in
+  `registry.LAYERS` (`tests/grader/sandbox/marker_layer.py` is such a layer, in the tests); only a new *kind*
+  of child-side step also needs code in `bootstrap.py` (stdlib only, run before the harness).
+"""
 
 from __future__ import annotations
 

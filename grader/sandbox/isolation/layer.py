@@ -3,6 +3,11 @@ the `LaunchSpec` every active layer adds its part to, composed into a `Launch`.
 
 `launch.py` composes a child's start from the layers listed in `registry.py`; each layer's module imports
 this contract only, never the composer.
+
+Besides `Layer`, `LayerReport` and `IsolationReport`, the contract holds the `LaunchSpec`/`BootstrapSteps`/
+`Launch` a layer adds its part to, and `ChildJob`, what a launch needs of the cgroup layer's job. The
+grading's scope (`scope.py`) knows no layer: it runs the cleanups layers register for what they record
+(`register_cleanup(kind, cleanup)`).
 """
 
 from __future__ import annotations

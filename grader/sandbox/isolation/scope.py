@@ -9,6 +9,16 @@ runs each kind's cleanup on what is still recorded, then deletes the directory.
 
 The scope knows no layer: a layer that records a kind registers its cleanup (`register_cleanup`) when
 its module is imported, which importing this package does (`grader.sandbox.isolation` lists every layer).
+
+In detail:
+
+- **No leftovers.** `grader.grading.grade.grade_files` opens a `grader.sandbox.isolation.scope.sandbox_scope`:
+  a directory named to the session's xdist workers by `GYMGRADE_SANDBOX_SCOPE` (set in `os.environ` for the
+  session only), holding every harness tree and scratch dir of its workers and a record of every job cgroup
+  (written before the cgroup is made, under the kind `cgroups` whose cleanup `cgroup.py` registers with the
+  scope). Closing it (after the session's workers are SIGKILLed) runs each registered cleanup (kills what is
+  left in those cgroups and removes them) and removes the directory. Outside a grading, trees go to the temp
+  dir (removed at exit; trees and cgroups of dead graders are swept when the next sandbox starts).
 """
 
 from __future__ import annotations

@@ -1,6 +1,70 @@
 """Jupyter notebooks as submissions: the graded module built from their code cells, in bounded time and
 memory (see `grader.submission.notebook.building` for what is kept, `grader.submission.notebook.bounded` for
-the bounds)."""
+the bounds).
+
+In detail:
+
+A notebook is graded as the module its code cells make: the parent builds that module in a bounded child
+process (never running student code), and the sandbox imports it like any `.py` submission.
+
+- `grader/submission/notebook/__init__.py`: the public face (`build_module`, `read_notebook`, `is_notebook`,
+  the models).
+- **A notebook's JSON is parsed once, in the bounded child, never in the parent.** `read_notebook(data,
+  name) -> NotebookCells | FileVerdict` (edition detection and similarity use it) and `build_module` (grading)
+  both ask the child; its reply carries the code cells as read (`_Read`: number, In [n], source, and the
+  ignored notes), which the parent keeps by the bytes' blake2b digest and the file name (`_Kept`, least
+  recently used dropped past `KEPT_CHARACTERS` = 32,000,000 characters of code). `build_module` of bytes
+  already read sends the kept cells (a few KB) to the child, which builds the module from them
+  (`building.build_from_cells`) without the file: `grade --similarity` on a notebook runs two children
+  (read for detection, build) and parses its JSON once. The request travels as the child's argument, so
+  the notebook's bytes are piped without a copy. Figures: bench/notebook_memory.py.
+- `build_module(data, name, graded) -> NotebookModule | FileVerdict`: `NotebookModule(source, summary:
+  NotebookSummary, origins)`: the module the sandbox imports (code cells' imports, definitions and simple
+  constants, in cell order, `__future__` imports first) and `NotebookSummary(code_cells, kept_statements,
+  skipped: list[SkippedCode], unbound_globals: list[UnboundGlobal])`. What may run at import is decided
+  statement by statement: imports, `def`/`class` (their defaults and decorators must be simple), string
+  constants, assignments to names of "simple" expressions (literals, operators, names already bound by kept
+  statements, and the calls in `CHEAP_CALLS`), and `if`/`try` blocks made only of those. Everything else is a
+  `SkippedCode`. `UnboundGlobal`: a top-level function that reads (directly or through other top-level
+  functions, found with `symtable`) a global only skipped statements set.
+- `grader.grading.grade.grade_files` builds the module of every `.ipynb` into a temporary directory as
+  `<name>.ipynb.py` and grades that file; `grader.grading.outcomes.with_notebook(report, module)` attaches
+  `Report.notebook`, prefixes the affected problems' feedback with `UnboundGlobal.note()` and rewrites
+  `File "<name>.ipynb.py", line N` into `File "<name>.ipynb", cell C, line L`. `Report.submission` and
+  `Report.sha256` stay the notebook's.
+- `grader/submission/notebook/bounded.py`: `build_module(data, name, graded)` spawns `python -m
+  grader.submission.notebook.bounded REQUEST` (cwd and PYTHONPATH = the project root), which sets its own
+  RLIMIT_AS (1.5 GiB), RLIMIT_CPU (30 s) and recursion limit before reading stdin, runs
+  `building.build_module`, and prints a `_Reply` (pydantic) that the parent validates. A wall timeout (60 s),
+  a limit signal, a crash, a `RecursionError`/`MemoryError` or an unreadable reply becomes a
+  `FileVerdict("error", ...)`: that submission's `submission_error`, never the batch's. Figures:
+  bench/notebook_reader.py.
+- `grader/submission/notebook/reading.py`: bytes -> `NotebookCells(cells, ignored)`. JSON is read directly
+  (nbformat 4, any minor, or 3's worksheets); the nbformat schema is checked on the cells' sources and
+  metadata only (outputs blanked) and a failure is a note in `NotebookSummary.ignored`, not an error. Errors
+  only when the cells cannot be read (not JSON, no list of cells, more than `MAX_CELLS` = 10,000 cells, a code
+  cell whose source is not text, another language, more than 2,000,000 characters of code).
+- `grader/submission/notebook/ipython.py`: `transform_cell(source, defined)`, IPython's `inputtransformer2`
+  rules by hand: leading indent, `>>>`/`In [n]:` prompts, `%%cell
+  magics`, and, per logical line from one tokenization, `!`/`!!`/`%`/`?`/`??`/`,`/`;`/`/` escapes, `x = !cmd`,
+  `x = %magic`, trailing `?`; one-line cells get automagic (`pip install gym`) unless the name is bound, a
+  builtin or a keyword. Special lines become `pass` (line numbers kept) and are listed as skipped. A cell that
+  parses as it is is not tokenized (no transformation can apply to valid Python).
+- `grader/submission/notebook/rules.py`: `Kind` (SAFE, PLAIN_CLASS, PROPERTY, STUDENT) and `evaluate(expr,
+  scope)`, one case per `ast.expr` kind, default deny. Only SAFE values (literals, imports other than
+  `submission`/`__main__`, what `CHEAP_CALLS` return for SAFE arguments, operators on SAFE values) may be
+  operated on; student names may only be stored; subscripts yield STUDENT (a container may hold anything).
+  Decorators outside `KEPT_DECORATORS` are dropped (the function is graded undecorated, with a note). Classes
+  are kept when their bases are SAFE or plain student classes (no `__init_subclass__`, no student metaclass,
+  not Enum) and every statement of their body is keepable.
+- `grader/submission/notebook/building.py`: cells -> module. Per cell: size budget (200,000 characters),
+  IPython transformation, `ast.parse`, depth budget (500, measured without recursion); a cell failing any of
+  these is skipped as a whole with a note, the graded functions it defines get a stand-in raising
+  `SyntaxError` that names the cell ("opengym.ipynb, code cell 7 (In [12]) is not valid Python: ..."), and its
+  other names become `UnboundGlobal(broken_cell=True)` notes for the graded functions that use them. The
+  global-use analysis (`symtable`, one pass) searches from the `graded` functions only (the grading plan's
+  problem ids, passed by `grader.grading.grade._prepare`), at most 20 notes each.
+"""
 
 from __future__ import annotations
 
