@@ -21,11 +21,15 @@ from api.errors import (
     InvalidRequest,
     InvalidStudentName,
     InvalidUpload,
+    LaunchRefused,
     LengthRequired,
+    LtiRequestInvalid,
     MalformedBody,
     MethodNotAllowed,
     NotAuthenticated,
     PathNotFound,
+    PlatformExists,
+    PlatformUnreachable,
     RateLimited,
     ServiceError,
     StudentExists,
@@ -39,14 +43,17 @@ from api.web import PAGE_HEADERS, templates
 
 HTTP_STATUS: dict[type[ServiceError], int] = {
     MalformedBody: 400,
+    LtiRequestInvalid: 400,
     NotAuthenticated: 401,
     InstructorOnly: 403,
     StudentOnly: 403,
+    LaunchRefused: 403,
     PathNotFound: 404,
     SubmissionNotFound: 404,
     StudentNotFound: 404,
     MethodNotAllowed: 405,
     StudentExists: 409,
+    PlatformExists: 409,
     LengthRequired: 411,
     UploadTooLarge: 413,
     InvalidRequest: 422,
@@ -54,6 +61,7 @@ HTTP_STATUS: dict[type[ServiceError], int] = {
     InvalidUpload: 422,
     RateLimited: 429,
     InternalError: 500,
+    PlatformUnreachable: 502,
 }
 ERROR_HEADERS: dict[type[ServiceError], dict[str, dict[str, Any]]] = {
     NotAuthenticated: {
@@ -79,6 +87,8 @@ ERROR_HEADERS: dict[type[ServiceError], dict[str, dict[str, Any]]] = {
     },
 }
 UI_PREFIX = "/ui"
+PAGE_PATHS = ("/lti/login", "/lti/launch")
+"""Paths a browser reaches from the LMS: their errors are pages too."""
 HTTP_METHODS = ("DELETE", "GET", "HEAD", "OPTIONS", "PATCH", "POST", "PUT")
 MAX_SHOWN_INPUT_CHARS = 60
 
@@ -126,7 +136,7 @@ def error_response(request: Request, error: ServiceError) -> Response:
     status = status_of(error)
     headers = _headers_of(error)
     path = request.scope.get("path", "")
-    if path == "/" or path.startswith(UI_PREFIX):
+    if path == "/" or path.startswith(UI_PREFIX) or path in PAGE_PATHS:
         return templates.TemplateResponse(
             request,
             "error.html",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from typing import Annotated, Any
+from urllib.parse import urlencode
 
 from fastapi import APIRouter, File, Form, Request, UploadFile
 from fastapi.responses import RedirectResponse, Response
@@ -13,11 +14,12 @@ from api.deps import SESSION_COOKIE, DispatcherDep, PageCallerDep, SessionDep, S
 from api.disclosure import disclosure_for
 from api.errors import NotAuthenticated
 from api.gradebook import gradebook_csv
+from api.lti.sessions import SESSION_PARAMETER
 from api.models import JobStatus
 from api.settings import Settings
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
-from api.web import PAGE_HEADERS, templates
+from api.web import page_headers, templates
 
 router = APIRouter(include_in_schema=False)
 
@@ -25,9 +27,21 @@ FINAL_STATUSES = frozenset({JobStatus.DONE.value, JobStatus.FAILED.value})
 
 
 def _page(request: Request, template: str, context: dict[str, Any], status_code: int = 200) -> Response:
+    launched: Principal | None = getattr(request.state, "lti_caller", None)
     return templates.TemplateResponse(
-        request, template, context, status_code=status_code, headers=PAGE_HEADERS
+        request,
+        template,
+        {**context, "session_query": _session_query(launched)},
+        status_code=status_code,
+        headers=page_headers(launched.frame_origin if launched is not None else None),
     )
+
+
+def _session_query(caller: Principal | None) -> str:
+    """``?lti_session=...`` for the links and forms of a page an LTI launch signed in, else nothing."""
+    if caller is None or caller.session_token is None:
+        return ""
+    return "?" + urlencode({SESSION_PARAMETER: caller.session_token})
 
 
 def _signed_in(caller: Principal | None) -> Principal:
@@ -87,7 +101,7 @@ def upload(
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
     submission = create_submission(session, settings, student, upload, dispatcher)
-    return RedirectResponse(f"/ui/submissions/{submission.id}", status_code=303)
+    return RedirectResponse(f"/ui/submissions/{submission.id}{_session_query(caller)}", status_code=303)
 
 
 @router.get("/ui/submissions/{submission_id}")
