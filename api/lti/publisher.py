@@ -14,6 +14,7 @@ import logging
 import threading
 from dataclasses import dataclass
 from datetime import timedelta
+from typing import Any
 
 from sqlalchemy import select, update
 from sqlalchemy.orm import Session, sessionmaker
@@ -21,7 +22,17 @@ from sqlalchemy.orm import Session, sessionmaker
 from api.gradebook import kept_submissions
 from api.lti.claims import SCOPE_LINEITEM, SCOPE_LINEITEM_READONLY, SCOPE_SCORE
 from api.lti.services import AccessTokens, ServiceFailed, line_item, publish_score
-from api.models import JobStatus, LtiLink, LtiMember, LtiPlatform, LtiScore, LtiUser, Submission, utcnow
+from api.models import (
+    JobStatus,
+    LtiLink,
+    LtiMember,
+    LtiPlatform,
+    LtiScore,
+    LtiUser,
+    Student,
+    Submission,
+    utcnow,
+)
 from api.settings import GradebookPolicy, Settings
 
 log = logging.getLogger(__name__)
@@ -164,6 +175,31 @@ def _send(session: Session, tokens: AccessTokens, policy: PublishPolicy, row: Lt
         row.status, row.error, row.attempts = SENT, None, 0
     session.commit()
     return 1
+
+
+def publishing_status(session: Session) -> list[dict[str, Any]]:
+    """Each student's row: the kept score, the one the LMS holds, the state, the attempts, the last error."""
+    rows = session.execute(
+        select(LtiScore, LtiMember, Student)
+        .join(LtiMember, LtiMember.id == LtiScore.member_id)
+        .join(LtiUser, LtiUser.id == LtiMember.user_id)
+        .join(Student, Student.id == LtiUser.student_id)
+        .order_by(Student.name, LtiMember.link_id)
+    ).all()
+    return [
+        {
+            "student": student.name,
+            "link_id": member.link_id,
+            "submission_id": score.submission_id,
+            "score": score.score,
+            "max_score": score.max_score,
+            "sent_score": score.sent_score,
+            "status": score.status,
+            "attempts": score.attempts,
+            "error": score.error,
+        }
+        for score, member, student in rows
+    ]
 
 
 class ScorePublisher:

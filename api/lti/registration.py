@@ -26,7 +26,6 @@ from api.models import LtiPlatform
 TICKET_PURPOSE = "lti-registration"
 TICKET_SECONDS = 7 * 24 * 3600
 TOOL_CONFIGURATION = "https://purl.imsglobal.org/spec/lti-tool-configuration"
-PLATFORM_CONFIGURATION = "https://purl.imsglobal.org/spec/lti-platform-configuration"
 TOOL_NAME = "gymgrade"
 
 

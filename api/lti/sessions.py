@@ -25,4 +25,10 @@ def session_caller(session: Session, token: str) -> Principal | None:
         return None
     student = session.get(Student, user.student_id) if user.student_id is not None else None
     name = student.name if student is not None else user.name
-    return Principal(name=name, student=student, frame_origin=row.frame_origin, session_token=token)
+    return Principal(
+        name=name,
+        student=student,
+        frame_origin=row.frame_origin,
+        session_token=token,
+        lti_link_id=row.link_id,
+    )

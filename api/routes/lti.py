@@ -20,11 +20,12 @@ from api.lti import claims as names
 from api.lti.deep_linking import choices, deep_linking_response, picker_token
 from api.lti.keys import public_jwks, rotate
 from api.lti.launch import accept_launch, frame_origins, login_redirect, verify_launch
-from api.lti.platforms import PlatformRegistration, register_platform
+from api.lti.platforms import PlatformRegistration, add_deployment, register_platform
+from api.lti.publisher import publishing_status
 from api.lti.registration import ToolUrls, check_ticket, register_dynamically, registration_ticket
 from api.lti.roster import import_roster
 from api.lti.sessions import SESSION_PARAMETER
-from api.models import LtiLink, LtiMember, LtiPlatform, LtiScore, LtiUser, Student
+from api.models import LtiLink, LtiPlatform
 from api.settings import Settings
 from api.web import page_headers, templates
 
@@ -187,6 +188,24 @@ def post_platform(body: PlatformIn, session: SessionDep, _instructor: Instructor
     return _platform_view(row)
 
 
+class DeploymentIn(BaseModel):
+    """One more deployment of a registered platform (the LMS shows its id when the tool is deployed)."""
+
+    deployment_id: str = Field(min_length=1, max_length=255)
+
+
+@router.post("/lti/platforms/{platform_id}/deployments")
+def post_deployment(
+    platform_id: int, body: DeploymentIn, session: SessionDep, _instructor: InstructorDep
+) -> dict[str, Any]:
+    """Accept launches from one more deployment of a platform."""
+    platform = session.get(LtiPlatform, platform_id)
+    if platform is None:
+        raise LtiRequestInvalid(f"no platform has id {platform_id}; list them with GET /lti/platforms")
+    add_deployment(session, platform, body.deployment_id)
+    return _platform_view(platform)
+
+
 @router.get("/lti/platforms")
 def get_platforms(session: SessionDep, _instructor: InstructorDep) -> list[dict[str, Any]]:
     """The registered platforms."""
@@ -243,24 +262,4 @@ def post_roster(
 @router.get("/lti/scores")
 def get_scores(session: SessionDep, _instructor: InstructorDep) -> list[dict[str, Any]]:
     """Each student's score publishing to the LMS: kept score, the one the LMS holds, state, last error."""
-    rows = session.execute(
-        select(LtiScore, LtiMember, LtiUser, Student)
-        .join(LtiMember, LtiMember.id == LtiScore.member_id)
-        .join(LtiUser, LtiUser.id == LtiMember.user_id)
-        .join(Student, Student.id == LtiUser.student_id)
-        .order_by(Student.name)
-    ).all()
-    return [
-        {
-            "student": student.name,
-            "link_id": member.link_id,
-            "submission_id": score.submission_id,
-            "score": score.score,
-            "max_score": score.max_score,
-            "sent_score": score.sent_score,
-            "status": score.status,
-            "attempts": score.attempts,
-            "error": score.error,
-        }
-        for score, member, _user, student in rows
-    ]
+    return publishing_status(session)

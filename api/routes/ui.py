@@ -10,12 +10,14 @@ from fastapi.responses import RedirectResponse, Response
 from sqlalchemy.orm import Session
 
 from api.auth import Principal, authenticate
-from api.deps import SESSION_COOKIE, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
+from api.deps import SESSION_COOKIE, ContextDep, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
 from api.disclosure import disclosure_for
-from api.errors import NotAuthenticated
+from api.errors import LtiRequestInvalid, NotAuthenticated
 from api.gradebook import gradebook_csv
+from api.lti.publisher import publishing_status
+from api.lti.roster import import_roster
 from api.lti.sessions import SESSION_PARAMETER
-from api.models import JobStatus
+from api.models import JobStatus, LtiLink
 from api.settings import Settings
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
@@ -60,8 +62,29 @@ def home(request: Request, session: SessionDep, caller: PageCallerDep, settings:
     return _page(
         request,
         "home.html",
-        {"caller": caller, "submissions": submissions, "max_upload_bytes": settings.max_upload_bytes},
+        {
+            "caller": caller,
+            "submissions": submissions,
+            "max_upload_bytes": settings.max_upload_bytes,
+            "lms_scores": publishing_status(session) if caller.is_instructor else [],
+        },
     )
+
+
+@router.post("/ui/lti/roster")
+def roster_import(
+    request: Request, session: SessionDep, context: ContextDep, caller: PageCallerDep
+) -> Response:
+    """Import the course roster of the link an instructor launched from (Names and Role Provisioning)."""
+    instructor = _signed_in(caller)
+    instructor.require_instructor()
+    link = session.get(LtiLink, instructor.lti_link_id) if instructor.lti_link_id is not None else None
+    if link is None:
+        raise LtiRequestInvalid(
+            "the roster is imported from a launch in the LMS; open the tool from the course"
+        )
+    found = import_roster(session, link, context.access_tokens)
+    return _page(request, "roster.html", {"caller": instructor, "found": found})
 
 
 @router.post("/ui/sign-in")

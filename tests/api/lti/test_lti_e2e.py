@@ -297,28 +297,56 @@ def test_scores_refused_by_the_platform_are_sent_again_and_shown_to_the_instruct
     assert platform.refused_scores - refused_before == 4
     rows = httpx.get(tool.url + "/lti/scores", headers=instructor_headers()).json()
     assert [(row["status"], row["error"]) for row in rows if row["student"] == "Grace"] == [("sent", None)]
+    teacher = platform.add_person("staff-grace", "Gale Grader", INSTRUCTOR)
+    with httpx.Client() as client:
+        _, page = landed(client, tool, platform.launch(client, LaunchSpec(teacher, "link-2")))
+    assert "Scores in the LMS" in page.text
+    assert re.search(
+        r"<td>Grace</td>\s*<td>1 / 3</td>\s*<td>1</td>\s*<td class=\"lms-sent\">sent</td>", page.text
+    )
 
 
 def test_staff_land_as_the_instructor_and_import_the_roster(platform: LtiPlatform, tool: LiveProcess) -> None:
     teacher = platform.add_person("staff-ta", "Terry TA", TEACHING_ASSISTANT)
     platform.add_person("learner-never", "Nora Neverlaunched", LEARNER)
     with httpx.Client() as client:
-        _, page = landed(client, tool, platform.launch(client, LaunchSpec(teacher, "link-1")))
-    assert "All submissions" in page.text and "Upload your solution" not in page.text
-    links = httpx.get(tool.url + "/lti/links", headers=instructor_headers()).json()
-    link = next(link for link in links if link["resource_link_id"] == "link-1")
-    imported = httpx.post(f"{tool.url}/lti/links/{link['id']}/roster", headers=instructor_headers())
+        token, page = landed(client, tool, platform.launch(client, LaunchSpec(teacher, "link-1")))
+        assert "All submissions" in page.text and "Upload your solution" not in page.text
+        assert f'action="/ui/lti/roster?lti_session={token}"' in page.text
+        imported = client.post(tool.url + "/ui/lti/roster", params={"lti_session": token})
     assert imported.status_code == 200, imported.text
-    assert imported.json()["learners"] >= 2 and imported.json()["staff"] >= 1
+    found = re.search(r"(\d+) students \(each now has a row in the gradebook\), (\d+) staff", imported.text)
+    assert found and int(found.group(1)) >= 2 and int(found.group(2)) >= 1
     gradebook = httpx.get(tool.url + "/gradebook.csv", headers=instructor_headers()).text
     assert "Nora Neverlaunched," in gradebook
     assert "Terry TA" not in gradebook
-    again = httpx.post(f"{tool.url}/lti/links/{link['id']}/roster", headers=instructor_headers()).json()
-    assert (
-        httpx.get(tool.url + "/gradebook.csv", headers=instructor_headers()).text.count("Nora Neverlaunched")
-        == 1
-    )
-    assert again["learners"] == imported.json()["learners"]
+    links = httpx.get(tool.url + "/lti/links", headers=instructor_headers()).json()
+    link = next(link for link in links if link["resource_link_id"] == "link-1")
+    again = httpx.post(f"{tool.url}/lti/links/{link['id']}/roster", headers=instructor_headers())
+    assert again.status_code == 200, again.text
+    assert again.json()["learners"] == int(found.group(1))
+    gradebook = httpx.get(tool.url + "/gradebook.csv", headers=instructor_headers()).text
+    assert gradebook.count("Nora Neverlaunched") == 1, "an import made a second row"
+
+
+def test_a_deployment_added_by_the_instructor_is_accepted(platform: LtiPlatform, tool: LiveProcess) -> None:
+    person = platform.add_person("learner-dep", "Dana Deployment", LEARNER)
+    other = {"claims": {"https://purl.imsglobal.org/spec/lti/claim/deployment_id": "deployment-7"}}
+    with httpx.Client() as client:
+        assert platform.launch(client, LaunchSpec(person, "link-7", **other)).status_code == 403
+        (row,) = [
+            p
+            for p in httpx.get(tool.url + "/lti/platforms", headers=instructor_headers()).json()
+            if p["issuer"] == platform.issuer
+        ]
+        added = httpx.post(
+            f"{tool.url}/lti/platforms/{row['id']}/deployments",
+            json={"deployment_id": "deployment-7"},
+            headers=instructor_headers(),
+        )
+        assert added.status_code == 200 and "deployment-7" in added.json()["deployment_ids"]
+        _, page = landed(client, tool, platform.launch(client, LaunchSpec(person, "link-7", **other)))
+    assert "signed in as Dana Deployment" in page.text
 
 
 def test_deep_linking_carries_the_lab_and_edition_picked(platform: LtiPlatform, tool: LiveProcess) -> None:
