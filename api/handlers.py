@@ -39,7 +39,7 @@ from api.errors import (
     UploadTooLarge,
 )
 from api.schemas import ErrorBody, FieldProblem
-from api.web import PAGE_HEADERS, templates
+from api.web import PAGE_HEADERS, page_headers, templates
 
 HTTP_STATUS: dict[type[ServiceError], int] = {
     MalformedBody: 400,
@@ -88,7 +88,7 @@ ERROR_HEADERS: dict[type[ServiceError], dict[str, dict[str, Any]]] = {
 }
 UI_PREFIX = "/ui"
 PAGE_PATHS = ("/lti/login", "/lti/launch")
-"""Paths a browser reaches from the LMS: their errors are pages too."""
+"""Paths a browser reaches from the LMS: their errors are pages too, which any LMS's iframe may show."""
 HTTP_METHODS = ("DELETE", "GET", "HEAD", "OPTIONS", "PATCH", "POST", "PUT")
 MAX_SHOWN_INPUT_CHARS = 60
 
@@ -142,7 +142,7 @@ def error_response(request: Request, error: ServiceError) -> Response:
             "error.html",
             {"message": str(error), "status": status},
             status_code=status,
-            headers={**headers, **PAGE_HEADERS},
+            headers={**headers, **(page_headers("*") if path in PAGE_PATHS else PAGE_HEADERS)},
         )
     return JSONResponse(
         error_body(error).model_dump(mode="json", exclude_none=True), status_code=status, headers=headers

@@ -267,6 +267,7 @@ def accept_launch(session: Session, launch: Launch, *, session_seconds: float) -
     """
     now = utcnow()
     session.execute(delete(LtiNonce).where(LtiNonce.expires_at < now))
+    session.execute(delete(LtiSession).where(LtiSession.expires_at < now))
     expires = datetime.fromtimestamp(float(launch.claims["exp"]) + LEEWAY_SECONDS, UTC).replace(tzinfo=None)
     session.add(
         LtiNonce(

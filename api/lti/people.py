@@ -27,7 +27,7 @@ def display_name(claims: dict[str, Any], sub: str) -> str:
 
 def _free_name(session: Session, wanted: str, sub: str) -> str:
     try:
-        base = normalise_name(wanted)
+        base = normalise_name(wanted.strip()[:MAX_NAME_CHARS])
     except Exception:
         base = normalise_name(f"lti {sub[:80]}")
     for candidate in (base, f"{base} ({sub})", f"{base} ({secrets.token_hex(4)})"):

@@ -102,7 +102,7 @@ def sync_outbox(session: Session, policy: GradebookPolicy) -> int:
             row = LtiScore(member_id=member_id, attempts=0)
             session.add(row)
         row.submission_id, row.score, row.max_score = chosen.id, score, maximum
-        row.timestamp = chosen.finished_at or now
+        row.timestamp = now  # later than any score sent before: an LMS keeps the newest
         already = (row.sent_submission_id, row.sent_score) == (chosen.id, score)
         row.status = SENT if already else PENDING
         row.attempts, row.next_attempt_at, row.error = 0, now, None
@@ -136,6 +136,12 @@ def send_due(session: Session, tokens: AccessTokens, policy: PublishPolicy) -> i
     return accepted
 
 
+def _scopes(link: LtiLink) -> tuple[str, ...]:
+    """The AGS scopes to ask for: those the launch granted (an LMS may refuse any other), score always."""
+    wanted = (SCOPE_LINEITEM, SCOPE_LINEITEM_READONLY, SCOPE_SCORE)
+    return tuple(scope for scope in wanted if scope in link.ags_scopes or scope == SCOPE_SCORE)
+
+
 def _send(session: Session, tokens: AccessTokens, policy: PublishPolicy, row: LtiScore) -> int:
     member = session.get(LtiMember, row.member_id)
     assert member is not None  # a foreign key
@@ -146,7 +152,7 @@ def _send(session: Session, tokens: AccessTokens, policy: PublishPolicy, row: Lt
     assert platform is not None
     sending = (row.submission_id, row.score)
     try:
-        token = tokens.token(session, platform, (SCOPE_LINEITEM, SCOPE_LINEITEM_READONLY, SCOPE_SCORE))
+        token = tokens.token(session, platform, _scopes(link))
         if not link.lineitem_url:
             link.lineitem_url = line_item(link, token, score_maximum=row.max_score)
             session.commit()

@@ -58,7 +58,7 @@ class ToolUrls:
 
 
 def registration_ticket(session: Session) -> str:
-    """A ticket allowing one dynamic registration within ``TICKET_SECONDS``."""
+    """A ticket allowing dynamic registrations for ``TICKET_SECONDS`` (each registers one platform)."""
     now = int(time.time())
     return sign(session, {"purpose": TICKET_PURPOSE, "iat": now, "exp": now + TICKET_SECONDS})
 

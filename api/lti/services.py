@@ -36,6 +36,13 @@ def _refused(what: str, response: httpx.Response) -> ServiceFailed:
     return ServiceFailed(f"{what}: the LMS answered {response.status_code} {response.text[:200]!r}")
 
 
+def _json(response: httpx.Response, what: str) -> Any:
+    try:
+        return response.json()
+    except ValueError:
+        raise ServiceFailed(f"{what}: the LMS answered {response.text[:200]!r}, which is not JSON") from None
+
+
 class AccessTokens:
     """Access tokens per (platform, scopes), requested with client_credentials and kept until near expiry."""
 
@@ -79,9 +86,14 @@ class AccessTokens:
             ) from None
         if response.status_code != 200:
             raise _refused(f"the LMS refused an access token at {platform.token_url}", response)
-        body = response.json()
+        body = _json(response, "asking for an access token")
+        if not isinstance(body, dict) or not isinstance(body.get("access_token"), str):
+            raise ServiceFailed(f"the LMS's token endpoint answered {body!r:.200} without an access_token")
         token = str(body["access_token"])
-        lifetime = float(body.get("expires_in", 3600))
+        try:
+            lifetime = float(body.get("expires_in", 3600))
+        except (TypeError, ValueError):
+            lifetime = 60.0
         with self._lock:
             self._tokens[key] = (time.monotonic() + max(lifetime - 60.0, 1.0), token)
         return token
@@ -117,8 +129,13 @@ def line_item(link: LtiLink, token: str, *, score_maximum: float) -> str:
         )
         if response.status_code != 200:
             raise _refused("listing the link's line items", response)
-        for item in response.json():
-            if item.get("resourceId") == RESOURCE_ID and item.get("resourceLinkId") == link.resource_link_id:
+        for item in _json(response, "listing the link's line items"):
+            if (
+                isinstance(item, dict)
+                and item.get("resourceId") == RESOURCE_ID
+                and item.get("resourceLinkId") == link.resource_link_id
+                and item.get("id")
+            ):
                 return str(item["id"])
         response = httpx.post(
             link.lineitems_url,
@@ -136,7 +153,10 @@ def line_item(link: LtiLink, token: str, *, score_maximum: float) -> str:
         raise ServiceFailed(f"the LMS's line items service did not answer: {error}") from None
     if response.status_code not in (200, 201):
         raise _refused("creating the link's line item", response)
-    return str(response.json()["id"])
+    created = _json(response, "creating the link's line item")
+    if not isinstance(created, dict) or not created.get("id"):
+        raise ServiceFailed(f"the LMS made a line item without an id: {created!r:.200}")
+    return str(created["id"])
 
 
 def publish_score(
@@ -181,6 +201,13 @@ def roster(memberships_url: str, token: str) -> list[dict[str, Any]]:
             raise PlatformUnreachable(f"the LMS's roster service did not answer: {error}") from None
         if response.status_code != 200:
             raise PlatformUnreachable(str(_refused("reading the course roster", response)))
-        members.extend(response.json().get("members", []))
+        try:
+            page = _json(response, "reading the course roster")
+        except ServiceFailed as error:
+            raise PlatformUnreachable(str(error)) from None
+        found = page.get("members") if isinstance(page, dict) else None
+        if not isinstance(found, list):
+            raise PlatformUnreachable("the LMS's roster has no members list")
+        members.extend(member for member in found if isinstance(member, dict))
         url = response.links.get("next", {}).get("url")
     raise PlatformUnreachable(f"the roster has more than {MAX_ROSTER_PAGES} pages; expected a course's")
