@@ -34,15 +34,16 @@ class ServiceContext:
     access_tokens: AccessTokens = field(default_factory=AccessTokens)
 
     @classmethod
-    def open(cls, settings: Settings, *, pool_size: int) -> ServiceContext:
+    def open(cls, settings: Settings, *, pool_size: int, publish: bool = True) -> ServiceContext:
         """Connect, migrate the schema, and start grading: ``pool_size`` in-process workers (none when 0),
-        or, with GYMGRADE_BROKER_URL, no grading here but Celery tasks and their reconciler; and in both
-        cases publish scores to the LMSs the students launched from (LTI AGS)."""
+        or, with GYMGRADE_BROKER_URL, no grading here but Celery tasks and their reconciler; and, when
+        ``publish`` (the server; not `gymgrade worker`), publish scores to the LMSs (LTI AGS)."""
         engine = make_engine(settings)
         migrate(engine)
         sessions = make_session_factory(engine)
-        publisher = ScorePublisher(sessions, settings)
-        publisher.start()
+        publisher = ScorePublisher(sessions, settings) if publish else None
+        if publisher is not None:
+            publisher.start()
         jobs = DatabaseQueue(
             sessions, lease_seconds=settings.lease_seconds, max_attempts=settings.max_attempts
         )
