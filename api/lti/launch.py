@@ -137,8 +137,8 @@ def verify_launch(
         token = jwt.decode(id_token, key_set, algorithms=[ALGORITHM])
     except JoseError as error:
         raise LaunchRefused(
-            f"the id_token's signature does not verify against the platform's keys at {platform.jwks_url} "
-            f"(key id {header.get('kid')!r}: {error.error}); it was not signed by {platform.issuer}"
+            f"the id_token's signature does not verify against the platform's keys at {platform.jwks_url} (key id {header.get('kid')!r}: {error.error}); "  # noqa: E501
+            f"it was not signed by {platform.issuer}"
         ) from None
     claims = dict(token.claims)
     _check_times(claims)
@@ -146,8 +146,7 @@ def verify_launch(
     role = role_of(claims.get(names.ROLES) or [])
     if role is None:
         raise LaunchRefused(
-            f"the launch's roles {claims.get(names.ROLES)!r} include neither a learner nor an instructor or "
-            "teaching assistant role of the course"
+            f"the launch's roles {claims.get(names.ROLES)!r} include neither a learner nor an instructor or teaching assistant role of the course"  # noqa: E501
         )
     message_type = claims[names.MESSAGE_TYPE]
     if message_type == names.DEEP_LINKING_REQUEST and role is not Role.STAFF:

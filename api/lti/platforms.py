@@ -42,8 +42,8 @@ class PlatformRegistration:
             value = getattr(self, field)
             if urlsplit(value).scheme not in ("http", "https") or not urlsplit(value).netloc:
                 raise LtiRequestInvalid(
-                    f"a platform's {field} must be an http(s) URL, found {value!r}; copy it from the LMS's "
-                    "tool registration page"
+                    f"a platform's {field} must be an http(s) URL, found {value!r}; "
+                    "copy it from the LMS's tool registration page"
                 )
         return self
 

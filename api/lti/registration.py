@@ -119,9 +119,8 @@ def register_dynamically(
     issuer = str(config.get("issuer") or "")
     if not issuer or not openid_configuration.startswith(issuer.rstrip("/")):
         raise LtiRequestInvalid(
-            f"the platform's OpenID configuration at {openid_configuration} names issuer {issuer!r}, "
-            "which does "
-            "not own that URL (the spec requires the configuration URL to start with the issuer)"
+            f"the platform's OpenID configuration at {openid_configuration} names issuer {issuer!r}, which does not own that URL; "  # noqa: E501
+            "the spec requires the configuration URL to start with the issuer"
         )
     missing = [
         field
