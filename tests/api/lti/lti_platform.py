@@ -13,6 +13,7 @@ to the platform's authorisation endpoint and the form post of the id_token to th
 from __future__ import annotations
 
 import copy
+import html
 import secrets
 import threading
 import time
@@ -28,7 +29,7 @@ from api_testing import free_port
 from cryptography.hazmat.primitives import serialization
 from cryptography.hazmat.primitives.asymmetric import rsa
 from fastapi import FastAPI, Request
-from fastapi.responses import JSONResponse, Response
+from fastapi.responses import HTMLResponse, JSONResponse, Response
 from lti1p3platform.exceptions import LtiException
 from lti1p3platform.ltiplatform import LTI1P3PlatformConfAbstract
 from lti1p3platform.message_launch import LTIAdvantageMessageLaunchAbstract
@@ -98,6 +99,8 @@ class LaunchSpec:
     expiration: int = 300
     signing_key: str | None = None
     """Another private key to sign with (under the platform's key id): a forged launch."""
+    browser: bool = False
+    """The authorisation endpoint answers as an LMS does for a browser: a form posted by a script."""
 
 
 class _Config(LTI1P3PlatformConfAbstract):
@@ -148,6 +151,7 @@ class LtiPlatform:
         self.refused_scores = 0
         self.registrations: list[dict[str, Any]] = []
         self.deep_link_items: list[dict[str, Any]] = []
+        self.course_pages: dict[str, str] = {}
         self.lock = threading.Lock()
         self.app = self._make_app()
         self._server: uvicorn.Server | None = None
@@ -201,6 +205,12 @@ class LtiPlatform:
         if spec.deep_linking:
             login.set_deeplinking_launch_url()
         return login.initiate_login(spec.person.sub)
+
+    def course_page(self, spec: LaunchSpec) -> str:
+        """The URL of the course's page framing the tool, which a browser opens (the launch starts there)."""
+        hint = secrets.token_urlsafe(8)
+        self.course_pages[hint] = self.login_url(spec)
+        return f"{self.issuer}/course/{hint}"
 
     def id_token_post(self, client: httpx.Client, spec: LaunchSpec) -> dict[str, str]:
         """Follow the login to the form the platform posts to the tool: {launch_url, id_token, state}."""
@@ -307,9 +317,28 @@ class LtiPlatform:
             config.get_registration()
             return dict(config.get_jwks())
 
-        @app.get("/auth")
-        def auth(request: Request) -> dict[str, Any]:
-            return self._authorise(dict(request.query_params))
+        @app.get("/auth", response_model=None)
+        def auth(request: Request) -> dict[str, Any] | Response:
+            query = dict(request.query_params)
+            form = self._authorise(query)
+            if not self.launches[query["lti_message_hint"]].browser:
+                return form
+            fields = "".join(
+                f'<input type="hidden" name="{name}" value="{html.escape(form[name])}">'
+                for name in ("id_token", "state")
+            )
+            return HTMLResponse(
+                f'<form id="launch" method="post" action="{html.escape(form["launch_url"])}">{fields}</form>'
+                '<script>document.getElementById("launch").submit();</script>'
+            )
+
+        @app.get("/course/{hint}")
+        def course(hint: str) -> Response:
+            login = self.course_pages[hint]
+            return HTMLResponse(
+                "<h1>Reinforcement learning</h1>"
+                f'<iframe id="tool" src="{html.escape(login)}" width="1000" height="800"></iframe>'
+            )
 
         @app.post("/token")
         async def token(request: Request) -> Response:
