@@ -12,6 +12,7 @@ from fastapi.staticfiles import StaticFiles
 from api.context import ServiceContext
 from api.handlers import install_error_handlers
 from api.limits import BodyLimitMiddleware
+from api.lti.sessions import redact_access_log
 from api.routes import gradebook, health, lti, students, submissions, ui
 from api.settings import Settings, load_settings
 from api.web import STATIC_DIR
@@ -38,6 +39,7 @@ def create_app(settings: Settings | None = None, *, run_workers: bool = True) ->
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        redact_access_log()
         context = ServiceContext.open(settings, pool_size=settings.workers if run_workers else 0)
         app.state.context = context
         try:

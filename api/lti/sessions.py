@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import logging
+import re
+
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
@@ -32,3 +35,31 @@ def session_caller(session: Session, token: str) -> Principal | None:
         session_token=token,
         lti_link_id=row.link_id,
     )
+
+
+_IN_A_URL = re.compile(rf"({SESSION_PARAMETER}=)[^&\s\"']+")
+
+
+def redacted(text: str) -> str:
+    """``text`` with every ``lti_session=...`` value replaced (a session token is a password)."""
+    return _IN_A_URL.sub(r"\1[redacted]", text)
+
+
+class RedactSessions(logging.Filter):
+    """Keeps launch session tokens out of the logs (uvicorn's access log prints each URL with its query)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        """Redact the record's message arguments and message; never drops a record."""
+        if isinstance(record.args, tuple):
+            record.args = tuple(redacted(arg) if isinstance(arg, str) else arg for arg in record.args)
+        if isinstance(record.msg, str):
+            record.msg = redacted(record.msg)
+        return True
+
+
+def redact_access_log() -> None:
+    """Install :class:`RedactSessions` on uvicorn's access and error loggers (once)."""
+    for name in ("uvicorn.access", "uvicorn.error"):
+        logger = logging.getLogger(name)
+        if not any(isinstance(existing, RedactSessions) for existing in logger.filters):
+            logger.addFilter(RedactSessions())

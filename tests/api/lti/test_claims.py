@@ -6,6 +6,7 @@ import pytest
 
 from api.lti.claims import Role, role_of
 from api.lti.launch import Launch, frame_origins
+from api.lti.sessions import redacted
 from api.models import LtiPlatform
 
 MEMBERSHIP = "http://purl.imsglobal.org/vocab/lis/v2/membership"
@@ -61,3 +62,19 @@ def _launch(claims: dict[str, object]) -> Launch:
 def test_the_lms_pages_that_may_frame_the_tool(presentation: dict[str, str], expected: str) -> None:
     claims = {"https://purl.imsglobal.org/spec/lti/claim/launch_presentation": presentation}
     assert frame_origins(_launch(claims)) == expected
+
+
+@pytest.mark.parametrize(
+    ("line", "expected"),
+    [
+        (
+            '127.0.0.1:5 - "GET /?lti_session=ggl_abc-DEF_1 HTTP/1.1" 200',
+            '127.0.0.1:5 - "GET /?lti_session=[redacted] HTTP/1.1" 200',
+        ),
+        ("/ui/submissions?lti_session=ggl_x&y=1", "/ui/submissions?lti_session=[redacted]&y=1"),
+        ("/ui/submissions/3", "/ui/submissions/3"),
+    ],
+    ids=["access-log-line", "followed-by-a-parameter", "none"],
+)
+def test_session_tokens_are_kept_out_of_the_logs(line: str, expected: str) -> None:
+    assert redacted(line) == expected

@@ -15,7 +15,8 @@ from typing import Any
 import httpx
 import pytest
 from api_testing import FAKE_GRADER, TESTS_DIR, instructor_headers
-from live_server import LiveProcess, service_environment
+from live_server import LiveProcess, create_student, service_environment
+from live_server import upload as upload_with_token
 from lti_platform import (
     INSTRUCTOR,
     LEARNER,
@@ -160,6 +161,9 @@ def test_a_learner_lands_signed_in_and_each_grading_reaches_the_gradebook_once(
         # Launching again lands in the same student, with the same line item.
         again, page = landed(client, tool, platform.launch(client, LaunchSpec(person, "link-1")))
         assert again != token and "Ada Lovelace" in page.text
+    log = tool._log_path.read_text(encoding="utf-8")
+    assert token not in log and again not in log, "a session token was written to the server's log"
+    assert "lti_session=[redacted]" in log
     listed = httpx.get(tool.url + "/lti/scores", headers=instructor_headers()).json()
     ada = [row for row in listed if row["student"] == "Ada Lovelace"]
     assert [(row["status"], row["sent_score"], row["error"]) for row in ada] == [("sent", 2.0, None)]
@@ -441,3 +445,15 @@ def test_dynamic_registration_needs_the_instructors_ticket_then_registers_the_to
         person = lms.add_person("learner-dyn", "Dyn Amic", LEARNER)
         _, page = landed(client, tool, lms.launch(client, LaunchSpec(person, "link-dyn")))
         assert "signed in as Dyn Amic" in page.text
+
+
+def test_token_sign_in_keeps_working_beside_lti(platform: LtiPlatform, tool: LiveProcess) -> None:
+    token = create_student(tool.url, "Tom Token")
+    submission = upload_with_token(tool.url, token, ONE_PROBLEM)
+    wait(lambda: graded(tool, submission), "the token student's grading")
+    with httpx.Client() as client:
+        signed_in = client.post(tool.url + "/ui/sign-in", data={"token": token})
+        assert signed_in.status_code == 303
+        assert "signed in as Tom Token" in client.get(tool.url + "/").text
+    rows = httpx.get(tool.url + "/lti/scores", headers=instructor_headers()).json()
+    assert "Tom Token" not in [row["student"] for row in rows], "a student who never launched has no LMS"
