@@ -4,7 +4,6 @@ blocked and no cookie set at all."""
 
 from __future__ import annotations
 
-import os
 import shutil
 import time
 from collections.abc import Iterator
@@ -12,9 +11,10 @@ from pathlib import Path
 
 import httpx
 import pytest
-from api_testing import FAKE_GRADER, TESTS_DIR, instructor_headers
-from live_server import LiveProcess, service_environment
+from api_testing import instructor_headers
+from live_server import LiveProcess
 from lti_platform import LEARNER, LaunchSpec, LtiPlatform
+from lti_testing import tool_environment
 
 pytestmark = [pytest.mark.browser, pytest.mark.e2e, pytest.mark.slow]
 
@@ -33,10 +33,7 @@ WAIT_MS = 60_000
 
 @pytest.fixture
 def tool(tmp_path: Path) -> Iterator[LiveProcess]:
-    env = service_environment(tmp_path / "data", FAKE_GRADER, lti_publish_seconds=0.2)
-    env["PYTHONPATH"] = os.pathsep.join(
-        [str(TESTS_DIR), *filter(None, env.get("PYTHONPATH", "").split(os.pathsep))]
-    )
+    env = tool_environment(tmp_path / "data", lti_publish_seconds=0.2)
     server = LiveProcess("serve", env, tmp_path / "serve.log").start()
     yield server
     server.stop()

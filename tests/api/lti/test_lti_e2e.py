@@ -4,7 +4,6 @@ loopback, see lti_platform.py) against `gymgrade serve` (real uvicorn, the fake 
 from __future__ import annotations
 
 import html
-import os
 import re
 import sqlite3
 import time
@@ -14,8 +13,8 @@ from typing import Any
 
 import httpx
 import pytest
-from api_testing import FAKE_GRADER, TESTS_DIR, instructor_headers
-from live_server import LiveProcess, create_student, service_environment
+from api_testing import instructor_headers
+from live_server import LiveProcess, create_student
 from live_server import upload as upload_with_token
 from lti_platform import (
     INSTRUCTOR,
@@ -27,12 +26,10 @@ from lti_platform import (
     new_private_key,
     query_of,
 )
+from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, landed, tool_environment, upload, wait
 
 pytestmark = [pytest.mark.e2e, pytest.mark.slow]
 
-ONE_PROBLEM = b"def random_blackjack(n):\n    return 0.4\n"
-TWO_PROBLEMS = ONE_PROBLEM + b"def blackjack(n):\n    return 0.4\n"
-WAIT_SECONDS = 60.0
 PUBLISH_SECONDS = 0.2
 
 
@@ -47,16 +44,12 @@ def platform() -> Iterator[LtiPlatform]:
 def tool(tmp_path_factory: pytest.TempPathFactory, platform: LtiPlatform) -> Iterator[LiveProcess]:
     """`gymgrade serve` with the platform registered by hand (POST /lti/platforms)."""
     directory = tmp_path_factory.mktemp("lti-tool")
-    env = service_environment(
+    env = tool_environment(
         directory / "data",
-        FAKE_GRADER,
         lti_publish_seconds=PUBLISH_SECONDS,
         lti_retry_seconds=0.2,
         lti_publish_attempts=3,
         rate_limit_per_minute=1000,
-    )
-    env["PYTHONPATH"] = os.pathsep.join(
-        [str(TESTS_DIR), *filter(None, env.get("PYTHONPATH", "").split(os.pathsep))]
     )
     server = LiveProcess("serve", env, directory / "serve.log").start()
     try:
@@ -83,34 +76,6 @@ def counts(tool: LiveProcess) -> dict[str, int]:
         }
 
 
-def landed(client: httpx.Client, tool: LiveProcess, response: httpx.Response) -> tuple[str, httpx.Response]:
-    """Follow a launch's redirect; the session token and the page it lands on."""
-    assert response.status_code == 303, response.text
-    location = response.headers["location"]
-    token = query_of(location)["lti_session"]
-    return token, client.get(tool.url + location)
-
-
-def upload(client: httpx.Client, tool: LiveProcess, token: str, content: bytes) -> int:
-    response = client.post(
-        tool.url + "/ui/submissions", params={"lti_session": token}, files={"file": ("opengym.py", content)}
-    )
-    assert response.status_code == 303, response.text
-    match = re.match(r"/ui/submissions/(\d+)\?lti_session=", response.headers["location"])
-    assert match, response.headers["location"]
-    return int(match.group(1))
-
-
-def wait(condition: Any, what: str, timeout: float = WAIT_SECONDS) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}")
-
-
 def scores_for(platform: LtiPlatform, sub: str) -> list[dict[str, Any]]:
     return [score for scores in platform.scores.values() for score in scores if score["userId"] == sub]
 
@@ -126,7 +91,7 @@ def test_a_learner_lands_signed_in_and_each_grading_reaches_the_gradebook_once(
 ) -> None:
     person = platform.add_person("learner-ada", "Ada Lovelace", LEARNER)
     with httpx.Client() as client:
-        token, page = landed(client, tool, platform.launch(client, LaunchSpec(person, "link-1")))
+        token, page = landed(client, tool.url, platform.launch(client, LaunchSpec(person, "link-1")))
         assert page.status_code == 200
         assert "Upload your solution" in page.text
         assert "signed in as Ada Lovelace" in page.text
@@ -134,7 +99,7 @@ def test_a_learner_lands_signed_in_and_each_grading_reaches_the_gradebook_once(
         assert f"frame-ancestors {platform.issuer}" in page.headers["content-security-policy"]
         assert f'action="/ui/submissions?lti_session={token}"' in page.text
 
-        first = upload(client, tool, token, ONE_PROBLEM)
+        first = upload(client, tool.url, token, ONE_PROBLEM)
         sent = wait(lambda: scores_for(platform, person.sub), "the first score at the platform")
         assert len(sent) == 1
         assert sent[0]["scoreGiven"] == 1.0 and sent[0]["scoreMaximum"] == 3.0
@@ -153,13 +118,13 @@ def test_a_learner_lands_signed_in_and_each_grading_reaches_the_gradebook_once(
         time.sleep(10 * PUBLISH_SECONDS)
         assert len(scores_for(platform, person.sub)) == 1
 
-        upload(client, tool, token, TWO_PROBLEMS)
+        upload(client, tool.url, token, TWO_PROBLEMS)
         wait(lambda: len(scores_for(platform, person.sub)) == 2, "the better score")
         assert scores_for(platform, person.sub)[-1]["scoreGiven"] == 2.0
         assert len([item for item in platform.line_items.values() if item["resourceLinkId"] == "link-1"]) == 1
 
         # Launching again lands in the same student, with the same line item.
-        again, page = landed(client, tool, platform.launch(client, LaunchSpec(person, "link-1")))
+        again, page = landed(client, tool.url, platform.launch(client, LaunchSpec(person, "link-1")))
         assert again != token and "Ada Lovelace" in page.text
     log = tool._log_path.read_text(encoding="utf-8")
     assert token not in log and again not in log, "a session token was written to the server's log"
@@ -257,9 +222,9 @@ def test_a_student_cannot_publish_scores_or_read_another_students_work(
     alice = platform.add_person("learner-alice", "Alice", LEARNER)
     bob = platform.add_person("learner-bob", "Bob", LEARNER)
     with httpx.Client() as client:
-        alice_token, _ = landed(client, tool, platform.launch(client, LaunchSpec(alice, "link-1")))
-        bob_token, _ = landed(client, tool, platform.launch(client, LaunchSpec(bob, "link-1")))
-        bobs = upload(client, tool, bob_token, ONE_PROBLEM)
+        alice_token, _ = landed(client, tool.url, platform.launch(client, LaunchSpec(alice, "link-1")))
+        bob_token, _ = landed(client, tool.url, platform.launch(client, LaunchSpec(bob, "link-1")))
+        bobs = upload(client, tool.url, bob_token, ONE_PROBLEM)
         other = client.get(f"{tool.url}/ui/submissions/{bobs}", params={"lti_session": alice_token})
         assert other.status_code == 404
         for method, path in [
@@ -284,8 +249,8 @@ def test_scores_refused_by_the_platform_are_sent_again_and_shown_to_the_instruct
     platform.score_failures = 4
     refused_before = platform.refused_scores
     with httpx.Client() as client:
-        token, _ = landed(client, tool, platform.launch(client, LaunchSpec(person, "link-2")))
-        submission = upload(client, tool, token, ONE_PROBLEM)
+        token, _ = landed(client, tool.url, platform.launch(client, LaunchSpec(person, "link-2")))
+        submission = upload(client, tool.url, token, ONE_PROBLEM)
 
         def shown() -> list[dict[str, Any]]:
             rows = httpx.get(tool.url + "/lti/scores", headers=instructor_headers()).json()
@@ -303,7 +268,7 @@ def test_scores_refused_by_the_platform_are_sent_again_and_shown_to_the_instruct
     assert [(row["status"], row["error"]) for row in rows if row["student"] == "Grace"] == [("sent", None)]
     teacher = platform.add_person("staff-grace", "Gale Grader", INSTRUCTOR)
     with httpx.Client() as client:
-        _, page = landed(client, tool, platform.launch(client, LaunchSpec(teacher, "link-2")))
+        _, page = landed(client, tool.url, platform.launch(client, LaunchSpec(teacher, "link-2")))
     assert "Scores in the LMS" in page.text
     assert re.search(
         r"<td>Grace</td>\s*<td>1 / 3</td>\s*<td>1</td>\s*<td class=\"lms-sent\">sent</td>", page.text
@@ -314,7 +279,7 @@ def test_staff_land_as_the_instructor_and_import_the_roster(platform: LtiPlatfor
     teacher = platform.add_person("staff-ta", "Terry TA", TEACHING_ASSISTANT)
     platform.add_person("learner-never", "Nora Neverlaunched", LEARNER)
     with httpx.Client() as client:
-        token, page = landed(client, tool, platform.launch(client, LaunchSpec(teacher, "link-1")))
+        token, page = landed(client, tool.url, platform.launch(client, LaunchSpec(teacher, "link-1")))
         assert "All submissions" in page.text and "Upload your solution" not in page.text
         assert f'action="/ui/lti/roster?lti_session={token}"' in page.text
         imported = client.post(tool.url + "/ui/lti/roster", params={"lti_session": token})
@@ -349,7 +314,7 @@ def test_a_deployment_added_by_the_instructor_is_accepted(platform: LtiPlatform,
             headers=instructor_headers(),
         )
         assert added.status_code == 200 and "deployment-7" in added.json()["deployment_ids"]
-        _, page = landed(client, tool, platform.launch(client, LaunchSpec(person, "link-7", **other)))
+        _, page = landed(client, tool.url, platform.launch(client, LaunchSpec(person, "link-7", **other)))
     assert "signed in as Dana Deployment" in page.text
 
 
@@ -404,8 +369,8 @@ def test_a_launch_started_before_a_key_rotation_completes_after_it(
             form["launch_url"], data={"id_token": form["id_token"], "state": form["state"]}
         )
         assert response.status_code == 303, response.text
-        token, _ = landed(client, tool, response)
-        upload(client, tool, token, ONE_PROBLEM)
+        token, _ = landed(client, tool.url, response)
+        upload(client, tool.url, token, ONE_PROBLEM)
         # The access token for the score is asked for with an assertion signed by the new key.
         wait(lambda: scores_for(platform, person.sub), "a score sent after the rotation")
 
@@ -443,7 +408,7 @@ def test_dynamic_registration_needs_the_instructors_ticket_then_registers_the_to
         platforms = httpx.get(tool.url + "/lti/platforms", headers=instructor_headers()).json()
         assert any(row["issuer"] == lms.issuer and row["client_id"] == lms.client_id for row in platforms)
         person = lms.add_person("learner-dyn", "Dyn Amic", LEARNER)
-        _, page = landed(client, tool, lms.launch(client, LaunchSpec(person, "link-dyn")))
+        _, page = landed(client, tool.url, lms.launch(client, LaunchSpec(person, "link-dyn")))
         assert "signed in as Dyn Amic" in page.text
 
 
