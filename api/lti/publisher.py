@@ -1,5 +1,8 @@
 """Scores to the LMS (LTI AGS) from a durable outbox: one ``lti_scores`` row per (link, student).
 
+The row holds the kept score (``score`` None: nothing graded yet, a submission is being graded: the LMS
+is told ``Submitted``/``Pending`` without a score; once graded, ``Completed``/``FullyGraded`` with it).
+
 Each round (``GYMGRADE_LTI_PUBLISH_SECONDS``) first brings every row up to the score the gradebook policy
 keeps now, read from the submission rows (the only truth: a regrade or a better upload changes it), then
 sends the rows that are due. A row is sent only while the kept score differs from the one the platform
@@ -16,7 +19,7 @@ from dataclasses import dataclass
 from datetime import timedelta
 from typing import Any
 
-from sqlalchemy import select, update
+from sqlalchemy import func, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
 from api.gradebook import kept_submissions
@@ -68,13 +71,14 @@ class PublishPolicy:
 def sync_outbox(session: Session, policy: GradebookPolicy) -> int:
     """Bring each member's row to the score the policy keeps now; return how many rows changed."""
     members = session.execute(
-        select(LtiMember.id, LtiUser.student_id)
+        select(LtiMember.id, LtiUser.student_id, LtiLink.lineitem_url)
         .join(LtiUser, LtiUser.id == LtiMember.user_id)
+        .join(LtiLink, LtiLink.id == LtiMember.link_id)
         .where(LtiUser.student_id.is_not(None))
     ).all()
     if not members:
         return 0
-    students = {student_id for _, student_id in members}
+    students = {student_id for _, student_id, _ in members}
     graded = session.execute(
         select(
             Submission.id,
@@ -87,28 +91,52 @@ def sync_outbox(session: Session, policy: GradebookPolicy) -> int:
         .order_by(Submission.id)
     ).all()
     kept = kept_submissions(graded, policy)
+    in_progress = dict(
+        session.execute(
+            select(Submission.student_id, func.max(Submission.id))
+            .where(
+                Submission.status.in_((JobStatus.QUEUED.value, JobStatus.RUNNING.value)),
+                Submission.student_id.in_(students),
+            )
+            .group_by(Submission.student_id)
+        ).all()
+    )
     rows = {row.member_id: row for row in session.scalars(select(LtiScore))}
     changed = 0
     now = utcnow()
-    for member_id, student_id in members:
+    for member_id, student_id, lineitem_url in members:
         chosen = kept.get(student_id) if student_id is not None else None
-        if chosen is None:
+        if chosen is not None:
+            wanted: tuple[int, float | None, float | None] = (
+                chosen.id,
+                float(chosen.score or 0.0),
+                float(chosen.max_score or 0.0),
+            )
+        elif student_id in in_progress and lineitem_url and _holds_no_score(rows.get(member_id)):
+            # Nothing graded (a first upload, or the only one being regraded): the LMS is told a submission
+            # is being graded, without a score, unless it holds one (which that would erase). Only where
+            # the line item exists: making one needs the score's maximum.
+            wanted = (in_progress[student_id], None, None)
+        else:
             continue
-        score, maximum = float(chosen.score or 0.0), float(chosen.max_score or 0.0)
         row = rows.get(member_id)
-        if row is not None and (row.submission_id, row.score, row.max_score) == (chosen.id, score, maximum):
+        if row is not None and (row.submission_id, row.score, row.max_score) == wanted:
             continue
         if row is None:
             row = LtiScore(member_id=member_id, attempts=0)
             session.add(row)
-        row.submission_id, row.score, row.max_score = chosen.id, score, maximum
+        row.submission_id, row.score, row.max_score = wanted
         row.timestamp = now  # later than any score sent before: an LMS keeps the newest
-        already = (row.sent_submission_id, row.sent_score) == (chosen.id, score)
+        already = (row.sent_submission_id, row.sent_score) == wanted[:2]
         row.status = SENT if already else PENDING
         row.attempts, row.next_attempt_at, row.error = 0, now, None
         changed += 1
     session.commit()
     return changed
+
+
+def _holds_no_score(row: LtiScore | None) -> bool:
+    return row is None or row.sent_score is None
 
 
 def send_due(session: Session, tokens: AccessTokens, policy: PublishPolicy) -> int:
@@ -154,6 +182,8 @@ def _send(session: Session, tokens: AccessTokens, policy: PublishPolicy, row: Lt
     try:
         token = tokens.token(session, platform, _scopes(link))
         if not link.lineitem_url:
+            if row.max_score is None:
+                raise ServiceFailed("the link has no line item yet; it is made with the first score")
             link.lineitem_url = line_item(link, token, score_maximum=row.max_score)
             session.commit()
         publish_score(

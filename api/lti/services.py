@@ -160,17 +160,29 @@ def line_item(link: LtiLink, token: str, *, score_maximum: float) -> str:
 
 
 def publish_score(
-    lineitem_url: str, token: str, *, user_id: str, score: float, maximum: float, timestamp: datetime
+    lineitem_url: str,
+    token: str,
+    *,
+    user_id: str,
+    score: float | None,
+    maximum: float | None,
+    timestamp: datetime,
 ) -> None:
-    """POST one score to a line item's scores endpoint (raises ServiceFailed)."""
+    """POST one score to a line item's scores endpoint (raises ServiceFailed); ``score`` None: submitted,
+    being graded (no score given)."""
     body: dict[str, Any] = {
         "userId": user_id,
-        "scoreGiven": score,
-        "scoreMaximum": maximum,
         "timestamp": timestamp.isoformat(timespec="microseconds") + "Z",
-        "activityProgress": "Completed",
-        "gradingProgress": "FullyGraded",
+        "activityProgress": "Submitted",
+        "gradingProgress": "Pending",
     }
+    if score is not None:
+        body.update(
+            scoreGiven=score,
+            scoreMaximum=maximum,
+            activityProgress="Completed",
+            gradingProgress="FullyGraded",
+        )
     try:
         response = httpx.post(
             _with_path(lineitem_url, "/scores"),

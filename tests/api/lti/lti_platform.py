@@ -99,6 +99,8 @@ class LaunchSpec:
     expiration: int = 300
     signing_key: str | None = None
     """Another private key to sign with (under the platform's key id): a forged launch."""
+    lineitem: str | None = None
+    """The line item the platform made for the link (as Canvas and Moodle do for an assignment)."""
     browser: bool = False
     """The authorisation endpoint answers as an LMS does for a browser: a form posted by a script."""
 
@@ -146,8 +148,8 @@ class LtiPlatform:
         self.launches: dict[str, LaunchSpec] = {}
         self.line_items: dict[str, dict[str, Any]] = {}
         self.scores: dict[str, list[dict[str, Any]]] = {}
-        self.score_failures = 0
-        """Score POSTs still to answer with 500 (an LMS in trouble)."""
+        self.score_failures: dict[str, int] = {}
+        """By user id: score POSTs still to answer with 500 (an LMS in trouble)."""
         self.refused_scores = 0
         self.registrations: list[dict[str, Any]] = []
         self.deep_link_items: list[dict[str, Any]] = []
@@ -243,7 +245,11 @@ class LtiPlatform:
             )
         else:
             launch.set_resource_link_claim(spec.resource_link_id, title="Lab: OpenGym")
-            launch.set_ags(self.issuer + f"/lineitems?context={CONTEXT_ID}", allow_creating_lineitems=True)
+            launch.set_ags(
+                self.issuer + f"/lineitems?context={CONTEXT_ID}",
+                lineitem_url=spec.lineitem,
+                allow_creating_lineitems=True,
+            )
             launch.set_nrps(self.issuer + "/memberships")
             if spec.custom:
                 launch.set_custom_parameters_claim(spec.custom)
@@ -373,12 +379,12 @@ class LtiPlatform:
         @app.post("/lineitems/{number}/scores")
         async def post_score(number: int, request: Request) -> Response:
             self._check_token(request, ags + "score")
+            body = await request.json()
             with self.lock:
-                if self.score_failures > 0:
-                    self.score_failures -= 1
+                if self.score_failures.get(body.get("userId"), 0) > 0:
+                    self.score_failures[body["userId"]] -= 1
                     self.refused_scores += 1
                     return JSONResponse({"error": "the gradebook is down"}, status_code=500)
-            body = await request.json()
             item_id = f"{self.issuer}/lineitems/{number}"
             if item_id not in self.line_items:
                 return JSONResponse({"error": "no such line item"}, status_code=404)
@@ -429,6 +435,18 @@ class LtiPlatform:
         finally:
             server.should_exit = True
             thread.join(timeout=10)
+
+    def add_line_item(self, resource_link_id: str, score_maximum: float) -> str:
+        """A line item the platform makes itself for a link; its URL."""
+        with self.lock:
+            item_id = f"{self.issuer}/lineitems/{len(self.line_items) + 1}"
+            self.line_items[item_id] = {
+                "id": item_id,
+                "scoreMaximum": score_maximum,
+                "label": "Lab",
+                "resourceLinkId": resource_link_id,
+            }
+        return item_id
 
     def add_person(self, sub: str, name: str, *roles: str) -> Person:
         """A member of the course."""

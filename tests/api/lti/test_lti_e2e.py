@@ -246,7 +246,7 @@ def test_scores_refused_by_the_platform_are_sent_again_and_shown_to_the_instruct
     platform: LtiPlatform, tool: LiveProcess
 ) -> None:
     person = platform.add_person("learner-grace", "Grace", LEARNER)
-    platform.score_failures = 4
+    platform.score_failures[person.sub] = 4
     refused_before = platform.refused_scores
     with httpx.Client() as client:
         token, _ = landed(client, tool.url, platform.launch(client, LaunchSpec(person, "link-2")))
@@ -422,3 +422,25 @@ def test_token_sign_in_keeps_working_beside_lti(platform: LtiPlatform, tool: Liv
         assert "signed in as Tom Token" in client.get(tool.url + "/").text
     rows = httpx.get(tool.url + "/lti/scores", headers=instructor_headers()).json()
     assert "Tom Token" not in [row["student"] for row in rows], "a student who never launched has no LMS"
+
+
+def test_the_lms_hears_of_a_submission_being_graded_then_its_score(
+    platform: LtiPlatform, tool: LiveProcess
+) -> None:
+    person = platform.add_person("learner-pat", "Pat Pending", LEARNER)
+    item = platform.add_line_item("link-li", score_maximum=3.0)
+    slow = b"# fake-grader: sleep=1\n" + ONE_PROBLEM
+    with httpx.Client() as client:
+        token, _ = landed(
+            client, tool.url, platform.launch(client, LaunchSpec(person, "link-li", lineitem=item))
+        )
+        upload(client, tool.url, token, slow)
+        wait(lambda: [s for s in scores_for(platform, person.sub) if "scoreGiven" in s], "the score")
+    sent = platform.scores[item]
+    assert [(s["activityProgress"], s["gradingProgress"], s.get("scoreGiven")) for s in sent] == [
+        ("Submitted", "Pending", None),
+        ("Completed", "FullyGraded", 1.0),
+    ]
+    assert [i for i in platform.line_items.values() if i["resourceLinkId"] == "link-li"] == [
+        platform.line_items[item]
+    ], "the platform's own line item is used, none is made"

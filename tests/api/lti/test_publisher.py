@@ -24,7 +24,7 @@ def session(make_settings: SettingsFactory) -> Iterator[Session]:
     engine.dispose()
 
 
-def _member(session: Session, name: str) -> tuple[Student, LtiMember]:
+def _member(session: Session, name: str, lineitem_url: str | None = None) -> tuple[Student, LtiMember]:
     platform = session.query(LtiPlatform).first()
     if platform is None:
         platform = LtiPlatform(
@@ -50,6 +50,7 @@ def _member(session: Session, name: str) -> tuple[Student, LtiMember]:
         )
         session.flush()
     link = session.query(LtiLink).one()
+    link.lineitem_url = lineitem_url
     student = Student(name=name, token_sha256=name.ljust(64, "0"))
     session.add(student)
     session.flush()
@@ -182,3 +183,46 @@ def test_refused_sends_wait_twice_as_long_each_time_up_to_ten_minutes(attempts: 
 
 def test_the_states_are_distinct() -> None:
     assert len({PENDING, SENT, RETRYING, FAILED}) == 4
+
+
+@pytest.mark.parametrize(
+    ("lineitem_url", "expected"),
+    [("https://lms.example/lineitems/1", [(PENDING, None)]), (None, [])],
+    ids=["the-link-has-a-line-item", "no-line-item-yet"],
+)
+def test_a_submission_being_graded_is_announced_without_a_score_where_the_line_item_exists(
+    session: Session, lineitem_url: str | None, expected: list[tuple[str, float | None]]
+) -> None:
+    student, member = _member(session, "fay", lineitem_url)
+    submission = _graded(session, student, 0.0, status="queued")
+    sync_outbox(session, GradebookPolicy.LATEST)
+    session.expire_all()
+    assert [(row.status, row.score) for row in session.query(LtiScore).all()] == expected
+    if not expected:
+        return
+    _as_sent(session, member)
+    submission.status, submission.score, submission.max_score = "done", 2.0, 3.0
+    session.commit()
+    sync_outbox(session, GradebookPolicy.LATEST)
+    assert (_row(session, member).status, _row(session, member).score) == (PENDING, 2.0)
+
+
+def test_a_new_upload_never_announces_pending_over_a_score_the_lms_holds(session: Session) -> None:
+    student, member = _member(session, "gus", "https://lms.example/lineitems/1")
+    graded = _graded(session, student, 2.0)
+    sync_outbox(session, GradebookPolicy.LATEST)
+    _as_sent(session, member)
+    _graded(session, student, 0.0, status="running")
+    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
+    assert (_row(session, member).status, _row(session, member).submission_id) == (SENT, graded.id)
+
+
+def test_a_regrade_of_the_only_graded_upload_never_announces_pending_over_its_score(session: Session) -> None:
+    student, member = _member(session, "hal", "https://lms.example/lineitems/1")
+    submission = _graded(session, student, 2.0)
+    sync_outbox(session, GradebookPolicy.LATEST)
+    _as_sent(session, member)
+    submission.status = "running"  # regraded: for a while nothing of the student's is graded
+    session.commit()
+    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
+    assert (_row(session, member).status, _row(session, member).score) == (SENT, 2.0)
