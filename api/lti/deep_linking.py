@@ -17,7 +17,7 @@ from api.lti import claims as names
 from api.lti.keys import ALGORITHM, published_keys, sign
 from api.lti.launch import Launch
 from api.models import LtiPlatform
-from grader.editions import EDITIONS
+from grader.lab.editions import EDITIONS
 
 PICKER_PURPOSE = "lti-deep-link"
 PICKER_SECONDS = 3600
