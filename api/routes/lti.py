@@ -13,6 +13,7 @@ from fastapi import APIRouter, Form, Request
 from fastapi.responses import JSONResponse, RedirectResponse, Response
 from pydantic import BaseModel, Field
 from sqlalchemy import select
+from starlette.concurrency import run_in_threadpool
 
 from api.deps import ContextDep, InstructorDep, SessionDep, SettingsDep
 from api.errors import LtiRequestInvalid
@@ -52,8 +53,12 @@ async def login(request: Request, context: ContextDep) -> Response:
     if request.method == "POST":
         params.update({key: str(value) for key, value in (await request.form()).items()})
     urls = tool_urls(request, context.settings)
-    with context.sessions() as session:
-        target = login_redirect(session, params, urls.launch, urls.origin)
+
+    def redirect() -> str:  # the database (and the first key's generation) off the event loop
+        with context.sessions() as session:
+            return login_redirect(session, params, urls.launch, urls.origin)
+
+    target = await run_in_threadpool(redirect)
     return RedirectResponse(target, status_code=302 if request.method == "GET" else 303)
 
 
