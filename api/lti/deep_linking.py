@@ -18,6 +18,7 @@ from api.lti.keys import ALGORITHM, published_keys, sign
 from api.lti.launch import Launch
 from api.models import LtiPlatform
 from grader.lab.editions import EDITIONS
+from grader.lab.editions.choice import service_edition
 
 PICKER_PURPOSE = "lti-deep-link"
 PICKER_SECONDS = 3600
@@ -27,6 +28,26 @@ RESPONSE_SECONDS = 600
 def choices() -> list[tuple[str, str]]:
     """The (edition name, lab title) pairs an instructor picks from."""
     return [(edition.name, edition.title) for edition in EDITIONS.values()]
+
+
+def graded_edition(setting: str | None) -> str:
+    """The edition the service grades every upload as (GYMGRADE_EDITION, else the first)."""
+    return service_edition(setting).edition.name
+
+
+def check_link_edition(custom: dict[str, object], graded: str) -> None:
+    """Refuse a link made for another edition than the one the service grades (its students would be
+    graded on problems their template does not pose).
+
+    Raises:
+        LaunchRefused: The link's custom ``edition`` names another edition.
+    """
+    wanted = custom.get("edition")
+    if wanted is not None and wanted != graded:
+        raise LaunchRefused(
+            f"this assignment was added for edition {wanted!r}, and this service grades {graded!r} (GYMGRADE_EDITION); "  # noqa: E501
+            "the instructor adds the assignment again with the service's edition, or runs a service for that edition"  # noqa: E501
+        )
 
 
 def picker_token(session: Session, launch: Launch) -> str:
@@ -54,13 +75,13 @@ def picker_token(session: Session, launch: Launch) -> str:
 
 
 def deep_linking_response(
-    session: Session, token: str, edition: str, launch_url: str, *, grace_seconds: float
+    session: Session, token: str, edition: str, launch_url: str, *, graded: str, grace_seconds: float
 ) -> tuple[str, str]:
     """The return URL and the signed LtiDeepLinkingResponse JWT for the picked edition.
 
     Raises:
         LaunchRefused: The picker's token is not the tool's, or expired.
-        LtiRequestInvalid: No such edition.
+        LtiRequestInvalid: No such edition, or not the one the service grades (``graded``).
     """
     try:
         picked = jwt.decode(token, published_keys(session, grace_seconds), algorithms=[ALGORITHM])
@@ -74,6 +95,11 @@ def deep_linking_response(
         raise LaunchRefused("the lab picker's token was issued for something else")
     if edition not in EDITIONS:
         raise LtiRequestInvalid(f"no edition is named {edition!r}; pick one of {', '.join(EDITIONS)}")
+    if edition != graded:
+        raise LtiRequestInvalid(
+            f"this service grades edition {graded!r} (GYMGRADE_EDITION), so a link for {edition!r} would grade its students on other problems; "  # noqa: E501
+            f"pick {graded!r}, or add the tool of a service run for {edition!r}"
+        )
     platform = session.get(LtiPlatform, context["platform"])
     if platform is None:
         raise LaunchRefused("the platform of this deep linking request is no longer registered")

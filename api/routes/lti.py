@@ -18,7 +18,13 @@ from starlette.concurrency import run_in_threadpool
 from api.deps import ContextDep, InstructorDep, SessionDep, SettingsDep
 from api.errors import LtiRequestInvalid
 from api.lti import claims as names
-from api.lti.deep_linking import choices, deep_linking_response, picker_token
+from api.lti.deep_linking import (
+    check_link_edition,
+    choices,
+    deep_linking_response,
+    graded_edition,
+    picker_token,
+)
 from api.lti.keys import public_jwks, rotate
 from api.lti.launch import accept_launch, frame_origins, login_redirect, verify_launch
 from api.lti.platforms import PlatformRegistration, add_deployment, register_platform
@@ -81,9 +87,16 @@ def launch(
         return templates.TemplateResponse(
             request,
             "lti_picker.html",
-            {"choices": choices(), "picker": token, "session_query": ""},
+            {
+                "choices": choices(),
+                "graded": graded_edition(settings.edition),
+                "picker": token,
+                "session_query": "",
+            },
             headers=page_headers(frame_origins(checked)),
         )
+    custom = checked.claims.get(names.CUSTOM)
+    check_link_edition(custom if isinstance(custom, dict) else {}, graded_edition(settings.edition))
     landing = accept_launch(session, checked, session_seconds=settings.lti_session_seconds)
     return RedirectResponse("/?" + urlencode({SESSION_PARAMETER: landing.token}), status_code=303)
 
@@ -99,7 +112,12 @@ def deep_link(
     """The instructor's pick: the signed LtiDeepLinkingResponse, posted back to the LMS by the browser."""
     urls = tool_urls(request, settings)
     return_url, response_jwt = deep_linking_response(
-        session, picker, edition, urls.launch, grace_seconds=settings.lti_key_grace_seconds
+        session,
+        picker,
+        edition,
+        urls.launch,
+        graded=graded_edition(settings.edition),
+        grace_seconds=settings.lti_key_grace_seconds,
     )
     target = urlsplit(return_url)
     headers = page_headers(f"{target.scheme}://{target.netloc}")

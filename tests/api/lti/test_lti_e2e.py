@@ -324,8 +324,14 @@ def test_deep_linking_carries_the_lab_and_edition_picked(platform: LtiPlatform, 
         picker = platform.launch(client, LaunchSpec(teacher, "", deep_linking=True))
         assert picker.status_code == 200, picker.text
         token = re.search(r'name="picker" value="([^"]+)"', picker.text)
-        assert token and 'value="rl1"' in picker.text
-        answer = client.post(tool.url + "/lti/deep-link", data={"picker": token.group(1), "edition": "rl1"})
+        assert token and 'value="classic" required checked' in picker.text
+        assert 'value="rl1" required disabled' in picker.text, "an edition this service does not grade"
+        other = client.post(tool.url + "/lti/deep-link", data={"picker": token.group(1), "edition": "rl1"})
+        assert other.status_code == 400
+        assert "this service grades edition 'classic' (GYMGRADE_EDITION), so a link for 'rl1'" in other.text
+        answer = client.post(
+            tool.url + "/lti/deep-link", data={"picker": token.group(1), "edition": "classic"}
+        )
         assert answer.status_code == 200, answer.text
         action = re.search(r'action="([^"]+)"', answer.text)
         response_jwt = re.search(r'name="JWT" value="([^"]+)"', answer.text)
@@ -338,8 +344,31 @@ def test_deep_linking_carries_the_lab_and_edition_picked(platform: LtiPlatform, 
     assert accepted.status_code == 200, accepted.text
     (item,) = accepted.json()["items"]
     assert item["type"] == "ltiResourceLink"
-    assert item["custom"] == {"lab": "Reinforcement Learning 1: Gymnasium", "edition": "rl1"}
+    assert item["custom"] == {"lab": "OpenGym AI (classic gym)", "edition": "classic"}
     assert item["url"] == tool.url + "/lti/launch"
+    learner = platform.add_person("learner-linked", "Lin Linked", LEARNER)
+    with httpx.Client() as client:
+        _, page = landed(
+            client, tool.url, platform.launch(client, LaunchSpec(learner, "link-dl", custom=item["custom"]))
+        )
+    assert "signed in as Lin Linked" in page.text
+
+
+def test_a_link_made_for_another_edition_is_refused_and_stores_nothing(
+    platform: LtiPlatform, tool: LiveProcess
+) -> None:
+    learner = platform.add_person("learner-rl1", "Rhea", LEARNER)
+    before = counts(tool)
+    with httpx.Client() as client:
+        response = platform.launch(
+            client,
+            LaunchSpec(learner, "link-rl1", custom={"lab": "Reinforcement Learning 1", "edition": "rl1"}),
+        )
+    assert response.status_code == 403
+    assert "this assignment was added for edition 'rl1', and this service grades 'classic'" in html.unescape(
+        response.text
+    )
+    assert counts(tool) == before
 
 
 def test_a_learner_cannot_add_the_tool_by_deep_linking(platform: LtiPlatform, tool: LiveProcess) -> None:
