@@ -19,6 +19,12 @@ class Principal:
 
     name: str
     student: Student | None
+    frame_origin: str | None = None
+    """The LMS origins that may frame the pages (an LTI launch's session); None: no framing."""
+    session_token: str | None = None
+    """An LTI launch's session token, carried in the pages' links (None: the cookie or bearer token)."""
+    lti_link_id: int | None = None
+    """The LTI resource link the session was launched from."""
 
     @property
     def is_instructor(self) -> bool:

@@ -107,7 +107,7 @@ def work(args: argparse.Namespace) -> int:
             print(f"gymgrade worker: {problem}", file=sys.stderr)
             return 2
         return run_worker(settings, args.workers)
-    context = ServiceContext.open(settings, pool_size=args.workers or max(settings.workers, 1))
+    context = ServiceContext.open(settings, pool_size=args.workers or max(settings.workers, 1), publish=False)
     pool = context.pool
     if pool is None:
         raise RuntimeError("ServiceContext.open started no pool for a pool size of at least 1")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from sqlalchemy import Engine
 from sqlalchemy.orm import Session, sessionmaker
@@ -12,6 +12,9 @@ from api.jobs.job_queue import Dispatcher, JobQueue
 from api.jobs.local import DatabaseQueue, PollingDispatcher
 from api.jobs.pool import WorkerPool
 from api.jobs.reconciler import Reconciler
+from api.lti.platforms import PlatformKeys
+from api.lti.publisher import ScorePublisher
+from api.lti.services import AccessTokens
 from api.settings import Settings
 
 
@@ -26,14 +29,21 @@ class ServiceContext:
     dispatcher: Dispatcher
     pool: WorkerPool | None = None
     reconciler: Reconciler | None = None
+    publisher: ScorePublisher | None = None
+    platform_keys: PlatformKeys = field(default_factory=PlatformKeys)
+    access_tokens: AccessTokens = field(default_factory=AccessTokens)
 
     @classmethod
-    def open(cls, settings: Settings, *, pool_size: int) -> ServiceContext:
+    def open(cls, settings: Settings, *, pool_size: int, publish: bool = True) -> ServiceContext:
         """Connect, migrate the schema, and start grading: ``pool_size`` in-process workers (none when 0),
-        or, with GYMGRADE_BROKER_URL, no grading here but Celery tasks and their reconciler."""
+        or, with GYMGRADE_BROKER_URL, no grading here but Celery tasks and their reconciler; and, when
+        ``publish`` (the server; not `gymgrade worker`), publish scores to the LMSs (LTI AGS)."""
         engine = make_engine(settings)
         migrate(engine)
         sessions = make_session_factory(engine)
+        publisher = ScorePublisher(sessions, settings) if publish else None
+        if publisher is not None:
+            publisher.start()
         jobs = DatabaseQueue(
             sessions, lease_seconds=settings.lease_seconds, max_attempts=settings.max_attempts
         )
@@ -43,11 +53,13 @@ class ServiceContext:
             celery = CeleryDispatcher(settings)
             reconciler = Reconciler(sessions, celery, settings.reconcile_seconds)
             reconciler.start()
-            return cls(settings, engine, sessions, jobs, dispatcher=celery, reconciler=reconciler)
+            return cls(settings, engine, sessions, jobs, celery, reconciler=reconciler, publisher=publisher)
         pool = WorkerPool(jobs, settings, pool_size) if pool_size > 0 else None
         if pool is not None:
             pool.start()
-        return cls(settings, engine, sessions, jobs, dispatcher=PollingDispatcher(), pool=pool)
+        return cls(
+            settings, engine, sessions, jobs, dispatcher=PollingDispatcher(), pool=pool, publisher=publisher
+        )
 
     def close(self) -> None:
         """Stop the workers (their running jobs return to the queue) and close the database."""
@@ -55,5 +67,7 @@ class ServiceContext:
             self.pool.stop()
         if self.reconciler is not None:
             self.reconciler.stop()
+        if self.publisher is not None:
+            self.publisher.stop()
         self.dispatcher.close()
         self.engine.dispose()

@@ -20,6 +20,7 @@ from api.context import ServiceContext
 from api.disclosure import Disclosure, disclosure_for
 from api.errors import NotAuthenticated
 from api.jobs.job_queue import Dispatcher
+from api.lti.sessions import SESSION_PARAMETER, SESSION_PREFIX, session_caller
 from api.models import Student
 from api.settings import Settings
 
@@ -103,7 +104,13 @@ StudentDep = Annotated[Student, Depends(get_student)]
 
 
 def get_page_caller(request: Request, session: SessionDep, settings: SettingsDep) -> Principal | None:
-    """The web page's signed-in caller (from the session cookie), or None when signed out."""
+    """The web page's signed-in caller (from the session cookie, or an LTI launch's session carried in the
+    page's links), or None when signed out."""
+    launched = request.query_params.get(SESSION_PARAMETER, "")
+    if launched.startswith(SESSION_PREFIX):
+        caller = session_caller(session, launched)
+        request.state.lti_caller = caller
+        return caller
     token = request.cookies.get(SESSION_COOKIE)
     if not token:
         return None

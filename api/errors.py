@@ -103,3 +103,20 @@ class GraderUnavailable(ServiceError):
 
 class GraderFailed(ServiceError):
     """Raised when the grader reports a failure of its own on a submission (stored as the job's failure)."""
+
+
+class LtiRequestInvalid(ServiceError):
+    """Raised when an LTI request (login initiation, registration) lacks what the LTI 1.3 spec requires."""
+
+
+class LaunchRefused(ServiceError):
+    """Raised when an LTI launch fails a check of the spec (issuer, audience, deployment, nonce, state,
+    expiry, signature, message type or version); nothing of it is stored."""
+
+
+class PlatformExists(ServiceError):
+    """Raised when a platform is registered again under the same issuer and client id."""
+
+
+class PlatformUnreachable(ServiceError):
+    """Raised when a platform's endpoint (OpenID configuration, JWKS, token, registration) cannot be used."""

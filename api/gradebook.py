@@ -43,6 +43,19 @@ def _chosen(session: Session, policy: GradebookPolicy) -> tuple[list[Student], d
         .where(Submission.status == JobStatus.DONE.value)
         .order_by(Submission.id)
     ).all()
+    return students, kept_submissions(graded, policy)
+
+
+def kept_submissions(graded: Iterable[Any], policy: GradebookPolicy) -> dict[int, Any]:
+    """The graded submission each student is represented by (the gradebook's and the LMS's score).
+
+    Args:
+        graded: Rows with ``student_id`` and ``score``, in the order of their ids (upload order).
+        policy: The latest, or the best (the latest among ties).
+
+    Returns:
+        The kept row by student id.
+    """
     chosen: dict[int, Any] = {}
     for row in graded:
         current = chosen.get(row.student_id)
@@ -52,7 +65,7 @@ def _chosen(session: Session, policy: GradebookPolicy) -> tuple[list[Student], d
             or (row.score or 0.0) >= (current.score or 0.0)
         ):
             chosen[row.student_id] = row
-    return students, chosen
+    return chosen
 
 
 def gradebook_export(

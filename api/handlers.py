@@ -22,11 +22,15 @@ from api.errors import (
     InvalidRequest,
     InvalidStudentName,
     InvalidUpload,
+    LaunchRefused,
     LengthRequired,
+    LtiRequestInvalid,
     MalformedBody,
     MethodNotAllowed,
     NotAuthenticated,
     PathNotFound,
+    PlatformExists,
+    PlatformUnreachable,
     RateLimited,
     ServiceError,
     StudentExists,
@@ -36,19 +40,22 @@ from api.errors import (
     UploadTooLarge,
 )
 from api.schemas import ErrorBody, FieldProblem
-from api.web import PAGE_HEADERS, templates
+from api.web import PAGE_HEADERS, page_headers, templates
 
 HTTP_STATUS: dict[type[ServiceError], int] = {
     MalformedBody: 400,
+    LtiRequestInvalid: 400,
     NotAuthenticated: 401,
     InstructorOnly: 403,
     StudentOnly: 403,
+    LaunchRefused: 403,
     PathNotFound: 404,
     SubmissionNotFound: 404,
     StudentNotFound: 404,
     MethodNotAllowed: 405,
     StudentExists: 409,
     GradingInProgress: 409,
+    PlatformExists: 409,
     LengthRequired: 411,
     UploadTooLarge: 413,
     InvalidRequest: 422,
@@ -56,6 +63,7 @@ HTTP_STATUS: dict[type[ServiceError], int] = {
     InvalidUpload: 422,
     RateLimited: 429,
     InternalError: 500,
+    PlatformUnreachable: 502,
 }
 ERROR_HEADERS: dict[type[ServiceError], dict[str, dict[str, Any]]] = {
     NotAuthenticated: {
@@ -81,6 +89,8 @@ ERROR_HEADERS: dict[type[ServiceError], dict[str, dict[str, Any]]] = {
     },
 }
 UI_PREFIX = "/ui"
+PAGE_PATHS = ("/lti/login", "/lti/launch")
+"""Paths a browser reaches from the LMS: their errors are pages too, which any LMS's iframe may show."""
 HTTP_METHODS = ("DELETE", "GET", "HEAD", "OPTIONS", "PATCH", "POST", "PUT")
 MAX_SHOWN_INPUT_CHARS = 60
 
@@ -128,13 +138,13 @@ def error_response(request: Request, error: ServiceError) -> Response:
     status = status_of(error)
     headers = _headers_of(error)
     path = request.scope.get("path", "")
-    if path == "/" or path.startswith(UI_PREFIX):
+    if path == "/" or path.startswith(UI_PREFIX) or path in PAGE_PATHS:
         return templates.TemplateResponse(
             request,
             "error.html",
             {"message": str(error), "status": status},
             status_code=status,
-            headers={**headers, **PAGE_HEADERS},
+            headers={**headers, **(page_headers("*") if path in PAGE_PATHS else PAGE_HEADERS)},
         )
     return JSONResponse(
         error_body(error).model_dump(mode="json", exclude_none=True), status_code=status, headers=headers

@@ -12,7 +12,8 @@ from fastapi.staticfiles import StaticFiles
 from api.context import ServiceContext
 from api.handlers import install_error_handlers
 from api.limits import BodyLimitMiddleware
-from api.routes import gradebook, health, overrides, students, submissions, ui
+from api.lti.sessions import redact_access_log
+from api.routes import gradebook, health, lti, overrides, students, submissions, ui
 from api.settings import Settings, load_settings
 from api.web import STATIC_DIR
 
@@ -38,6 +39,7 @@ def create_app(settings: Settings | None = None, *, run_workers: bool = True) ->
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        redact_access_log()
         context = ServiceContext.open(settings, pool_size=settings.workers if run_workers else 0)
         app.state.context = context
         try:
@@ -48,7 +50,7 @@ def create_app(settings: Settings | None = None, *, run_workers: bool = True) ->
     app = FastAPI(title="gymgrade", version="0.1.0", description=DESCRIPTION, lifespan=lifespan)
     app.add_middleware(BodyLimitMiddleware, max_upload_bytes=settings.max_upload_bytes)
     install_error_handlers(app)
-    for module in (students, submissions, gradebook, overrides, health, ui):
+    for module in (students, submissions, gradebook, overrides, health, ui, lti):
         app.include_router(module.router)
     app.mount("/ui/static", StaticFiles(directory=STATIC_DIR), name="static")
 

@@ -6,7 +6,7 @@ from datetime import UTC, datetime
 from enum import StrEnum
 from typing import Any
 
-from sqlalchemy import JSON, DateTime, Float, ForeignKey, Integer, LargeBinary, String, Text
+from sqlalchemy import JSON, DateTime, Float, ForeignKey, Integer, LargeBinary, String, Text, UniqueConstraint
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column, relationship
 
 
@@ -83,3 +83,116 @@ class Override(Base):
     reason: Mapped[str] = mapped_column(Text)
     author: Mapped[str] = mapped_column(String(100))
     created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
+class LtiKey(Base):
+    """One of the tool's own RSA signing keys (LTI 1.3): the newest unretired one signs; retired ones stay
+    published and accepted for ``LTI_KEY_GRACE_SECONDS`` so launches and platform caches in flight hold."""
+
+    __tablename__ = "lti_keys"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    kid: Mapped[str] = mapped_column(String(100), unique=True)
+    private_pem: Mapped[str] = mapped_column(Text)
+    created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
+    retired_at: Mapped[datetime | None] = mapped_column(DateTime, nullable=True)
+
+
+class LtiPlatform(Base):
+    """A platform (LMS) registered with the tool: manually or by LTI Dynamic Registration."""
+
+    __tablename__ = "lti_platforms"
+    __table_args__ = (UniqueConstraint("issuer", "client_id", name="uq_lti_platforms_issuer_client"),)
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    issuer: Mapped[str] = mapped_column(String(500))
+    client_id: Mapped[str] = mapped_column(String(255))
+    deployment_ids: Mapped[list[str]] = mapped_column(JSON, default=list)
+    jwks_url: Mapped[str] = mapped_column(String(1000))
+    auth_url: Mapped[str] = mapped_column(String(1000))
+    token_url: Mapped[str] = mapped_column(String(1000))
+    created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
+
+
+class LtiNonce(Base):
+    """A launch's nonce, stored when the launch is accepted: a second launch with it is a replay."""
+
+    __tablename__ = "lti_nonces"
+
+    nonce: Mapped[str] = mapped_column(String(255), primary_key=True)
+    platform_id: Mapped[int] = mapped_column(ForeignKey("lti_platforms.id"))
+    expires_at: Mapped[datetime] = mapped_column(DateTime, index=True)
+
+
+class LtiUser(Base):
+    """A platform user, keyed by (platform, sub): a learner's student row, or none for staff."""
+
+    __tablename__ = "lti_users"
+    __table_args__ = (UniqueConstraint("platform_id", "sub", name="uq_lti_users_platform_sub"),)
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    platform_id: Mapped[int] = mapped_column(ForeignKey("lti_platforms.id"))
+    sub: Mapped[str] = mapped_column(String(255))
+    student_id: Mapped[int | None] = mapped_column(ForeignKey("students.id"), nullable=True, unique=True)
+    name: Mapped[str] = mapped_column(String(255))
+
+
+class LtiLink(Base):
+    """A resource link of a platform's context, with its Advantage service URLs and its line item."""
+
+    __tablename__ = "lti_links"
+    __table_args__ = (UniqueConstraint("platform_id", "resource_link_id", name="uq_lti_links_platform_link"),)
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    platform_id: Mapped[int] = mapped_column(ForeignKey("lti_platforms.id"))
+    deployment_id: Mapped[str] = mapped_column(String(255))
+    context_id: Mapped[str] = mapped_column(String(255))
+    resource_link_id: Mapped[str] = mapped_column(String(255))
+    title: Mapped[str] = mapped_column(String(255), default="")
+    lineitems_url: Mapped[str | None] = mapped_column(String(1000), nullable=True)
+    lineitem_url: Mapped[str | None] = mapped_column(String(1000), nullable=True)
+    ags_scopes: Mapped[list[str]] = mapped_column(JSON, default=list)
+    memberships_url: Mapped[str | None] = mapped_column(String(1000), nullable=True)
+    custom: Mapped[dict[str, Any]] = mapped_column(JSON, default=dict)
+
+
+class LtiMember(Base):
+    """A student of a link (by launch or roster import): the platform user the link's scores go to."""
+
+    __tablename__ = "lti_members"
+    __table_args__ = (UniqueConstraint("link_id", "user_id", name="uq_lti_members_link_user"),)
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    link_id: Mapped[int] = mapped_column(ForeignKey("lti_links.id"), index=True)
+    user_id: Mapped[int] = mapped_column(ForeignKey("lti_users.id"))
+
+
+class LtiSession(Base):
+    """A signed-in browser after a launch: only the SHA-256 of its token is stored; no student = staff."""
+
+    __tablename__ = "lti_sessions"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    token_sha256: Mapped[str] = mapped_column(String(64), unique=True)
+    user_id: Mapped[int] = mapped_column(ForeignKey("lti_users.id"))
+    link_id: Mapped[int | None] = mapped_column(ForeignKey("lti_links.id"), nullable=True)
+    frame_origin: Mapped[str] = mapped_column(String(500))
+    expires_at: Mapped[datetime] = mapped_column(DateTime)
+
+
+class LtiScore(Base):
+    """The outbox of one (link, member): the score the policy keeps, the one the platform last accepted,
+    and the publishing's state (pending, sent, retrying, failed) with its next attempt and last error."""
+
+    __tablename__ = "lti_scores"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    member_id: Mapped[int] = mapped_column(ForeignKey("lti_members.id"), unique=True)
+    submission_id: Mapped[int] = mapped_column(ForeignKey("submissions.id"))
+    score: Mapped[float | None] = mapped_column(Float, nullable=True)
+    max_score: Mapped[float | None] = mapped_column(Float, nullable=True)
+    timestamp: Mapped[datetime] = mapped_column(DateTime)
+    sent_submission_id: Mapped[int | None] = mapped_column(Integer, nullable=True)
+    sent_score: Mapped[float | None] = mapped_column(Float, nullable=True)
+    status: Mapped[str] = mapped_column(String(16), index=True)
+    attempts: Mapped[int] = mapped_column(Integer, default=0)
+    next_attempt_at: Mapped[datetime] = mapped_column(DateTime)
+    error: Mapped[str | None] = mapped_column(Text, nullable=True)

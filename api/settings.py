@@ -152,6 +152,33 @@ class Settings(BrokerSettings):
         description="A grading still running after this long is stopped and marked failed.",
     )
 
+    public_url: str | None = Field(
+        default=None,
+        description="The service's address as browsers and LMS platforms reach it (https://gymgrade.example.edu): "  # noqa: E501
+        "the LTI login, launch and JWKS URLs are made from it; unset, from each request's own address.",
+    )
+    lti_key_grace_seconds: float = Field(
+        default=2 * 24 * 3600.0,
+        gt=0,
+        description="A rotated LTI signing key stays published and accepted this long (platforms cache the JWKS; launches in flight).",  # noqa: E501
+    )
+    lti_session_seconds: float = Field(
+        default=8 * 3600.0, gt=0, description="How long an LTI launch keeps its browser signed in."
+    )
+    lti_publish_seconds: float = Field(
+        default=2.0, gt=0, description="How often the server publishes new scores to the LMS (LTI AGS)."
+    )
+    lti_publish_attempts: int = Field(
+        default=8,
+        gt=0,
+        description="Times a score is sent to an LMS that refuses it before it is shown as failed to the instructor.",  # noqa: E501
+    )
+    lti_retry_seconds: float = Field(
+        default=2.0,
+        gt=0,
+        description="The first wait before sending a refused score again; each retry doubles it (at most 10 minutes).",  # noqa: E501
+    )
+
     @field_validator("edition")
     @classmethod
     def _known_edition(cls, edition: str | None) -> str | None:

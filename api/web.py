@@ -78,11 +78,18 @@ def _config(path: Path | None) -> AssignmentConfig:
 
 templates.env.globals["page_figures"] = page_figures
 
-PAGE_HEADERS = {
-    "Content-Security-Policy": (
-        "default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data:; "
-        "connect-src 'self'; form-action 'self'; frame-ancestors 'none'; base-uri 'none'"
-    ),
-    "X-Content-Type-Options": "nosniff",
-    "Referrer-Policy": "no-referrer",
-}
+
+def page_headers(frame_origins: str | None = None) -> dict[str, str]:
+    """The pages' security headers; ``frame_origins`` (an LTI launch's LMS) may frame them, else nobody."""
+    ancestors = frame_origins or "'none'"
+    return {
+        "Content-Security-Policy": (
+            "default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data:; "
+            f"connect-src 'self'; form-action 'self'; frame-ancestors {ancestors}; base-uri 'none'"
+        ),
+        "X-Content-Type-Options": "nosniff",
+        "Referrer-Policy": "no-referrer",
+    }
+
+
+PAGE_HEADERS = page_headers()

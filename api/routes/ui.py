@@ -3,22 +3,26 @@
 from __future__ import annotations
 
 from typing import Annotated, Any
+from urllib.parse import urlencode
 
 from fastapi import APIRouter, File, Form, Request, UploadFile
 from fastapi.responses import RedirectResponse, Response
 from sqlalchemy.orm import Session
 
 from api.auth import Principal, authenticate
-from api.deps import SESSION_COOKIE, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
+from api.deps import SESSION_COOKIE, ContextDep, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
 from api.disclosure import disclosure_for
-from api.errors import InvalidRequest, NotAuthenticated, StudentNotFound, SubmissionNotFound
+from api.errors import InvalidRequest, LtiRequestInvalid, NotAuthenticated, StudentNotFound, SubmissionNotFound
 from api.gradebook import gradebook_csv, late_policy_of
-from api.models import JobStatus
+from api.lti.publisher import publishing_status
+from api.lti.roster import import_roster
+from api.lti.sessions import SESSION_PARAMETER
+from api.models import JobStatus, LtiLink
 from api.overrides import overrides_shown, record_override
 from api.settings import Settings
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
-from api.web import PAGE_HEADERS, templates
+from api.web import page_headers, templates
 
 router = APIRouter(include_in_schema=False)
 
@@ -26,9 +30,21 @@ FINAL_STATUSES = frozenset({JobStatus.DONE.value, JobStatus.FAILED.value})
 
 
 def _page(request: Request, template: str, context: dict[str, Any], status_code: int = 200) -> Response:
+    launched: Principal | None = getattr(request.state, "lti_caller", None)
     return templates.TemplateResponse(
-        request, template, context, status_code=status_code, headers=PAGE_HEADERS
+        request,
+        template,
+        {**context, "session_query": _session_query(launched)},
+        status_code=status_code,
+        headers=page_headers(launched.frame_origin if launched is not None else None),
     )
+
+
+def _session_query(caller: Principal | None) -> str:
+    """``?lti_session=...`` for the links and forms of a page an LTI launch signed in, else nothing."""
+    if caller is None or caller.session_token is None:
+        return ""
+    return "?" + urlencode({SESSION_PARAMETER: caller.session_token})
 
 
 def _signed_in(caller: Principal | None) -> Principal:
@@ -47,8 +63,29 @@ def home(request: Request, session: SessionDep, caller: PageCallerDep, settings:
     return _page(
         request,
         "home.html",
-        {"caller": caller, "submissions": submissions, "max_upload_bytes": settings.max_upload_bytes},
+        {
+            "caller": caller,
+            "submissions": submissions,
+            "max_upload_bytes": settings.max_upload_bytes,
+            "lms_scores": publishing_status(session) if caller.is_instructor else [],
+        },
     )
+
+
+@router.post("/ui/lti/roster")
+def roster_import(
+    request: Request, session: SessionDep, context: ContextDep, caller: PageCallerDep
+) -> Response:
+    """Import the course roster of the link an instructor launched from (Names and Role Provisioning)."""
+    instructor = _signed_in(caller)
+    instructor.require_instructor()
+    link = session.get(LtiLink, instructor.lti_link_id) if instructor.lti_link_id is not None else None
+    if link is None:
+        raise LtiRequestInvalid(
+            "the roster is imported from a launch in the LMS; open the tool from the course"
+        )
+    found = import_roster(session, link, context.access_tokens)
+    return _page(request, "roster.html", {"caller": instructor, "found": found})
 
 
 @router.post("/ui/sign-in")
@@ -88,7 +125,7 @@ def upload(
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
     submission = create_submission(session, settings, student, upload, dispatcher)
-    return RedirectResponse(f"/ui/submissions/{submission.id}", status_code=303)
+    return RedirectResponse(f"/ui/submissions/{submission.id}{_session_query(caller)}", status_code=303)
 
 
 @router.get("/ui/submissions/{submission_id}")

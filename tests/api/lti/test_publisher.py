@@ -1,0 +1,228 @@
+"""The score outbox: which score each LMS member gets, when it is sent again, and when never."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from datetime import timedelta
+
+import pytest
+from api_testing import SettingsFactory
+from sqlalchemy.orm import Session
+
+from api.database import make_engine, make_session_factory, migrate
+from api.lti.publisher import FAILED, PENDING, RETRYING, SENT, PublishPolicy, publishing_status, sync_outbox
+from api.models import LtiLink, LtiMember, LtiPlatform, LtiScore, LtiUser, Student, Submission, utcnow
+from api.settings import GradebookPolicy
+
+
+@pytest.fixture
+def session(make_settings: SettingsFactory) -> Iterator[Session]:
+    engine = make_engine(make_settings())
+    migrate(engine)
+    with make_session_factory(engine)() as opened:
+        yield opened
+    engine.dispose()
+
+
+def _member(session: Session, name: str, lineitem_url: str | None = None) -> tuple[Student, LtiMember]:
+    platform = session.query(LtiPlatform).first()
+    if platform is None:
+        platform = LtiPlatform(
+            issuer="https://lms.example",
+            client_id="c",
+            deployment_ids=["d"],
+            jwks_url="https://lms.example/jwks",
+            auth_url="https://lms.example/auth",
+            token_url="https://lms.example/token",
+        )
+        session.add(platform)
+        session.flush()
+        session.add(
+            LtiLink(
+                platform_id=platform.id,
+                deployment_id="d",
+                context_id="course",
+                resource_link_id="link",
+                title="",
+                ags_scopes=[],
+                custom={},
+            )
+        )
+        session.flush()
+    link = session.query(LtiLink).one()
+    link.lineitem_url = lineitem_url
+    student = Student(name=name, token_sha256=name.ljust(64, "0"))
+    session.add(student)
+    session.flush()
+    user = LtiUser(platform_id=platform.id, sub="sub-" + name, student_id=student.id, name=name)
+    session.add(user)
+    session.flush()
+    member = LtiMember(link_id=link.id, user_id=user.id)
+    session.add(member)
+    session.commit()
+    return student, member
+
+
+def _graded(session: Session, student: Student, score: float, status: str = "done") -> Submission:
+    row = Submission(
+        student_id=student.id,
+        filename="opengym.py",
+        sha256="0" * 64,
+        content=b"x",
+        size=1,
+        seed=1,
+        status=status,
+        score=score if status == "done" else None,
+        max_score=3.0 if status == "done" else None,
+        finished_at=utcnow(),
+        progress=[],
+    )
+    session.add(row)
+    session.commit()
+    return row
+
+
+def _row(session: Session, member: LtiMember) -> LtiScore:
+    session.expire_all()
+    return session.query(LtiScore).filter_by(member_id=member.id).one()
+
+
+def _as_sent(session: Session, member: LtiMember) -> None:
+    row = _row(session, member)
+    row.sent_submission_id, row.sent_score, row.status = row.submission_id, row.score, SENT
+    session.commit()
+
+
+@pytest.mark.parametrize("database_url", ["sqlite", "postgresql"], indirect=True)
+def test_a_regrade_that_changes_the_score_is_sent_again_and_one_that_does_not_is_not(
+    session: Session,
+) -> None:
+    student, member = _member(session, "ada")
+    submission = _graded(session, student, 1.0)
+    assert sync_outbox(session, GradebookPolicy.LATEST) == 1
+    assert (_row(session, member).status, _row(session, member).score) == (PENDING, 1.0)
+    _as_sent(session, member)
+
+    submission.status = "queued"  # a regrade: the row is graded again
+    session.commit()
+    assert sync_outbox(session, GradebookPolicy.LATEST) == 0, "a score still held by the LMS"
+    submission.status, submission.score = "done", 1.0
+    session.commit()
+    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
+    assert _row(session, member).status == SENT
+
+    submission.score = 2.0  # the regrade found more
+    session.commit()
+    assert sync_outbox(session, GradebookPolicy.LATEST) == 1
+    assert (_row(session, member).status, _row(session, member).score) == (PENDING, 2.0)
+
+
+@pytest.mark.parametrize(
+    ("policy", "kept"), [(GradebookPolicy.LATEST, 1.0), (GradebookPolicy.BEST, 3.0)], ids=["latest", "best"]
+)
+def test_the_gradebook_policy_chooses_the_score_sent(
+    session: Session, policy: GradebookPolicy, kept: float
+) -> None:
+    student, member = _member(session, "bea")
+    for score in (2.0, 3.0, 1.0):
+        _graded(session, student, score)
+    _graded(session, student, 0.0, status="failed")
+    _graded(session, student, 0.0, status="queued")
+    sync_outbox(session, policy)
+    assert _row(session, member).score == kept
+
+
+def test_a_student_without_a_graded_submission_gets_no_row(session: Session) -> None:
+    student, _ = _member(session, "cy")
+    _graded(session, student, 0.0, status="running")
+    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
+    assert publishing_status(session) == []
+
+
+def test_going_back_to_the_score_the_lms_holds_sends_nothing(session: Session) -> None:
+    student, member = _member(session, "dee")
+    first = _graded(session, student, 2.0)
+    sync_outbox(session, GradebookPolicy.BEST)
+    _as_sent(session, member)
+    later = _graded(session, student, 3.0)
+    sync_outbox(session, GradebookPolicy.BEST)
+    assert (_row(session, member).status, _row(session, member).submission_id) == (PENDING, later.id)
+    later.score = 1.0  # regraded lower before it was sent: the best is the score the LMS holds already
+    session.commit()
+    sync_outbox(session, GradebookPolicy.BEST)
+    row = _row(session, member)
+    assert (row.status, row.submission_id, row.score) == (SENT, first.id, 2.0)
+
+
+def test_the_instructor_sees_each_students_state_and_error(session: Session) -> None:
+    student, member = _member(session, "eve")
+    _graded(session, student, 1.0)
+    sync_outbox(session, GradebookPolicy.LATEST)
+    row = _row(session, member)
+    row.status, row.attempts, row.error = RETRYING, 2, "publishing the score: the LMS answered 500"
+    row.next_attempt_at = utcnow() + timedelta(seconds=4)
+    session.commit()
+    (shown,) = publishing_status(session)
+    assert shown["student"] == "eve"
+    assert (shown["status"], shown["attempts"], shown["error"]) == (
+        RETRYING,
+        2,
+        "publishing the score: the LMS answered 500",
+    )
+    assert shown["sent_score"] is None
+
+
+@pytest.mark.parametrize(
+    ("attempts", "seconds"),
+    [(1, 2.0), (2, 4.0), (3, 8.0), (8, 256.0), (9, 512.0), (10, 600.0), (40, 600.0)],
+    ids=lambda value: str(value),
+)
+def test_refused_sends_wait_twice_as_long_each_time_up_to_ten_minutes(attempts: int, seconds: float) -> None:
+    assert PublishPolicy(GradebookPolicy.LATEST, 8, 2.0).wait(attempts) == seconds
+
+
+def test_the_states_are_distinct() -> None:
+    assert len({PENDING, SENT, RETRYING, FAILED}) == 4
+
+
+@pytest.mark.parametrize(
+    ("lineitem_url", "expected"),
+    [("https://lms.example/lineitems/1", [(PENDING, None)]), (None, [])],
+    ids=["the-link-has-a-line-item", "no-line-item-yet"],
+)
+def test_a_submission_being_graded_is_announced_without_a_score_where_the_line_item_exists(
+    session: Session, lineitem_url: str | None, expected: list[tuple[str, float | None]]
+) -> None:
+    student, member = _member(session, "fay", lineitem_url)
+    submission = _graded(session, student, 0.0, status="queued")
+    sync_outbox(session, GradebookPolicy.LATEST)
+    session.expire_all()
+    assert [(row.status, row.score) for row in session.query(LtiScore).all()] == expected
+    if not expected:
+        return
+    _as_sent(session, member)
+    submission.status, submission.score, submission.max_score = "done", 2.0, 3.0
+    session.commit()
+    sync_outbox(session, GradebookPolicy.LATEST)
+    assert (_row(session, member).status, _row(session, member).score) == (PENDING, 2.0)
+
+
+def test_a_new_upload_never_announces_pending_over_a_score_the_lms_holds(session: Session) -> None:
+    student, member = _member(session, "gus", "https://lms.example/lineitems/1")
+    graded = _graded(session, student, 2.0)
+    sync_outbox(session, GradebookPolicy.LATEST)
+    _as_sent(session, member)
+    _graded(session, student, 0.0, status="running")
+    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
+    assert (_row(session, member).status, _row(session, member).submission_id) == (SENT, graded.id)
+
+
+def test_a_regrade_of_the_only_graded_upload_never_announces_pending_over_its_score(session: Session) -> None:
+    student, member = _member(session, "hal", "https://lms.example/lineitems/1")
+    submission = _graded(session, student, 2.0)
+    sync_outbox(session, GradebookPolicy.LATEST)
+    _as_sent(session, member)
+    submission.status = "running"  # regraded: for a while nothing of the student's is graded
+    session.commit()
+    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
+    assert (_row(session, member).status, _row(session, member).score) == (SENT, 2.0)
