@@ -29,7 +29,7 @@ from reference.oracles.mdp import (
     terminal_states,
 )
 from reference.oracles.mdps import (
-    FROZEN_LAKE_TIME_LIMITS,
+    TIME_LIMITS,
     frozen_lake,
     grading_cases,
     lab_example,
@@ -75,10 +75,8 @@ def test_frozen_lake_is_gymnasiums_table(map_name: str, slippery: bool) -> None:
         s: {a: [tuple(o) for o in outcomes] for a, outcomes in actions.items()}
         for s, actions in expected.items()
     }
-    assert (
-        gym.spec("FrozenLake-v1" if map_name == "4x4" else "FrozenLake8x8-v1").max_episode_steps
-        == (FROZEN_LAKE_TIME_LIMITS[map_name])
-    )
+    for env_id in ("FrozenLake-v1", "FrozenLake8x8-v1"):
+        assert gym.spec(env_id).max_episode_steps == TIME_LIMITS[env_id]
 
 
 def _plain_value_iteration(mdp: Mdp, beta: float) -> list[float]:
@@ -218,7 +216,7 @@ def _monte_carlo(
 def test_return_moments_match_gymnasiums_episodes(beta: float, limit: bool, seed: int) -> None:
     lake = frozen_lake("4x4", slippery=True)
     policy = optimal_solution(lake, 1.0).policy
-    moments = return_moments(lake, policy, beta, steps=FROZEN_LAKE_TIME_LIMITS["4x4"] if limit else None)
+    moments = return_moments(lake, policy, beta, steps=TIME_LIMITS["FrozenLake-v1"] if limit else None)
     returns = _monte_carlo("4x4", policy, beta, 4_000, seed, limit=limit)
     mean, variance = moments.mean[0], moments.variance[0]
     assert abs(returns.mean() - mean) / np.sqrt(variance / len(returns)) <= Z_LIMIT
