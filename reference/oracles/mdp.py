@@ -303,9 +303,10 @@ def optimal_solution(mdp: Mdp, beta: float) -> OptimalSolution:
     """The optimal values, exact: the value of an optimal policy solved as a linear system.
 
     Value iteration from zeros approaches the values; a policy is then chosen among the (nearly) greedy
-    actions that moves towards the end of the episode (so that, at discount 1, it does not loop on a tie),
-    evaluated exactly, improved while an action is strictly better, and its values are checked to be a fixed
-    point of the Bellman optimality operator.
+    actions: the first best action in each state, as the lab takes it, when that policy achieves the
+    values, otherwise one that moves towards the end of the episode (at discount 1 the first best action
+    may loop on a tie forever); it is evaluated exactly, improved while an action is strictly better, and
+    its values are checked to be a fixed point of the Bellman optimality operator.
 
     Raises:
         UnboundedValueError: no optimal policy with finite values is found (the oracle's domain: discount
@@ -320,7 +321,15 @@ def optimal_solution(mdp: Mdp, beta: float) -> OptimalSolution:
         values = updated
         if change <= 1e-15 * (1 + np.max(np.abs(values))):
             break
-    policy = _ending_policy(mdp, q_values(mdp, values, beta))
+    look_ahead = q_values(mdp, values, beta)
+    policy = _ending_policy(mdp, look_ahead)
+    first_greedy = np.argmax(look_ahead, axis=1).astype(np.int64)
+    try:
+        # The lab's own choice (first best action) is kept when it is optimal: its episodes are short.
+        if np.all(values - policy_value(mdp, first_greedy, beta) <= 1e-9 * (1 + np.abs(values))):
+            policy = first_greedy
+    except UnboundedValueError:
+        pass
     for _ in range(mdp.n_states * mdp.n_actions + 1):
         values = policy_value(mdp, policy, beta)
         look_ahead = q_values(mdp, values, beta)
@@ -347,23 +356,27 @@ def _ending_policy(
 ) -> IntArray:
     """A policy of nearly greedy actions that, where it can, moves closer to a silent (terminal) state.
 
-    States are taken in rounds outward from the states whose every action is silent: a state joins when one
-    of its nearly greedy actions reaches a state that joined before; that action is its choice. States that
-    join no round keep their first greedy action. With `keep`, only states in `change` get a new action.
+    States are taken in rounds outward from the terminal states: a state joins when one of its nearly greedy
+    actions may reach a state that joined before; of those actions it takes the one most likely to, so that
+    episodes stay short (an optimal policy at discount 1 may otherwise wander for thousands of steps).
+    States that join no round keep their first greedy action. With `keep`, only states in `change` get a
+    new action.
     """
     best = look_ahead.max(axis=1, keepdims=True)
     greedy = look_ahead >= best - 1e-9 * (1 + np.abs(best))
     policy = np.argmax(greedy, axis=1).astype(np.int64) if keep is None else keep.copy()
     free = np.ones(mdp.n_states, dtype=bool) if change is None else change
-    moves = mdp.transitions() > 0
+    probabilities = mdp.transitions()
+    moves = probabilities > 0
     settled = _absorbing(mdp) | ~free
     while True:
         joining = ~settled & (greedy & (moves & settled[np.newaxis, np.newaxis, :]).any(axis=2)).any(axis=1)
         if not joining.any():
             break
         for state in np.flatnonzero(joining):
-            options = greedy[state] & (moves[state] & settled[np.newaxis, :]).any(axis=1)
-            policy[state] = int(np.argmax(options))
+            # Of the greedy actions, the one most likely to step into a settled state: short episodes.
+            into_settled = np.where(greedy[state], probabilities[state][:, settled].sum(axis=1), -1.0)
+            policy[state] = int(np.argmax(into_settled))
         settled |= joining
     return policy
 
