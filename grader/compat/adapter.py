@@ -38,7 +38,8 @@ class ClassicEnv:
     actions for a `Discrete` space become ints (gymnasium accepts them too; ints keep the logs plain).
 
     Attribute reads not defined here go down the gymnasium wrapper stack (`env.P`, `env.s`), as
-    classic `gym.Wrapper.__getattr__` did; private names are not forwarded.
+    classic `gym.Wrapper.__getattr__` did; private names are not forwarded. `nS` and `nA`, which classic
+    toy-text envs (FrozenLake, Taxi) had and gymnasium's do not, are the sizes of the discrete spaces.
     """
 
     def __init__(self, env: gymnasium.Env[Any, Any], requested_id: str, api: Api | None = None) -> None:
@@ -212,6 +213,21 @@ class ClassicEnv:
     def metadata(self) -> dict[str, Any]:
         """The environment's metadata."""
         return self.env.metadata
+
+    @property
+    def nS(self) -> int:
+        """Classic toy-text envs' number of states (`observation_space.n`), which the 2018 labs read."""
+        return self._discrete_size("nS", self.env.observation_space)
+
+    @property
+    def nA(self) -> int:
+        """Classic toy-text envs' number of actions (`action_space.n`)."""
+        return self._discrete_size("nA", self.env.action_space)
+
+    def _discrete_size(self, name: str, space: spaces.Space[Any]) -> int:
+        if not isinstance(space, spaces.Discrete):
+            raise AttributeError(f"the {self.requested_id} environment has no attribute {name!r}")
+        return int(space.n)
 
     @property
     def np_random(self) -> np.random.Generator:

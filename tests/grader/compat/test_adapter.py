@@ -229,6 +229,23 @@ def test_attributes_are_read_through_the_wrapper_stack() -> None:
     assert (len(env.P), env.s) == (500, env.unwrapped.s)
 
 
+@pytest.mark.parametrize(
+    ("env_id", "sizes"),
+    [("FrozenLake-v0", (16, 4)), ("FrozenLake8x8-v0", (64, 4)), ("Taxi-v3", (500, 6))],
+    ids=["FrozenLake-v0", "FrozenLake8x8-v0", "Taxi-v3"],
+)
+def test_classic_toy_text_sizes_are_served(env_id: str, sizes: tuple[int, int]) -> None:
+    env = make(env_id)
+    assert (env.nS, env.nA) == sizes
+    assert len(env.P) == sizes[0]  # the 2018 lab: value_iteration(env.P, env.nS, env.nA)
+
+
+def test_sizes_of_a_continuous_space_are_missing_attributes() -> None:
+    with pytest.raises(AttributeError) as raised:
+        _ = make("CartPole-v0").nS
+    assert str(raised.value) == "the CartPole-v0 environment has no attribute 'nS'"
+
+
 def test_private_attributes_are_not_forwarded() -> None:
     with pytest.raises(AttributeError, match="private attribute '_secret'"):
         _ = make("Taxi-v3")._secret
