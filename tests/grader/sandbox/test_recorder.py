@@ -75,6 +75,20 @@ STUDENT = textwrap.dedent("""
         gymnasium.make("Taxi-v2")
 
 
+    def gymnasium_frozen_lake_table():
+        env = gymnasium.make("FrozenLake-v1", map_name="8x8", is_slippery=True)
+        table = env.P  # the second lab's texts read P on gym.make's env
+        return [len(table), len(table[0][0]), env.nrow, env.observation_space.n]
+
+
+    def private_attribute():
+        env = gymnasium.make("FrozenLake-v1")
+        try:
+            env._secret_of_the_env
+        except AttributeError as error:
+            return str(error)  # caught here: a traceback would keep the env alive into later calls
+
+
     def from_spec():
         first = gymnasium.make(gymnasium.spec("CartPole-v0"))
         second = gymnasium.spec("MountainCar-v0").make()
@@ -246,6 +260,25 @@ def test_retired_ids_through_plain_gymnasium_name_the_lab_id(child: ChildClient)
 
     assert result is not None and result["status"] == "exception"
     assert "Taxi-v2 was retired before this lab; the lab uses Taxi-v3" in result["message"]
+
+
+def test_env_attributes_are_read_through_gymnasium_s_wrappers_and_reported(child: ChildClient) -> None:
+    result = child.call("gymnasium_frozen_lake_table", seed=1)
+    assert value_of(result) == [64, 3, 8, 64]
+    events = {event["env_id"]: event["detail"] for event in result["compat_events"]}  # type: ignore[index]
+    assert events["FrozenLake-v1: env.P"] == (
+        "env.P was read through gymnasium's wrappers, which gymnasium 1.x no longer forwards; the grader "
+        "forwarded it (env.unwrapped.P works everywhere)"
+    )
+    assert "FrozenLake-v1: env.nrow" in events
+
+
+def test_private_env_attributes_are_not_forwarded(child: ChildClient) -> None:
+    result = child.call("private_attribute", seed=1)
+    assert (
+        value_of(result)
+        == "accessing private attribute '_secret_of_the_env' of a gym environment is prohibited"
+    )
 
 
 def test_envs_made_from_specs_are_recorded(child: ChildClient) -> None:
