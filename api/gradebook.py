@@ -13,10 +13,10 @@ from sqlalchemy.orm import Session
 
 from api.models import JobStatus, Student, Submission
 from api.settings import GradebookPolicy
-from grader.class_report.text import safe_cell
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment, GradeRow
 from grader.classroom.model import Member
 from grader.classroom.roster import RosterEntry
+from grader.render.neutral import safe_cell
 from grader.report import ProblemResult, Report
 
 GRADEBOOK_FORMATS = ("gymgrade", *GRADEBOOKS)

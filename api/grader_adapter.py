@@ -17,10 +17,10 @@ ProgressCallback = Callable[[JsonObject], None]
 
 @dataclass(frozen=True)
 class ImportedGrader:
-    """Calls a function with the signature of ``grader.grading.grade_submission``, imported by name.
+    """Calls a function with the signature of ``grader.grading.grade.grade_submission``, imported by name.
 
     Attributes:
-        target: ``module:function``, e.g. ``grader.grading:grade_submission``.
+        target: ``module:function``, e.g. ``grader.grading.grade:grade_submission``.
         workers: Processes one grading may use (None: all cores).
         allow_weak_isolation: Grade with the strongest available isolation instead of failing closed.
     """
@@ -83,7 +83,7 @@ def check_grader_target(target: str) -> None:
     if not found:
         raise GraderUnavailable(
             f"GYMGRADE_GRADER names module {module_name!r}, which is not installed; "
-            "expected e.g. grader.grading:grade_submission"
+            "expected e.g. grader.grading.grade:grade_submission"
         )
 
 

@@ -119,13 +119,13 @@ class Settings(BrokerSettings):
         description="Grade even when the sandbox cannot enforce full isolation (never for real students).",
     )
     grader: str = Field(
-        default="grader.grading:grade_submission",
+        default="grader.grading.grade:grade_submission",
         description="module:function with grade_submission's signature that grades one file.",
     )
     edition: str | None = Field(
         default=None,
         pattern=r"^[a-z][a-z0-9_]*$",
-        description="The course's edition of the lab, set once per course: every upload is graded as it (grader/editions/: classic, gym026, volume2, rl1; rl1 for today's). "  # noqa: E501
+        description="The course's edition of the lab, set once per course: every upload is graded as it (grader/lab/editions/: classic, gym026, volume2, rl1; rl1 for today's). "  # noqa: E501
         "Unset: the first edition, classic. "
         "Never detected from an upload; a file written for another edition's problems is told so in its report.",  # noqa: E501
     )
@@ -152,8 +152,8 @@ class Settings(BrokerSettings):
     def _known_edition(cls, edition: str | None) -> str | None:
         if edition is None:
             return None
-        from grader.editions import edition_of  # the packs import the checks: only when an edition is set
-        from grader.editions.errors import UnknownEdition
+        from grader.lab.editions import edition_of  # the packs import the checks: only when an edition is set
+        from grader.lab.editions.errors import UnknownEdition
 
         try:
             edition_of(edition, where="GYMGRADE_EDITION")

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from api.errors import InvalidUpload, UploadTooLarge
-from grader.notebook import NOTEBOOK_SUFFIX
+from grader.submission.notebook import NOTEBOOK_SUFFIX
 
 MAX_DISPLAY_NAME_CHARS = 100
 _UNSAFE_NAME_CHARACTERS = re.compile(r"[^A-Za-z0-9._ -]+")

@@ -10,9 +10,9 @@ from typing import Any
 
 from fastapi.templating import Jinja2Templates
 
-from grader.config import AssignmentConfig, load_config
-from grader.editions.choice import edition_config
-from grader.figures import Figure, problem_figures
+from grader.lab.assignment import AssignmentConfig, load_config
+from grader.lab.editions.choice import edition_config
+from grader.render.figures import Figure, problem_figures
 from grader.report import ProblemResult
 
 TEMPLATES_DIR = Path(__file__).with_name("templates")

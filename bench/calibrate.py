@@ -1,9 +1,9 @@
 """Calibrate the checks: regrade the reference and every typical mistake many times with fresh seeds.
 
-Every regrade runs the problem's planned calls in-process (`grader.testing.simulation`: gymnasium envs,
-episodes logged like the sandbox logs them, judged as played) and judges them with the real check.
-Prints, per check, the reference's false-fail rate and each mistake's detection rate, and the CartPole
-rule analysis (the velocity policy's length distribution; pass probability of worse policies).
+Every regrade runs the problem's planned calls in-process (`grader.simulated_students.simulation`: gymnasium
+envs, episodes logged like the sandbox logs them, judged as played) and judges them with the real check.
+Prints, per check, the reference's false-fail rate and each mistake's detection rate, and the CartPole rule
+analysis (the velocity policy's length distribution; pass probability of worse policies).
 
     python bench/calibrate.py            # full: 1000 regrades per cheap problem, see --help
     python bench/calibrate.py --quick    # a smoke run in about a minute
@@ -33,15 +33,15 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from grader.checks.base import ProblemId, Status
-from grader.checks.cartpole import CartpoleConfig
-from grader.checks.taxi import TaxiConfig
-from grader.config import load_config
-from grader.problem_config import ProblemConfig
-from grader.problems import PROBLEMS
-from grader.stats import normal_cdf
-from grader.testing.behaviours import MISTAKES, REFERENCE, velocity_policy
-from grader.testing.simulation import StudentFunction, function_infos, simulate_calls
+from grader.lab.assignment import load_config
+from grader.lab.checks.base import ProblemId, Status
+from grader.lab.checks.cartpole import CartpoleConfig
+from grader.lab.checks.taxi import TaxiConfig
+from grader.lab.problems import PROBLEMS
+from grader.lab.settings import ProblemConfig
+from grader.lab.stats import normal_cdf
+from grader.simulated_students.behaviours import MISTAKES, REFERENCE, velocity_policy
+from grader.simulated_students.simulation import StudentFunction, function_infos, simulate_calls
 
 CHEAP: tuple[ProblemId, ...] = ("random_blackjack", "blackjack", "cartpole", "car")
 

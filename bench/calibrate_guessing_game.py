@@ -1,9 +1,9 @@
 """Calibrate the optional guessing_game check: regrade the midpoint search and each mistake on fresh seeds.
 
 Every regrade plans the check's calls (the bundled settings, the problem enabled), plays them in-process on
-real GuessingGame-v0 games (`grader.testing.simulation`), replays every game for real and judges with the
-real check. Prints the reference's false-fail rate, each mistake's detection rate, and the exact figures
-behind the statistic (`reference.oracles.guessing_game`).
+real GuessingGame-v0 games (`grader.simulated_students.simulation`), replays every game for real and judges
+with the real check. Prints the reference's false-fail rate, each mistake's detection rate, and the exact
+figures behind the statistic (`reference.oracles.guessing_game`).
 
     python bench/calibrate_guessing_game.py                # 200 regrades of the reference, 50 per mistake
     python bench/calibrate_guessing_game.py --regrades 20  # a smoke run
@@ -24,11 +24,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from grader.checks.guessing_game import MIDPOINT_SLACK, GuessingGameConfig, total_acceptance
 from grader.compat import register_envs
-from grader.config import load_config
-from grader.problems import PROBLEMS
-from grader.testing.simulation import Lab, function_infos, simulate_calls
+from grader.lab.assignment import load_config
+from grader.lab.checks.guessing_game import MIDPOINT_SLACK, GuessingGameConfig, total_acceptance
+from grader.lab.problems import PROBLEMS
+from grader.simulated_students.simulation import Lab, function_infos, simulate_calls
 from reference.oracles.guessing_game import midpoint_guess_counts
 
 Guesser = Callable[[float, float, int, Lab, Any], float]

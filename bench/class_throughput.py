@@ -69,7 +69,8 @@ EDITIONS = {
 }
 """Each edition's lab-literal solution (every problem passes with the edition's default configuration)."""
 PROJECTED_CLASS = 300
-CHUNK_SUBMISSIONS = 24  # grader.batch.CHUNK_SUBMISSIONS, repeated to keep this module importable alone
+CHUNK_SUBMISSIONS = 24  # grader.grading.batch.CHUNK_SUBMISSIONS, repeated to keep this module importable
+# alone
 _PR_SET_CHILD_SUBREAPER = 36
 _CLI = "import sys; from grader.cli import main; sys.exit(main(sys.argv[1:]))"
 

@@ -1,9 +1,9 @@
 """compare() and the notebook's cells (issue 23): calibration in-process, and the cost of running the cells.
 
-1. Calibration, in-process with the real check (`grader.testing.compare` students run by
-   `grader.testing.simulation`, the cells call simulated with the grader's two taxi tables as the notebook's
-   tables): the honest compare() (and one playing the SARSA table first) regraded `--regrades` times, each
-   typical mistake `--mistake-regrades` times.
+1. Calibration, in-process with the real check (`grader.simulated_students.compare` students run by
+   `grader.simulated_students.simulation`, the cells call simulated with the grader's two taxi tables as the
+   notebook's tables): the honest compare() (and one playing the SARSA table first) regraded `--regrades`
+   times, each typical mistake `--mistake-regrades` times.
 2. The cost of grading a complete current-edition notebook in the real sandbox, once with rl1's default
    configuration (compare() not gradable in isolation: skipped, no cells run) and once with
    `run_cells = true`. The notebook is built from the rl1 reference (`submissions/editions/rl1_complete.py`):
@@ -32,16 +32,16 @@ from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from grader.checks.compare import CompareConfig
-from grader.config import load_config
-from grader.editions.rl1 import RL1
-from grader.grading import grade_files
-from grader.plan import GradingPlan
+from grader.grading.grade import grade_files
+from grader.grading.plan import GradingPlan
+from grader.lab.assignment import load_config
+from grader.lab.checks.compare import CompareConfig
+from grader.lab.editions.rl1 import RL1
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.child.cells import RUN_CELLS
-from grader.testing import compare as students
-from grader.testing.simulation import simulate_calls
+from grader.simulated_students import compare as students
+from grader.simulated_students.simulation import simulate_calls
 
 REFERENCE = Path(__file__).resolve().parents[1] / "submissions" / "editions" / "rl1_complete.py"
 

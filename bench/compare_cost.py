@@ -7,7 +7,7 @@ A/B in one run, on the same machine, one after the other:
   lab's id, 200-step limit), matplotlib on Agg and pygame on SDL's dummy video driver (the render cells draw
   off screen at the render_fps gymnasium paces them to).
 - **graded**: `compare` alone (`--only compare`) with edition rl1's default configuration
-  (`grader/editions/rl1.toml`: `run_cells = true`), one worker: the problem's wall time (a sandbox child,
+  (`grader/lab/editions/rl1.toml`: `run_cells = true`), one worker: the problem's wall time (a sandbox child,
   the notebook's cells run in it, then compare() recorded, its 2 000 episodes replayed and judged).
 
 The ratio graded / plain, in wall time, is the figure `bench/RESULTS.md` records (target at most 1.0); the
@@ -41,9 +41,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from grader.editions.rl1 import RL1  # noqa: E402
-from grader.grading import grade_files  # noqa: E402
-from grader.plan import GradingPlan  # noqa: E402
+from grader.grading.grade import grade_files  # noqa: E402
+from grader.grading.plan import GradingPlan  # noqa: E402
+from grader.lab.editions.rl1 import RL1  # noqa: E402
 from grader.sandbox import IsolationPolicy  # noqa: E402
 
 NOTEBOOK = ROOT / "submissions" / "editions" / "rl1_template_honest.ipynb"

@@ -1,10 +1,10 @@
 """Editions (issue 23): calibrate epsilon_decay, time it in the real sandbox, time edition detection.
 
-1. Calibration, in-process with the real check (`grader.testing.epsilon_decay` students run by
-   `grader.testing.simulation`): every honest way of writing the decay regraded `--regrades` times (with the
-   optional exponential part off and on), every typical mistake `--mistake-regrades` times. The function is
-   pure and the grid fixed, so every regrade gives the same verdict: the figures show that nothing in the
-   verdict depends on the seed, and that the tolerance admits honest rounding and no mistake.
+1. Calibration, in-process with the real check (`grader.simulated_students.epsilon_decay` students run by
+   `grader.simulated_students.simulation`): every honest way of writing the decay regraded `--regrades` times
+   (with the optional exponential part off and on), every typical mistake `--mistake-regrades` times. The
+   function is pure and the grid fixed, so every regrade gives the same verdict: the figures show that nothing
+   in the verdict depends on the seed, and that the tolerance admits honest rounding and no mistake.
 2. The real sandbox: the edition's samples graded on epsilon_decay only (`grade_files`, one session).
 3. Detection: `detect_edition` on each edition's template and reference, and on a 1 MB source.
 
@@ -25,17 +25,17 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from grader.checks.epsilon_decay import EpsilonDecayConfig
-from grader.config import load_config
-from grader.editions import EDITIONS
-from grader.editions.detection import detect_edition
-from grader.editions.rl1 import RL1
-from grader.grading import grade_files
-from grader.plan import GradingPlan
+from grader.grading.grade import grade_files
+from grader.grading.plan import GradingPlan
+from grader.lab.assignment import load_config
+from grader.lab.checks.epsilon_decay import EpsilonDecayConfig
+from grader.lab.editions import EDITIONS
+from grader.lab.editions.detection import detect_edition
+from grader.lab.editions.rl1 import RL1
 from grader.sandbox import IsolationPolicy
-from grader.testing import epsilon_decay as students
-from grader.testing import taxi_tables
-from grader.testing.simulation import simulate_calls
+from grader.simulated_students import epsilon_decay as students
+from grader.simulated_students import taxi_tables
+from grader.simulated_students.simulation import simulate_calls
 
 SAMPLES = Path(__file__).resolve().parents[1] / "submissions" / "editions"
 

@@ -4,8 +4,8 @@ mistake caught and named.
 A registry of per-problem calibrations (`CALIBRATIONS`): each names the edition and problem, the honest
 students (regraded `--regrades` times each on fresh seeds) and the typical mistakes (each regraded
 `--mistake-regrades` times; "caught" means status `failed` AND the feedback names the mistake: it contains
-the mistake's diagnosis). Students are simulated in-process (`grader.testing.*`) and judged by the real
-check with the edition's default configuration; Taxi episodes are real gymnasium episodes.
+the mistake's diagnosis). Students are simulated in-process (`grader.simulated_students.*`) and judged by the
+real check with the edition's default configuration; Taxi episodes are real gymnasium episodes.
 
 Another problem's calibration is one more `Calibration` in `CALIBRATIONS`.
 
@@ -30,12 +30,12 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from grader.config import load_config
-from grader.editions import edition_of
-from grader.testing import epsilon_decay as epsilon_students
-from grader.testing import sarsa as sarsa_students
-from grader.testing import taxi_tables as taxi_students
-from grader.testing.simulation import simulate_calls
+from grader.lab.assignment import load_config
+from grader.lab.editions import edition_of
+from grader.simulated_students import epsilon_decay as epsilon_students
+from grader.simulated_students import sarsa as sarsa_students
+from grader.simulated_students import taxi_tables as taxi_students
+from grader.simulated_students.simulation import simulate_calls
 
 SEED_BASE = 23_000_000
 """Regrade k of a calibration uses seed SEED_BASE + k (fresh: no other bench uses these)."""

@@ -25,7 +25,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from grader.grading import grade_submission  # noqa: E402
+from grader.grading.grade import grade_submission  # noqa: E402
 from grader.report import Report  # noqa: E402
 from grader.sandbox import IsolationPolicy  # noqa: E402
 

@@ -1,10 +1,10 @@
 """Grading instrumented for bench/speed.py: where one problem's time goes, and a shared-child prototype.
 
-`grade_serially` runs `grader.execution.run_problem` problem by problem in this process with timers around
-the sandbox's child start, its calls, the replay and the teardown, and records every call made.
-`SharedChild` is a prototype that exists here only: it hands `run_problem` one sandbox child for every
-problem of a submission. `leaky_orders` grades a submission with module-level state through it in both
-orders, to show what a shared child would let flow from one problem into the next.
+`grade_serially` runs `grader.grading.execution.run_problem` problem by problem in this process with timers
+around the sandbox's child start, its calls, the replay and the teardown, and records every call made.
+`SharedChild` is a prototype that exists here only: it hands `run_problem` one sandbox child for every problem
+of a submission. `leaky_orders` grades a submission with module-level state through it in both orders, to show
+what a shared child would let flow from one problem into the next.
 """
 
 from __future__ import annotations
@@ -58,7 +58,8 @@ class Buckets:
 
 
 class Instruments:
-    """Timers wrapped around the sandbox, the replay and the teardown of `grader.execution.run_problem`."""
+    """Timers wrapped around the sandbox, the replay and the teardown of
+    `grader.grading.execution.run_problem`."""
 
     def __init__(self) -> None:
         self.current = Buckets()
@@ -67,13 +68,13 @@ class Instruments:
         self._restore: list[tuple[Any, str, Any]] = []
 
     def __enter__(self) -> Instruments:
-        import grader.execution
+        import grader.grading.execution
         from grader.sandbox.runner import Sandbox
 
         self._wrap(Sandbox, "_ensure_child", self._timed_ensure)
         self._wrap(Sandbox, "call", self._timed_call)
         self._wrap(Sandbox, "close", self._timer("close"))
-        self._wrap(grader.execution, "replay_call", self._timer("replay"))
+        self._wrap(grader.grading.execution, "replay_call", self._timer("replay"))
         return self
 
     def __exit__(
@@ -163,20 +164,20 @@ def grade_serially(
     Returns:
         Per-problem costs, the results, and every call made in order.
     """
-    import grader.execution
+    import grader.grading.execution
     from grader.sandbox import IsolationPolicy
 
     costs: list[ProblemCost] = []
     results: list[Any] = []
     calls: list[tuple[str, tuple[Any, ...], dict[str, Any]]] = []
-    original_sandbox = grader.execution.Sandbox
+    original_sandbox = grader.grading.execution.Sandbox
     if sandbox_factory is not None:
-        grader.execution.Sandbox = sandbox_factory
+        grader.grading.execution.Sandbox = sandbox_factory
     try:
         with Instruments() as instruments:
             for problem in problems:
                 started = time.perf_counter()
-                run = grader.execution.run_problem(
+                run = grader.grading.execution.run_problem(
                     submission,
                     problem,
                     config=config,
@@ -206,7 +207,7 @@ def grade_serially(
                 results.append(run.result)
                 calls += buckets.calls
     finally:
-        grader.execution.Sandbox = original_sandbox
+        grader.grading.execution.Sandbox = original_sandbox
     return costs, results, calls
 
 

@@ -1,11 +1,11 @@
 """Each integrity rule's false-fail rate on honest patterns and its catch rate on the patterns it targets.
 
-Every regrade runs a problem's planned calls in-process with a fresh seed (`grader.testing.simulation`:
-real gymnasium envs, episodes logged as the sandbox logs them, replayed for real) and judges them with
-the real check, so every rule and every statistical test of the check runs as in a grading. A regrade
-counts against a rule when the verdict is not the one an instructor would give (honest: passed;
-targeted: failed, with the rule's own words in the feedback). The honest functions are the in-process
-twins of the files in `submissions/honest/` (same loops, same resets, same post-terminal steps).
+Every regrade runs a problem's planned calls in-process with a fresh seed
+(`grader.simulated_students.simulation`: real gymnasium envs, episodes logged as the sandbox logs them,
+replayed for real) and judges them with the real check, so every rule and every statistical test of the check
+runs as in a grading. A regrade counts against a rule when the verdict is not the one an instructor would give
+(honest: passed; targeted: failed, with the rule's own words in the feedback). The honest functions are the
+in-process twins of the files in `submissions/honest/` (same loops, same resets, same post-terminal steps).
 
 The selection rule reads only the starts a call dealt and which of them it played, so its false-fail
 rate on the honest "double reset" (two resets, the second played) is also measured on its own, cheaply:
@@ -33,18 +33,18 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from grader.checks.base import ProblemId
-from grader.checks.starts import SELECTION_ALPHA, selection_tests
-from grader.config import load_config
-from grader.problem_config import ProblemConfig
-from grader.problems import PROBLEMS
+from grader.lab.assignment import load_config
+from grader.lab.checks.base import ProblemId
+from grader.lab.checks.starts import SELECTION_ALPHA, selection_tests
+from grader.lab.problems import PROBLEMS
+from grader.lab.settings import ProblemConfig
 from grader.sandbox.child.seeding import reset_seeds
-from grader.testing.behaviours import (
+from grader.simulated_students.behaviours import (
     MISTAKES,
     car_policy,
     velocity_policy,
 )
-from grader.testing.simulation import StudentFunction, function_infos, simulate_calls
+from grader.simulated_students.simulation import StudentFunction, function_infos, simulate_calls
 
 SIZES: dict[ProblemId, dict[str, Any]] = {
     "random_blackjack": {"games": 2000},

@@ -3,12 +3,12 @@
     python bench/hostile.py [--write] [--heading "## Fourth round"]
 
 Each row grades one problem of one sample in a fresh process with the bundled assignment configuration
-(`grader.execution.run_problem`, the code an acceptance test runs) and reads that process's own CPU time
-and peak resident memory (`getrusage(RUSAGE_SELF)`: the sandbox child, which runs the student's code, is
+(`grader.grading.execution.run_problem`, the code an acceptance test runs) and reads that process's own CPU
+time and peak resident memory (`getrusage(RUSAGE_SELF)`: the sandbox child, which runs the student's code, is
 not counted). So the figures are what the student's code can make the *grader* spend: parsing frames,
 replaying episodes, judging. `--write` replaces the `## Integrity and bounded cost` section of
-bench/RESULTS.md (or the section `--heading` names). The machine's load average before and after the run
-is recorded with the figures: on a shared machine the wall times grow with it, the grader's CPU much less.
+bench/RESULTS.md (or the section `--heading` names). The machine's load average before and after the run is
+recorded with the figures: on a shared machine the wall times grow with it, the grader's CPU much less.
 """
 
 from __future__ import annotations
@@ -48,8 +48,8 @@ CASES: list[tuple[str, str]] = [
 _PROBE = """
 import json, resource, sys, time
 from pathlib import Path
-from grader.config import load_config
-from grader.execution import run_problem
+from grader.lab.assignment import load_config
+from grader.grading.execution import run_problem
 from grader.sandbox import IsolationPolicy
 started = time.perf_counter()
 run = run_problem(Path(sys.argv[1]), sys.argv[2], config=load_config(), grading_seed=0,
@@ -135,7 +135,7 @@ def main() -> None:
     parser.add_argument("--heading", default=HEADING, help=f"the section's heading (default {HEADING!r})")
     arguments = parser.parse_args()
     sys.path.insert(0, str(ROOT))
-    from grader.config import load_config
+    from grader.lab.assignment import load_config
 
     call_seconds = load_config().problem("car").call_seconds
     rows = []

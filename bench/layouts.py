@@ -29,12 +29,12 @@ sys.path[:1] = [str(ROOT), str(ROOT / "tests" / "grader")]
 from classroom.downloads import BUILDERS, DUE  # noqa: E402
 
 import grader  # noqa: E402
-from grader.batch import grade_many  # noqa: E402
 from grader.classroom import GradedFileRule, discover  # noqa: E402
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment  # noqa: E402
 from grader.classroom.output import ClassGradebook  # noqa: E402
-from grader.collector import GradingListener  # noqa: E402
-from grader.plan import GradingPlan  # noqa: E402
+from grader.grading.batch import grade_many  # noqa: E402
+from grader.grading.outcomes import GradingListener  # noqa: E402
+from grader.grading.plan import GradingPlan  # noqa: E402
 from grader.report import ProblemResult, Report  # noqa: E402
 
 RULE = GradedFileRule(functions=("random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues"))

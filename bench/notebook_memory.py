@@ -35,12 +35,12 @@ HONEST = {
 TARGET_BYTES = 19_900_000
 
 STEPS = {
-    "detection": "from grader.editions.detection import detect_edition\nresult = detect_edition(path)",
+    "detection": "from grader.lab.editions.detection import detect_edition\nresult = detect_edition(path)",
     "grading (module)": (
-        "from grader.notebook import build_module\nfrom grader.plan import GradingPlan\n"
+        "from grader.submission.notebook import build_module\nfrom grader.grading.plan import GradingPlan\n"
         "result = build_module(path.read_bytes(), path.name, GradingPlan.load(None, None).problems)"
     ),
-    "similarity": "from grader.similarity.sources import read_source\nresult = read_source(path)",
+    "similarity": "from grader.classroom.similarity.sources import read_source\nresult = read_source(path)",
     "grade --similarity": (
         "from grader.cli import main\n"
         "result = main(['grade', str(path), '--out', str(out), '--similarity', '--only', "
@@ -62,7 +62,8 @@ def peak():
         return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
-import grader.cli, grader.editions.detection, grader.notebook, grader.similarity.sources, grader.plan
+import grader.cli, grader.lab.editions.detection, grader.submission.notebook
+import grader.classroom.similarity.sources, grader.grading.plan
 before = peak()
 started = time.perf_counter()
 {step}

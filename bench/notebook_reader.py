@@ -3,9 +3,9 @@
     python bench/notebook_reader.py [--rounds 3] [--write]
 
 Reads every hostile and honest notebook sample (and two generated extremes) through
-`grader.notebook.build_module`, `--rounds` times each, and prints per file: its size, the wall time of a
-read, the reading child's CPU time (user + system, from the parent's RUSAGE_CHILDREN) and peak resident
-memory, the parent's own CPU time per read and its peak memory over the whole run, and the outcome (a
+`grader.submission.notebook.build_module`, `--rounds` times each, and prints per file: its size, the wall
+time of a read, the reading child's CPU time (user + system, from the parent's RUSAGE_CHILDREN) and peak
+resident memory, the parent's own CPU time per read and its peak memory over the whole run, and the outcome (a
 module, or the verdict). The parent only spawns the child and validates its reply, so its figures must
 stay flat whatever the file. `--write` replaces the `## Fourth round: notebook reader` section of
 bench/RESULTS.md.
@@ -30,9 +30,9 @@ sys.path.insert(0, str(ROOT))
 import nbformat  # noqa: E402
 from nbformat.v4 import new_code_cell, new_notebook  # noqa: E402
 
-from grader.notebook import NotebookModule, build_module  # noqa: E402
-from grader.notebook.bounded import CPU_SECONDS, MEMORY_BYTES  # noqa: E402
-from grader.problems import PROBLEM_IDS  # noqa: E402
+from grader.lab.problems import PROBLEM_IDS  # noqa: E402
+from grader.submission.notebook import NotebookModule, build_module  # noqa: E402
+from grader.submission.notebook.bounded import CPU_SECONDS, MEMORY_BYTES  # noqa: E402
 
 RESULTS = ROOT / "bench" / "RESULTS.md"
 HEADING = "## Fourth round: notebook reader"
@@ -104,7 +104,8 @@ def main() -> None:
         f"`python bench/notebook_reader.py --rounds {arguments.rounds}` on {date.today()}, "
         f"{platform.python_implementation()} {platform.python_version()}, {os.cpu_count()} cores, "
         f"load average {load:.1f} at the end (the machine was shared: wall times are inflated, CPU times are not). "  # noqa: E501
-        f"Each file is read {arguments.rounds} times through `grader.notebook.build_module` (the bounded "
+        f"Each file is read {arguments.rounds} times through "
+        f"`grader.submission.notebook.build_module` (the bounded "
         f"child: {CPU_SECONDS} s CPU, {MEMORY_BYTES // 2**20:,} MiB address space); medians. "
         "Child peak RSS is the largest of any child so far (RUSAGE_CHILDREN), so it only grows down the table.",  # noqa: E501
         "",

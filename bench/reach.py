@@ -25,13 +25,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from grader.config import load_config  # noqa: E402
-from grader.figures import all_figures  # noqa: E402
-from grader.grading import grade_submission  # noqa: E402
-from grader.notebook import NotebookModule, build_module  # noqa: E402
-from grader.problems import PROBLEM_IDS  # noqa: E402
+from grader.grading.grade import grade_submission  # noqa: E402
+from grader.lab.assignment import load_config  # noqa: E402
+from grader.lab.problems import PROBLEM_IDS  # noqa: E402
+from grader.render.figures import all_figures  # noqa: E402
 from grader.render.html import render_html  # noqa: E402
 from grader.report import Report  # noqa: E402
+from grader.submission.notebook import NotebookModule, build_module  # noqa: E402
 
 RESULTS = ROOT / "bench" / "RESULTS.md"
 PY = ROOT / "submissions" / "classic_complete.py"

@@ -3,7 +3,7 @@
     python bench/session.py --baseline /path/to/old/checkout [--fixed-pairs 6] [--full-pairs 2]
 
 Every measurement is a fresh process, `python -c PROBE FILE WORKERS` with ``PYTHONPATH`` set to one tree
-(the probe calls `grader.grading.grade_submission` the way `gymgrade check` does: the practice seed,
+(the probe calls `grader.grading.grade.grade_submission` the way `gymgrade check` does: the practice seed,
 ``ALLOW_FALLBACK``, all enabled problems) and prints, from its own clock: the import of the grader, the first
 and last result, and the return of the call; the bench adds the process's wall time. Runs alternate
 baseline / this tree so that load from other jobs hits both alike; the figures are medians of the pairs.
@@ -33,7 +33,7 @@ PROBE = """
 import json, sys, time
 started = time.perf_counter()
 from pathlib import Path
-from grader.grading import grade_submission
+from grader.grading.grade import grade_submission
 from grader.sandbox import IsolationPolicy
 imported = time.perf_counter()
 arrivals = []

@@ -40,9 +40,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from grader.similarity.cache import IndexCache  # noqa: E402
-from grader.similarity.run import run_similarity  # noqa: E402
-from grader.similarity.template import BUNDLED  # noqa: E402
+from grader.classroom.similarity.cache import IndexCache  # noqa: E402
+from grader.classroom.similarity.run import run_similarity  # noqa: E402
+from grader.classroom.similarity.template import BUNDLED  # noqa: E402
 
 CORPUS = ROOT / "submissions" / "similarity" / "class"
 BASES = sorted(CORPUS.glob("h[0-9][0-9]_*.py"))
@@ -293,8 +293,8 @@ def _summary(
 
 
 def _gymgrade(klass: Path, copied, identities, references=(), universe=None):
-    import grader.similarity.run as run_module
-    from grader.similarity.compare import all_scores
+    import grader.classroom.similarity.run as run_module
+    from grader.classroom.similarity.compare import all_scores
 
     captured = []
     build = run_module.build_report
@@ -480,7 +480,7 @@ def refused_links(count: int) -> tuple[float, int]:
     listing what was refused."""
     import zipfile
 
-    from grader.similarity.sources import submissions_from
+    from grader.classroom.similarity.sources import submissions_from
 
     with tempfile.TemporaryDirectory() as folder:
         klass = Path(folder) / "class"

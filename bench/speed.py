@@ -61,7 +61,7 @@ from results_section import replace_section  # noqa: E402
 HEADING = "## Speed (issue 11)"
 PLAIN_CHILD_ENVS = "plain, the child's envs"
 DEFAULT_SUBMISSION = ROOT / "submissions" / "classic_complete.py"
-ACCEPTANCE_DIR = ROOT / "grader" / "acceptance"
+ACCEPTANCE_DIR = ROOT / "grader" / "grading" / "cases"
 _PR_SET_CHILD_SUBREAPER = 36
 _CLI = "import sys; from grader.cli import main; sys.exit(main(sys.argv[1:]))"
 
@@ -255,7 +255,7 @@ def session_command(submission: Path, workers: int) -> list[str]:
         "-m",
         "pytest",
         "-p",
-        "grader.plugin",
+        "grader.grading.plugin",
         "-p",
         "xdist.plugin",
         "-p",
@@ -280,7 +280,7 @@ def sandbox_start(submission: Path, repeats: int, *, isolated: bool = True) -> f
         repeats: How many children to start.
         isolated: False starts the child with every isolation layer off (to time the layers' set-up).
     """
-    from grader.config import load_config
+    from grader.lab.assignment import load_config
     from grader.sandbox import IsolationPolicy, probe_isolation
     from grader.sandbox.isolation.registry import LAYERS
     from grader.sandbox.runner import Sandbox
@@ -714,8 +714,8 @@ def main() -> int:
         plain_child(calls_file, submission, child_envs=args.plain_child_envs)
         return 0
 
-    from grader.config import load_config
-    from grader.plan import GradingPlan
+    from grader.grading.plan import GradingPlan
+    from grader.lab.assignment import load_config
 
     submission = args.submission.resolve()
     if args.config is not None:

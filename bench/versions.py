@@ -33,9 +33,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from calibrate import Job, Result, _init_worker, _seed, calibration_table, run_job
 
 from grader.compat.detection import detect_api
-from grader.config import load_config
-from grader.stats import binomial_acceptance
-from grader.testing.behaviours import MISTAKES, velocity_policy
+from grader.lab.assignment import load_config
+from grader.lab.stats import binomial_acceptance
+from grader.simulated_students.behaviours import MISTAKES, velocity_policy
 from reference.oracles import random_policy_outcome, threshold_policy_outcome
 
 SUBMISSIONS = Path(__file__).resolve().parents[1] / "submissions"

@@ -1,4 +1,11 @@
-"""Errors raised by the grader's own code (never by a student's submission, whose failures are data)."""
+"""Errors raised by the grader's own code (never by a student's submission, whose failures are data), and the
+exit statuses the commands end with."""
+
+EXIT_FULL_MARKS, EXIT_NOT_FULL, EXIT_ERROR = 0, 1, 2
+"""`gymgrade check`: every problem passed; not every problem passed; the grading could not be done (a
+missing file, a bad configuration, a grader error). `gymgrade grade` ends 0 or EXIT_ERROR."""
+EXIT_INTERRUPTED = 130
+"""A command stopped by Ctrl-C or SIGTERM (128 + SIGINT): what finished is kept."""
 
 
 class GraderError(Exception):

@@ -9,9 +9,9 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, JsonValue, WrapSerializer
 
-from grader.notebook import NotebookSummary
 from grader.sandbox.outcome import CompatEventRecord
 from grader.sandbox.text import clean_plain
+from grader.submission.notebook import NotebookSummary
 
 Status = Literal["passed", "failed", "error", "timeout", "missing", "skipped"]
 Visibility = Literal["visible", "after_due_date", "hidden"]
@@ -110,7 +110,7 @@ class ProblemResult(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    id: str = Field(description="Problem id, one of the registry's (grader/problems.py lists the lab's).")
+    id: str = Field(description="Problem id, one of the registry's (grader/lab/problems.py lists the lab's).")
     title: str = Field(description="The problem's title in the lab.")
     status: Status = Field(
         description="passed, failed, error, timeout, missing, or skipped (not run: no verdict needed it)."
@@ -212,7 +212,7 @@ class Report(BaseModel):
     )
     edition: str = Field(
         default=FIRST_EDITION,
-        description="The edition of the lab graded (grader/editions/). "
+        description="The edition of the lab graded (grader/lab/editions/). "
         "Absent in reports older than editions, all graded in the first, 'classic'.",
     )
     edition_note: str | None = Field(

@@ -22,7 +22,7 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from grader.execution import problem_seed
+from grader.grading.execution import problem_seed
 from grader.sandbox.child.seeding import derive_call_seed, reset_seeds
 from reference.solutions import cartpole_policy, mountain_car_policy
 

@@ -25,41 +25,18 @@ THIRD_PARTY_OF_THE_CHILD = ("numpy", "gymnasium")
 PACKAGES = ("grader", "api", "reference")
 """The project's packages: the import graph whose circles are counted."""
 GRADER_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("commands", ("cli", "__main__", "acceptance")),
-    ("outputs and classes", ("render", "gradescope", "class_report", "similarity", "classroom", "doctor")),
-    (
-        "grading",
-        ("batch", "grading", "collector", "session", "plugin", "plan", "execution", "scheduling", "progress"),
-    ),
-    (
-        "the lab's problems",
-        (
-            "checks",
-            "editions",
-            "problems",
-            "problem_registry",
-            "problem_config",
-            "problem_id",
-            "problem_plots",
-            "config",
-            "games",
-            "showcase",
-            "figures",
-            "testing",
-        ),
-    ),
-    (
-        "plain data",
-        (
-            "report", "notebook", "stats", "seeds", "gradescope_upload", "untrusted_file", "validation",
-            "errors",
-        ),
-    ),
+    ("commands", ("__main__", "cli")),
+    ("simulated students (calibration and tests only)", ("simulated_students",)),
+    ("classes", ("classroom",)),
+    ("one report's outputs", ("render",)),
+    ("one grading", ("grading",)),
+    ("the lab", ("lab",)),
+    ("what came in, and plain data", ("submission", "report", "errors", "seeds")),
     ("untrusted execution", ("sandbox",)),
     ("the lab's dialects", ("compat",)),
 )
-"""The parts of grader/ (its modules and subpackages), top layer first: each imports only its own layer or
-those below it (a part of the same layer too, as long as no circle forms)."""
+"""The entries of grader/ (its folders and its few plain-data modules), top layer first: a module imports
+only its own layer or those below it (a module of the same layer too, as long as no circle forms)."""
 
 
 def imported_modules(path: Path) -> set[str]:
@@ -217,7 +194,7 @@ def import_circles(graph: dict[str, set[str]]) -> list[list[str]]:
 
 
 def test_the_circle_finder_sees_type_only_imports_and_circles() -> None:
-    assert "grader.config" in imported_modules(ROOT / "grader/render/text.py")  # under TYPE_CHECKING
+    assert "grader.lab.assignment" in imported_modules(ROOT / "grader/render/text.py")  # under TYPE_CHECKING
     graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": {"e", "f"}, "f": set()}
     assert import_circles(graph) == [["a", "b", "c"]]
 
@@ -273,3 +250,71 @@ def test_architecture_shows_the_layers_held_here() -> None:
     assert f"```text\n{layers_diagram()}\n```" in architecture, (
         "ARCHITECTURE.md, section 'Layers inside grader/', must show exactly:\n" + layers_diagram()
     )
+
+
+def _own_layer_graph() -> tuple[dict[str, int], dict[str, set[str]]]:
+    """Each grader module's layer, and the grader modules each imports."""
+    layer_of = _layer_of()
+    modules = _module_files()
+
+    def resolved(name: str) -> str | None:
+        while name and name not in modules:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    graph = {  # as import_graph, but a module's import of its own package counts (`grader.cli.__main__`)
+        module: {
+            target
+            for name in imported_modules(path)
+            if (target := resolved(name)) is not None
+            and target != module
+            and _grader_part(target) in layer_of
+        }
+        for module, path in modules.items()
+        if _grader_part(module) in layer_of
+    }
+    return {module: layer_of[_grader_part(module) or ""] for module in graph}, graph
+
+
+def test_every_module_sits_in_the_lowest_layer_its_imports_allow_unless_its_layer_uses_it() -> None:
+    """A module that imports grader modules sits as low as they allow, or is tied to the layer it sits in
+    (it imports a module of that layer, or one imports it): `grader.render.figures` sits in the outputs
+    because the HTML report draws with it. One that neither uses nor is used by its layer belongs lower,
+    where its imports put it. A module that imports nothing of grader (`grader.grading.scheduling`,
+    `grader.submission.notebook.cells`) has no such floor and sits with the concept it serves."""
+    level, graph = _own_layer_graph()
+    used_in_own_layer = {
+        target for module, targets in graph.items() for target in targets if level[target] == level[module]
+    }
+    misplaced = []
+    for module, targets in sorted(graph.items()):
+        if not targets or _module_files()[module].name == "__init__.py":
+            continue
+        lowest_allowed = max(level[target] for target in targets)
+        tied = module in used_in_own_layer or any(level[target] == level[module] for target in targets)
+        if level[module] != lowest_allowed and not tied:
+            misplaced.append(
+                f"{module} sits in {GRADER_LAYERS[level[module]][0]!r}, but imports nothing of it and no module "  # noqa: E501
+                f"of it imports it; its imports allow {GRADER_LAYERS[lowest_allowed][0]!r}"
+            )
+    assert misplaced == []
+
+
+def test_nothing_on_the_grading_path_imports_the_simulated_students() -> None:
+    _, graph = _own_layer_graph()
+    importers = sorted(
+        module
+        for module, targets in graph.items()
+        if _grader_part(module) != "simulated_students"
+        and any(_grader_part(target) == "simulated_students" for target in targets)
+    )
+    assert importers == []
+
+
+def test_grader_shows_one_entry_per_layer() -> None:
+    entries = sorted(
+        path.name.removesuffix(".py")
+        for path in (ROOT / "grader").iterdir()
+        if path.name != "__pycache__" and (path.suffix == ".py" or (path / "__init__.py").exists())
+    )
+    assert entries == sorted(["__init__", *_layer_of()])

@@ -1,6 +1,6 @@
 """`gymgrade grade` on the cluster: each file is a Celery task, each report comes back on a Redis list.
 
-The batch core (``grader.batch``) decides what to grade and keeps every report as it arrives, so a
+The batch core (``grader.grading.batch``) decides what to grade and keeps every report as it arrives, so a
 distributed batch resumes exactly like a local one. This module only ships files to the workers and
 hands their reports back. It is found through the ``gymgrade.executors`` entry point, so ``grader``
 never imports ``api``.
@@ -22,14 +22,14 @@ from typing import Any
 from pydantic import ValidationError
 
 from api.settings import BrokerSettings
-from grader.collector import Collector, GradingListener, Silent, Submission
-from grader.config import config_from_data
 from grader.errors import ConfigError, ExecutorUnavailable
-from grader.grading import READ_LIMIT, grade_files
-from grader.plan import GradingPlan
+from grader.grading.grade import READ_LIMIT, grade_files
+from grader.grading.outcomes import GradingListener, Outcomes, Silent, Submission
+from grader.grading.plan import GradingPlan
+from grader.lab.assignment import config_from_data
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
-from grader.untrusted_file import UnsafeFile, read_untrusted
+from grader.submission.untrusted_file import UnsafeFile, read_untrusted
 
 logger = logging.getLogger(__name__)
 
@@ -94,7 +94,7 @@ def configuration_text(plan: GradingPlan) -> str | None:
 
 @dataclass(frozen=True)
 class CeleryExecutor:
-    """A :class:`grader.batch.BatchExecutor` that grades on the cluster's workers.
+    """A :class:`grader.grading.batch.BatchExecutor` that grades on the cluster's workers.
 
     Attributes:
         settings: The broker settings.
@@ -198,7 +198,7 @@ def _report(path: Path, data: bytes, message: dict[str, Any], plan: GradingPlan,
         report = Report.model_validate(message["report"])
         return report.model_copy(update={"submission": path.name})
     reason = str(message.get("error", "the worker sent no report"))
-    collector = Collector(plan, seed=seed, workers=0, listener=Silent())
+    collector = Outcomes(plan, seed=seed, workers=0, listener=Silent())
     collector.expect(Submission(path, data, path))
     collector.close(f"the cluster could not grade it: {reason}")
     return collector.reports[path]

@@ -91,7 +91,7 @@ def _edition_config(edition: str | None) -> Path | None:
     first edition; never detected from the upload (a student does not choose what they are graded on). None:
     the bundled (first edition's) one. Which edition and why goes to the job's stderr log; the report tells a
     file written for another edition's problems so."""
-    from grader.editions.choice import service_edition  # the grader is heavy: import it only here
+    from grader.lab.editions.choice import service_edition  # the grader is heavy: import it only here
 
     choice = service_edition(edition)
     print(choice.line, file=sys.stderr, flush=True)

@@ -1,6 +1,6 @@
 """Gradebooks people upload: ``grades.csv`` and the import formats of Canvas, Gradescope and GitHub
 Classroom, built as pure functions of the class's rows. Every cell goes through
-``grader.class_report.text.safe_cell``: controls and bidi overrides inert, and a leading apostrophe where
+``grader.render.neutral.safe_cell``: controls and bidi overrides inert, and a leading apostrophe where
 a spreadsheet would evaluate it (``= + - @`` after any blanks, their fullwidth forms, a tab, a carriage
 return)."""
 
@@ -11,10 +11,10 @@ import io
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
-from grader.class_report.text import safe_cell
 from grader.classroom.errors import GradebookError
 from grader.classroom.model import ClassDownload, Member, Submission
 from grader.classroom.roster import Roster, RosterEntry
+from grader.render.neutral import safe_cell
 from grader.report import Report
 
 

@@ -6,16 +6,17 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grader.batch import GRADES_FILE, write_atomically
 from grader.classroom.gradebooks import GRADEBOOKS, Assignment, GradeRow, class_rows, grades_csv
 from grader.classroom.model import ClassDownload
 from grader.classroom.roster import Roster
+from grader.grading.batch import GRADES_FILE, write_atomically
 from grader.report import Report
 
 
 @dataclass
 class ClassGradebook:
-    """A ``grader.batch.GradebookWriter`` writing ``grades.csv`` and each ``--gradebook`` format by identity.
+    """A ``grader.grading.batch.GradebookWriter`` writing ``grades.csv`` and each ``--gradebook`` format by
+    identity.
 
     Attributes:
         download: The class's submissions.

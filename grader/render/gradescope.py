@@ -2,7 +2,7 @@
 
 Gradescope's specification (https://gradescope-autograders.readthedocs.io/en/latest/specs/) is declared
 once, as the pydantic models below, so what gymgrade writes is checked against it when it is built. Every
-`output` passes through `grader.class_report.text.display_block` as the models are built, as the text
+`output` passes through `grader.render.neutral.display_block` as the models are built, as the text
 summary does: a control character (ESC, BEL...) of a student's exception message or printed output is shown
 as U+FFFD, never handed to Gradescope's page.
 """
@@ -13,13 +13,13 @@ from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
-from grader.class_report.text import display_block
-from grader.gradescope_upload import UploadSeed
+from grader.render.neutral import display_block
 from grader.render.text import edition_name, isolation_lines, notebook_lines
 from grader.report import SHOWN_AT_ONCE, Report, errors_shown, withheld_ids
+from grader.submission.gradescope_upload import UploadSeed
 
 if TYPE_CHECKING:
-    from grader.config import AssignmentConfig
+    from grader.lab.assignment import AssignmentConfig
 
 Visibility = Literal["hidden", "after_due_date", "after_published", "visible"]
 ShownText = Annotated[str, AfterValidator(display_block)]

@@ -15,8 +15,8 @@ from grader.render.text import edition_name, isolation_lines
 from grader.report import Report
 
 if TYPE_CHECKING:
-    from grader.config import AssignmentConfig
-    from grader.figures import Figure
+    from grader.lab.assignment import AssignmentConfig
+    from grader.render.figures import Figure
 
 STYLE = (
     "body{font-family:system-ui,sans-serif;max-width:52rem;margin:2rem auto;padding:0 1rem;color:#222}"
@@ -48,7 +48,7 @@ def render_html(
         The page.
     """
     # Drawing needs matplotlib: imported only when a page is drawn, not whenever a format is chosen.
-    from grader.figures import all_figures
+    from grader.render.figures import all_figures
 
     drawn = figures if figures is not None else all_figures(report.problems, config)
     isolation = " ".join(isolation_lines(report.isolation))

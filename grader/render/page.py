@@ -2,7 +2,7 @@
 
 A page template extends ``page.html``, filling its ``title`` and ``body`` blocks; the frame adds the page's
 Content-Security-Policy (`grader.render.csp`) and its one stylesheet, passed as ``csp`` and ``style``. Hostile
-text is shown through the filters of ``grader.class_report.text.PAGE_FILTERS`` (``identity``,
+text is shown through the filters of ``grader.render.neutral.PAGE_FILTERS`` (``identity``,
 ``document``, ``name``, ``note``, ``line``, ``code``), installed in every page's environment.
 """
 
@@ -12,9 +12,9 @@ from pathlib import Path
 
 from jinja2 import Environment, FileSystemLoader, select_autoescape
 
-from grader.class_report.text import PAGE_FILTERS
+from grader.render.neutral import PAGE_FILTERS
 
-TEMPLATES = Path(__file__).resolve().parents[1] / "templates"
+TEMPLATES = Path(__file__).with_name("templates")
 """The report pages' templates and the frame."""
 
 

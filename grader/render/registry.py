@@ -15,7 +15,7 @@ from grader.render.report_json import render_json
 from grader.render.text import render_text
 
 if TYPE_CHECKING:
-    from grader.config import AssignmentConfig
+    from grader.lab.assignment import AssignmentConfig
     from grader.report import Report
 
 

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 from grader.report import Report
 
 if TYPE_CHECKING:
-    from grader.config import AssignmentConfig
+    from grader.lab.assignment import AssignmentConfig
 
 
 def render_json(report: Report, config: AssignmentConfig | None = None) -> str:

@@ -1,7 +1,7 @@
 """The text summary `gymgrade check` prints: every verdict's feedback, the total, the isolation.
 
 Its pieces (`notebook_lines`, `isolation_lines`) are also what the Gradescope output and the HTML report
-say of the notebook and the sandbox. The summary is shown through `grader.class_report.text.display_block`
+say of the notebook and the sandbox. The summary is shown through `grader.render.neutral.display_block`
 (the Gradescope output too): control characters a student's code raised or printed (ESC, BEL...) are shown
 as U+FFFD, never sent to the terminal.
 """
@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from grader.class_report.text import display_block
-from grader.notebook import NotebookSummary
+from grader.render.neutral import display_block
 from grader.report import IsolationSummary, Report
+from grader.submission.notebook import NotebookSummary
 
 if TYPE_CHECKING:
-    from grader.config import AssignmentConfig
+    from grader.lab.assignment import AssignmentConfig
 
 
 def render_text(report: Report, config: AssignmentConfig | None = None) -> str:
@@ -49,7 +49,7 @@ def summary(report: Report) -> str:
 
 def edition_name(name: str) -> str:
     """How a report names its edition to a person: `rl1 (Reinforcement Learning 1: Gymnasium)`."""
-    from grader.editions import edition_label  # the packs import the checks: only when a report is shown
+    from grader.lab.editions import edition_label  # the packs import the checks: only when a report is shown
 
     return edition_label(name)
 

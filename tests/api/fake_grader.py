@@ -1,4 +1,4 @@
-"""A fast stand-in for grader.grading.grade_submission whose behaviour the uploaded file itself chooses.
+"""A fast stand-in for grader.grading.grade.grade_submission whose behaviour the uploaded file itself chooses.
 
 Directives in the file (one per line):
     ``# fake-grader: sleep=SECONDS``  wait this long before each problem finishes;
@@ -22,7 +22,7 @@ from typing import Any
 from pydantic import JsonValue
 
 import grader
-from grader.plan import GradingPlan
+from grader.grading.plan import GradingPlan
 from grader.report import ProblemResult, Report
 
 PROBLEMS = (

@@ -15,7 +15,7 @@ import httpx
 from api_testing import INSTRUCTOR_TOKEN, free_port, instructor_headers
 
 START_TIMEOUT_SECONDS = 60.0
-REAL_GRADER = "grader.grading:grade_submission"
+REAL_GRADER = "grader.grading.grade:grade_submission"
 E2E_GRADER = REAL_GRADER
 """The grader behind the end-to-end, browser and restart tests: the real one."""
 PARTIAL_SOLUTION = (Path(__file__).with_name("data") / "partial_solution.py").read_bytes()

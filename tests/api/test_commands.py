@@ -99,9 +99,12 @@ def test_invalid_settings_name_the_variable_and_the_value(
         (
             "no_such_module:grade",
             "GYMGRADE_GRADER names module 'no_such_module', which is not installed; "
-            "expected e.g. grader.grading:grade_submission",
+            "expected e.g. grader.grading.grade:grade_submission",
         ),
-        ("grader.grading", "GYMGRADE_GRADER must look like module:function, found 'grader.grading'"),
+        (
+            "grader.grading.grade",
+            "GYMGRADE_GRADER must look like module:function, found 'grader.grading.grade'",
+        ),
     ],
     ids=["missing-module", "no-function"],
 )

@@ -1,7 +1,7 @@
 """`gymgrade grade` on the cluster: a real redis-server and `gymgrade worker`, the fake grader.
 
-The batch core is the local one (tests/grader/test_batch.py); these tests pin that the cluster's executor
-hands every report back, that a re-run resumes, and that an interrupted batch keeps what it finished.
+The batch core is the local one (tests/grader/grading/test_batch.py); these tests pin that the cluster's
+executor hands every report back, that a re-run resumes, and that an interrupted batch keeps what it finished.
 """
 
 from __future__ import annotations
@@ -19,8 +19,9 @@ from live_server import LiveProcess, service_environment
 from api.jobs.batch import CeleryExecutor, executor_from_environment
 from api.settings import BrokerSettings
 from grader import cli
-from grader.batch import grade_many
+from grader.classroom import command
 from grader.errors import BatchInterrupted, ExecutorUnavailable
+from grader.grading.batch import grade_many
 from grader.report import ProblemResult
 from grader.sandbox import IsolationPolicy
 
@@ -63,7 +64,9 @@ def _use_cluster(monkeypatch: pytest.MonkeyPatch, broker_url: str) -> None:
 
     monkeypatch.setenv("GYMGRADE_BROKER_URL", broker_url)
     monkeypatch.setattr(
-        cli, "entry_points", lambda group: [ClusterEntryPoint()] if group == cli.EXECUTOR_GROUP else []
+        command,
+        "entry_points",
+        lambda group: [ClusterEntryPoint()] if group == command.EXECUTOR_GROUP else [],
     )
 
 
@@ -135,7 +138,7 @@ def test_an_unreachable_broker_is_refused_with_a_remedy(monkeypatch: pytest.Monk
 
 def test_a_file_the_cluster_could_not_grade_is_a_grader_error_in_every_problem(tmp_path: Path) -> None:
     from api.jobs.batch import _report
-    from grader.plan import GradingPlan
+    from grader.grading.plan import GradingPlan
 
     path = tmp_path / "alice.py"
     path.write_bytes(b"def car():\n    return 1\n")
@@ -155,9 +158,9 @@ def test_a_file_the_cluster_could_not_grade_is_a_grader_error_in_every_problem(t
 
 def test_the_workers_are_sent_the_configuration_the_batch_checked(tmp_path: Path) -> None:
     from api.jobs.batch import configuration_text
-    from grader.config import DEFAULT_CONFIG_PATH
     from grader.errors import ConfigError
-    from grader.plan import GradingPlan
+    from grader.grading.plan import GradingPlan
+    from grader.lab.assignment import DEFAULT_CONFIG_PATH
 
     bundled = DEFAULT_CONFIG_PATH.read_text(encoding="utf-8")
     config = tmp_path / "assignment.toml"

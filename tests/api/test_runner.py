@@ -215,7 +215,11 @@ def test_the_real_grader_grades_the_services_edition_never_the_uploads(
     told: str | None,
 ) -> None:
     # Hostile: a file written for another edition does not choose what it is graded on; it is told so.
-    real = {"grader": "grader.grading:grade_submission", "allow_weak_isolation": True, "grading_workers": 1}
+    real = {
+        "grader": "grader.grading.grade:grade_submission",
+        "allow_weak_isolation": True,
+        "grading_workers": 1,
+    }
     settings = make_settings(**real, edition=edition)
     row = _grade(sessions, settings, upload, filename="gymnasium.py")
     assert row.status == "done", row.error

@@ -115,7 +115,7 @@ def test_a_notebook_report_lists_what_was_skipped_and_shows_its_figures() -> Non
     from types import SimpleNamespace
 
     from api.web import templates
-    from grader.notebook import NotebookSummary, SkippedCode
+    from grader.submission.notebook import NotebookSummary, SkippedCode
 
     notebook = NotebookSummary(
         code_cells=3,

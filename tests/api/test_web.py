@@ -1,4 +1,5 @@
-"""The page's figures are the HTML report's, drawn per problem by `grader.figures`, also while it grades."""
+"""The page's figures are the HTML report's, drawn per problem by `grader.render.figures`, also while it
+grades."""
 
 from __future__ import annotations
 
@@ -8,10 +9,10 @@ import pytest
 from pydantic import JsonValue
 
 from api.web import page_figures
-from grader.config import load_config
-from grader.editions import DEFAULT_EDITION, EDITIONS
-from grader.editions.choice import edition_config
-from grader.figures import problem_figures
+from grader.lab.assignment import load_config
+from grader.lab.editions import DEFAULT_EDITION, EDITIONS
+from grader.lab.editions.choice import edition_config
+from grader.render.figures import problem_figures
 from grader.report import EpisodeReplay, ProblemResult
 
 CARTPOLE_ACTIONS = [0, 1] * 6 + [0] * 5

@@ -7,11 +7,11 @@ from dataclasses import dataclass
 
 from pydantic import Field
 
-from grader.checks.base import CallRecord, Verdict, outcome_verdict
-from grader.checks.integrity import NO_EPISODES
-from grader.problem_config import ProblemConfig
-from grader.problem_registry import Problem, Registry
-from grader.problems import PROBLEMS
+from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict
+from grader.lab.checks.integrity import NO_EPISODES
+from grader.lab.problems import PROBLEMS
+from grader.lab.registry import Problem, Registry
+from grader.lab.settings import ProblemConfig
 from grader.sandbox.outcome import Call, FunctionInfo
 
 ECHO_SOURCE = "def echo(n):\n    return n\n"

@@ -25,9 +25,9 @@ def pytest_runtest_call(item: pytest.Item) -> None:
 
 def pytest_configure(config: pytest.Config) -> None:
     if hasattr(config, "workerinput") and os.environ.get(NO_ISOLATION):
-        import grader.execution
+        import grader.grading.execution
 
         def refuse(*args: object, **kwargs: object) -> None:
             raise IsolationUnavailable("test double: this worker cannot isolate")
 
-        grader.execution.run_problem = refuse  # type: ignore[assignment]
+        grader.grading.execution.run_problem = refuse  # type: ignore[assignment]

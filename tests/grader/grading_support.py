@@ -9,7 +9,7 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[2]
 SUBMISSIONS = ROOT / "submissions"
 CLASSIC_COMPLETE = SUBMISSIONS / "classic_complete.py"
-DEFAULT_CONFIG = ROOT / "grader" / "assignment.toml"
+DEFAULT_CONFIG = ROOT / "grader" / "lab" / "assignment.toml"
 
 FAST_OVERRIDES: dict[str, dict[str, Any]] = {
     # Verdicts that do not depend on size: the lab solution's car() reaches the flag every time, and

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 from grading_support import SUBMISSIONS, write_config
 
-from grader.grading import grade_submission
-from grader.plan import GradingPlan
+from grader.grading.grade import grade_submission
+from grader.grading.plan import GradingPlan
 from grader.sandbox import IsolationPolicy
 
 HONEST = SUBMISSIONS / "guessing_game.py"

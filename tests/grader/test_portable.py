@@ -153,7 +153,7 @@ def test_a_hung_function_times_out_at_its_limit_on_every_shape(
     )
     submission = directory / "opengym.py"
     submission.write_text(hung, encoding="utf-8")
-    config_text = (ROOT / "grader" / "assignment.toml").read_text(encoding="utf-8")
+    config_text = (ROOT / "grader" / "lab" / "assignment.toml").read_text(encoding="utf-8")
     config_text, replaced = re.subn(
         r"(\[problems\.random_blackjack\][^\[]*?call_seconds = )[0-9.]+",
         rf"\g<1>{HUNG_CALL_SECONDS}",

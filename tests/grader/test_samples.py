@@ -17,10 +17,10 @@ from typing import Any
 import pytest
 from grading_support import SUBMISSIONS, write_config
 
-from grader.config import load_config
-from grader.grading import grade_files
-from grader.plan import GradingPlan
-from grader.problems import PROBLEM_IDS, ProblemId
+from grader.grading.grade import grade_files
+from grader.grading.plan import GradingPlan
+from grader.lab.assignment import load_config
+from grader.lab.problems import PROBLEM_IDS, ProblemId
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
 

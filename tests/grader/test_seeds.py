@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 from grading_support import SUBMISSIONS, write_config
 
-from grader.grading import grade_submission
+from grader.grading.grade import grade_submission
 from grader.sandbox import IsolationPolicy
 from grader.seeds import PRACTICE_SEED, held_out_seed, new_secret, upload_seed
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from grader.grading import grade_submission
+from grader.grading.grade import grade_submission
 
 HONEST = Path(__file__).resolve().parents[2] / "submissions" / "honest"
 CHEAP = ("random_blackjack", "blackjack")

@@ -2,11 +2,12 @@
 
 Standard library only (the child imports it before the student's code, the parent without the child's
 gymnasium set-up). An episode has the fields `EPISODE_FIELDS` (the child's `EpisodeRecord`, the parent's
-`EpisodeLog`, the in-process simulation of `grader.testing`). A call's episodes travel as one block with the
-keys `LOG_FIELDS` (`grader.sandbox.child.log_block` builds it, `grader.sandbox.episode_log.WireLog`
-validates it): the made-env fields as a table of distinct descriptions, the other header fields as
-per-episode columns (sparse where mostly absent), the per-step columns concatenated over all episodes, and
-one array of episode lengths. Both models are checked against these declarations at import.
+`EpisodeLog`, the in-process simulation of `grader.simulated_students`). A call's episodes travel as one
+block with the keys `LOG_FIELDS` (`grader.sandbox.child.log_block` builds it,
+`grader.sandbox.episode_log.WireLog` validates it): the made-env fields as a table of distinct descriptions,
+the other header fields as per-episode columns (sparse where mostly absent), the per-step columns concatenated
+over all episodes, and one array of episode lengths. Both models are checked against these declarations at
+import.
 """
 
 from __future__ import annotations

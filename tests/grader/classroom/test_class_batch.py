@@ -15,11 +15,11 @@ from grading_support import FAST_OVERRIDES, write_config
 
 import grader
 from grader import cli
-from grader.batch import grade_many, identity_stem
-from grader.classroom import GradedFileRule, discover
+from grader.classroom import GradedFileRule, command, discover
 from grader.classroom.output import ClassGradebook
-from grader.collector import GradingListener
-from grader.plan import GradingPlan
+from grader.grading.batch import grade_many, identity_stem
+from grader.grading.outcomes import GradingListener
+from grader.grading.plan import GradingPlan
 from grader.report import ProblemResult, Report
 
 from .canvas_import import canvas_import
@@ -170,8 +170,8 @@ class InterruptingExecutor(FakeExecutor):
 def test_an_interrupted_batch_leaves_gradebooks_with_every_finished_report(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from grader import batch
     from grader.errors import BatchInterrupted
+    from grader.grading import batch
 
     monkeypatch.setattr(batch, "GRADEBOOK_INTERVAL", 3600.0)  # only the first report rewrites at once
     expected = BUILDERS["plain"](tmp_path / "download", 3)
@@ -189,7 +189,7 @@ def test_gymgrade_grade_each_layout_into_every_gradebook(
     layout: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The command's whole path but grading (an instant executor stands in for the sandbox)."""
-    monkeypatch.setattr(cli, "find_executor", lambda policy: FakeExecutor())
+    monkeypatch.setattr(command, "find_executor", lambda policy: FakeExecutor())
     expected = BUILDERS[layout](tmp_path / "download", 3)
     out = tmp_path / "out"
     argv = ["grade", str(expected.path), "--out", str(out), "--only", "random_blackjack", "--seed", "3"]
@@ -279,9 +279,9 @@ def test_a_class_zip_is_extracted_once_whatever_edition_it_is_graded_as(
     import zipfile
 
     from grader.classroom import discovery
-    from grader.editions import EDITIONS
+    from grader.lab.editions import EDITIONS
 
-    monkeypatch.setattr(cli, "find_executor", lambda policy: FakeExecutor())
+    monkeypatch.setattr(command, "find_executor", lambda policy: FakeExecutor())
     reads: list[Path] = []
     real_read_tree = discovery.read_tree
 

@@ -9,7 +9,6 @@ from pathlib import Path
 
 import pytest
 
-from grader.class_report.text import safe_cell
 from grader.classroom import GradedFileRule, discover
 from grader.classroom.errors import GradebookError, RosterError
 from grader.classroom.gradebooks import (
@@ -21,6 +20,7 @@ from grader.classroom.gradebooks import (
     gradescope_csv,
 )
 from grader.classroom.roster import parse_roster, read_roster
+from grader.render.neutral import safe_cell
 from grader.report import ProblemResult, Report
 
 from .canvas_import import CanvasImportError, canvas_import

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from grader.class_report import CSP as CLASS_CSP
+from grader.classroom.report import CSP as CLASS_CSP
+from grader.classroom.similarity.html_output import CSP as SIMILARITY_CSP
 from grader.render.csp import content_security_policy
 from grader.render.html import CSP as REPORT_CSP
-from grader.similarity.html_output import CSP as SIMILARITY_CSP
 
 EMPTY_STYLE_DIGEST = "47DEQpj8HBSa+/TImW+5JCeuQeRkm5NMpJWZG3hSuFU="
 """sha256 of the empty string, base64: the hash a browser computes for an empty ``<style>``."""

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from grader.config import load_config
-from grader.figures import MAX_GIF_FRAMES, MAX_GIF_WIDTH, all_figures, replay_gif
+from grader.lab.assignment import load_config
+from grader.render.figures import MAX_GIF_FRAMES, MAX_GIF_WIDTH, all_figures, replay_gif
 from grader.render.html import CSP, render_html
 from grader.report import EpisodeReplay, ProblemResult, Report
 from reference.oracles.taxi import optimal_q_table

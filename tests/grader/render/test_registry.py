@@ -5,10 +5,10 @@ from __future__ import annotations
 import json
 
 import pytest
-from class_report.support import STOOD_ON_N, report, result
+from classroom.report.support import STOOD_ON_N, report, result
 
 from grader.cli import build_parser
-from grader.config import load_config
+from grader.lab.assignment import load_config
 from grader.render.csp import content_security_policy
 from grader.render.gradescope import GradescopeResults
 from grader.render.html import STYLE

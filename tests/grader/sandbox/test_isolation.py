@@ -74,6 +74,7 @@ PROBE = textwrap.dedent("""
     def probe(project_root, outside, port):
         libc = ctypes.CDLL(None, use_errno=True)
         scratch = os.path.join(tempfile.gettempdir(), "scratch.txt")
+        config = os.path.join(project_root, "grader", "lab", "assignment.toml")
         return {
             "inet": _errno(lambda: socket.socket(socket.AF_INET, socket.SOCK_STREAM).close()),
             "unix": _errno(lambda: socket.socket(socket.AF_UNIX, socket.SOCK_STREAM).close()),
@@ -82,7 +83,7 @@ PROBE = textwrap.dedent("""
             "uid": os.getuid(),
             "cwd_is_scratch": os.getcwd() == tempfile.gettempdir(),
             "reference": _errno(lambda: open(os.path.join(project_root, "reference", "__init__.py")).close()),
-            "config": _errno(lambda: open(os.path.join(project_root, "grader", "assignment.toml")).close()),
+            "config": _errno(lambda: open(config).close()),
             "write_outside": _errno(lambda: open(outside, "w").close()),
             "write_scratch": _errno(lambda: open(scratch, "w").close()),
             "environment": sorted(os.environ),

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from grader.collector import OnResult
-from grader.grading import grade_files
-from grader.plan import GradingPlan
+from grader.grading.grade import grade_files
+from grader.grading.outcomes import OnResult
+from grader.grading.plan import GradingPlan
 from grader.report import Report
 from grader.sandbox import IsolationPolicy, probe_isolation
 from grader.sandbox.isolation.cgroup import CGROUP_RECORDS

@@ -7,7 +7,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from grader.config import STUDENT_MODULES
+from grader.lab.assignment import STUDENT_MODULES
 from grader.sandbox import Call, IsolationPolicy, Limits, OutcomeStatus, Sandbox
 
 SUBMISSION = textwrap.dedent(

@@ -1,0 +1,181 @@
+"""Grade one problem of one submission: sandboxed calls, trusted replays, the check's verdict."""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import replace
+from pathlib import Path
+
+from grader.lab.assignment import AssignmentConfig
+from grader.lab.checks.base import CallRecord, Verdict
+from grader.lab.checks.integrity import replay_call, settled_by
+from grader.lab.registry import ProblemId
+from grader.lab.showcase import showcase_episode
+from grader.report import (
+    IsolationSummary,
+    LayerSummary,
+    ProblemResult,
+    ProblemRun,
+    Timings,
+    cap_output,
+    plain_json,
+)
+from grader.sandbox import (
+    CallOutcome,
+    CompatEventRecord,
+    FunctionInfo,
+    IsolationPolicy,
+    IsolationReport,
+    Sandbox,
+)
+from grader.sandbox.child.cells import RUN_CELLS
+from grader.submission.notebook.cells import runnable_cells
+
+MAX_COMPAT_EVENTS = 20
+"""Distinct compatibility events kept per problem: enough to explain, bounded for 100-call problems."""
+
+
+def problem_seed(grading_seed: int, problem: str) -> int:
+    """The sandbox seed of one problem: a stable hash of (grading seed, problem id), 63 bits.
+
+    Independent of the worker, the order of the tests and the other problems, so a problem gets the same
+    calls and episodes whether it is graded alone, under xdist or in a batch.
+    """
+    digest = hashlib.sha256(f"gymgrade:{grading_seed}:{problem}".encode()).digest()
+    return int.from_bytes(digest[:8], "big") >> 1
+
+
+def isolation_summary(isolation: IsolationReport) -> IsolationSummary:
+    """The sandbox's isolation report for the report: ``full``, ``layers`` and a readable ``summary``."""
+    return IsolationSummary(
+        full=isolation.full,
+        layers=[
+            LayerSummary(
+                name=layer.name,
+                active=layer.active,
+                required=layer.required,
+                detail=layer.detail,
+                remedy=layer.remedy,
+            )
+            for layer in isolation.layers
+        ],
+        summary=isolation.summary(),
+    )
+
+
+class FunctionsOnDemand(Mapping[str, FunctionInfo]):
+    """The submission's functions, read from the sandbox only when a plan looks at them.
+
+    The child starts (and imports the submission) on the first read or the first call, so a problem whose
+    plan calls nothing (find_qvalues when no verdict needs it) costs no child and no import.
+    """
+
+    def __init__(self, sandbox: Sandbox) -> None:
+        self._sandbox = sandbox
+
+    def __getitem__(self, name: str) -> FunctionInfo:
+        return self._sandbox.functions[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._sandbox.functions)
+
+    def __len__(self) -> int:
+        return len(self._sandbox.functions)
+
+
+def run_problem(
+    submission: Path,
+    problem: ProblemId,
+    *,
+    config: AssignmentConfig,
+    grading_seed: int,
+    policy: IsolationPolicy,
+) -> ProblemRun:
+    """Run one problem's planned calls in a fresh sandbox, replay every episode and judge.
+
+    A student's failure (import error, crash, timeout, wrong values) is part of the returned result;
+    only a failure of the grader itself raises.
+
+    Args:
+        submission: The student's file.
+        problem: Which problem to grade (one of the configuration's registry).
+        config: The assignment configuration.
+        grading_seed: The grading seed; the problem's sandbox seed derives from it and the problem id.
+        policy: Whether weaker isolation than full is acceptable.
+
+    Returns:
+        The problem's result and the sandbox's isolation report.
+
+    Raises:
+        grader.sandbox.errors.IsolationUnavailable: Full isolation was required and is not available.
+    """
+    started = time.perf_counter()
+    entry = config.registry.problem(problem)
+    check, settings = entry.check, entry.settings(config)
+    seed = problem_seed(grading_seed, problem)
+    limits = config.sandbox.to_limits(settings.call_seconds)
+    games = settings.game_rules()
+    records: list[CallRecord] = []
+    stopped: str | None = None
+    with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:
+        calls = check.plan(settings, FunctionsOnDemand(sandbox))
+        for call in calls:
+            if call.function == RUN_CELLS:  # the cells are the submission's, known here, not to the plan
+                call = replace(call, args=(runnable_cells(submission),))
+            records.append(replay_call(sandbox.call(call), games))
+            stopped = settled_by(records[-1], games)
+            if stopped is not None:
+                break
+        isolation = isolation_summary(sandbox.isolation)
+    outcomes = [record.outcome for record in records]
+    verdict = check.judge(settings, records)
+    cells_failed = bool(records) and records[-1].outcome.call.function == RUN_CELLS  # the check says so
+    if stopped is not None and len(records) < len(calls) and not cells_failed:
+        verdict = _stopped_early(verdict, stopped, len(records), len(calls))
+    wall_seconds = time.perf_counter() - started
+    student_seconds = sum(outcome.wall_time for outcome in outcomes)
+    fraction = min(max(verdict.fraction, 0.0), 1.0)
+    measurements = plain_json(verdict.measurements)
+    result = ProblemResult(
+        id=problem,
+        title=settings.title,
+        status=verdict.status,
+        score=round(settings.points * fraction, 6),
+        max_score=settings.points,
+        feedback=verdict.feedback,
+        measurements=measurements if isinstance(measurements, dict) else {"value": measurements},
+        output=cap_output(student_output(outcomes)),
+        compat_events=_distinct_events(outcomes),
+        seed=seed,
+        visibility=settings.visibility,
+        replay=showcase_episode(entry.showcase, records),
+        timings=Timings(
+            wall_seconds=wall_seconds,
+            student_seconds=student_seconds,
+            overhead_seconds=max(wall_seconds - student_seconds, 0.0),
+        ),
+    )
+    return ProblemRun(submission=str(submission), result=result, isolation=isolation)
+
+
+def _stopped_early(verdict: Verdict, reason: str, made: int, planned: int) -> Verdict:
+    """The verdict of a problem whose calls stopped once it could no longer change, saying so."""
+    measurements = {**verdict.measurements, "calls_planned": planned, "calls_made": made}
+    note = (
+        f" Grading stopped after call {made} of {planned}: "
+        f"{reason}, so no later call could change the verdict."
+    )
+    feedback = verdict.feedback if verdict.feedback.endswith((".", "!", "?")) else f"{verdict.feedback}."
+    return Verdict(verdict.status, verdict.fraction, feedback + note, measurements)
+
+
+def student_output(outcomes: Sequence[CallOutcome]) -> str:
+    """Everything the student's calls printed, stdout then stderr per call, in call order."""
+    return "".join(outcome.stdout + outcome.stderr for outcome in outcomes)
+
+
+def _distinct_events(outcomes: Sequence[CallOutcome]) -> list[CompatEventRecord]:
+    distinct = dict.fromkeys(event for outcome in outcomes for event in outcome.compat_events)
+    return list(distinct)[:MAX_COMPAT_EVENTS]

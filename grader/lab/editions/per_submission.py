@@ -1,0 +1,112 @@
+"""The edition of a class graded without `--edition` or a configuration: the one its files all show.
+
+What a student is graded on is the instructor's assignment, never a majority of the class's files: each
+submission's graded file is read statically (`grader.lab.editions.detection`, never run), files that show no
+edition (empty, unreadable, a shared function without imports) are left out, and the class is graded as the
+edition the others show only when they all ask the same problems (editions 1-3 grade the same problems and
+agree). Otherwise `ClassEditions.disagreement` says which editions were found and whose files are behind
+each, and the command stops before grading so that the instructor names the assignment's edition.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from grader.lab.editions import DEFAULT_EDITION, EDITIONS
+from grader.lab.editions.choice import EditionChoice, default_config
+from grader.lab.editions.detection import Detection, detect_edition
+from grader.lab.editions.rl1 import RL1
+
+MAX_NAMED = 20
+"""Identities named per edition in a disagreement (the rest are counted)."""
+
+
+@dataclass(frozen=True)
+class ClassEditions:
+    """The edition a class is graded as (or why none can be chosen), and each submission's own detection.
+
+    Attributes:
+        choice: The class's edition, its configuration (None: the bundled one) and why.
+        detected: Each submission's detection, by identity (in the order given).
+        disagreement: Why no edition is chosen (files showing editions of different problems), with the
+            editions found and whose files are behind each; None when `choice` grades the class.
+    """
+
+    choice: EditionChoice
+    detected: Mapping[str, Detection]
+    disagreement: str | None = None
+
+    def lines(self) -> list[str]:
+        """What `gymgrade grade` prints: the class's edition, then one line per submission."""
+        lines = [self.choice.line]
+        for identity, found in self.detected.items():
+            shown = found.edition.name if found.shown else "no edition"
+            lines.append(f"  {identity}: {shown}: {found.reason}")
+        return lines
+
+
+def class_editions(files: Mapping[str, Path]) -> ClassEditions:
+    """Detect each submission's edition and choose the class's, or say why none can be chosen.
+
+    Args:
+        files: Each submission's graded file, by identity.
+
+    Returns:
+        The class's edition: the one every file showing an edition asks the problems of (of several names
+        for the same problems, the most common, a tie to the newer); the first edition when no file shows
+        one. With files showing editions of different problems, `disagreement` is set.
+    """
+    detected = {identity: detect_edition(path) for identity, path in files.items()}
+    shown = {identity: found for identity, found in detected.items() if found.shown}
+    unshown = len(detected) - len(shown)
+    if not shown:
+        first = EDITIONS[DEFAULT_EDITION]
+        reason = (
+            f"no --edition and no configuration, and none of the {len(detected)} files shows an edition: "
+            f"the first edition (--edition {RL1.name} grades today's)"
+        )
+        return ClassEditions(EditionChoice(first, None, reason), detected)
+    problem_sets = {id(found.edition.registry) for found in shown.values()}
+    order = list(EDITIONS)
+    names = Counter(found.edition.name for found in shown.values())
+    named = max(names, key=lambda name: (names[name], order.index(name)))
+    edition = EDITIONS[named]
+    counts = ", ".join(f"{name} {count}" for name, count in names.most_common())
+    left_out = f"; {unshown} showing no edition not counted" if unshown else ""
+    if len(problem_sets) == 1:
+        reason = (
+            "no --edition and no configuration; "
+            f"every file that shows an edition asks its problems ({counts} of {len(detected)}{left_out})"
+        )
+        return ClassEditions(EditionChoice(edition, default_config(edition), reason), detected)
+    reason = f"no --edition and no configuration, and the files disagree ({counts}{left_out})"
+    return ClassEditions(
+        EditionChoice(edition, default_config(edition), reason), detected, _disagreement(shown, unshown)
+    )
+
+
+def _disagreement(shown: Mapping[str, Detection], unshown: int) -> str:
+    """Which editions the files show, whose files are behind each, and what to do."""
+    by_edition: dict[str, list[str]] = {}
+    for identity, found in shown.items():
+        by_edition.setdefault(found.edition.name, []).append(identity)
+    order = list(EDITIONS)
+    parts = []
+    for name in sorted(by_edition, key=order.index):
+        who = by_edition[name]
+        listed = ", ".join(who[:MAX_NAMED]) + (
+            f" and {len(who) - MAX_NAMED} more" if len(who) > MAX_NAMED else ""
+        )
+        parts.append(f"{name} ({EDITIONS[name].title}, {len(who)}): {listed}")
+    left_out = f" ({unshown} files showing no edition are not counted)" if unshown else ""
+    choices = " or ".join(f"--edition {name}" for name in sorted(by_edition, key=order.index))
+    return (
+        f"the class's files were written for editions that ask different problems{left_out}: "
+        f"{'; '.join(parts)}. What a student is graded on is the assignment's edition, not the files': "
+        "nothing was graded; "
+        f'pass the assignment\'s edition ({choices}) or a configuration naming it (edition = "..."); '
+        "a file written for another edition is then graded as the assignment and told so"
+    )

@@ -1,0 +1,122 @@
+"""Simulated `compare()` students (edition rl1) and the notebook cells they ran before it.
+
+The cells call is simulated by `cells`: it reports the tables a notebook's training cells left (the grader's
+two taxi tables, labelled as the decaying-epsilon Q-learning and SARSA tables, and a constant-epsilon
+Q-learning table). Each student plays on them as its `compare()` would.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from grader.lab.checks.taxi_tables import grader_tables
+from grader.simulated_students.simulation import Lab
+from grader.simulated_students.taxi_tables import EPISODES, _play
+from reference.oracles import optimal_q_table
+from reference.oracles.taxi import ACTIONS
+
+GAMMA = 0.6
+
+
+@cache
+def notebook_tables() -> dict[str, npt.NDArray[np.float64]]:
+    """The tables the simulated notebook trained: by global name."""
+    detour, optimal = grader_tables(GAMMA)
+    constant = np.random.default_rng(20261125).random((500, ACTIONS))
+    return {"q_table_decay": detour, "sarsa_table_decay": optimal, "q_table": constant}
+
+
+def cells(_lab: Lab, *_args: Any, **_kwargs: Any) -> dict[str, Any]:
+    """What the cells call returns after a notebook trained its three tables."""
+    tables = notebook_tables()
+    labels = {
+        "q_table_decay": ("qlearn", True),
+        "sarsa_table_decay": ("sarsa0", True),
+        "q_table": ("qlearn", False),
+    }
+    return {
+        "cells": [{"cell": number, "seconds": 0.5} for number in (2, 4, 6, 8)],
+        "tables": [
+            {
+                "names": [name],
+                "learner": labels[name][0],
+                "decay": labels[name][1],
+                "N": 70_000,
+                "table": table,
+            }
+            for name, table in tables.items()
+        ],
+    }
+
+
+def _tables() -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    tables = notebook_tables()
+    return tables["q_table_decay"], tables["sarsa_table_decay"]
+
+
+def honest(lab: Lab) -> tuple[float, float]:
+    """The lab's compare(): 1 000 greedy episodes with each decaying-epsilon table, both means."""
+    q_table, sarsa_table = _tables()
+    return _play(lab, q_table, EPISODES), _play(lab, sarsa_table, EPISODES)
+
+
+def sarsa_first(lab: Lab) -> tuple[float, float]:
+    """Honest too: plays the SARSA table first, but returns the Q-learning mean first."""
+    q_table, sarsa_table = _tables()
+    sarsa = _play(lab, sarsa_table, EPISODES)
+    return _play(lab, q_table, EPISODES), sarsa
+
+
+def swapped(lab: Lab) -> tuple[float, float]:
+    first, second = honest(lab)
+    return second, first
+
+
+def random_play(lab: Lab) -> tuple[float, float]:
+    q_table, sarsa_table = _tables()
+    return _play(lab, q_table, EPISODES, random_play=True), _play(
+        lab, sarsa_table, EPISODES, random_play=True
+    )
+
+
+def single_episode(lab: Lab) -> tuple[float, float]:
+    q_table, sarsa_table = _tables()
+    return _play(lab, q_table, 1), _play(lab, sarsa_table, 1)
+
+
+def same_table(lab: Lab) -> tuple[float, float]:
+    q_table, _ = _tables()
+    return _play(lab, q_table, EPISODES), _play(lab, q_table, EPISODES)
+
+
+def constant_epsilon_table(lab: Lab) -> tuple[float, float]:
+    _, sarsa_table = _tables()
+    return _play(lab, notebook_tables()["q_table"], EPISODES), _play(lab, sarsa_table, EPISODES)
+
+
+def own_tables(lab: Lab) -> tuple[float, float]:
+    """Plays tables the notebook never made (here: the optimal table breaking ties the other way)."""
+    q_table, _ = _tables()
+    own = optimal_q_table(GAMMA) + 1e-6 * np.arange(ACTIONS)
+    return _play(lab, q_table, EPISODES), _play(lab, own, EPISODES)
+
+
+def final_reward(lab: Lab) -> tuple[float, float]:
+    q_table, sarsa_table = _tables()
+    return _play(lab, q_table, EPISODES, final_only=True), _play(lab, sarsa_table, EPISODES, final_only=True)
+
+
+MISTAKES: dict[str, tuple[Any, str]] = {
+    "swapped": (swapped, "the means are swapped"),
+    "random_play": (random_play, "as in random play"),
+    "single_episode": (single_episode, "a single episode per table"),
+    "same_table": (same_table, "played with the same table"),
+    "constant_epsilon_table": (constant_epsilon_table, "trained with a constant epsilon"),
+    "own_tables": (own_tables, "greedy on no table your notebook's cells made"),
+    "final_reward": (final_reward, "which are not those means"),
+}
+"""Mistakes: (the function, words its feedback must contain). Each must fail."""

@@ -1,8 +1,0 @@
-"""Simulated students for tests and calibration; never used when grading.
-
-`grader.testing.simulation` runs student-like functions in-process on gymnasium and builds the
-`CallRecord`s the sandbox and the replay would (no processes, no isolation); `grader.testing.behaviours`
-holds the reference's policies and the typical mistakes as such functions. The checks' tests and
-`bench/calibrate.py` / `bench/versions.py` judge them with the real checks. Nothing on the grading path
-imports this package (tests/grader/testing/test_boundaries.py holds that).
-"""

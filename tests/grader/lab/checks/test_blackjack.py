@@ -1,0 +1,133 @@
+"""blackjack(n): naming how replayed decisions deviate from 'draw while sum <= n', and the exact curve."""
+
+import pytest
+
+from grader.lab.checks.blackjack import _Decision, exact_best_n, exact_curve, policy_deviation
+
+from .support import grade, small_config
+
+
+def _decisions(*rows: tuple[int, int, int, bool]) -> list[_Decision]:
+    return [_Decision(*row) for row in rows]
+
+
+@pytest.mark.parametrize(
+    ("rows", "expected"),
+    [
+        ([(0, 0, 12, True), (0, 1, 15, False)], None),
+        (
+            [(0, 0, 12, False), (1, 0, 11, True), (1, 1, 16, False)],
+            "your games stood on a sum of exactly 12 in 1 hands, so they follow 'draw while the sum is < "
+            "12': "
+            "check `<` versus `<=`",
+        ),
+        (
+            [(0, 0, 13, True), (0, 1, 18, False)],
+            "your games drew on a sum of 13 in 1 hands, so they follow 'draw while the sum is <= 13': the "
+            "threshold "
+            "is off by one",
+        ),
+        (
+            [(0, 0, 18, True), (1, 0, 10, True), (1, 1, 15, False)],
+            "in 1 games the first decision drew a card before looking at the dealt hand; every later "
+            "decision "
+            "followed 'draw while the sum is <= 12'. Read the player's sum from the observation reset() "
+            "returns "
+            "before the first decision",
+        ),
+        (
+            [(0, 0, 8, False), (1, 0, 10, True), (1, 1, 11, True), (1, 2, 19, False)],
+            "in 1 games the first decision stood before looking at the dealt hand; every later decision "
+            "followed "
+            "'draw while the sum is <= 12'. Read the player's sum from the observation reset() returns "
+            "before the "
+            "first decision",
+        ),
+        (
+            [(0, 0, 18, True), (1, 0, 8, False), (2, 0, 10, True), (2, 1, 15, False)],
+            "in 2 games the first decision decided with a stale hand (e.g. the previous game's sum) instead "
+            "of the "
+            "one reset() dealt; every later decision followed 'draw while the sum is <= 12'. Read the "
+            "player's sum "
+            "from the observation reset() returns before the first decision",
+        ),
+        (
+            [(0, 0, 10, True), (0, 1, 14, True), (0, 2, 17, False)],
+            "your games follow 'draw while the sum is <= 14' whatever n is: use the parameter n, not a fixed "
+            "number",
+        ),
+        (
+            [(0, 0, 13, False), (1, 0, 5, True), (1, 1, 14, True), (1, 2, 20, True)],
+            "2 of 4 decisions broke 'draw while the sum is <= 12' (e.g. game 2, decision 2: sum 14, you "
+            "drew)",
+        ),
+    ],
+    ids=[
+        "follows",
+        "less-than",
+        "off-by-one-up",
+        "draws-before-looking",
+        "stands-before-looking",
+        "stale-hand",
+        "fixed-threshold",
+        "other",
+    ],
+)
+def test_policy_deviation_is_named(rows: list[tuple[int, int, int, bool]], expected: str | None) -> None:
+    assert policy_deviation(_decisions(*rows), 12) == expected
+
+
+def test_exact_curve_and_best_n() -> None:
+    curve = exact_curve()
+    assert list(curve) == list(range(22))
+    assert exact_best_n() == 13
+    assert curve[13] == pytest.approx(0.41795126514575, abs=1e-12)
+
+
+def test_fixed_threshold_student_is_told_to_use_n(seed: int) -> None:
+    def blackjack(lab, n, games=1000):  # type: ignore[no-untyped-def]
+        env = lab.make("Blackjack-v0")
+        wins = 0
+        for _ in range(games):
+            observation, _ = env.reset()
+            done = False
+            while not done:
+                observation, reward, terminated, truncated, _ = env.step(int(observation[0] <= 16))
+                done = terminated or truncated
+            wins += reward > 0
+        return wins / games
+
+    verdict = grade("blackjack", {"blackjack": blackjack}, seed)
+    assert verdict.status == "failed"
+    assert "follow 'draw while the sum is <= 16' whatever n is: use the parameter n" in verdict.feedback
+
+
+def test_too_few_games_fail_with_the_lab_number(seed: int) -> None:
+    from grader.simulated_students.behaviours import blackjack
+
+    settings = small_config("blackjack")
+    verdict = grade("blackjack", {"blackjack": lambda lab, n: blackjack(lab, n, games=100)}, seed, settings)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith(
+        "blackjack(12) must play 1000 games (the lab's number); the replay shows 100."
+    )
+
+
+def test_measurements_hold_both_curves(seed: int) -> None:
+    from grader.simulated_students.behaviours import REFERENCE
+
+    verdict = grade("blackjack", REFERENCE["blackjack"], seed)
+    assert verdict.status == "passed"
+    assert set(verdict.measurements["curve"]) == {"12", "13", "14", "20"}  # type: ignore[arg-type]
+    assert verdict.measurements["exact_best_n"] == 13
+    assert len(verdict.measurements["exact_curve"]) == 22  # type: ignore[arg-type]
+
+
+def test_a_failing_student_still_gets_the_whole_curve(seed: int) -> None:
+    from grader.simulated_students.behaviours import MISTAKES
+
+    (less_than,) = [mistake for mistake in MISTAKES if mistake.name == "blackjack_less_than"]
+    verdict = grade("blackjack", less_than.functions, seed)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith("blackjack(12) returned")
+    assert set(verdict.measurements["curve"]) == {"12", "13", "14", "20"}  # type: ignore[arg-type]

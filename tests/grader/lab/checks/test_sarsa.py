@@ -1,0 +1,142 @@
+"""sarsa0(env, alpha, gamma, epsilon, N, decay) (edition rl1): honest learners pass; each mistake is named.
+
+The behaviour test's false-fail probability is 1e-6 per call (two calls per judgement), so the honest
+cases here fail falsely with probability below 1e-5 in all.
+"""
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from grader.lab.assignment import load_config
+from grader.lab.checks.base import Verdict
+from grader.lab.checks.sarsa import SarsaConfig, returned_table
+from grader.lab.editions.rl1 import RL1
+from grader.sandbox.outcome import ENV_NAME_OR_OBJECT, EnvArgument
+from grader.simulated_students import sarsa as students
+from grader.simulated_students.simulation import Lab, simulate_calls
+
+PROBLEM = RL1.registry.problem("sarsa0")
+
+
+def _settings() -> SarsaConfig:
+    """The default settings with fewer episodes (the verdicts do not depend on them; the tests run faster)."""
+    settings = load_config(RL1.default_config).problems["sarsa0"]
+    assert isinstance(settings, SarsaConfig)
+    return settings.model_copy(update={"episodes": 25, "decay_episodes": 10})
+
+
+def _judge(function: Any, seed: int, decay: Any = students.epsilon_decay) -> Verdict:
+    settings = _settings()
+    calls = PROBLEM.check.plan(settings, {})
+    functions = {"sarsa0": function, "epsilon_decay": decay}
+    return PROBLEM.check.judge(settings, simulate_calls(calls, functions, seed))
+
+
+@pytest.mark.parametrize("name", list(students.HONEST))
+def test_honest_learners_pass(name: str, seed: int) -> None:
+    verdict = _judge(students.HONEST[name], seed)
+    assert verdict.status == "passed", verdict.feedback
+    assert "every update of your table is SARSA(0)'s" in verdict.feedback
+    form = "object" if name == "object_form" else "name"
+    assert verdict.measurements["env_form"] == form
+    assert FORM_WORDS[form] in verdict.feedback
+
+
+FORM_WORDS = {
+    "name": "The grader called sarsa0 with the environment's name, 'Taxi-v3', as the template's `env = gym.make(env)` expects.",  # noqa: E501
+    "object": "The grader called sarsa0 with an environment object, gym.make('Taxi-v3')",
+}
+
+
+def test_the_plan_passes_the_environments_name_first() -> None:
+    call = PROBLEM.check.plan(_settings(), {})[0]
+    (env,) = [argument for argument in call.args if isinstance(argument, EnvArgument)]
+    assert (env.env_id, env.form, repr(env)) == ("Taxi-v3", ENV_NAME_OR_OBJECT, "'Taxi-v3'")
+
+
+def test_a_template_shaped_learner_that_fails_after_making_the_env_keeps_the_names_error(seed: int) -> None:
+    def broken(lab: Lab, env: Any, *args: Any) -> Any:
+        env = lab.make(env)
+        raise ValueError("after gym.make")
+
+    verdict = _judge(broken, seed)
+    assert verdict.status == "error"
+    assert "ValueError: after gym.make" in verdict.feedback
+    assert FORM_WORDS["name"] in verdict.feedback
+
+
+@pytest.mark.parametrize(("name", "mistake"), students.MISTAKES.items(), ids=list(students.MISTAKES))
+def test_each_mistake_fails_and_is_named(name: str, mistake: tuple[Any, str], seed: int) -> None:
+    function, words = mistake
+    verdict = _judge(function, seed)
+    assert verdict.status == "failed", name
+    assert words in verdict.feedback, verdict.feedback
+
+
+def test_a_q_learning_update_names_the_first_wrong_cell(seed: int) -> None:
+    verdict = _judge(students.MISTAKES["q_learning"][0], seed)
+    assert verdict.feedback.startswith("sarsa0, the call with epsilon constant (N=25): at episode ")
+    assert "SARSA(0) from the transitions you played gives" in verdict.feedback
+
+
+def epsilon_decay_zero_based(lab: Lab, episode: int, n: int, start: float = 1.0, end: float = 1e-6) -> float:
+    """A wrong decay (0-based episodes), graded in problem 5 and not again in sarsa0."""
+    return start - episode * (start - end) / n
+
+
+def test_a_wrong_epsilon_decay_is_not_counted_again(seed: int) -> None:
+    """The decay call is judged against the student's own schedule: problem 5 counts the mistake."""
+    learner = students.learner(schedule=epsilon_decay_zero_based)
+    verdict = _judge(learner, seed, decay=epsilon_decay_zero_based)
+    assert verdict.status == "passed", verdict.feedback
+
+
+def test_a_missing_epsilon_decay_leaves_the_constant_call_graded(seed: int) -> None:
+    settings = _settings()
+    calls = PROBLEM.check.plan(settings, {})
+    records = simulate_calls(calls[:2], {"sarsa0": students.HONEST["lab_loop"]}, seed)
+    verdict = PROBLEM.check.judge(settings, records)
+    assert verdict.status == "passed", verdict.feedback
+    assert "The decay=True call was not made" in verdict.feedback
+
+
+@pytest.mark.parametrize(
+    ("value", "found"),
+    [
+        (np.zeros((500, 5)), "an array of shape (500, 5)"),
+        (np.full((500, 6), np.nan), "NaN or infinite"),
+        ("table", "'table'"),
+        ([[0.0] * 6] * 499, "[[0.0"),
+        (np.zeros((500, 6), dtype=bool), "dtype bool"),
+    ],
+    ids=["shape", "nan", "str", "short-list", "bool"],
+)
+def test_a_returned_value_that_is_no_table_is_refused(value: Any, found: str) -> None:
+    table, _, wrong = returned_table(value)
+    assert table is None
+    assert found in wrong
+
+
+def test_a_list_table_and_penalties_are_read() -> None:
+    table, penalties, wrong = returned_table(([[1, 2, 3, 4, 5, 6]] * 500, 7))
+    assert table is not None and table.shape == (500, 6) and penalties == 7 and wrong == ""
+
+
+def test_an_epsilon_decay_returning_no_number_is_not_counted_again(seed: int) -> None:
+    """sarsa0 crashes on the student's None epsilon; the decay call is dropped, the constant one graded."""
+
+    def no_number(lab: Any, episode: int, n: int) -> None:
+        return None
+
+    def crashes_on_decay(
+        lab: Any, env: Any, alpha: float, gamma: float, epsilon: float, n: int, decay: bool
+    ) -> Any:
+        if decay:
+            raise TypeError("'<' not supported between instances of 'float' and 'NoneType'")
+        return students.HONEST["lab_loop"](lab, env, alpha, gamma, epsilon, n, decay)
+
+    verdict = _judge(crashes_on_decay, seed, decay=no_number)
+    assert verdict.status == "passed", verdict.feedback
+    assert "The decay=True call is not counted" in verdict.feedback

@@ -1,0 +1,49 @@
+"""taxi(q_table, q_table_decay) (edition rl1): honest greedy play passes; each typical mistake is named."""
+
+from typing import Any
+
+import pytest
+
+from grader.lab.assignment import load_config
+from grader.lab.checks.base import Verdict
+from grader.lab.checks.taxi_tables import TaxiTablesConfig, grader_tables
+from grader.lab.editions.rl1 import RL1
+from grader.simulated_students import taxi_tables as students
+from grader.simulated_students.simulation import simulate_calls
+from reference.oracles import greedy_policy_return
+
+PROBLEM = RL1.registry.problem("taxi")
+
+
+def _judge(function: Any, seed: int) -> Verdict:
+    settings = load_config(RL1.default_config).problems["taxi"]
+    assert isinstance(settings, TaxiTablesConfig)
+    calls = PROBLEM.check.plan(settings, {})
+    return PROBLEM.check.judge(settings, simulate_calls(calls, {"taxi": function}, seed))
+
+
+def test_the_grader_tables_differ_clearly_and_always_end() -> None:
+    detour, optimal = (greedy_policy_return(table) for table in grader_tables(0.6))
+    assert (round(detour.mean, 3), round(optimal.mean, 3)) == (5.757, 7.93)
+    assert greedy_policy_return(grader_tables(0.6)[0], 1000).mean == pytest.approx(detour.mean)
+
+
+def test_honest_greedy_play_passes(seed: int) -> None:
+    verdict = _judge(students.honest, seed)
+    assert verdict.status == "passed", verdict.feedback
+    assert "every action was greedy on its table" in verdict.feedback
+
+
+@pytest.mark.parametrize(("name", "mistake"), students.MISTAKES.items(), ids=list(students.MISTAKES))
+def test_each_mistake_fails_and_is_named(name: str, mistake: tuple[Any, str], seed: int) -> None:
+    function, words = mistake
+    verdict = _judge(function, seed)
+    assert verdict.status == "failed", name
+    assert words in verdict.feedback, verdict.feedback
+
+
+def test_a_stub_is_missing(seed: int) -> None:
+    def stub(_lab: Any, q_table: Any, q_table_decay: Any) -> None:
+        raise NotImplementedError("Problem 6 incomplete")
+
+    assert _judge(stub, seed).status == "missing"
