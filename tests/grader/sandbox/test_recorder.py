@@ -21,7 +21,7 @@ from grader.sandbox.child.log_block import log_block
 from grader.sandbox.child.recorder import EpisodeRecord, MadeEnv, Recorder, RecordingEnv
 from grader.sandbox.child.seeding import derive_call_seed, reset_seeds
 from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
-from grader.sandbox.replay import verify_reset_seeds
+from grader.sandbox.replay import replay_episode, verify_reset_seeds
 
 STUDENT = textwrap.dedent("""
     import random
@@ -73,6 +73,15 @@ STUDENT = textwrap.dedent("""
 
     def gymnasium_retired_id():
         gymnasium.make("Taxi-v2")
+
+
+    def classic_env_env_without_time_limit():
+        env = gym.make("FrozenLake-v0", is_slippery=False).env  # the 2018 lab's idiom
+        env.reset()
+        dones = [env.step(0)[2] for _ in range(120)]  # left at the start: against the wall
+        for action in (1, 1, 2, 1, 2, 2):  # down, down, right, down, right, right: the goal
+            observation, reward, done, _ = env.step(action)
+        return [any(dones), env.nS, observation, reward, done]
 
 
     def gymnasium_frozen_lake_table():
@@ -271,6 +280,17 @@ def test_env_attributes_are_read_through_gymnasium_s_wrappers_and_reported(child
         "forwarded it (env.unwrapped.P works everywhere)"
     )
     assert "FrozenLake-v1: env.nrow" in events
+
+
+def test_classic_env_env_runs_past_the_time_limit_and_replays(child: ChildClient) -> None:
+    result = child.call("classic_env_env_without_time_limit", seed=2)
+    assert value_of(result) == [False, 16, 15, 1.0, True]
+    (log,) = episodes_of(result)
+    assert log.steps == 126 and log.truncated[99] and log.rewards[-1] == 1.0
+    replayed = replay_episode(log)
+    # The log agrees with the real env step for step; the replay's episode ends where gym.make's limit cut
+    # it (step 100), and the 26 steps the view took past it are counted, not lost.
+    assert (replayed.matches, replayed.length, replayed.steps_after_done) == (True, 100, 26)
 
 
 def test_private_env_attributes_are_not_forwarded(child: ChildClient) -> None:
