@@ -92,7 +92,13 @@ def test_each_edition_defines_its_own_names_and_signatures(edition: str) -> None
     ]
 
 
-@pytest.mark.parametrize("case", CASES, ids=[case.key for case in CASES])
+@pytest.mark.parametrize(
+    "case",
+    [
+        pytest.param(case, id=case.key, marks=[pytest.mark.slow] if case.key == "lake8" else [])
+        for case in CASES
+    ],
+)
 def test_the_model_answers_pass_the_oracles(case) -> None:  # type: ignore[no-untyped-def]
     P, nS, nA = case.mdp.as_dict(), case.mdp.n_states, case.mdp.n_actions
     optimum = optimal_solution(case.mdp, case.beta).values
