@@ -23,3 +23,11 @@ class InvalidParameterError(ReferencePackageError, ValueError):
 
 class UnexpectedEnvironmentError(ReferencePackageError, RuntimeError):
     """Raised when gymnasium's Taxi model is not the deterministic one the Taxi oracle is built for."""
+
+
+class InvalidMdpError(ReferencePackageError, ValueError):
+    """Raised when an MDP table `P[s][a]` is incomplete, leads outside its states or has bad probabilities."""
+
+
+class UnboundedValueError(ReferencePackageError, ArithmeticError):
+    """Raised when a policy's return has no finite value (it loops through nonzero rewards at discount 1)."""

@@ -38,20 +38,34 @@ class ClassicEnv:
     actions for a `Discrete` space become ints (gymnasium accepts them too; ints keep the logs plain).
 
     Attribute reads not defined here go down the gymnasium wrapper stack (`env.P`, `env.s`), as
-    classic `gym.Wrapper.__getattr__` did; private names are not forwarded.
+    classic `gym.Wrapper.__getattr__` did; private names are not forwarded. `nS` and `nA`, which classic
+    toy-text envs (FrozenLake, Taxi) had and gymnasium's do not, are the sizes of the discrete spaces.
+    `env.env` is classic gym's env inside the time limit: a view of the same env whose episodes end only
+    when the env ends them. The gymnasium env underneath is `gymnasium_env`.
     """
 
-    def __init__(self, env: gymnasium.Env[Any, Any], requested_id: str, api: Api | None = None) -> None:
+    def __init__(
+        self,
+        env: gymnasium.Env[Any, Any],
+        requested_id: str,
+        api: Api | None = None,
+        *,
+        time_limit: bool = True,
+    ) -> None:
         """Wrap `env`, which `gymnasium.make` created for the id `requested_id`.
 
         Args:
             env: the gymnasium environment.
             requested_id: the id the student asked for.
             api: serve this API to every caller; None decides per call site from the calling code.
+            time_limit: False for the view classic `env.env` gives: episodes end only when the env ends
+                them, as classic `gym.make(id).env` (the env inside `TimeLimit`) did.
         """
-        self.env = env
+        self.gymnasium_env = env
         self.requested_id = requested_id
         self.api = api
+        self.time_limit = time_limit
+        self._inner_view: ClassicEnv | None = None
         self._discrete_actions = isinstance(env.action_space, spaces.Discrete)
         self._needs_reset = True
         self._done = False
@@ -79,7 +93,7 @@ class ClassicEnv:
         if seed is None:
             seed = self._next_seed
         self._next_seed = None
-        observation, info = self.env.reset(seed=seed, options=options)
+        observation, info = self.gymnasium_env.reset(seed=seed, options=options)
         self._needs_reset = False
         self._done = False
         return observation, info
@@ -108,9 +122,11 @@ class ClassicEnv:
                 "the step was passed to the environment as classic gym did, so what followed is undefined",
             )
             with quiet_gymnasium(STEP_AFTER_TERMINATED):
-                observation, reward, terminated, truncated, info = self.env.step(action)
+                observation, reward, terminated, truncated, info = self.gymnasium_env.step(action)
         else:
-            observation, reward, terminated, truncated, info = self.env.step(action)
+            observation, reward, terminated, truncated, info = self.gymnasium_env.step(action)
+        if truncated and not terminated and not self.time_limit and self._cut_by_time_limit():
+            truncated = False  # classic `env.env` had no time limit: the episode goes on
         if api is Api.GYM026:
             self._done = self._done or bool(terminated or truncated)
             return observation, reward, terminated, truncated, info
@@ -154,9 +170,9 @@ class ClassicEnv:
         Raises:
             UnsupportedRenderModeError: the environment cannot draw in `mode`.
         """
-        own_mode = self.env.render_mode
+        own_mode = self.gymnasium_env.render_mode
         if own_mode is not None and mode in (None, own_mode):
-            return self.env.render()
+            return self.gymnasium_env.render()
         if mode in (None, "human"):
             if not self._render_recorded:
                 self._render_recorded = True
@@ -170,7 +186,7 @@ class ClassicEnv:
         return self._render_in(mode)
 
     def _render_in(self, mode: str) -> Any:
-        base = self.env.unwrapped
+        base = self.gymnasium_env.unwrapped
         supported = base.metadata.get("render_modes", [])
         if mode not in supported:
             raise UnsupportedRenderModeError(
@@ -186,42 +202,76 @@ class ClassicEnv:
 
     def close(self) -> None:
         """Close the environment."""
-        self.env.close()
+        self.gymnasium_env.close()
 
     @property
     def unwrapped(self) -> gymnasium.Env[Any, Any]:
         """The innermost gymnasium environment (its own API is gymnasium's)."""
-        return self.env.unwrapped
+        return self.gymnasium_env.unwrapped
 
     @property
     def spec(self) -> Any:
         """The gymnasium spec of the environment actually made."""
-        return self.env.spec
+        return self.gymnasium_env.spec
 
     @property
     def action_space(self) -> spaces.Space[Any]:
         """The action space."""
-        return self.env.action_space
+        return self.gymnasium_env.action_space
 
     @property
     def observation_space(self) -> spaces.Space[Any]:
         """The observation space."""
-        return self.env.observation_space
+        return self.gymnasium_env.observation_space
 
     @property
     def metadata(self) -> dict[str, Any]:
         """The environment's metadata."""
-        return self.env.metadata
+        return self.gymnasium_env.metadata
+
+    @property
+    def nS(self) -> int:
+        """Classic toy-text envs' number of states (`observation_space.n`), which the 2018 labs read."""
+        return self._discrete_size("nS", self.gymnasium_env.observation_space)
+
+    @property
+    def nA(self) -> int:
+        """Classic toy-text envs' number of actions (`action_space.n`)."""
+        return self._discrete_size("nA", self.gymnasium_env.action_space)
+
+    def _discrete_size(self, name: str, space: spaces.Space[Any]) -> int:
+        if not isinstance(space, spaces.Discrete):
+            raise AttributeError(f"the {self.requested_id} environment has no attribute {name!r}")
+        return int(space.n)
 
     @property
     def np_random(self) -> np.random.Generator:
         """The environment's random generator."""
-        return self.env.np_random
+        return self.gymnasium_env.np_random
+
+    @property
+    def env(self) -> ClassicEnv:
+        """Classic `gym.make(id).env`: the same environment without the time limit (one view, kept).
+
+        Classic gym wrapped every made env in `TimeLimit`; the second lab's early texts step
+        `gym.make(name).env` so that FrozenLake episodes run to their end. The view steps the same
+        gymnasium env (so a recorder sees every step) and ignores the truncation the limit reports.
+        """
+        if not self.time_limit:
+            raise AttributeError(f"the {self.requested_id} environment has no attribute 'env'")
+        if self._inner_view is None:
+            self._inner_view = ClassicEnv(self.gymnasium_env, self.requested_id, self.api, time_limit=False)
+        return self._inner_view
+
+    def _cut_by_time_limit(self) -> bool:
+        limit = self._time_limit()
+        elapsed = None if limit is None else limit._elapsed_steps
+        return limit is not None and elapsed is not None and elapsed >= limit._max_episode_steps
 
     @property
     def _max_episode_steps(self) -> int | None:
         """Classic `TimeLimit`'s step limit, which classic code read (and set) on the env; None if none."""
-        limit = self._time_limit()
+        limit = self._time_limit() if self.time_limit else None
         return None if limit is None else limit._max_episode_steps
 
     @_max_episode_steps.setter
@@ -232,7 +282,7 @@ class ClassicEnv:
         limit._max_episode_steps = steps
 
     def _time_limit(self) -> TimeLimit[Any, Any] | None:
-        env = self.env
+        env = self.gymnasium_env
         while isinstance(env, gymnasium.Wrapper):
             if isinstance(env, TimeLimit):
                 return env
@@ -242,9 +292,11 @@ class ClassicEnv:
     def __getattr__(self, name: str) -> Any:
         if name.startswith("_"):
             raise AttributeError(f"accessing private attribute {name!r} of a gym environment is prohibited")
-        env = self.__dict__.get("env")
+        env = self.__dict__.get("gymnasium_env")
         if env is None:
             raise AttributeError(name)
+        if name == "env":  # only when the property refused: the view has no inner env
+            raise AttributeError(f"the {self.requested_id} environment has no attribute 'env'")
         try:
             return env.get_wrapper_attr(name)
         except AttributeError:
@@ -257,4 +309,4 @@ class ClassicEnv:
         self.close()
 
     def __repr__(self) -> str:
-        return f"<ClassicEnv{self.env}>"
+        return f"<ClassicEnv{self.gymnasium_env}>"

@@ -12,6 +12,9 @@ LEGACY_SEED_CALL = "legacy_seed_call"
 RENAMED_ID = "renamed_id"
 SEED_REPLACED = "seed_replaced"
 API_DETECTED = "api_detected"
+WRAPPER_ATTRIBUTE = "wrapper_attribute"
+"""An attribute of the env inside gymnasium's wrappers read on the outer env (`env.P`): gymnasium 1.x no
+longer forwards such reads, gym and gymnasium before 1.0 did, and the second lab's texts rely on it."""
 ENV_OBJECT_PASSED = "env_object"
 """Not the lab's API but the grader's call: a function given an environment's name failed on it before
 making or playing anything, so it was called again with an env object (`EnvArgument`'s `name_or_object`)."""
@@ -25,6 +28,7 @@ KINDS = (
     RENAMED_ID,
     SEED_REPLACED,
     API_DETECTED,
+    WRAPPER_ATTRIBUTE,
     ENV_OBJECT_PASSED,
 )
 

@@ -255,6 +255,28 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         self._episode: EpisodeRecord | None = None
         self._fresh = False
 
+    def __getattr__(self, name: str) -> Any:
+        """Read a public attribute of the wrapped envs (`env.P`, `env.nrow`), as gym and gymnasium before
+        1.0 forwarded it and the second lab's texts (`dictionary_P = env.P`) expect; a compat event says so.
+
+        Only reads reach here (names this wrapper lacks); private names are refused as gymnasium refuses
+        them. Nothing new is exposed: `env.unwrapped` gives the same objects.
+        """
+        env = self.__dict__.get("env")
+        if name.startswith("_"):
+            raise AttributeError(f"accessing private attribute {name!r} of a gym environment is prohibited")
+        if env is None:
+            raise AttributeError(name)
+        value = env.get_wrapper_attr(name)
+        made = self.__dict__.get("made")
+        compat_events.record(
+            compat_events.WRAPPER_ATTRIBUTE,
+            f"{made.requested_id if made is not None else 'env'}: env.{name}",
+            f"env.{name} was read through gymnasium's wrappers, which gymnasium 1.x no longer forwards; "
+            f"the grader forwarded it (env.unwrapped.{name} works everywhere)",
+        )
+        return value
+
     def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset with the next seed of the grader's stream, whatever seed the student passed.
 

@@ -155,13 +155,13 @@ def test_numpy_integer_actions_become_ints(action: Any) -> None:
     env = make("Taxi-v3")
     env.reset(seed=0)
     taken: list[Any] = []
-    real_step = env.env.step
+    real_step = env.gymnasium_env.step
 
     def spy(step_action: Any) -> Any:
         taken.append(step_action)
         return real_step(step_action)
 
-    env.env.step = spy  # type: ignore[method-assign]
+    env.gymnasium_env.step = spy  # type: ignore[method-assign]
     env.step(action)
     assert [type(value) for value in taken] == [int]
     assert _kinds() == [events.NUMPY_ACTION]
@@ -227,6 +227,44 @@ def test_attributes_are_read_through_the_wrapper_stack() -> None:
     env = make("Taxi-v3")
     env.reset(seed=0)
     assert (len(env.P), env.s) == (500, env.unwrapped.s)
+
+
+@pytest.mark.parametrize(
+    ("env_id", "sizes"),
+    [("FrozenLake-v0", (16, 4)), ("FrozenLake8x8-v0", (64, 4)), ("Taxi-v3", (500, 6))],
+    ids=["FrozenLake-v0", "FrozenLake8x8-v0", "Taxi-v3"],
+)
+def test_classic_toy_text_sizes_are_served(env_id: str, sizes: tuple[int, int]) -> None:
+    env = make(env_id)
+    assert (env.nS, env.nA) == sizes
+    assert len(env.P) == sizes[0]  # the 2018 lab: value_iteration(env.P, env.nS, env.nA)
+
+
+def test_env_env_is_the_same_environment_without_its_time_limit() -> None:
+    outer = make("FrozenLake-v0", is_slippery=False)
+    inner = outer.env  # the 2018 lab: env = gym.make("FrozenLake-v0").env
+    assert inner is outer.env and isinstance(inner, type(outer))
+    assert (inner.nS, inner.nA, len(inner.P), inner._max_episode_steps) == (16, 4, 16, None)
+    assert outer._max_episode_steps == 100
+    assert inner.reset() == 0
+    for _ in range(150):  # left from the start bumps into the wall forever
+        observation, reward, done, _info = inner.step(0)
+        assert (observation, reward, done) == (0, 0.0, False)
+    with pytest.raises(AttributeError, match="has no attribute 'env'"):
+        _ = inner.env
+
+
+def test_the_outer_env_keeps_its_time_limit() -> None:
+    outer = make("FrozenLake-v0", is_slippery=False)
+    outer.reset()
+    dones = [outer.step(0)[2] for _ in range(100)]
+    assert dones == [False] * 99 + [True]
+
+
+def test_sizes_of_a_continuous_space_are_missing_attributes() -> None:
+    with pytest.raises(AttributeError) as raised:
+        _ = make("CartPole-v0").nS
+    assert str(raised.value) == "the CartPole-v0 environment has no attribute 'nS'"
 
 
 def test_private_attributes_are_not_forwarded() -> None:

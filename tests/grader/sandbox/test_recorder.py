@@ -21,7 +21,7 @@ from grader.sandbox.child.log_block import log_block
 from grader.sandbox.child.recorder import EpisodeRecord, MadeEnv, Recorder, RecordingEnv
 from grader.sandbox.child.seeding import derive_call_seed, reset_seeds
 from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
-from grader.sandbox.replay import verify_reset_seeds
+from grader.sandbox.replay import replay_episode, verify_reset_seeds
 
 STUDENT = textwrap.dedent("""
     import random
@@ -73,6 +73,29 @@ STUDENT = textwrap.dedent("""
 
     def gymnasium_retired_id():
         gymnasium.make("Taxi-v2")
+
+
+    def classic_env_env_without_time_limit():
+        env = gym.make("FrozenLake-v0", is_slippery=False).env  # the 2018 lab's idiom
+        env.reset()
+        dones = [env.step(0)[2] for _ in range(120)]  # left at the start: against the wall
+        for action in (1, 1, 2, 1, 2, 2):  # down, down, right, down, right, right: the goal
+            observation, reward, done, _ = env.step(action)
+        return [any(dones), env.nS, observation, reward, done]
+
+
+    def gymnasium_frozen_lake_table():
+        env = gymnasium.make("FrozenLake-v1", map_name="8x8", is_slippery=True)
+        table = env.P  # the second lab's texts read P on gym.make's env
+        return [len(table), len(table[0][0]), env.nrow, env.observation_space.n]
+
+
+    def private_attribute():
+        env = gymnasium.make("FrozenLake-v1")
+        try:
+            env._secret_of_the_env
+        except AttributeError as error:
+            return str(error)  # caught here: a traceback would keep the env alive into later calls
 
 
     def from_spec():
@@ -246,6 +269,36 @@ def test_retired_ids_through_plain_gymnasium_name_the_lab_id(child: ChildClient)
 
     assert result is not None and result["status"] == "exception"
     assert "Taxi-v2 was retired before this lab; the lab uses Taxi-v3" in result["message"]
+
+
+def test_env_attributes_are_read_through_gymnasium_s_wrappers_and_reported(child: ChildClient) -> None:
+    result = child.call("gymnasium_frozen_lake_table", seed=1)
+    assert value_of(result) == [64, 3, 8, 64]
+    events = {event["env_id"]: event["detail"] for event in result["compat_events"]}  # type: ignore[index]
+    assert events["FrozenLake-v1: env.P"] == (
+        "env.P was read through gymnasium's wrappers, which gymnasium 1.x no longer forwards; the grader "
+        "forwarded it (env.unwrapped.P works everywhere)"
+    )
+    assert "FrozenLake-v1: env.nrow" in events
+
+
+def test_classic_env_env_runs_past_the_time_limit_and_replays(child: ChildClient) -> None:
+    result = child.call("classic_env_env_without_time_limit", seed=2)
+    assert value_of(result) == [False, 16, 15, 1.0, True]
+    (log,) = episodes_of(result)
+    assert log.steps == 126 and log.truncated[99] and log.rewards[-1] == 1.0
+    replayed = replay_episode(log)
+    # The log agrees with the real env step for step; the replay's episode ends where gym.make's limit cut
+    # it (step 100), and the 26 steps the view took past it are counted, not lost.
+    assert (replayed.matches, replayed.length, replayed.steps_after_done) == (True, 100, 26)
+
+
+def test_private_env_attributes_are_not_forwarded(child: ChildClient) -> None:
+    result = child.call("private_attribute", seed=1)
+    assert (
+        value_of(result)
+        == "accessing private attribute '_secret_of_the_env' of a gym environment is prohibited"
+    )
 
 
 def test_envs_made_from_specs_are_recorded(child: ChildClient) -> None:
