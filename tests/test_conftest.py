@@ -57,11 +57,11 @@ MODULE_SKIP = """
     ("source", "ci", "extra", "exit_code", "named"),
     [
         (NEEDS_REDIS, "true", (), 1, "test_needs_redis: could not start redis-server: not installed"),
-        (NEEDS_REDIS, "true", ("-n", "2"), 1, "test_needs_redis: could not start redis-server: not installed"),
+        (NEEDS_REDIS, "true", ("-p", "xdist.plugin", "-n", "2"), 1, "test_needs_redis: could not start redis-server: not installed"),
         (NEEDS_REDIS, "", (), 0, None),
         (NEEDS_REDIS, "false", (), 0, None),
         (DECLARED, "true", (), 0, None),
-        (DECLARED, "true", ("-n", "2"), 0, None),
+        (DECLARED, "true", ("-p", "xdist.plugin", "-n", "2"), 0, None),
         (DECLARED_FOR_ANOTHER_REASON, "true", (), 1, "test_as_root: needs a Debian machine"),
         (XFAIL, "true", (), 0, None),
         (MODULE_SKIP, "true", (), 1, "test_module.py: pip install a_module_nobody_has"),
@@ -81,6 +81,7 @@ def test_skips_under_ci(
     named: str | None,
 ) -> None:
     monkeypatch.setenv("CI", ci)
+    monkeypatch.setenv("PYTEST_DISABLE_PLUGIN_AUTOLOAD", "1")  # the installed plugins' start-up, ~10 s a run
     pytester.makeconftest(CONFTEST.read_text(encoding="utf-8"))
     pytester.makepyfile(test_module=textwrap.dedent(source))
 
