@@ -25,6 +25,8 @@ from grader.grading.session import run_session
 from grader.report import ProblemRun
 from grader.sandbox import IsolationPolicy
 
+pytestmark = pytest.mark.slow  # each test runs a nested pytest-xdist session
+
 ENDLESS = "def car():\n    while True:\n        pass\n"
 
 

@@ -13,6 +13,8 @@ from child_client import ChildClient, write_submission
 
 from grader.sandbox.child.frames import decode_value
 
+pytestmark = pytest.mark.slow  # starts the child harness as a process, one per test in part
+
 ROOT = Path(__file__).resolve().parents[3]
 
 STUDENT = textwrap.dedent("""
