@@ -36,7 +36,7 @@ def _skip_reason(report: pytest.TestReport | pytest.CollectReport) -> str:
 
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> pytest.TestReport:
-    # Runs where the test ran (an xdist worker too); user_properties travel to the controller with the report.
+    # Runs where the test ran (an xdist worker too); user_properties travel with the report to the controller.
     report: pytest.TestReport = yield
     if report.skipped and not hasattr(report, "wasxfail"):
         reason = _skip_reason(report)
@@ -75,5 +75,6 @@ def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter, config: p
         terminalreporter.line(f"SKIPPED (unexpected) {nodeid}: {reason}")
     terminalreporter.line(
         f"{len(_unexpected)} test(s) skipped under CI=true: install or start what they need "
-        f"(scripts/setup.sh), or declare the skip with @pytest.mark.{EXPECTED_SKIP}(\"<start of its reason>\")."
+        f"(scripts/setup.sh), or declare the skip with "
+        f'@pytest.mark.{EXPECTED_SKIP}("<start of its reason>").'
     )

@@ -12,6 +12,8 @@ pytest_plugins = ("pytester",)
 
 CONFTEST = Path(__file__).with_name("conftest.py")
 
+XDIST = ("-p", "xdist.plugin", "-n", "2")
+REDIS_MISSING = "test_needs_redis: could not start redis-server: not installed"
 NEEDS_REDIS = """
     import pytest
 
@@ -56,12 +58,12 @@ MODULE_SKIP = """
 @pytest.mark.parametrize(
     ("source", "ci", "extra", "exit_code", "named"),
     [
-        (NEEDS_REDIS, "true", (), 1, "test_needs_redis: could not start redis-server: not installed"),
-        (NEEDS_REDIS, "true", ("-p", "xdist.plugin", "-n", "2"), 1, "test_needs_redis: could not start redis-server: not installed"),
+        (NEEDS_REDIS, "true", (), 1, REDIS_MISSING),
+        (NEEDS_REDIS, "true", XDIST, 1, REDIS_MISSING),
         (NEEDS_REDIS, "", (), 0, None),
         (NEEDS_REDIS, "false", (), 0, None),
         (DECLARED, "true", (), 0, None),
-        (DECLARED, "true", ("-p", "xdist.plugin", "-n", "2"), 0, None),
+        (DECLARED, "true", XDIST, 0, None),
         (DECLARED_FOR_ANOTHER_REASON, "true", (), 1, "test_as_root: needs a Debian machine"),
         (XFAIL, "true", (), 0, None),
         (MODULE_SKIP, "true", (), 1, "test_module.py: pip install a_module_nobody_has"),

@@ -195,12 +195,11 @@ def test_a_real_worker_grades_through_the_real_sandbox(tmp_path: Path, redis_ser
     if not isolation.full:
         pytest.skip("needs full isolation:\n" + isolation.summary())
     url = redis_server.new_url()
-    env = service_environment(
-        tmp_path / "data", "grader.grading.grade:grade_submission", broker_url=url, allow_weak_isolation=0, nice=0
-    )
+    real_grader = "grader.grading.grade:grade_submission"
+    env = service_environment(tmp_path / "data", real_grader, broker_url=url, allow_weak_isolation=0, nice=0)
     worker = LiveProcess("worker", env, tmp_path / "worker.log").start(wait_for_http=False)
     try:
-        deadline = time.monotonic() + READY_SECONDS  # bounds a hang only: the loop ends when the log says ready
+        deadline = time.monotonic() + READY_SECONDS  # bounds a hang only: the loop ends at the log's "ready"
         while not re.search(r"gymgrade-\d+@\S+ ready", worker.log()):
             assert time.monotonic() < deadline, worker.log()
             time.sleep(0.1)

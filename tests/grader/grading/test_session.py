@@ -178,7 +178,9 @@ def test_ctrl_c_during_a_session_reaches_the_caller(tmp_path: Path) -> None:
     finally:
         session_over.set()
     watcher.join()
-    assert pressed.is_set() and not hung.is_set(), "an interrupted session must not wait for its endless check"
+    assert pressed.is_set() and not hung.is_set(), (
+        "an interrupted session must not wait for its endless check"
+    )
     assert workers and _gone(workers), "no worker may outlive the interrupted session"
 
 
