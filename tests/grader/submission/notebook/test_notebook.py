@@ -378,6 +378,7 @@ def test_the_death_of_the_reading_child_is_worded(returncode: int, stderr: bytes
     assert bounded._death(returncode, stderr) == expected
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_a_batch_with_poisoned_notebooks_grades_every_honest_one(tmp_path: Path) -> None:
     inputs = tmp_path / "inputs"
     inputs.mkdir()
