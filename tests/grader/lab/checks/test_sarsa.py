@@ -86,6 +86,7 @@ def epsilon_decay_zero_based(lab: Lab, episode: int, n: int, start: float = 1.0,
     return start - episode * (start - end) / n
 
 
+@pytest.mark.slow  # trains sarsa0 for real, minutes
 def test_a_wrong_epsilon_decay_is_not_counted_again(seed: int) -> None:
     """The decay call is judged against the student's own schedule: problem 5 counts the mistake."""
     learner = students.learner(schedule=epsilon_decay_zero_based)

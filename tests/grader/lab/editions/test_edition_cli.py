@@ -84,6 +84,7 @@ def test_grade_without_an_edition_grades_the_one_the_files_show(
     assert statuses == {"alice": "passed", "bob": "missing", "carol": "missing"}
 
 
+@pytest.mark.slow  # reads a class through the CLI
 def test_grade_stops_before_grading_when_the_files_show_editions_of_different_problems(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
