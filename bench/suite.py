@@ -45,6 +45,7 @@ def measure(extra: list[str], everything: bool) -> dict[str, object]:
         "cpu": usage.ru_utime + usage.ru_stime,
         "load": (load_before, os.getloadavg()[0]),
         "summary": summary.strip("= "),
+        "tail": "\n".join(done.stdout.splitlines()[-60:]),  # the --durations list, when asked for
     }
 
 
@@ -69,6 +70,7 @@ def main() -> int:
     arguments = parser.parse_args()
     result = measure(arguments.pytest_args, arguments.all)
     text = section(result)
+    print(result["tail"])
     print(text)
     if arguments.write:
         replace_section(HEADING, text)

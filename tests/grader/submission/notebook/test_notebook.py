@@ -460,6 +460,7 @@ def test_a_notebook_is_parsed_once_in_the_reader_and_never_in_the_parent(
     ]
 
 
+@pytest.mark.slow  # starts the reader child for every sample notebook
 @pytest.mark.parametrize("sample", sorted(path.name for path in NOTEBOOKS.glob("*.ipynb")))
 def test_a_module_built_from_kept_cells_is_the_module_built_from_the_file(sample: str) -> None:
     data = (NOTEBOOKS / sample).read_bytes()
