@@ -85,9 +85,9 @@ def _run(argv: list[str], project: Path, environment: dict[str, str], prefix: tu
     result = subprocess.run(
         [*prefix, *argv], cwd=project, env=environment, capture_output=True, text=True, timeout=900
     )
-    assert result.returncode in (0, 1), (
-        f"{argv} exited {result.returncode}:\n{result.stdout}\n{result.stderr}"
-    )
+    # setup.sh exits non-zero when any step fails (set -e); `gymgrade check` exits 0 on full marks,
+    # which the one cheap problem of the lab-literal file earns: anything else is a failure here.
+    assert result.returncode == 0, f"{argv} exited {result.returncode}:\n{result.stdout}\n{result.stderr}"
     return result.stdout
 
 
@@ -140,6 +140,7 @@ def test_a_virtualenv_under_tmp_grades_with_full_isolation(tmp_path: Path) -> No
 @pytest.mark.slow
 @pytest.mark.install
 @pytest.mark.sandbox
+@pytest.mark.expected_skip("already unprivileged")  # the test that runs as root drops to another user
 def test_an_unprivileged_user_grades_with_the_strongest_isolation_available_and_names_the_rest() -> None:
     reason = _debian_python()
     if reason is not None:

@@ -1,4 +1,5 @@
-"""`gymgrade grade` on the cluster: a real redis-server and `gymgrade worker`, the fake grader.
+"""`gymgrade grade` on the cluster: a real redis-server and `gymgrade worker`, the fake grader (and once
+the real grader, through the real sandbox under full isolation).
 
 The batch core is the local one (tests/grader/grading/test_batch.py); these tests pin that the cluster's
 executor hands every report back, that a re-run resumes, and that an interrupted batch keeps what it finished.
@@ -178,3 +179,47 @@ def test_the_workers_are_sent_the_configuration_the_batch_checked(tmp_path: Path
     config.write_text("[problems.car\n", encoding="utf-8")
     with pytest.raises(ConfigError, match="cannot read the assignment configuration"):
         configuration_text(plan)
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.slow
+@pytest.mark.sandbox
+def test_a_real_worker_grades_through_the_real_sandbox(tmp_path: Path, redis_server: RedisServer) -> None:
+    """The cluster with the real grader: a `gymgrade worker` on the service's default grader, full isolation
+    required, one cheap problem; the honest file passes and the mistaken one fails with its diagnosis."""
+    from grader.sandbox import probe_isolation
+
+    isolation = probe_isolation()
+    if not isolation.full:
+        pytest.skip("needs full isolation:\n" + isolation.summary())
+    url = redis_server.new_url()
+    real_grader = "grader.grading.grade:grade_submission"
+    env = service_environment(tmp_path / "data", real_grader, broker_url=url, allow_weak_isolation=0, nice=0)
+    worker = LiveProcess("worker", env, tmp_path / "worker.log").start(wait_for_http=False)
+    try:
+        deadline = time.monotonic() + READY_SECONDS  # bounds a hang only: the loop ends at the log's "ready"
+        while not re.search(r"gymgrade-\d+@\S+ ready", worker.log()):
+            assert time.monotonic() < deadline, worker.log()
+            time.sleep(0.1)
+        inputs = tmp_path / "inputs"
+        inputs.mkdir()
+        honest = (ROOT / "submissions" / "classic_complete.py").read_bytes()
+        mistaken = (ROOT / "submissions" / "mistakes" / "random_blackjack_average_reward.py").read_bytes()
+        (inputs / "ada.py").write_bytes(honest)
+        (inputs / "bob.py").write_bytes(mistaken)
+        executor = CeleryExecutor(BrokerSettings(broker_url=url), IsolationPolicy.REQUIRE_FULL)
+
+        outcome = grade_many(
+            sorted(inputs.glob("*.py")), tmp_path / "out", only=["random_blackjack"], executor=executor
+        )
+    finally:
+        worker.stop()
+
+    ada, bob = outcome.reports
+    assert (ada.grader_errors, bob.grader_errors) == ([], []), worker.log()
+    assert ada.isolation is not None and ada.isolation.full, worker.log()
+    assert [(result.id, result.status) for result in ada.problems] == [("random_blackjack", "passed")]
+    assert [(result.id, result.status) for result in bob.problems] == [("random_blackjack", "failed")]
+    assert "it equals the average reward" in bob.problems[0].feedback

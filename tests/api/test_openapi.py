@@ -16,6 +16,8 @@ from api.main import create_app
 from api.settings import Settings
 from api.students import create_student
 
+pytestmark = pytest.mark.slow  # schemathesis generates requests against the app on both databases
+
 EXAMPLES_PER_OPERATION = 30
 
 

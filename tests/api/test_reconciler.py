@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import pytest
 from api_testing import SettingsFactory
 from sqlalchemy.orm import Session, sessionmaker
-from test_local_queue import _submit
+from test_local_queue import _submit, expire_lease
 
 from api.database import make_engine, make_session_factory, migrate
 from api.jobs.local import DatabaseQueue
@@ -43,10 +42,10 @@ def test_only_rows_without_a_task_for_their_current_attempt_are_enqueued(
     sessions: sessionmaker[Session],
 ) -> None:
     queued_with_task, queued_lost, live, dead, done = _submit(sessions, 5)
-    queue = DatabaseQueue(sessions, lease_seconds=0.3, max_attempts=3)
+    queue = DatabaseQueue(sessions, lease_seconds=60, max_attempts=3)
     dispatcher = FakeDispatcher(marked={queued_with_task: 0, live: 0, dead: 0, done: 0})
     assert queue.claim("dead-worker", dead) is not None
-    time.sleep(0.4)  # the dead worker's lease runs out
+    expire_lease(sessions, dead)  # the dead worker's lease runs out
     assert queue.claim("live-worker", live) is not None
     assert queue.claim("w", done) is not None and queue.complete(done, "w", {"problems": []})
 

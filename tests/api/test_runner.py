@@ -16,6 +16,8 @@ from api.jobs.runner import run_job
 from api.models import Student, Submission, utcnow
 from api.settings import Settings
 
+pytestmark = pytest.mark.slow  # grades claimed jobs in child processes
+
 SOLUTION = b"def random_blackjack(n):\n    return 0.3\n\ndef blackjack(n=11):\n    return 0.4\n"
 
 

@@ -253,6 +253,7 @@ def test_each_submission_stores_its_grading_seed(
         assert len(set(seeds)) == 3 and all(1 <= seed < 2**31 for seed in seeds)
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_notebooks_are_accepted_and_graded_under_their_own_name(client: TestClient) -> None:
     token = add_student(client, "ada")
     notebook = (SUBMISSIONS / "notebooks" / "classic_complete.ipynb").read_bytes()

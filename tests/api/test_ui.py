@@ -80,6 +80,7 @@ def test_the_instructor_sees_everyone_and_the_gradebook_link(client: TestClient)
     assert client.post("/ui/submissions", files={"file": ("a.py", SOLUTION)}).status_code == 403
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_upload_then_watch_the_checks_complete(make_settings: SettingsFactory) -> None:
     settings = make_settings(workers=1)
     with TestClient(create_app(settings)) as client:

@@ -39,6 +39,7 @@ def _page_problems(results: list[ProblemResult]) -> list[dict[str, Any]]:
     return [{**result.model_dump(mode="json"), "seed": None} for result in results]
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_each_problem_shows_the_html_reports_figures_byte_for_byte() -> None:
     results = _results()
     shown = page_figures(_page_problems(results), "classic")

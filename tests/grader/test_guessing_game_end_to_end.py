@@ -11,6 +11,8 @@ from grader.grading.grade import grade_submission
 from grader.grading.plan import GradingPlan
 from grader.sandbox import IsolationPolicy
 
+pytestmark = pytest.mark.slow  # grades through the real sandbox
+
 HONEST = SUBMISSIONS / "guessing_game.py"
 
 

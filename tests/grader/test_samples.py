@@ -24,6 +24,8 @@ from grader.lab.problems import PROBLEM_IDS, ProblemId
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
 
+pytestmark = pytest.mark.slow  # grades every sample submission through the real sandbox
+
 VERDICTS = SUBMISSIONS / "verdicts.toml"
 HONEST_VERDICTS = SUBMISSIONS / "honest" / "verdicts.toml"
 HOSTILE_OUTCOMES = SUBMISSIONS / "hostile" / "outcomes.toml"

@@ -60,6 +60,7 @@ def five_calls(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return write_config(tmp_path_factory.mktemp("config") / "assignment.toml", {"cartpole": {"calls": 5}})
 
 
+@pytest.mark.slow  # a grading through the sandbox
 @pytest.mark.parametrize(
     ("seed", "status"),
     [(PRACTICE_SEED, "passed"), (HELD_OUT, "failed")],

@@ -41,6 +41,7 @@ def test_long_episodes_are_thinned_but_keep_the_last_frame(tmp_path: Path) -> No
         assert np.asarray(image.convert("RGB"))[0, 400].tolist() == [255, 255, 255]
 
 
+@pytest.mark.slow  # plays and draws every figure
 def test_command_writes_all_figures(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["--out", str(tmp_path), "--games", "20", "--seed", "3"]) == 0
     names = sorted(path.name for path in tmp_path.iterdir())

@@ -6,6 +6,8 @@ import pytest
 
 from reference.__main__ import main
 
+pytestmark = pytest.mark.slow  # runs the reference command end to end
+
 
 def test_main_job_runs_every_solution_and_prints_the_oracle_table(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["--quick", "--seed", "5"]) == 0

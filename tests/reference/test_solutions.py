@@ -70,6 +70,7 @@ def test_plain_calls_work() -> None:
     assert solutions.car() < 180
 
 
+@pytest.mark.slow  # trains a Q-table, seconds
 def test_find_qvalues_learns_something(seed: int) -> None:
     q_table = solutions.find_qvalues("Taxi-v4", episodes=2_000, seed=seed)
     assert q_table.shape == (500, 6)

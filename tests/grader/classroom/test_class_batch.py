@@ -116,6 +116,7 @@ def fast_config(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return write_config(tmp_path_factory.mktemp("config") / "fast.toml", FAST_OVERRIDES)
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_gymgrade_grade_a_canvas_zip_into_every_gradebook(
     tmp_path: Path, fast_config: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -184,6 +185,7 @@ def test_an_interrupted_batch_leaves_gradebooks_with_every_finished_report(
     )  # eve: nothing graded
 
 
+@pytest.mark.slow  # a grading through the sandbox
 @pytest.mark.parametrize("layout", list(BUILDERS), ids=list(BUILDERS))
 def test_gymgrade_grade_each_layout_into_every_gradebook(
     layout: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]

@@ -312,6 +312,7 @@ def _controls(text: str) -> list[str]:
     ]
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_control_characters_a_student_raised_and_printed_are_inert(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -334,6 +335,7 @@ def test_control_characters_a_student_raised_and_printed_are_inert(
         assert line in text.splitlines() or any(line in shown for shown in text.splitlines())
 
 
+@pytest.mark.slow  # builds two bundles and runs one's autograder end to end
 def test_each_bundle_draws_its_own_secret_and_keeps_it_private(tmp_path: Path) -> None:
     first, second = bundle(tmp_path / "a.zip", config=None), bundle(tmp_path / "b.zip", config=None)
     assert bundle_secret(first) != bundle_secret(second) and len(bundle_secret(first)) == 64

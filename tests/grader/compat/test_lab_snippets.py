@@ -77,6 +77,7 @@ def test_acrobot_render_loop_runs_headless_and_ends(run_through_layer: RunScript
     assert _event_lines(result.stderr) == ["render_without_mode [Acrobot-v1]", "numpy_action [Acrobot-v1]"]
 
 
+@pytest.mark.slow  # trains a Q-table, seconds
 def test_find_qvalues_as_printed_in_the_lab_trains_a_taxi_table(run_through_layer: RunScript) -> None:
     code = _snippet("find_qvalues.py")
     assert "range(1,100001)" in code
@@ -149,6 +150,7 @@ def test_a_retired_id_names_the_lab_id(run_through_layer: RunScript) -> None:
     )
 
 
+@pytest.mark.slow  # runs the whole lab solution
 def test_the_classic_complete_sample_submission_runs_through_the_layer(run_through_layer: RunScript) -> None:
     """Its functions on small inputs (running the whole file takes minutes: 100 000 Q-learning episodes)."""
     submission = SNIPPETS.parent / "classic_complete.py"

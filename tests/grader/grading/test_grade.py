@@ -27,6 +27,8 @@ from grader.sandbox import IsolationPolicy
 from grader.sandbox.errors import IsolationUnavailable
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 
+pytestmark = pytest.mark.slow  # each test grades through pytest-xdist sessions and the sandbox
+
 BAD_FILES = [
     ("empty.py", b"", "missing", "empty.py is empty: nothing to grade."),
     ("image.py", b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "error", "image.py is not a text file"),

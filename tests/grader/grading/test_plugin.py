@@ -161,6 +161,7 @@ def test_an_unreadable_outcome_is_the_graders_own_failure(carried: object) -> No
     assert CASE_OUTCOME.validate_json(outcome_json(outcome)) == outcome
 
 
+@pytest.mark.slow  # grades through pytest-xdist sessions
 def test_serial_and_parallel_runs_give_the_same_report(reports: dict[str, Report]) -> None:
     serial, parallel = reports["serial"], reports["parallel"]
     assert [problem.id for problem in serial.problems] == list(PROBLEMS)
@@ -168,6 +169,7 @@ def test_serial_and_parallel_runs_give_the_same_report(reports: dict[str, Report
     assert serial.graded_view() == parallel.graded_view()
 
 
+@pytest.mark.slow  # grades through pytest-xdist sessions
 def test_a_grading_is_a_function_of_bytes_and_seed(reports: dict[str, Report]) -> None:
     def seeds_and_measurements(report: Report) -> list[tuple[int, dict[str, Any]]]:
         return [(problem.seed, problem.measurements) for problem in report.problems]
@@ -177,6 +179,7 @@ def test_a_grading_is_a_function_of_bytes_and_seed(reports: dict[str, Report]) -
     assert first != second, "a different grading seed must play different episodes"
 
 
+@pytest.mark.slow  # grades through pytest-xdist sessions
 def test_every_check_reports_its_timings_apart_from_the_verdict(reports: dict[str, Report]) -> None:
     report = reports["parallel"]
     assert report.timings is not None and report.timings.workers == 2
@@ -229,6 +232,7 @@ def _vanished_report(plan: GradingPlan, tmp_path: Path) -> Report:
     return report
 
 
+@pytest.mark.slow  # grades through pytest-xdist sessions
 def test_a_grader_failure_is_reported_as_such(plan: GradingPlan, tmp_path: Path) -> None:
     report = _vanished_report(GradingPlan.load(plan.config, ["car"]), tmp_path)
     [result] = report.problems
@@ -237,12 +241,14 @@ def test_a_grader_failure_is_reported_as_such(plan: GradingPlan, tmp_path: Path)
     assert result.feedback.startswith("The grader failed while checking this problem (not your code's fault)")
 
 
+@pytest.mark.slow  # grades through pytest-xdist sessions
 def test_a_grader_failure_keeps_the_problems_visibility(tmp_path: Path) -> None:
     config = write_config(tmp_path / "assignment.toml", {"car": {"visibility": "hidden"}})
     [result] = _vanished_report(GradingPlan.load(config, ["car"]), tmp_path).problems
     assert (result.status, result.visibility) == ("error", "hidden")
 
 
+@pytest.mark.slow  # grades through pytest-xdist sessions
 def test_the_workers_grade_with_the_plans_configuration_even_if_its_file_is_gone(tmp_path: Path) -> None:
     config = write_config(tmp_path / "assignment.toml", {"car": {"points": 3.0, "visibility": "hidden"}})
     plan = GradingPlan.load(config, ["car"])

@@ -25,6 +25,8 @@ from grader.grading.session import run_session
 from grader.report import ProblemRun
 from grader.sandbox import IsolationPolicy
 
+pytestmark = pytest.mark.slow  # each test runs a nested pytest-xdist session
+
 ENDLESS = "def car():\n    while True:\n        pass\n"
 
 
@@ -54,21 +56,26 @@ def faulty_workers(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     return ["faulty_worker"]
 
 
-def _children() -> set[int]:
-    """Live processes whose parent is this one."""
+HANG_SECONDS = 300
+"""Bounds a hang only: waits poll for an event and end as soon as it happens."""
+
+
+def _children(parent: int | None = None) -> set[int]:
+    """Live processes whose parent is `parent` (this process by default)."""
+    parent = os.getpid() if parent is None else parent
     found = set()
     for entry in Path("/proc").iterdir():
         try:
             fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
         except (OSError, ValueError):
             continue
-        if fields[0] != "Z" and int(fields[1]) == os.getpid():
+        if fields[0] != "Z" and int(fields[1]) == parent:
             found.add(int(entry.name))
     return found
 
 
-def _gone(pids: set[int], seconds: float = 10) -> bool:
-    deadline = time.monotonic() + seconds
+def _gone(pids: set[int]) -> bool:
+    deadline = time.monotonic() + HANG_SECONDS
     while pids & _children() and time.monotonic() < deadline:
         time.sleep(0.1)
     return not pids & _children()
@@ -147,19 +154,33 @@ def test_ctrl_c_during_a_session_reaches_the_caller(tmp_path: Path) -> None:
     workers: set[int] = set()
     before = _children()  # processes earlier tests of this run left as children (servers, fixtures)
 
-    def press_ctrl_c() -> None:
-        workers.update(_children() - before)
-        os.kill(os.getpid(), signal.SIGINT)
+    pressed, session_over, hung = threading.Event(), threading.Event(), threading.Event()
 
-    started = time.monotonic()
-    timer = threading.Timer(4.0, press_ctrl_c)
-    timer.start()
+    def press_ctrl_c_once_the_check_runs() -> None:
+        # The event: a worker has started the student's child, which loops forever.
+        deadline = time.monotonic() + HANG_SECONDS
+        while not any(_children(worker) for worker in _children() - before) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        workers.update(_children() - before)
+        pressed.set()
+        os.kill(os.getpid(), signal.SIGINT)
+        # Bounds a hang only: a session that waited for its endless check would never return.
+        if not session_over.wait(HANG_SECONDS):
+            hung.set()
+            for worker in workers & _children():
+                os.kill(worker, signal.SIGKILL)
+
+    watcher = threading.Thread(target=press_ctrl_c_once_the_check_runs, daemon=True)
+    watcher.start()
     try:
         with pytest.raises(KeyboardInterrupt):
             run_session(plan, workers=1, on_outcome=lambda case, outcome: None)
     finally:
-        timer.cancel()
-    assert time.monotonic() - started < 15, "an interrupted session must not wait for its endless check"
+        session_over.set()
+    watcher.join()
+    assert pressed.is_set() and not hung.is_set(), (
+        "an interrupted session must not wait for its endless check"
+    )
     assert workers and _gone(workers), "no worker may outlive the interrupted session"
 
 

@@ -85,6 +85,7 @@ def _play(
     return episodes
 
 
+@pytest.mark.slow  # plays every taxi variant against gymnasium, seconds each
 @pytest.mark.parametrize(
     "kwargs",
     [{}, {"is_rainy": True}, {"fickle_passenger": True}, {"is_rainy": True, "fickle_passenger": True}],

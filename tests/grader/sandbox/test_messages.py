@@ -3,7 +3,6 @@ refused with a sentence saying where and what, strings are cleaned on the way in
 
 from __future__ import annotations
 
-import time
 from typing import Any, get_args
 
 import pytest
@@ -177,13 +176,12 @@ FORGED_RESULT = [
 
 
 def test_too_many_events_are_refused_before_any_is_validated() -> None:
-    events = [{"kind": "k", "env_id": "e", "detail": "d"}] * 1_000_000
-    started = time.perf_counter()
+    # Every entry is invalid: had one been validated first, the first problem would name compat_events.0.
+    events = [{"kind": 1}] * 1_000_000
 
     problem = result_message({**RESULT, "compat_events": events})
 
     assert problem == "a result frame: compat_events: should hold at most 100 entries, found 1000000"
-    assert time.perf_counter() - started < 0.5
 
 
 @pytest.mark.parametrize(

@@ -457,6 +457,7 @@ def short_episodes(count: int, steps: int = 2) -> Recorder:
     return recorder
 
 
+@pytest.mark.slow  # records up to a hundred thousand episodes
 @pytest.mark.parametrize("count", [1, 100, 100_000], ids=["one", "hundred", "hundred-thousand"])
 def test_a_calls_log_takes_the_same_few_json_elements_however_many_episodes_it_holds(count: int) -> None:
     episodes = short_episodes(count).finish_call()

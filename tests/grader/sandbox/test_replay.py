@@ -346,6 +346,7 @@ BLACKJACK_RULES = [
 ]
 
 
+@pytest.mark.slow  # replays many seeds per variant, seconds each
 @pytest.mark.parametrize(
     "kwargs", BLACKJACK_RULES, ids=["defaults", "plain", "natural", "sab", "natural-sab"]
 )

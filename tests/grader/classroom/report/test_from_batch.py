@@ -11,6 +11,7 @@ from grader import cli
 from grader.classroom.report.from_batch import page_clash_of_reports
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_grade_with_html_writes_the_class_page_and_its_summary(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -109,6 +109,7 @@ def test_a_planted_or_inconsistent_entry_is_indexed_again_with_a_note(
     assert IndexCache(tmp_path / "cache").get(SOLUTION) == TRUE, "the entry was rewritten"
 
 
+@pytest.mark.expected_skip("ownership is a POSIX notion")
 @pytest.mark.skipif(not hasattr(os, "geteuid"), reason="ownership is a POSIX notion")
 @pytest.mark.parametrize("shared", ["folder", "entry"], ids=["folder-open-to-all", "entry-open-to-all"])
 def test_a_cache_others_can_write_is_not_trusted(

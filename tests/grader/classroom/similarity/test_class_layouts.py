@@ -30,6 +30,8 @@ from grader.grading.outcomes import GradingListener
 from grader.grading.plan import GradingPlan
 from grader.report import ProblemResult, Report
 
+pytestmark = pytest.mark.slow  # grades and compares whole classes
+
 CLASS = Path(__file__).resolve().parents[4] / "submissions" / "similarity" / "class"
 ORIGINAL = (CLASS / "h01_loops.py").read_bytes()
 COPY = (CLASS / "c_renamed_from_h01.py").read_bytes()

@@ -72,6 +72,7 @@ def test_honest_play_passes_and_says_what_ran(function: Any, seed: int) -> None:
     assert verdict.measurements[RAN_CELLS] is True
 
 
+@pytest.mark.slow  # trains every mistaken table, tens of seconds each
 @pytest.mark.parametrize(("name", "mistake"), students.MISTAKES.items(), ids=list(students.MISTAKES))
 def test_each_mistake_fails_and_is_named(name: str, mistake: tuple[Any, str], seed: int) -> None:
     function, words = mistake

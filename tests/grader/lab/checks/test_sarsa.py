@@ -92,6 +92,7 @@ def epsilon_decay_over_n_plus_1(
     return start - (episode - 1) * (start - end) / (n + 1)
 
 
+@pytest.mark.slow  # trains sarsa0 for real, minutes
 def test_a_wrong_epsilon_decay_is_not_counted_again(seed: int) -> None:
     """The decay call is judged against the student's own schedule: problem 5 counts the mistake."""
     learner = students.learner(schedule=epsilon_decay_over_n_plus_1)

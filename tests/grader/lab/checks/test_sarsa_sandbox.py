@@ -15,6 +15,8 @@ from grader.lab.editions.rl1 import RL1
 from grader.report import ProblemResult
 from grader.sandbox import IsolationPolicy
 
+pytestmark = pytest.mark.slow  # grades through the sandbox
+
 REFERENCE = Path(RL1.reference).read_text(encoding="utf-8")
 BROKEN_DECAY = textwrap.dedent("""
     def epsilon_decay(episode, N, epsilon_start=1.0, epsilon_end=1e-6):

@@ -89,6 +89,7 @@ def _taxi_scout(lab, q_table, episodes=200):  # type: ignore[no-untyped-def]
     return means
 
 
+@pytest.mark.slow  # judges two taxi students with reference rollouts
 def test_a_double_reset_in_taxi_passes_and_a_taxi_scout_fails(seed: int) -> None:
     honest = grade("taxi", {"taxi": _taxi_double_reset}, seed)
     assert honest.status == "passed", honest.feedback

@@ -11,6 +11,8 @@ from grader.simulated_students.behaviours import MISTAKES, REFERENCE, Behaviour
 
 from .support import grade
 
+pytestmark = pytest.mark.slow  # every simulated student of every problem, judged
+
 
 @pytest.mark.parametrize("problem", list(REFERENCE), ids=str)
 def test_reference_passes(problem: ProblemId, seed: int) -> None:

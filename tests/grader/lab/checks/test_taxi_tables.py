@@ -34,6 +34,7 @@ def test_honest_greedy_play_passes(seed: int) -> None:
     assert "every action was greedy on its table" in verdict.feedback
 
 
+@pytest.mark.slow  # trains every mistaken table, tens of seconds each
 @pytest.mark.parametrize(("name", "mistake"), students.MISTAKES.items(), ids=list(students.MISTAKES))
 def test_each_mistake_fails_and_is_named(name: str, mistake: tuple[Any, str], seed: int) -> None:
     function, words = mistake

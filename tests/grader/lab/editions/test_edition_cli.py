@@ -14,6 +14,7 @@ RL1 = EDITIONS["rl1"]
 CLASSIC_COMPLETE = EDITIONS["classic"].reference
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_the_rl1_template_is_detected_and_its_epsilon_decay_is_missing(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
@@ -59,6 +60,7 @@ def _class(root: Path, **sources: bytes) -> Path:
     return root
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_grade_without_an_edition_grades_the_one_the_files_show(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -82,6 +84,7 @@ def test_grade_without_an_edition_grades_the_one_the_files_show(
     assert statuses == {"alice": "passed", "bob": "missing", "carol": "missing"}
 
 
+@pytest.mark.slow  # reads a class through the CLI
 def test_grade_stops_before_grading_when_the_files_show_editions_of_different_problems(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -122,6 +125,7 @@ def test_grade_stops_before_grading_when_the_files_show_editions_of_different_pr
     assert reports["alice"].edition_note is None and reports["bob"].edition_note is None
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_check_with_another_edition_tells_the_file_in_every_output(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -133,6 +137,7 @@ def test_check_with_another_edition_tells_the_file_in_every_output(
     assert told in html.read_text(encoding="utf-8")
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_grade_with_a_configuration_says_its_edition_and_detects_nothing(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

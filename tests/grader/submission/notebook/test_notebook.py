@@ -378,6 +378,7 @@ def test_the_death_of_the_reading_child_is_worded(returncode: int, stderr: bytes
     assert bounded._death(returncode, stderr) == expected
 
 
+@pytest.mark.slow  # a grading through the sandbox
 def test_a_batch_with_poisoned_notebooks_grades_every_honest_one(tmp_path: Path) -> None:
     inputs = tmp_path / "inputs"
     inputs.mkdir()
@@ -459,6 +460,7 @@ def test_a_notebook_is_parsed_once_in_the_reader_and_never_in_the_parent(
     ]
 
 
+@pytest.mark.slow  # starts the reader child for every sample notebook
 @pytest.mark.parametrize("sample", sorted(path.name for path in NOTEBOOKS.glob("*.ipynb")))
 def test_a_module_built_from_kept_cells_is_the_module_built_from_the_file(sample: str) -> None:
     data = (NOTEBOOKS / sample).read_bytes()
@@ -470,6 +472,7 @@ def test_a_module_built_from_kept_cells_is_the_module_built_from_the_file(sample
 
 
 @pytest.mark.slow
+@pytest.mark.expected_skip("reads VmHWM from /proc (Linux)")
 @pytest.mark.skipif(not Path("/proc/self/status").is_file(), reason="reads VmHWM from /proc (Linux)")
 def test_a_notebook_of_millions_of_empty_objects_is_refused_and_the_parent_stays_small(
     tmp_path: Path,

@@ -1,0 +1,100 @@
+"""tests/conftest.py's skip policy, run on small suites in a fresh pytest: under CI=true an undeclared skip
+fails the run and is named; a declared one, an xfail and any skip outside CI do not."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+
+pytest_plugins = ("pytester",)
+
+CONFTEST = Path(__file__).with_name("conftest.py")
+
+XDIST = ("-p", "xdist.plugin", "-n", "2")
+REDIS_MISSING = "test_needs_redis: could not start redis-server: not installed"
+NEEDS_REDIS = """
+    import pytest
+
+    def test_needs_redis():
+        pytest.skip("could not start redis-server: not installed")
+
+    def test_plain():
+        assert True
+"""
+DECLARED = """
+    import pytest
+
+    @pytest.mark.expected_skip("ownership is a POSIX notion")
+    @pytest.mark.skipif(True, reason="ownership is a POSIX notion")
+    def test_windows_only():
+        pass
+"""
+DECLARED_FOR_ANOTHER_REASON = """
+    import pytest
+
+    @pytest.mark.expected_skip("already unprivileged")
+    def test_as_root():
+        pytest.skip("needs a Debian machine with /usr/bin/python3")
+"""
+XFAIL = """
+    import pytest
+
+    @pytest.mark.xfail(reason="known")
+    def test_known():
+        assert False
+"""
+MODULE_SKIP = """
+    import pytest
+
+    pytest.importorskip("a_module_nobody_has", reason="pip install a_module_nobody_has")
+
+    def test_never_collected():
+        pass
+"""
+
+
+@pytest.mark.parametrize(
+    ("source", "ci", "extra", "exit_code", "named"),
+    [
+        (NEEDS_REDIS, "true", (), 1, REDIS_MISSING),
+        (NEEDS_REDIS, "true", XDIST, 1, REDIS_MISSING),
+        (NEEDS_REDIS, "", (), 0, None),
+        (NEEDS_REDIS, "false", (), 0, None),
+        (DECLARED, "true", (), 0, None),
+        (DECLARED, "true", XDIST, 0, None),
+        (DECLARED_FOR_ANOTHER_REASON, "true", (), 1, "test_as_root: needs a Debian machine"),
+        (XFAIL, "true", (), 0, None),
+        (MODULE_SKIP, "true", (), 1, "test_module.py: pip install a_module_nobody_has"),
+    ],
+    ids=[
+        "undeclared-skip-under-ci", "undeclared-skip-under-ci-xdist", "no-ci", "ci-false", "declared",
+        "declared-xdist", "declared-for-another-reason", "xfail", "module-level-skip",
+    ],
+)  # fmt: skip
+def test_skips_under_ci(
+    pytester: pytest.Pytester,
+    monkeypatch: pytest.MonkeyPatch,
+    source: str,
+    ci: str,
+    extra: tuple[str, ...],
+    exit_code: int,
+    named: str | None,
+) -> None:
+    monkeypatch.setenv("CI", ci)
+    monkeypatch.setenv("PYTEST_DISABLE_PLUGIN_AUTOLOAD", "1")  # the installed plugins' start-up, ~10 s a run
+    pytester.makeconftest(CONFTEST.read_text(encoding="utf-8"))
+    pytester.makepyfile(test_module=textwrap.dedent(source))
+
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider", *extra)
+
+    assert result.ret == exit_code, result.stdout.str()
+    summary = result.stdout.str()
+    if named is None:
+        assert "unexpected skips fail a CI run" not in summary
+    else:
+        assert "unexpected skips fail a CI run" in summary
+        assert any(line.startswith("SKIPPED (unexpected) test_module.py") and named in line
+                   for line in result.stdout.lines), summary  # fmt: skip
+        assert "declare the skip with @pytest.mark.expected_skip" in summary
