@@ -4,7 +4,7 @@ import pytest
 
 from grader.lab.checks.blackjack import _Decision, exact_best_n, exact_curve, policy_deviation
 
-from .support import grade, small_config
+from .support import grade, on_low_deck, small_config
 
 
 def _decisions(*rows: tuple[int, int, int, bool]) -> list[_Decision]:
@@ -130,4 +130,30 @@ def test_a_failing_student_still_gets_the_whole_curve(seed: int) -> None:
     verdict = grade("blackjack", less_than.functions, seed)
     assert verdict.status == "failed"
     assert verdict.feedback.startswith("blackjack(12) returned")
+    assert set(verdict.measurements["curve"]) == {"12", "13", "14", "20"}  # type: ignore[arg-type]
+
+
+def test_a_win_count_off_the_exact_law_fails_on_the_win_count_alone(seed: int) -> None:
+    """The reference's rule on games dealt from ace to five only, judged as played: every decision follows
+    the rule, the counts and returned rates are right, so only the exact two-sided binomial test of each
+    call's win count can fail it (every call is judged; the first failure is reported).
+
+    Statistic: wins in 1000 games per call against Binomial(1000, exact win probability of the rule),
+    n = 12 accepted 341..493 (alpha 1e-6 per call, exact false-fail 8.8e-7; 13, 14, 20 alike). The low
+    deck wins 0.0816 at n = 12, accepted with probability 6.2e-119 (0.0956, 0.1386, 0.4190 at 13, 14, 20:
+    at most 6.7e-42), bench/verdict_power.py, bench/RESULTS.md.
+    """
+    from grader.simulated_students.behaviours import blackjack
+
+    verdict = grade("blackjack", {"blackjack": on_low_deck(blackjack)}, seed, fast=True)
+    assert verdict.status == "failed", verdict.feedback
+    assert verdict.feedback.startswith(
+        "blackjack(12): a player drawing on sums <= 12 wins 0.4162 of games (341..493 of 1000); "
+        "your replayed games won "
+    ), verdict.feedback
+    assert verdict.feedback.endswith(
+        # 1 / 8.8e-7, the exact false-fail probability of the interval 341..493 (bench/verdict_power.py)
+        "The decisions followed the rule, so this is the 1-in-1,138,454 chance or not the lab's game: "
+        "regrade once."
+    ), verdict.feedback
     assert set(verdict.measurements["curve"]) == {"12", "13", "14", "20"}  # type: ignore[arg-type]

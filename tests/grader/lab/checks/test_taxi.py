@@ -11,6 +11,7 @@ from grader.lab.problems import PROBLEMS
 from grader.sandbox.outcome import FunctionInfo, ParameterInfo
 from grader.simulated_students.behaviours import taxi
 from reference.oracles import optimal_q_table
+from reference.oracles.taxi import detour_q_table
 
 from .support import grade, small_config
 
@@ -90,4 +91,78 @@ def test_a_tuple_of_three_is_refused(seed: int) -> None:
     assert (verdict.status, verdict.feedback) == (
         "failed",
         "taxi returned [1.0, 2.0, 3.0]; expected two numbers (random mean, Q-table mean).",
+    )
+
+
+@pytest.mark.slow
+def test_a_random_mean_off_the_exact_one_fails_on_the_mean_alone(seed: int) -> None:
+    """Random episodes that play a fresh shuffle of the six actions in turn: the action counts are uniform
+    (the chi-square test passes), the Q-table episodes are right, the means are the replay's, so only the
+    z-test of the random mean can fail it. Judged as played (Taxi is deterministic once reset).
+
+    Statistic: the mean total reward of 1000 random episodes against the exact -771.09, tolerance
+    ± 15.75 (alpha 1e-6, the exact variance). The shuffled turns average -795.4 with a deviation of 17.6
+    (20000 episodes measured): the test misses them with probability below 1e-300 (a 70-sigma gap)
+    (bench/verdict_power.py, bench/RESULTS.md).
+    """
+    episodes = 1000
+
+    def shuffled_turns(lab, q_table):  # type: ignore[no-untyped-def]
+        env = lab.make("Taxi-v3")
+        greedy = np.argmax(q_table, axis=1)
+        totals = [0.0, 0.0]
+        for which in (0, 1):
+            for _ in range(episodes):
+                state, _ = env.reset()
+                turn: list[int] = []
+                done = False
+                while not done:
+                    if which == 1:
+                        action = int(greedy[state])
+                    else:
+                        if not turn:
+                            turn = list(range(6))
+                            lab.random.shuffle(turn)
+                        action = turn.pop()
+                    state, reward, terminated, truncated, _ = env.step(action)
+                    totals[which] += reward
+                    done = terminated or truncated
+        return [totals[0] / episodes, totals[1] / episodes]
+
+    settings = small_config("taxi", episodes_per_scenario=episodes)
+    verdict = grade("taxi", {"taxi": shuffled_turns}, seed, settings, fast=True)
+    assert verdict.status == "failed", verdict.feedback
+    assert verdict.feedback.startswith(
+        "taxi: random actions average -771.09 ± 15.75 over 1000 episodes; yours averaged "
+    ), verdict.feedback
+    assert verdict.feedback.endswith(
+        "(replayed). The episodes are real, so this is a near-impossible chance or not the lab's game: "
+        "regrade once."
+    )
+
+
+@pytest.mark.slow
+def test_a_trained_table_below_the_floor_fails_on_the_floor_alone(seed: int) -> None:
+    """taxi() that ends its training with the detour table (an extra wall's optimal routes): random episodes
+    right, greedy play consistent, the means the replay's, so only the trained table's floor can fail it.
+
+    Statistic: the mean total reward of 1000 greedy episodes against the floor 7.930 - 0.401 (z-test
+    tolerance, alpha 1e-6) - 0.5 (trained_slack) = 7.029; an optimal table falls below it with probability
+    at most 5e-7. The detour table averages exactly 5.757 (sd 3.75): the floor misses it with
+    probability 3.4e-27 (10.7 sigma) (bench/verdict_power.py, bench/RESULTS.md).
+    """
+    table = detour_q_table(0.6)
+
+    def detour(lab, episodes=1000):  # type: ignore[no-untyped-def]
+        return taxi(lab, table, episodes=episodes)
+
+    settings = small_config("taxi", episodes_per_scenario=1000)
+    verdict = grade("taxi", {"taxi": detour}, seed, settings, fast=True)
+    assert verdict.status == "failed", verdict.feedback
+    assert verdict.feedback.startswith(
+        "taxi: a well-trained table averages at least 7.029 (optimal 7.930) and beats random actions; "
+        "your Q-table episodes averaged "
+    ), verdict.feedback
+    assert verdict.feedback.endswith(
+        "(replayed). Train with find_qvalues as the lab does, then act with np.argmax(q_table[state])."
     )
