@@ -157,3 +157,68 @@ def test_a_win_count_off_the_exact_law_fails_on_the_win_count_alone(seed: int) -
         "regrade once."
     ), verdict.feedback
     assert set(verdict.measurements["curve"]) == {"12", "13", "14", "20"}  # type: ignore[arg-type]
+
+
+def _text(lab, n, games=1000):  # type: ignore[no-untyped-def]
+    return "x"
+
+
+def _same_seed(lab, n, games=1000):  # type: ignore[no-untyped-def]
+    env = lab.make("Blackjack-v0")
+    wins = 0
+    for _ in range(games):
+        observation, _ = env.reset(seed=42)
+        done = False
+        while not done:
+            observation, reward, terminated, truncated, _ = env.step(int(observation[0] <= n))
+            done = terminated or truncated
+        wins += reward > 0
+    return wins / games
+
+
+def _average_reward(lab, n, games=1000):  # type: ignore[no-untyped-def]
+    from grader.simulated_students.behaviours import _play_blackjack
+
+    env = lab.make("Blackjack-v0")
+    return (
+        sum(_play_blackjack(env, lambda observation, _step: int(observation[0] <= n)) for _ in range(games))
+        / games
+    )
+
+
+def _reset_options(lab, n, games=1000):  # type: ignore[no-untyped-def]
+    from grader.simulated_students.behaviours import blackjack
+
+    lab.make("Blackjack-v0").reset(options={"x": 1})
+    return blackjack(lab, n, games)
+
+
+@pytest.mark.parametrize(
+    ("function", "diagnosis"),
+    [
+        (_text, "blackjack(12) returned 'x'; expected the win rate as a number."),
+        (
+            _same_seed,
+            "blackjack(12): 1000 episodes were reset with the same seed (42), so outside the grader they are "
+            "the same game played 1000 times",
+        ),
+        (
+            _average_reward,
+            "blackjack(12) returned -0.",  # then the replay's win count, named as the average reward
+        ),
+        (
+            _reset_options,
+            "blackjack: 4 reset(s) passed options (e.g. reset 1: options={'x': 1}), which choose the start "
+            "of the game",
+        ),
+    ],
+    ids=["not-a-number", "repeated-seed", "average-reward", "integrity"],
+)
+def test_each_diagnosis_fails_a_sample_of_its_own(function, diagnosis: str, seed: int) -> None:  # type: ignore[no-untyped-def]
+    verdict = grade("blackjack", {"blackjack": function}, seed)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith(diagnosis), verdict.feedback
+    if function is _average_reward:
+        assert verdict.feedback.endswith(
+            "it equals the average reward (wins minus losses per game), not the win rate."
+        )
