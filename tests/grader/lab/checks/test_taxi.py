@@ -166,3 +166,46 @@ def test_a_trained_table_below_the_floor_fails_on_the_floor_alone(seed: int) -> 
     assert verdict.feedback.endswith(
         "(replayed). Train with find_qvalues as the lab does, then act with np.argmax(q_table[state])."
     )
+
+
+def _reset_with_options(lab, q_table, episodes=200):  # type: ignore[no-untyped-def]
+    lab.make("Taxi-v3").reset(options={"state": 0})
+    return taxi(lab, q_table, episodes=episodes)
+
+
+def _one_random_episode_short(lab, q_table, episodes=200):  # type: ignore[no-untyped-def]
+    env = lab.make("Taxi-v3")
+    greedy = np.argmax(q_table, axis=1)
+    means = []
+    for count, policy in ((episodes - 1, lambda _state: int(env.action_space.sample())), (episodes, None)):
+        total = 0.0
+        for _ in range(count):
+            state, _ = env.reset()
+            done = False
+            while not done:
+                action = policy(state) if policy else int(greedy[state])
+                state, reward, terminated, truncated, _ = env.step(action)
+                total, done = total + reward, terminated or truncated
+        means.append(total / count)
+    return means
+
+
+@pytest.mark.parametrize(
+    ("function", "diagnosis"),
+    [
+        (
+            _reset_with_options,
+            "taxi: 1 reset(s) passed options (e.g. reset 1: options={'state': 0}), which choose the start of "
+            "the game",
+        ),
+        (
+            _one_random_episode_short,
+            "taxi must run each scenario 200 times (the lab's number); the replay shows ",
+        ),
+    ],
+    ids=["integrity", "episode-count"],
+)
+def test_each_diagnosis_fails_a_sample_of_its_own(function, diagnosis: str, seed: int) -> None:  # type: ignore[no-untyped-def]
+    verdict = grade("taxi", {"taxi": function}, seed)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith(diagnosis), verdict.feedback
