@@ -190,9 +190,31 @@ def _one_random_episode_short(lab, q_table, episodes=200):  # type: ignore[no-un
     return means
 
 
+def _moves_only(lab, q_table, episodes=200):  # type: ignore[no-untyped-def]
+    # Random episodes that only move (never pick up or drop off): not uniform over the six actions.
+    env = lab.make("Taxi-v3")
+    greedy = np.argmax(q_table, axis=1)
+    means = []
+    for policy in (lambda _state: lab.random.randrange(4), lambda state: int(greedy[state])):
+        total = 0.0
+        for _ in range(episodes):
+            state, _ = env.reset()
+            done = False
+            while not done:
+                state, reward, terminated, truncated, _ = env.step(policy(state))
+                total, done = total + reward, terminated or truncated
+        means.append(total / episodes)
+    return means
+
+
 @pytest.mark.parametrize(
     ("function", "diagnosis"),
     [
+        (
+            _moves_only,
+            "taxi: random actions are uniform over the 6 actions, but your random episodes chose them with "
+            "shares 0.2",
+        ),
         (
             _reset_with_options,
             "taxi: 1 reset(s) passed options (e.g. reset 1: options={'state': 0}), which choose the start of "
@@ -203,7 +225,7 @@ def _one_random_episode_short(lab, q_table, episodes=200):  # type: ignore[no-un
             "taxi must run each scenario 200 times (the lab's number); the replay shows ",
         ),
     ],
-    ids=["integrity", "episode-count"],
+    ids=["random-not-uniform", "integrity", "episode-count"],
 )
 def test_each_diagnosis_fails_a_sample_of_its_own(function, diagnosis: str, seed: int) -> None:  # type: ignore[no-untyped-def]
     verdict = grade("taxi", {"taxi": function}, seed)
