@@ -1,8 +1,12 @@
 """blackjack(n): naming how replayed decisions deviate from 'draw while sum <= n', and the exact curve."""
 
+from fractions import Fraction
+from functools import cache
+
 import pytest
 
 from grader.lab.checks.blackjack import _Decision, exact_best_n, exact_curve, policy_deviation
+from reference.oracles import random_policy_outcome
 
 from .support import grade, on_low_deck, small_config
 
@@ -77,11 +81,58 @@ def test_policy_deviation_is_named(rows: list[tuple[int, int, int, bool]], expec
     assert policy_deviation(_decisions(*rows), 12) == expected
 
 
+_CARDS = {card: Fraction(4 if card == 10 else 1, 13) for card in range(1, 11)}
+
+
+def _score(hard: int, ace: bool) -> int:
+    return hard + 10 if ace and hard + 10 <= 21 else hard
+
+
+@cache
+def _final_scores(hard: int, ace: bool, draw_below: int, coin: bool) -> dict[int, Fraction]:
+    """Final score law (0: bust) of a hand that draws while its score is below `draw_below` (`coin`: draws
+    with probability 1/2 at each decision instead, until it stops or busts). Written here from the
+    rules in gymnasium's blackjack.py, independently of `reference.oracles.blackjack`."""
+    if hard > 21:
+        return {0: Fraction(1)}
+    score = _score(hard, ace)
+    stops = Fraction(1, 2) if coin else Fraction(int(score >= draw_below))
+    law: dict[int, Fraction] = {score: stops} if stops else {}
+    if stops < 1:
+        for card, probability in _CARDS.items():
+            for final, weight in _final_scores(hard + card, ace or card == 1, draw_below, coin).items():
+                law[final] = law.get(final, Fraction(0)) + (1 - stops) * probability * weight
+    return law
+
+
+def _win_probability(draw_below: int, *, coin: bool = False) -> float:
+    """P(player's score > dealer's) for two-card starts; the dealer shows one card and draws below 17."""
+    player: dict[int, Fraction] = {}
+    dealer: dict[int, Fraction] = {}
+    for first, p_first in _CARDS.items():
+        for second, p_second in _CARDS.items():
+            start = (first + second, 1 in (first, second))
+            for law, draw_below_, coin_ in ((player, draw_below, coin), (dealer, 17, False)):
+                for final, weight in _final_scores(*start, draw_below_, coin_).items():
+                    law[final] = law.get(final, Fraction(0)) + p_first * p_second * weight
+    win = sum(
+        p_player * sum((p for score, p in dealer.items() if score < final), Fraction(0))
+        for final, p_player in player.items()
+        if final > 0
+    )
+    return float(win)
+
+
 def test_exact_curve_and_best_n() -> None:
+    """The oracle's curve against an independent exact computation (fractions, written from the rules)."""
     curve = exact_curve()
     assert list(curve) == list(range(22))
+    assert curve == pytest.approx({n: _win_probability(n + 1) for n in range(22)}, abs=1e-12)
     assert exact_best_n() == 13
-    assert curve[13] == pytest.approx(0.41795126514575, abs=1e-12)
+
+
+def test_the_random_policy_win_probability_is_derived_independently() -> None:
+    assert random_policy_outcome().win == pytest.approx(_win_probability(0, coin=True), abs=1e-12)
 
 
 def test_fixed_threshold_student_is_told_to_use_n(seed: int) -> None:
