@@ -207,9 +207,29 @@ def _moves_only(lab, q_table, episodes=200):  # type: ignore[no-untyped-def]
     return means
 
 
+def _two_tables(lab, episodes=200):  # type: ignore[no-untyped-def]
+    # taxi() whose "trained" episodes act on two tables in turn: not one greedy policy.
+    env = lab.make("Taxi-v3")
+    tables = [np.argmax(optimal_q_table(0.6), axis=1), np.argmax(detour_q_table(0.6), axis=1)]
+    means = []
+    for scenario in ("random", "greedy"):
+        total = 0.0
+        for episode in range(episodes):
+            state, _ = env.reset()
+            done = False
+            while not done:
+                greedy = tables[episode % 2]
+                action = int(env.action_space.sample()) if scenario == "random" else int(greedy[state])
+                state, reward, terminated, truncated, _ = env.step(action)
+                total, done = total + reward, terminated or truncated
+        means.append(total / episodes)
+    return means
+
+
 @pytest.mark.parametrize(
     ("function", "diagnosis"),
     [
+        (_two_tables, "taxi: your Q-table episodes chose actions "),
         (
             _moves_only,
             "taxi: random actions are uniform over the 6 actions, but your random episodes chose them with "
@@ -225,7 +245,7 @@ def _moves_only(lab, q_table, episodes=200):  # type: ignore[no-untyped-def]
             "taxi must run each scenario 200 times (the lab's number); the replay shows ",
         ),
     ],
-    ids=["random-not-uniform", "integrity", "episode-count"],
+    ids=["greedy-on-two-tables", "random-not-uniform", "integrity", "episode-count"],
 )
 def test_each_diagnosis_fails_a_sample_of_its_own(function, diagnosis: str, seed: int) -> None:  # type: ignore[no-untyped-def]
     verdict = grade("taxi", {"taxi": function}, seed)
