@@ -251,3 +251,51 @@ def test_each_diagnosis_fails_a_sample_of_its_own(function, diagnosis: str, seed
     verdict = grade("taxi", {"taxi": function}, seed)
     assert verdict.status == "failed"
     assert verdict.feedback.startswith(diagnosis), verdict.feedback
+
+
+def test_a_greedy_mean_off_the_given_tables_fails_on_that_mean_alone(seed: int) -> None:
+    """taxi(q_table) whose Q-table episodes start only where the optimal table's return is at most 4 (a
+    start law that is not the lab's, judged as played): random episodes right, every greedy action the
+    given table's argmax, the means the replay's, so only the z-test of the Q-table mean can fail it.
+
+    Statistic: the mean total reward of 200 greedy episodes against the exact 7.930 ± 0.896 (alpha 1e-6,
+    the exact variance); the rigged starts average at most 4, outside the tolerance whatever they draw
+    (a deterministic miss of 0).
+    """
+    table = optimal_q_table(0.6)
+    greedy = np.argmax(table, axis=1)
+
+    def hard_starts(lab, q_table, episodes=200):  # type: ignore[no-untyped-def]
+        env = lab.make("Taxi-v3")
+        random_total = 0.0
+        for _ in range(episodes):
+            env.reset()
+            done = False
+            while not done:
+                _, reward, terminated, truncated, _ = env.step(int(env.action_space.sample()))
+                random_total, done = random_total + reward, terminated or truncated
+        game = env._env.unwrapped  # the simulated game, rigged: only its hardest starts are dealt
+        law = np.asarray(game.initial_state_distrib, dtype=float)
+        for start in np.flatnonzero(law):
+            game.s, total, done = int(start), 0.0, False
+            while not done:
+                _, reward, terminated, truncated, _ = game.step(int(greedy[game.s]))
+                total, done = total + reward, terminated or truncated
+            law[start] = float(total <= 4)
+        game.initial_state_distrib = law / law.sum()
+        totals = []
+        for _ in range(episodes):
+            state, _ = env.reset()
+            total, done = 0.0, False
+            while not done:
+                state, reward, terminated, truncated, _ = env.step(int(np.argmax(q_table[state])))
+                total, done = total + reward, terminated or truncated
+            totals.append(total)
+        return [random_total / episodes, sum(totals) / episodes]
+
+    verdict = grade("taxi", {"taxi": hard_starts}, seed, fast=True)
+    assert verdict.status == "failed", verdict.feedback
+    assert verdict.feedback.startswith(
+        "taxi: the optimal table averages 7.930 ± 0.896 and beats random actions; "
+        "your Q-table episodes averaged "
+    ), verdict.feedback
