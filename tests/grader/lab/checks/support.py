@@ -7,6 +7,8 @@ from collections.abc import Sequence
 from functools import partial
 from typing import Any
 
+import numpy as np
+
 from grader.lab.assignment import load_config
 from grader.lab.checks.base import CallRecord, ProblemId, Verdict
 from grader.lab.problems import PROBLEMS
@@ -101,3 +103,18 @@ def grade(
     settings = settings or small_config(problem)
     records = simulate(problem, functions, seed, settings, fast=fast)
     return PROBLEMS.problem(problem).check.judge(settings, records)
+
+
+def deal_only_hard_starts(env: LabEnv, greedy: Any, at_most: float = 4.0) -> None:
+    """Rig a simulated Taxi env so that its resets deal only the starts where greedy play on `greedy` (an
+    action per state) returns at most `at_most`: a start law that is not the lab's, for episodes judged as
+    played, so that only a test of the greedy mean can tell."""
+    game = env._env.unwrapped  # the simulated gymnasium game; a student in the sandbox cannot reach it
+    law = np.asarray(game.initial_state_distrib, dtype=float)
+    for start in np.flatnonzero(law):
+        game.s, total, done = int(start), 0.0, False
+        while not done:
+            _, reward, terminated, truncated, _ = game.step(int(greedy[game.s]))
+            total, done = total + reward, terminated or truncated
+        law[start] = float(total <= at_most)
+    game.initial_state_distrib = law / law.sum()

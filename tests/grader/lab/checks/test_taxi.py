@@ -13,7 +13,7 @@ from grader.simulated_students.behaviours import taxi
 from reference.oracles import optimal_q_table
 from reference.oracles.taxi import detour_q_table
 
-from .support import grade, small_config
+from .support import deal_only_hard_starts, grade, small_config
 
 
 def _info(*kinds: str) -> dict[str, FunctionInfo]:
@@ -274,15 +274,7 @@ def test_a_greedy_mean_off_the_given_tables_fails_on_that_mean_alone(seed: int) 
             while not done:
                 _, reward, terminated, truncated, _ = env.step(int(env.action_space.sample()))
                 random_total, done = random_total + reward, terminated or truncated
-        game = env._env.unwrapped  # the simulated game, rigged: only its hardest starts are dealt
-        law = np.asarray(game.initial_state_distrib, dtype=float)
-        for start in np.flatnonzero(law):
-            game.s, total, done = int(start), 0.0, False
-            while not done:
-                _, reward, terminated, truncated, _ = game.step(int(greedy[game.s]))
-                total, done = total + reward, terminated or truncated
-            law[start] = float(total <= 4)
-        game.initial_state_distrib = law / law.sum()
+        deal_only_hard_starts(env, greedy)
         totals = []
         for _ in range(episodes):
             state, _ = env.reset()

@@ -13,6 +13,8 @@ from grader.simulated_students import taxi_tables as students
 from grader.simulated_students.simulation import simulate_calls
 from reference.oracles import greedy_policy_return
 
+from .support import deal_only_hard_starts
+
 PROBLEM = RL1.registry.problem("taxi")
 
 
@@ -65,16 +67,8 @@ def test_a_mean_off_its_tables_exact_one_fails_on_the_means_alone(seed: int) -> 
     def hard_starts(lab: Any, q_table: Any, q_table_decay: Any) -> tuple[float, float]:
         first = students._play(lab, q_table, students.EPISODES)
         env = lab.make("Taxi-v3")
-        game = env._env.unwrapped  # the simulated game, rigged: only its hardest starts are dealt
         greedy = np.argmax(q_table_decay, axis=1)
-        law = np.asarray(game.initial_state_distrib, dtype=float)
-        for start in np.flatnonzero(law):
-            game.s, total, done = int(start), 0.0, False
-            while not done:
-                _, reward, terminated, truncated, _ = game.step(int(greedy[game.s]))
-                total, done = total + reward, terminated or truncated
-            law[start] = float(total <= 4)
-        game.initial_state_distrib = law / law.sum()
+        deal_only_hard_starts(env, greedy)
         totals = []
         for _ in range(students.EPISODES):
             state, _ = env.reset()
