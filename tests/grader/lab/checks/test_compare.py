@@ -2,6 +2,7 @@
 
 from typing import Any
 
+import numpy as np
 import pytest
 
 from grader.lab.assignment import load_config
@@ -13,6 +14,8 @@ from grader.sandbox.outcome import OutcomeStatus
 from grader.simulated_students import compare as students
 from grader.simulated_students.simulation import simulate_calls
 from grader.submission.notebook.cells import RAN_CELLS
+
+from .support import deal_only_hard_starts
 
 PROBLEM = RL1.registry.problem("compare")
 
@@ -164,3 +167,37 @@ def test_a_submission_that_trains_no_table_fails_saying_where_to_train(
     assert "compare() raised NameError: name 'q_table_decay' is not defined" in verdict.feedback
     assert words in verdict.feedback
     assert 'sarsa_table_decay = sarsa0("Taxi-v3", decay=True)' in verdict.feedback
+
+
+def test_a_mean_off_its_tables_exact_one_fails_on_the_means_alone(seed: int) -> None:
+    """The SARSA table's episodes dealt only the starts where its greedy return is at most 4 (a start law
+    that is not the lab's, judged as played): both tables the notebook's, every action greedy, the means the
+    replay's and in order, so only the z-tests of the means can fail it.
+
+    Statistic: each table's mean total reward over 1000 greedy episodes against its exact greedy return
+    (alpha 1e-6 each, exact variances); the rigged starts average at most 4, below the SARSA table's
+    tolerance whatever they draw (a deterministic miss of 0).
+    """
+
+    def hard_starts(lab: Any) -> tuple[float, float]:
+        q_table, sarsa_table = students._tables()
+        first = students._play(lab, q_table, students.EPISODES)
+        env = lab.make("Taxi-v3")
+        greedy = np.argmax(sarsa_table, axis=1)
+        deal_only_hard_starts(env, greedy)
+        totals = []
+        for _ in range(students.EPISODES):
+            state, _ = env.reset()
+            total, done = 0.0, False
+            while not done:
+                state, reward, terminated, truncated, _ = env.step(int(greedy[state]))
+                total, done = total + reward, terminated or truncated
+            totals.append(total)
+        return first, float(np.mean(totals))
+
+    verdict = _judge(hard_starts, seed)
+    assert verdict.status == "failed", verdict.feedback
+    assert verdict.feedback.endswith(
+        "a mean beyond its tolerance (false-fail probability 1e-06 each) means the episodes were not played "
+        "from env.reset() without a seed until they ended."
+    ), verdict.feedback

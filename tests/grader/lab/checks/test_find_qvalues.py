@@ -34,6 +34,8 @@ def _judge(value: object):  # type: ignore[no-untyped-def]
 def test_optimal_table_reports_the_optimal_return() -> None:
     verdict = _judge(optimal_q_table(0.6))
     assert verdict.status == "passed"
+    # 7.93: a regression snapshot of the exact oracle `optimal_return()` (checked by simulation and against
+    # the Bellman equation in tests/reference/oracles/test_taxi_oracle.py).
     assert verdict.measurements["greedy_mean_return"] == pytest.approx(7.93, abs=1e-9)
     assert verdict.measurements["optimal_mean_return"] == pytest.approx(7.93, abs=1e-9)
 

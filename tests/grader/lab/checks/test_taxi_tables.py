@@ -2,6 +2,7 @@
 
 from typing import Any
 
+import numpy as np
 import pytest
 
 from grader.lab.assignment import load_config
@@ -11,6 +12,8 @@ from grader.lab.editions.rl1 import RL1
 from grader.simulated_students import taxi_tables as students
 from grader.simulated_students.simulation import simulate_calls
 from reference.oracles import greedy_policy_return
+
+from .support import deal_only_hard_starts
 
 PROBLEM = RL1.registry.problem("taxi")
 
@@ -24,6 +27,8 @@ def _judge(function: Any, seed: int) -> Verdict:
 
 def test_the_grader_tables_differ_clearly_and_always_end() -> None:
     detour, optimal = (greedy_policy_return(table) for table in grader_tables(0.6))
+    # Regression snapshots of the exact oracle (the greedy returns are checked by simulation in
+    # tests/reference/oracles/test_taxi_oracle.py); what this test holds is that they differ clearly.
     assert (round(detour.mean, 3), round(optimal.mean, 3)) == (5.757, 7.93)
     assert greedy_policy_return(grader_tables(0.6)[0], 1000).mean == pytest.approx(detour.mean)
 
@@ -48,3 +53,34 @@ def test_a_stub_is_missing(seed: int) -> None:
         raise NotImplementedError("Problem 6 incomplete")
 
     assert _judge(stub, seed).status == "missing"
+
+
+def test_a_mean_off_its_tables_exact_one_fails_on_the_means_alone(seed: int) -> None:
+    """q_table_decay's episodes dealt only the starts where its greedy return is at most 4 (a start law that
+    is not the lab's, judged as played): every action greedy on its table, the means the replay's and in
+    order, so only the z-tests of the means can fail it.
+
+    Statistic: each table's mean total reward over 1000 greedy episodes against its exact mean (5.757 and
+    7.930, alpha 1e-6 each, exact variances); the rigged starts average at most 4, far outside the optimal
+    table's tolerance whatever they draw (a deterministic miss of 0).
+    """
+
+    def hard_starts(lab: Any, q_table: Any, q_table_decay: Any) -> tuple[float, float]:
+        first = students._play(lab, q_table, students.EPISODES)
+        env = lab.make("Taxi-v3")
+        greedy = np.argmax(q_table_decay, axis=1)
+        deal_only_hard_starts(env, greedy)
+        totals = []
+        for _ in range(students.EPISODES):
+            state, _ = env.reset()
+            total, done = 0.0, False
+            while not done:
+                state, reward, terminated, truncated, _ = env.step(int(greedy[state]))
+                total, done = total + reward, terminated or truncated
+            totals.append(total)
+        return first, float(np.mean(totals))
+
+    verdict = _judge(hard_starts, seed)
+    assert verdict.status == "failed", verdict.feedback
+    assert verdict.feedback.startswith("taxi: "), verdict.feedback
+    assert "beyond the tolerance (false-fail probability 1e-06 each)" in verdict.feedback, verdict.feedback
