@@ -12,7 +12,13 @@ from sqlalchemy.orm import Session
 from api.auth import Principal, authenticate
 from api.deps import SESSION_COOKIE, ContextDep, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
 from api.disclosure import disclosure_for
-from api.errors import InvalidRequest, LtiRequestInvalid, NotAuthenticated, StudentNotFound, SubmissionNotFound
+from api.errors import (
+    InvalidRequest,
+    LtiRequestInvalid,
+    NotAuthenticated,
+    StudentNotFound,
+    SubmissionNotFound,
+)
 from api.gradebook import gradebook_csv, late_policy_of
 from api.lti.publisher import publishing_status
 from api.lti.roster import import_roster
@@ -58,18 +64,7 @@ def home(request: Request, session: SessionDep, caller: PageCallerDep, settings:
     """The start page: the sign-in form, or the caller's submissions and the upload form."""
     if caller is None:
         return _page(request, "signin.html", {})
-    disclosure = disclosure_for(caller, settings)
-    submissions = [summary(item, disclosure) for item in list_submissions(session, caller)]
-    return _page(
-        request,
-        "home.html",
-        {
-            "caller": caller,
-            "submissions": submissions,
-            "max_upload_bytes": settings.max_upload_bytes,
-            "lms_scores": publishing_status(session) if caller.is_instructor else [],
-        },
-    )
+    return _home(request, session, caller, settings, None)
 
 
 @router.post("/ui/lti/roster")
@@ -193,14 +188,16 @@ def _home(
     session: Session,
     caller: Principal,
     settings: Settings,
-    message: str,
+    message: str | None,
     *,
     error: bool = False,
 ) -> Response:
+    """The start page of a signed-in caller, with the outcome of an override when there is one."""
     disclosure = disclosure_for(caller, settings)
     submissions = [summary(item, disclosure) for item in list_submissions(session, caller)]
     context = {
         "caller": caller, "submissions": submissions, "max_upload_bytes": settings.max_upload_bytes,
+        "lms_scores": publishing_status(session) if caller.is_instructor else [],
         "override_message": message, "override_error": error,
     }  # fmt: skip
     return _page(request, "home.html", context, status_code=422 if error else 200)
