@@ -69,6 +69,11 @@ class GradingInProgress(ServiceError):
     """Raised when a regrade is asked of a submission that is queued or being graded already."""
 
 
+class NothingGradedYet(ServiceError):
+    """Raised when an override names a student none of whose uploads is graded yet: what each problem is worth
+    comes from a graded report, so the override waits for one."""
+
+
 class StudentExists(ServiceError):
     """Raised when a student is created under a name that is already taken."""
 

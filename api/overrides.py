@@ -15,7 +15,7 @@ from sqlalchemy import select
 from sqlalchemy.orm import Session
 
 from api.disclosure import Disclosure
-from api.errors import InvalidRequest, SubmissionNotFound
+from api.errors import InvalidRequest, NothingGradedYet, SubmissionNotFound
 from api.models import JobStatus, Override, Student, Submission
 from api.schemas import OverrideShown
 from api.students import find_student
@@ -37,9 +37,9 @@ def _graded(session: Session, student: Student, submission_id: int | None) -> Su
             raise SubmissionNotFound(
                 f"no graded submission {submission_id} of {student.name}; list theirs with GET /submissions?student=..."  # noqa: E501
             )
-        raise InvalidRequest(
-            f"{student.name} has no graded submission yet: an override needs one to know what each problem is worth",  # noqa: E501
-            [(["path", "name"], "no graded submission", "no_graded_submission")],
+        raise NothingGradedYet(
+            f"{student.name} has no graded submission yet: an override needs one to know what each problem is worth; "  # noqa: E501
+            "override once one is graded"
         )
     return found
 

@@ -16,6 +16,7 @@ from api.errors import (
     InvalidRequest,
     LtiRequestInvalid,
     NotAuthenticated,
+    NothingGradedYet,
     StudentNotFound,
     SubmissionNotFound,
 )
@@ -178,7 +179,7 @@ def override(
             session, student_name=student, problem=problem.strip(), points=value, reason=reason,
             author=signed_in.name, submission_id=upload,
         )  # fmt: skip
-    except (InvalidRequest, StudentNotFound, SubmissionNotFound) as refused:
+    except (InvalidRequest, NothingGradedYet, StudentNotFound, SubmissionNotFound) as refused:
         return _home(request, session, signed_in, settings, str(refused), error=True)
     return _home(request, session, signed_in, settings, f"{problem} of {student} set to {value:g}: {reason}")
 

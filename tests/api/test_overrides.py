@@ -205,3 +205,17 @@ def test_the_student_sees_the_reason_on_their_submission_but_nothing_withheld(
         client.cookies.set("gymgrade_token", ada)
         page = client.get(f"/ui/submissions/{upload}").text
         assert "&lt;i&gt;checked by hand&lt;/i&gt;" in page and "secret" not in page
+
+
+def test_an_override_of_a_student_with_nothing_graded_waits(make_settings: SettingsFactory) -> None:
+    # A schema-valid request the state refuses: 409, not 422 (schemathesis holds the difference).
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        add_student(client, "ada")
+        response = _override(client, "ada", problem="car", points=0, reason="checked by hand")
+        assert response.status_code == 409, response.text
+        assert response.json()["detail"] == (
+            "ada has no graded submission yet: an override needs one to know what each problem is worth; "
+            "override once one is graded"
+        )
+        with client.app.state.context.sessions() as session:  # type: ignore[attr-defined]
+            assert session.query(Override).count() == 0
