@@ -44,8 +44,9 @@ process (never running student code), and the sandbox imports it like any `.py` 
   metadata only (outputs blanked) and a failure is a note in `NotebookSummary.ignored`, not an error. Errors
   only when the cells cannot be read (not JSON, no list of cells, more than `MAX_CELLS` = 10,000 cells, a code
   cell whose source is not text, another language, more than 2,000,000 characters of code).
-- `grader/submission/notebook/ipython.py`: `transform_cell(source, defined)`, with IPython's own
-  `inputtransformer2` (its cleanup transforms and finders, in the reader's child only): leading indent,
+- `grader/submission/notebook/ipython.py`: `transform_cell(source, defined)`, IPython's `inputtransformer2`
+  rules restated (importing IPython in the reader imports pexpect on POSIX, which a Windows-shaped
+  interpreter lacks: tests/grader/test_portable.py): leading indent,
   `>>>`/`In [n]:` prompts, `%%cell magics`, and, per logical line from one tokenization,
   `!`/`!!`/`%`/`?`/`??`/`,`/`;`/`/` escapes, `x = !cmd`,
   `x = %magic`, trailing `?`; one-line cells get automagic (`pip install gym`) unless the name is bound, a

@@ -1,30 +1,24 @@
-"""Read a cell the way IPython does before Python sees it: IPython's own input transformations.
+"""Read a cell the way IPython does before Python sees it: its input transformations, done by hand.
 
-IPython's ``IPython.core.inputtransformer2`` turns ``%magic``, ``%%cell magic``, ``!shell``, ``x = !cmd``,
-``obj?``, ``,autocall`` and prompts pasted from a console into Python that calls ``get_ipython()``; its
-prefilter's automagic does the same to a one-line cell such as ``pip install gym``. The grader runs none of
-those commands, so each such line becomes ``pass`` (same indentation, same line numbers) and is listed as
-skipped. The cleanup transforms, the cell-magic test, the tokenizer grouping and each token transformer's
-``find`` (MagicAssign, SystemAssign, EscapedCommand, HelpEnd) are IPython's; this module only applies them
-to every logical line of one tokenization, where ``TransformerManager.transform_cell`` re-tokenizes the
-whole cell after each special line (quadratic: a 200,000-character cell of ``!echo`` lines would take
-minutes). Automagic, a prefilter rule outside the transformer, is written out (`_automagic`). This module
-runs in the notebook reader's bounded child (`grader.submission.notebook.bounded`), where IPython's import
-costs nothing the parent pays.
+IPython's ``IPython.core.inputtransformer2.TransformerManager`` (and, for one-line cells, the prefilter's
+automagic) turns ``%magic``, ``%%cell magic``, ``!shell``, ``x = !cmd``, ``obj?``, ``,autocall``, prompts
+pasted from a console and a bare ``pip install gym`` into Python that calls ``get_ipython()``. The grader
+runs none of those commands, so each such line becomes ``pass`` (same indentation, same line numbers) and
+is listed as skipped. IPython is not a dependency of the trusted parent, hence this copy of its rules;
+IPython re-tokenizes the cell after every transformation, this finds every special line in a few passes
+of one tokenization each, so a cell costs time linear in its size.
 """
 
 from __future__ import annotations
 
 import ast
 import builtins
-import importlib
+import io
 import keyword
 import re
 import tokenize
 from collections.abc import Container
 from dataclasses import dataclass, field
-from types import ModuleType
-from typing import Any
 
 ESCAPES = {"!": "shell command", "%": "IPython magic", "?": "help request", ",": "IPython autocall",
            ";": "IPython autocall", "/": "IPython autocall"}  # fmt: skip
@@ -134,6 +128,9 @@ LINE_MAGICS = frozenset(
 PASSES = 20
 """Rounds of tokenization: one finds every special line the tokenizer reaches; another is needed only
 when a special line stopped the tokenizer (an unclosed quote in a shell command)."""
+_CLASSIC_FIRST = re.compile(r"^>>>( |$)")
+_CLASSIC_ANY = re.compile(r"^(>>>|\.\.\.)( |$)")
+_IPYTHON_PROMPT = re.compile(r"^(((\[nav\]|\[ins\])?\ )?In\ \[\d+\]:\ |\s*\.{3,}:\ ?)")
 _AUTOMAGIC = re.compile(r"^\s*([\w*.]+)(.*)$")
 _INDENT = re.compile(r"^[ \t]+")
 _BUILTIN_NAMES = frozenset(dir(builtins))
@@ -180,10 +177,10 @@ def transform_cell(source: str, defined: Container[str]) -> TransformedCell:
     """
     lines = source.splitlines()
     first = next((index for index, line in enumerate(lines) if line.strip()), 0)
-    # IPython drops the leading blank lines first; they are kept here (and untouched) for the line numbers.
-    lines = lines[:first] + _cleaned(lines[first:])
+    lines = _dedented(lines, first)
+    lines = _without_prompts(lines, first)
     result = TransformedCell("")
-    if lines and _inputtransformer2().cell_magic([lines[first]]) != [lines[first]]:
+    if lines and lines[first].startswith("%%"):
         result.cell_magic = lines[first].split()[0]
         lines[first] = ""
         # IPython runs the body of %%time/%%capture as Python; it has no escapes of its own.
@@ -209,17 +206,20 @@ def transform_cell(source: str, defined: Container[str]) -> TransformedCell:
     return result
 
 
-def _inputtransformer2() -> ModuleType:
-    """IPython's input transformer module, imported when a cell is first read (in the reader's child)."""
-    return importlib.import_module("IPython.core.inputtransformer2")
+def _dedented(lines: list[str], first: int) -> list[str]:
+    indent = _INDENT.match(lines[first]) if lines else None
+    if indent is None:
+        return lines
+    space = indent.group(0)
+    return [line[len(space) :] if line.startswith(space) else line for line in lines]
 
 
-def _cleaned(lines: list[str]) -> list[str]:
-    """IPython's cleanup transforms after its leading blank lines: the first line's indentation removed
-    from every line, then ``>>>`` / ``...`` or ``In [n]:`` prompts."""
-    transforms = _inputtransformer2()
-    for transform in (transforms.leading_indent, transforms.classic_prompt, transforms.ipython_prompt):
-        lines = transform(lines)
+def _without_prompts(lines: list[str], first: int) -> list[str]:
+    rest = lines[first:]
+    if rest and _CLASSIC_FIRST.match(rest[0]):
+        return [_CLASSIC_ANY.sub("", line, count=1) for line in lines]
+    if rest and (_IPYTHON_PROMPT.match(rest[0]) or (len(rest) > 1 and _IPYTHON_PROMPT.match(rest[1]))):
+        return [_IPYTHON_PROMPT.sub("", line, count=1) for line in lines]
     return lines
 
 
@@ -233,61 +233,78 @@ def _parsed(lines: list[str]) -> ast.Module | None:
         return None
 
 
+def _logical_lines(lines: list[str]) -> tuple[list[list[tokenize.TokenInfo]], bool]:
+    """Tokens grouped by logical line, as IPython's ``make_tokens_by_line`` groups them, and whether the
+    tokenizer reached the end."""
+    by_line: list[list[tokenize.TokenInfo]] = [[]]
+    depth = 0
+    text = "".join(line + "\n" for line in lines)
+    try:
+        for token in tokenize.generate_tokens(io.StringIO(text).readline):
+            by_line[-1].append(token)
+            if token.type == tokenize.NEWLINE or (token.type == tokenize.NL and depth <= 0):
+                by_line.append([])
+            elif token.string in "([{" and token.type == tokenize.OP:
+                depth += 1
+            elif token.string in ")]}" and token.type == tokenize.OP and depth > 0:
+                depth -= 1
+    except (tokenize.TokenError, SyntaxError):  # an unclosed string or bracket: IPython stops there too
+        return [tokens for tokens in by_line if tokens], False
+    return [tokens for tokens in by_line if tokens], True
+
+
 def _special_lines(lines: list[str]) -> tuple[list[tuple[SpecialLine, int]], bool]:
     """Each special line of the cell with the index after its last (backslash-continued) line, and whether
-    the whole cell was tokenized.
-
-    IPython's `make_tokens_by_line` groups the tokens by logical line; on each, every token transformer's
-    ``find`` is asked, and the match IPython would apply first (`TokenTransformBase.sortby`) says what the
-    line is. A help request whose target IPython's `_help_end_re` refuses is no transformation (IPython
-    raises SyntaxError there, and the cell stays broken).
-    """
-    transforms = _inputtransformer2()
-    ended = [line + "\n" for line in lines]
+    the whole cell was tokenized."""
     found: list[tuple[SpecialLine, int]] = []
-    tokens_by_line = transforms.make_tokens_by_line(ended)
-    complete = _tokenized_to_the_end(tokens_by_line)
-    for tokens in tokens_by_line:
-        matches = [match for finder in _finders(transforms) if (match := finder.find([tokens])) is not None]
-        for match in sorted(matches, key=transforms.TokenTransformBase.sortby):
-            special = _special(match, tokens, ended, transforms)
-            if special is not None:
-                found.append(special)
-                break
+    logical, complete = _logical_lines(lines)
+    for tokens in logical:
+        body = [token for token in tokens if token.type not in (tokenize.INDENT, tokenize.DEDENT)]
+        meaningful = [
+            token
+            for token in body
+            if token.type not in (tokenize.NEWLINE, tokenize.NL, tokenize.COMMENT)
+            and not token.string.isspace()
+        ]
+        if not meaningful:
+            continue
+        start = meaningful[0]
+        row = start.start[0]
+        binds: tuple[str, ...] = ()
+        kind = ESCAPES.get(start.string[:1]) if start.string not in ("%=", "/=") else None
+        if kind is None:
+            assigned = _assigned_command(meaningful)
+            if assigned is not None:
+                kind, binds, row = assigned
+            elif meaningful[-1].string == "?":
+                kind = "help request"
+        if kind is None:
+            continue
+        end = row
+        while end < len(lines) and lines[end - 1].endswith("\\"):
+            end += 1
+        code = lines[start.start[0] - 1].strip()
+        found.append((SpecialLine(start.start[0], kind, code, binds), end))
     return found, complete
 
 
-def _finders(transforms: ModuleType) -> tuple[Any, ...]:
-    """The token transformers of IPython's `TransformerManager`, in its order."""
-    return (transforms.MagicAssign, transforms.SystemAssign, transforms.EscapedCommand, transforms.HelpEnd)
-
-
-def _special(
-    match: Any, tokens: list[tokenize.TokenInfo], ended: list[str], transforms: ModuleType
-) -> tuple[SpecialLine, int] | None:
-    """The special line one of IPython's token transformers found, with the index after its last line."""
-    row = match.start_line
-    binds: tuple[str, ...] = ()
-    if isinstance(match, transforms.HelpEnd):
-        piece = "".join(ended[row : match.q_line + 1])[match.start_col :]
-        if transforms._help_end_re.search(piece) is None:  # IPython's own test of a help target
+def _assigned_command(tokens: list[tokenize.TokenInfo]) -> tuple[str, tuple[str, ...], int] | None:
+    """``x = %magic`` / ``files = !ls`` (IPython's MagicAssign and SystemAssign)."""
+    depth = 0
+    for index, token in enumerate(tokens):
+        if token.type == tokenize.OP and token.string in "([{":
+            depth += 1
+        elif token.type == tokenize.OP and token.string in ")]}":
+            depth -= 1
+        elif depth == 0 and token.type == tokenize.OP and token.string == "=":
+            following = [t for t in tokens[index + 1 : index + 4] if not t.string.isspace()][:2]
+            names = tuple(t.string for t in tokens[:index] if t.type == tokenize.NAME)
+            if following and following[0].string == "!":
+                return "shell command", names, token.start[0]
+            if len(following) == 2 and following[0].string == "%" and following[1].type == tokenize.NAME:
+                return "IPython magic", names, token.start[0]
             return None
-        kind, end = "help request", match.q_line + 1
-    else:
-        end = transforms.find_end_of_continued_line(ended, row) + 1
-        if isinstance(match, transforms.EscapedCommand):
-            kind = ESCAPES[ended[row][match.start_col]]
-        else:
-            assign = transforms._find_assign_op(tokens)  # where IPython splits the assignment
-            binds = tuple(token.string for token in tokens[:assign] if token.type == tokenize.NAME)
-            kind = "IPython magic" if isinstance(match, transforms.MagicAssign) else "shell command"
-    return SpecialLine(row + 1, kind, ended[row].strip(), binds), end
-
-
-def _tokenized_to_the_end(tokens_by_line: list[list[tokenize.TokenInfo]]) -> bool:
-    """Whether the tokenizer reached the end of the cell (IPython's grouping stops silently at an unclosed
-    quote or bracket; a complete tokenization ends with ENDMARKER)."""
-    return bool(tokens_by_line) and tokens_by_line[-1][-1].type == tokenize.ENDMARKER
+    return None
 
 
 def _automagic(lines: list[str], defined: Container[str]) -> SpecialLine | None:
