@@ -126,21 +126,23 @@ def _module_files() -> dict[str, Path]:
     return modules
 
 
+def _resolved(name: str, modules: dict[str, Path]) -> str | None:
+    """The project module an imported name refers to (``package.name`` when it is one, else its package)."""
+    while name and name not in modules:
+        name = name.rpartition(".")[0]
+    return name or None
+
+
 def import_graph() -> dict[str, set[str]]:
     """Which project modules each project module imports (``from package import name`` counts as the
     module ``package.name`` when there is one, else as ``package``; a module's own packages are left out,
     as Python imports them whatever the module says)."""
     modules = _module_files()
 
-    def resolved(name: str) -> str | None:
-        while name and name not in modules:
-            name = name.rpartition(".")[0]
-        return name or None
-
     graph: dict[str, set[str]] = {module: set() for module in modules}
     for module, path in modules.items():
         for name in imported_modules(path):
-            target = resolved(name)
+            target = _resolved(name, modules)
             if target is not None and target != module and not module.startswith(f"{target}."):
                 graph[module].add(target)
     return graph
@@ -257,16 +259,11 @@ def _own_layer_graph() -> tuple[dict[str, int], dict[str, set[str]]]:
     layer_of = _layer_of()
     modules = _module_files()
 
-    def resolved(name: str) -> str | None:
-        while name and name not in modules:
-            name = name.rpartition(".")[0]
-        return name or None
-
     graph = {  # as import_graph, but a module's import of its own package counts (`grader.cli.__main__`)
         module: {
             target
             for name in imported_modules(path)
-            if (target := resolved(name)) is not None
+            if (target := _resolved(name, modules)) is not None
             and target != module
             and _grader_part(target) in layer_of
         }
