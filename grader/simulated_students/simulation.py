@@ -208,7 +208,7 @@ def simulate_call(
             type(argument) is EnvArgument and argument.form == ENV_NAME_OR_OBJECT
             for argument in (*call.args, *dict(call.kwargs).values())
         )
-        failure = error
+        failure: Exception | None = error
         value = None
         if replaceable and not (lab.made_by_name or lab.episodes):  # as the child: again with objects
             lab = Lab(call_seed, fast=fast)
