@@ -150,7 +150,7 @@ class ValueIterationCheck:
                 continue
             if np.max(np.abs(values - want.optimum)) > want.tolerance:
                 wrong_values.append((case, record.outcome.call, values, want))
-            if count not in want.counts:
+            elif count not in want.counts:  # n is judged where V is right: wrong values take other sweeps
                 wrong_counts.append((case, record.outcome.call, count, want))
         measurements: dict[str, PlainValue] = {
             "mdps_graded": len(graded),
@@ -210,10 +210,10 @@ def _count_problem(wrong: Sequence[tuple[GradingCase, Call, int, Expected]], tot
     _, call, count, want = wrong[0]
     accepted = " or ".join(str(n) for n in want.counts)
     message = f"{call_text(call)} returned n = {count}; the lab's value iteration from V = 0 makes {accepted} sweeps there ({len(wrong)} of {total} MDPs with another n). The lab counts every sweep made, the one that finds the change below tol included: on its example V1 = [0, 1, 1, 0], V2 = [1, 1, 1, 0], V3 = V2, so n = 3."  # noqa: E501
-    if all(count == min(want.counts) - 1 for _, _, count, want in wrong):
+    if all(count + 1 in want.counts for _, _, count, want in wrong):
         return (
             f"{message} Likely cause: counting the sweeps that changed V instead of the sweeps made (n - 1)."
         )
-    if all(count == max(want.counts) + 1 for _, _, count, want in wrong):
+    if all(count - 1 in want.counts for _, _, count, want in wrong):
         return f"{message} Likely cause: one sweep counted after the last one made (n + 1)."
     return message
