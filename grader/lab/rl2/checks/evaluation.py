@@ -113,12 +113,21 @@ def _evaluated(
     return iterate(sweep, mdp.n_states, tol, MAX_SWEEPS, Reading(False, "max"), start)[0]
 
 
-Mistake = Callable[[Point, float], FloatArray]
+def _undiscounted(point: Point, tol: float) -> FloatArray | None:
+    """The policy's values at discount 1, or None where it has none (its evaluation never stops there)."""
+    try:
+        policy_value(point.case.mdp, point.policy, 1.0)
+    except UnboundedValueError:
+        return None
+    return _evaluated(point.case.mdp, 1.0, point.policy, tol)
+
+
+Mistake = Callable[[Point, float], FloatArray | None]
 
 MISTAKES: tuple[tuple[str, Mistake], ...] = (
     (
         "beta ignored: your values are the policy's at discount 1 (the discount never applied); multiply the next state's value by beta",  # noqa: E501
-        lambda point, tol: _evaluated(point.case.mdp, 1.0, point.policy, tol),
+        _undiscounted,
     ),
     (
         "first outcome only: your values read P[s][policy[s]][0] alone; every outcome in P[s][a] counts, weighted by its probability",  # noqa: E501
@@ -207,9 +216,22 @@ def _values_problem(wrong: Sequence[tuple[Point, Call, FloatArray, float]], tota
     state = int(np.argmax(np.abs(values - point.exact)))
     message = f"{call_text(call)} ({point.kind}) returned {describe_values(values)}; its exact value on {point.case.mdp.name} at beta = {point.case.beta:g} is {describe_values(point.exact)} (state {state}: {values[state]:.6g} against {point.exact[state]:.6g}; tolerance {tolerance:.1e} at tol = {tol:g}). {len(wrong)} of {total} calls wrong."  # noqa: E501
     for cause, mistake in MISTAKES:
-        if all(close(values, mistake(point, tol)) for point, _, values, _ in wrong):
+        if _explains(mistake, wrong, tol):
             return f"{message} Likely cause: {cause}."
     return message
+
+
+def _explains(mistake: Mistake, wrong: Sequence[tuple[Point, Call, FloatArray, float]], tol: float) -> bool:
+    """Whether the mistake gives every wrong value (where it gives one: a discount-1 evaluation of a policy
+    with no value there never returns), and gives some."""
+    explained = 0
+    for point, _, values, _ in wrong:
+        guess = mistake(point, tol)
+        if guess is not None:
+            if not close(values, guess):
+                return False
+            explained += 1
+    return explained > 0
 
 
 def _shown(value: PlainValue) -> str:

@@ -163,9 +163,9 @@ class ValueIterationCheck:
             more = f" ({len(shape_problems)} of {len(graded)} calls)" if len(shape_problems) > 1 else ""
             return Verdict("failed", 0.0, shape_problems[0] + more + ".", measurements)
         problems = []
-        if wrong_values:
+        if wrong_values:  # a mistake in V changes the sweeps too: n is judged once every V is right
             problems.append(_values_problem(wrong_values, len(graded), settings))
-        if wrong_counts:
+        elif wrong_counts:
             problems.append(_count_problem(wrong_counts, len(graded)))
         if not problems:
             return Verdict(
