@@ -30,8 +30,14 @@ def epsilon_decay(
 Table = Mapping[int, Mapping[int, Sequence[tuple[float, int, float, bool]]]]
 
 
-def policy_improvement(P: Table, nS: int, nA: int, V: Any, beta: float = 1.0) -> np.ndarray:
-    """The greedy policy for V: in each state the first action of best `sum p * (r + beta * V[s'])`."""
+def policy_improvement(
+    P: Table, nS: int, nA: int, V: Any, beta: float = 1.0, *_: Any, **__: Any
+) -> np.ndarray:
+    """The greedy policy for V: in each state the first action of best `sum p * (r + beta * V[s'])`.
+
+    The parameters are the template's (2024 on); arguments a student's own version took beyond them are
+    accepted and unused, so a call written for that version still reaches the lab's algorithm.
+    """
     values = np.asarray(V, dtype=np.float64).reshape(-1)
     look = np.zeros((nS, nA))
     for state in range(nS):
@@ -41,10 +47,18 @@ def policy_improvement(P: Table, nS: int, nA: int, V: Any, beta: float = 1.0) ->
     return np.argmax(look, axis=1).astype(np.int64)
 
 
+def extract_policy(P: Table, nS: int, nA: int, v: Any, beta: float = 1.0, *_: Any, **__: Any) -> np.ndarray:
+    """`policy_improvement` under the 2018-2023 name and parameters (`v`)."""
+    return policy_improvement(P, nS, nA, v, beta)
+
+
 def iter_policy_eval(
-    P: Table, nS: int, nA: int, policy: Any, beta: float = 1.0, tol: float = 1e-8
+    P: Table, nS: int, nA: int, policy: Any, beta: float = 1.0, tol: float = 1e-8, *_: Any, **__: Any
 ) -> np.ndarray:
-    """The policy's values: sweeps of its own Bellman equation from zeros until a sweep changes V by < tol."""
+    """The policy's values: sweeps of its own Bellman equation from zeros until a sweep changes V by < tol.
+
+    Same parameters under the 2018-2023 name, `compute_policy_v`; extra arguments are accepted and unused.
+    """
     actions = np.asarray(policy).reshape(-1).astype(np.int64)
     values = np.zeros(nS)
     while True:
@@ -61,7 +75,7 @@ def iter_policy_eval(
 PROVIDED: dict[str, Callable[..., Any]] = {
     "epsilon_decay": epsilon_decay,
     "policy_improvement": policy_improvement,
-    "extract_policy": policy_improvement,
+    "extract_policy": extract_policy,
     "iter_policy_eval": iter_policy_eval,
     "compute_policy_v": iter_policy_eval,
 }

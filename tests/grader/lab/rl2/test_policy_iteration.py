@@ -106,3 +106,19 @@ def test_a_timeout_below_discount_1_is_not_blamed_on_the_start() -> None:
     verdict = judged_outcomes("v2024", "policy_iteration", _timing_out(RING_DISCOUNTED))
     assert verdict.status == "timeout"
     assert "never converges" not in verdict.feedback
+
+
+@pytest.mark.parametrize(
+    ("name", "keyword"),
+    [("extract_policy", "v"), ("policy_improvement", "V")],
+)
+def test_the_graders_improvement_step_takes_its_editions_parameter_names(name: str, keyword: str) -> None:
+    from grader.sandbox.child.provided import PROVIDED
+
+    example = cases()[0].mdp
+    policy = PROVIDED[name](example.as_dict(), 4, 4, **{keyword: np.array([1.0, 1.0, 1.0, 0.0])}, beta=1.0)
+    assert policy.tolist() == [2, 1, 2, 0]  # the lab's stated policy (first best action)
+    values = PROVIDED["compute_policy_v"](
+        example.as_dict(), 4, 4, policy, 1.0, 1e-8, 3000
+    )  # an extra maxiter
+    assert values.tolist() == [1.0, 1.0, 1.0, 0.0]
