@@ -2,11 +2,12 @@
 
 Each edition is an `Edition` (`lab="rl2"`) with its registry of problems (ids are the edition's function
 names), every function its template defines, its template, reference, default configuration
-(`grader/lab/rl2/<edition>.toml`) and file name. The pure problems are shared declarations
-(`VALUE_ITERATION`, the two namings of the improvement and evaluation steps, the two `policy_iteration`s
-bound to their edition's step names); an edition's registry is `Registry(PURE_2018 + ...)` built from them,
-so a later slice adds the episode problems (`run_simulation`, `frozen_lake`/`frozenlake`,
-`model_comparison`) by extending these tuples, and removes them from `not_graded`.
+(`grader/lab/rl2/<edition>.toml`) and file name. The pure problems are shared declarations (the two
+readings of value iteration's n, the two namings of the improvement and evaluation steps, the two
+`policy_iteration`s bound to their edition's step names); an edition's registry is built from a tuple of them
+(`PURE_2018`, `PURE_2023`, `PURE_2024`), so a later slice adds the episode problems (`run_simulation`,
+`frozen_lake`/`frozenlake`, `model_comparison`) by extending these tuples, and removes them from
+`not_graded`.
 """
 
 from __future__ import annotations
@@ -23,6 +24,15 @@ LAB = "rl2"
 PACKAGE = REPOSITORY / "grader" / "lab" / "rl2"
 SUBMISSIONS = REPOSITORY / "submissions" / "rl2"
 
+VALUE_ITERATION_2018 = Problem(
+    id="value_iteration",
+    title="Problem 1: value_iteration",
+    points=1.0,
+    config=ValueIterationConfig,
+    check=ValueIterationCheck(changes_counted=True),
+)
+"""The 2018 to mid-2022 texts: their example stops at "V2 = [1, 1, 1, 0], which is the solution", so n may
+count the sweeps that changed V (2 there) as well as the sweeps made (3)."""
 VALUE_ITERATION = Problem(
     id="value_iteration",
     title="Problem 1: value_iteration",
@@ -30,6 +40,8 @@ VALUE_ITERATION = Problem(
     config=ValueIterationConfig,
     check=ValueIterationCheck(),
 )
+"""The texts since mid-2022: "Repeating a third time gives V3 = [1, 1, 1, 0], which is the same as V2, so the
+process has converged": n = 3 on the example."""
 EXTRACT_POLICY = Problem(
     id="extract_policy",
     title="Problem 2: extract_policy",
@@ -73,8 +85,10 @@ POLICY_ITERATION_2024 = Problem(
     check=PolicyIterationCheck(evaluation="iter_policy_eval", improvement="policy_improvement"),
 )
 
-PURE_2018 = (VALUE_ITERATION, EXTRACT_POLICY, COMPUTE_POLICY_V, POLICY_ITERATION_2018)
-"""The pure problems of the 2018-2023 editions, in lab order."""
+PURE_2018 = (VALUE_ITERATION_2018, EXTRACT_POLICY, COMPUTE_POLICY_V, POLICY_ITERATION_2018)
+"""The pure problems of the 2018-2022 editions (v2018, v2019), in lab order."""
+PURE_2023 = (VALUE_ITERATION, EXTRACT_POLICY, COMPUTE_POLICY_V, POLICY_ITERATION_2018)
+"""The pure problems of the 2023 edition: the 2018 names, the example counted to n = 3."""
 PURE_2024 = (VALUE_ITERATION, POLICY_IMPROVEMENT, ITER_POLICY_EVAL, POLICY_ITERATION_2024)
 """The pure problems of the 2024 and 2026 editions, in lab order."""
 
@@ -137,7 +151,7 @@ V2023 = Edition(
     title="Policy Function Iteration (2023, gymnasium)",
     api="gymnasium",
     lab=LAB,
-    registry=Registry(PURE_2018),
+    registry=Registry(PURE_2023),
     functions=(
         *_solvers("1.0", "extract_policy", "v", "compute_policy_v"),
         ExpectedFunction("frozen_lake", ("basic_case=True", "M=1000", "render=False"), env_ids=_LAKES),

@@ -4,10 +4,13 @@ Called once on every MDP and discount of `mdp_calls.cases()` with `(P, nS, nA, b
 positionally. V must lie within `mdp_calls.value_tolerance` of the exact optimal values
 (`reference.oracles.mdp.optimal_solution`); n must be the number of sweeps the lab's algorithm makes from
 V = 0 at that tol, the sweep that found the change below tol included (the example: V1, V2, V3 = V2, so
-n = 3, as every edition's text works it), under one of the readings the text allows (`mdp_calls.READINGS`:
-the text's `||V^{k+1} - V^k||` names no norm, so the max norm and the 2-norm; a sweep in place is accepted
-too). A wrong V is compared with the typical mistakes (`MISTAKES`), each named when it explains every wrong
-V; a wrong n by one sweep is named as such.
+n = 3, as the texts since mid-2022 work it), under one of the readings the text allows
+(`mdp_calls.READINGS`: the text's `||V^{k+1} - V^k||` names no norm, so the max norm and the 2-norm; a
+sweep in place is accepted too). The texts of 2018 to mid-2022 (editions v2018, v2019) stop their example
+at "V2 = [1, 1, 1, 0], which is the solution" without the sweep that finds no change, so there n may also
+count only the sweeps that changed V (`changes_counted`: the example's n = 2). A wrong V is compared with
+the typical mistakes (`MISTAKES`), each named when it explains every wrong V; a wrong n by one sweep is
+named as such.
 """
 
 from __future__ import annotations
@@ -119,13 +122,25 @@ MISTAKES: tuple[tuple[str, Mistake], ...] = (
 
 @dataclass(frozen=True)
 class ValueIterationCheck:
-    """One call per graded MDP; values exact within the tolerance the tol earns, n by the lab's count."""
+    """One call per graded MDP; values exact within the tolerance the tol earns, n by the lab's count.
 
+    Attributes:
+        changes_counted: The edition's text also allows n to count only the sweeps that changed V (its
+            example stops at "V2 ..., which is the solution"): n - 1 is accepted too.
+    """
+
+    changes_counted: bool = False
     function: str = FUNCTION
 
     def plan(self, settings: ValueIterationConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
         """`value_iteration(P, nS, nA, beta, tol, maxiter)` on every case, positionally."""
         return [mdp_call(self.function, case, case.beta, settings.tol, settings.maxiter) for case in cases()]
+
+    def accepted(self, want: Expected) -> tuple[int, ...]:
+        """The counts of n accepted for a call: the lab's sweep counts (one less where the text allows)."""
+        if not self.changes_counted:
+            return want.counts
+        return tuple(sorted({*want.counts, *(count - 1 for count in want.counts)}))
 
     @paused_gc
     def judge(self, settings: ValueIterationConfig, records: Sequence[CallRecord]) -> Verdict:
@@ -150,7 +165,9 @@ class ValueIterationCheck:
                 continue
             if np.max(np.abs(values - want.optimum)) > want.tolerance:
                 wrong_values.append((case, record.outcome.call, values, want))
-            elif count not in want.counts:  # n is judged where V is right: wrong values take other sweeps
+            elif count not in self.accepted(
+                want
+            ):  # n is judged where V is right: wrong values take other sweeps
                 wrong_counts.append((case, record.outcome.call, count, want))
         measurements: dict[str, PlainValue] = {
             "mdps_graded": len(graded),
@@ -166,7 +183,7 @@ class ValueIterationCheck:
         if wrong_values:  # a mistake in V changes the sweeps too: n is judged once every V is right
             problems.append(_values_problem(wrong_values, len(graded), settings))
         elif wrong_counts:
-            problems.append(_count_problem(wrong_counts, len(graded)))
+            problems.append(_count_problem(wrong_counts, len(graded), self))
         if not problems:
             return Verdict(
                 "passed",
@@ -206,14 +223,21 @@ def _values_problem(
     return message
 
 
-def _count_problem(wrong: Sequence[tuple[GradingCase, Call, int, Expected]], total: int) -> str:
+def _count_problem(
+    wrong: Sequence[tuple[GradingCase, Call, int, Expected]], total: int, check: ValueIterationCheck
+) -> str:
     _, call, count, want = wrong[0]
-    accepted = " or ".join(str(n) for n in want.counts)
-    message = f"{call_text(call)} returned n = {count}; the lab's value iteration from V = 0 makes {accepted} sweeps there ({len(wrong)} of {total} MDPs with another n). The lab counts every sweep made, the one that finds the change below tol included: on its example V1 = [0, 1, 1, 0], V2 = [1, 1, 1, 0], V3 = V2, so n = 3."  # noqa: E501
-    if all(count + 1 in want.counts for _, _, count, want in wrong):
+    accepted = " or ".join(str(n) for n in check.accepted(want))
+    convention = (
+        "Your edition's text counts either the sweeps that reached its example's solution (V1 = [0, 1, 1, 0], V2 = [1, 1, 1, 0], which is the solution: n = 2) or every sweep made, the one that finds no change included (n = 3)."  # noqa: E501
+        if check.changes_counted
+        else "The lab counts every sweep made, the one that finds the change below tol included: on its example V1 = [0, 1, 1, 0], V2 = [1, 1, 1, 0], V3 = V2, so n = 3."  # noqa: E501
+    )
+    message = f"{call_text(call)} returned n = {count}; the lab's value iteration from V = 0 makes {accepted} sweeps there ({len(wrong)} of {total} MDPs with another n). {convention}"  # noqa: E501
+    if all(count + 1 in check.accepted(want) for _, _, count, want in wrong):
         return (
             f"{message} Likely cause: counting the sweeps that changed V instead of the sweeps made (n - 1)."
         )
-    if all(count - 1 in want.counts for _, _, count, want in wrong):
+    if all(count - 1 in check.accepted(want) for _, _, count, want in wrong):
         return f"{message} Likely cause: one sweep counted after the last one made (n + 1)."
     return message

@@ -129,3 +129,14 @@ def test_a_call_that_did_not_return_is_the_outcomes_verdict() -> None:
         ),
     )
     assert verdict.status == "timeout" and "did not return within 30 seconds" in verdict.feedback
+
+
+def test_the_2018_to_2022_texts_also_allow_counting_the_sweeps_that_changed_V() -> None:
+    counts_changes = partial(value_iteration, shift=-1)
+    for edition in ("v2018", "v2019"):
+        verdict = judged(edition, "value_iteration", counts_changes)
+        assert verdict.status == "passed", verdict.feedback
+    verdict = judged("v2019", "value_iteration", partial(value_iteration, shift=-2))
+    assert verdict.status == "failed" and "makes 2 or 3 sweeps there" in verdict.feedback
+    for edition in ("v2023", "v2024", "v2026"):
+        assert judged(edition, "value_iteration", counts_changes).status == "failed"
