@@ -158,7 +158,7 @@ class PolicyIterationCheck:
         case = cases()[index]
         if case.beta < 1:
             return Verdict(early.status, early.fraction, f"{early.feedback}. {reading}", early.measurements)
-        cause = f"Likely cause: on {case.mdp.name} at beta = 1 your start policy never converges at discount 1: a policy whose moves loop forever through costly states (all zeros here walks the ring) has no finite value, so its iterative evaluation never stops. Start from the lab's all-ones policy (np.ones(nS, dtype=int)), which ends its episodes."  # noqa: E501
+        cause = f"Likely cause: on {case.mdp.name} at beta = 1 your start policy never converges at discount 1: a policy whose moves loop forever through costly states (all zeros walks the ring at a cost forever) has no finite value, so its iterative evaluation never stops. Start from a policy that ends its episodes, such as the all-ones start of the 2023 and later texts (np.ones(nS, dtype=int))."  # noqa: E501
         return Verdict(
             early.status, early.fraction, f"{early.feedback}. {cause} {reading}", early.measurements
         )
