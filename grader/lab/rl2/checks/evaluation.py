@@ -36,6 +36,7 @@ from grader.lab.rl2.checks.mdp_calls import (
     iterate,
     last_outcomes,
     mdp_call,
+    shown,
     value_tolerance,
 )
 from grader.lab.settings import ProblemConfig
@@ -177,7 +178,7 @@ class EvaluationCheck:
                     tuples.append(call)
                 else:
                     shapes.append(
-                        f"{call_text(call)} returned {_shown(value)}; expected one array of the {size} values"
+                        f"{call_text(call)} returned {shown(value)}; expected one array of the {size} values"
                     )
                 continue
             tolerance = evaluation_tolerance(point.case, point.policy, point.exact, settings.tol)
@@ -232,11 +233,3 @@ def _explains(mistake: Mistake, wrong: Sequence[tuple[Point, Call, FloatArray, f
                 return False
             explained += 1
     return explained > 0
-
-
-def _shown(value: PlainValue) -> str:
-    if isinstance(value, np.ndarray):
-        return f"an array of shape {value.shape}"
-    if isinstance(value, list):
-        return f"a sequence of {len(value)} items"
-    return f"a {type(value).__name__}"

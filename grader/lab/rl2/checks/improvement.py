@@ -30,6 +30,7 @@ from grader.lab.rl2.checks.mdp_calls import (
     first_outcomes,
     last_outcomes,
     mdp_call,
+    shown,
 )
 from grader.lab.settings import ProblemConfig
 from grader.sandbox.outcome import Call, FunctionInfo, PlainValue
@@ -130,7 +131,7 @@ class ImprovementCheck:
         point, call, value, policy = wrong[0]
         mdp = point.case.mdp
         if policy is None:
-            return f"{call_text(call)} returned {_shown(value)}; expected a policy: one action number in 0..{mdp.n_actions - 1} for each of the {mdp.n_states} states of {mdp.name} ({len(wrong)} of {total} calls)."  # noqa: E501
+            return f"{call_text(call)} returned {shown(value)}; expected a policy: one action number in 0..{mdp.n_actions - 1} for each of the {mdp.n_states} states of {mdp.name} ({len(wrong)} of {total} calls)."  # noqa: E501
         gaps = greedy_gaps(mdp, point.values, policy, point.case.beta)
         state = int(np.argmax(gaps))
         message = f"{call_text(call)} (V: {point.kind}) returned {describe_values(policy, 8)}; in state {state} its action {int(policy[state])} falls {gaps[state]:.4g} short of the best one-step look-ahead sum p * (r + beta * V[s']) at beta = {point.case.beta:g} ({len(wrong)} of {total} calls wrong)."  # noqa: E501
@@ -140,11 +141,3 @@ class ImprovementCheck:
                 if all(_explained(kind, p, pol) for p, pol in usable):
                     return f"{message} Likely cause: {cause}."
         return message
-
-
-def _shown(value: PlainValue) -> str:
-    if isinstance(value, np.ndarray):
-        return f"an array of shape {value.shape} and dtype {value.dtype}"
-    if isinstance(value, list):
-        return f"a sequence of {len(value)} items"
-    return f"a {type(value).__name__}"

@@ -68,13 +68,13 @@ def mdp_call(function: str, case: GradingCase, *rest: PlainValue) -> Call:
 
 def call_text(call: Call) -> str:
     """`value_iteration(P of FrozenLake 4x4 (slippery), 16, 4, 0.9, 1e-08, 3000)` for feedback."""
-    shown = []
+    arguments = []
     for argument in call.args:
         if isinstance(argument, np.ndarray):
-            shown.append(f"<array of {argument.size}>")
+            arguments.append(f"<array of {argument.size}>")
         else:
-            shown.append(repr(argument))
-    return f"{call.function}({', '.join(shown)})"
+            arguments.append(repr(argument))
+    return f"{call.function}({', '.join(arguments)})"
 
 
 def as_vector(value: PlainValue, size: int) -> FloatArray | None:
@@ -114,11 +114,22 @@ def as_count(value: PlainValue) -> int | None:
     return None
 
 
+def shown(value: PlainValue) -> str:
+    """What a returned value is, for feedback: `an array of shape (4,) and dtype int64`, `a sequence of 2
+    items`, `a str`."""
+    if isinstance(value, np.ndarray):
+        return f"an array of shape {value.shape} and dtype {value.dtype}"
+    if isinstance(value, list):
+        return f"a sequence of {len(value)} item{'' if len(value) == 1 else 's'}"
+    name = type(value).__name__
+    return f"{'an' if name[0] in 'aeiou' else 'a'} {name}"
+
+
 def describe_values(values: Sequence[float] | FloatArray, limit: int = 6) -> str:
     """A short readable list of values: `[0.9, 1, 1, 0]`, or the first `limit` and how many more."""
-    shown = ", ".join(f"{float(value):.6g}" for value in list(values)[:limit])
+    listed = ", ".join(f"{float(value):.6g}" for value in list(values)[:limit])
     more = len(values) - limit
-    return f"[{shown}{f', ... ({more} more)' if more > 0 else ''}]"
+    return f"[{listed}{f', ... ({more} more)' if more > 0 else ''}]"
 
 
 def value_tolerance(case: GradingCase, tol: float, worst: float, optimum: FloatArray) -> float:

@@ -39,6 +39,7 @@ from grader.lab.rl2.checks.mdp_calls import (
     cases,
     describe_values,
     mdp_call,
+    shown,
 )
 from grader.lab.settings import ProblemConfig
 from grader.sandbox.outcome import Call, FunctionInfo, OutcomeStatus, PlainValue
@@ -135,7 +136,7 @@ class PolicyIterationCheck:
         policy = None if parts is None else as_policy(parts[1], mdp)
         count = None if parts is None else as_count(parts[2])
         if values is None or policy is None or count is None:
-            return f"{call_text(call)} returned {_shown(value)}; expected (V, policy, n): the {mdp.n_states} values, one action in 0..{mdp.n_actions - 1} per state, and the number of iterations"  # noqa: E501
+            return f"{call_text(call)} returned {shown(value)}; expected (V, policy, n): the {mdp.n_states} values, one action in 0..{mdp.n_actions - 1} per state, and the number of iterations"  # noqa: E501
         judged = judge_policy(mdp, policy, case.beta)
         if not judged.optimal:
             state = int(np.argmax(judged.shortfall))
@@ -162,11 +163,3 @@ class PolicyIterationCheck:
         return Verdict(
             early.status, early.fraction, f"{early.feedback}. {cause} {reading}", early.measurements
         )
-
-
-def _shown(value: PlainValue) -> str:
-    if isinstance(value, np.ndarray):
-        return f"one array of shape {value.shape}"
-    if isinstance(value, list):
-        return f"a sequence of {len(value)} items"
-    return f"a {type(value).__name__}"

@@ -38,6 +38,7 @@ from grader.lab.rl2.checks.mdp_calls import (
     iterate,
     last_outcomes,
     mdp_call,
+    shown,
     value_tolerance,
 )
 from grader.lab.settings import ProblemConfig, Share
@@ -158,9 +159,13 @@ class ValueIterationCheck:
             values = None if parts is None else as_vector(parts[0], case.mdp.n_states)
             count = None if parts is None else as_count(parts[1])
             if values is None or count is None:
+                found = (
+                    f"(V, n) with V {shown(parts[0])} and n {shown(parts[1])}"
+                    if parts is not None
+                    else shown(record.outcome.value)
+                )
                 shape_problems.append(
-                    f"{call_text(record.outcome.call)} returned {_shown(record.outcome.value)}; expected (V, n): "  # noqa: E501
-                    f"V the {case.mdp.n_states} values (an array) and n the number of sweeps (an int)"
+                    f"{call_text(record.outcome.call)} returned {found}; expected (V, n): V the {case.mdp.n_states} values of {case.mdp.name} (an array) and n the number of sweeps (an int)"  # noqa: E501
                 )
                 continue
             if np.max(np.abs(values - want.optimum)) > want.tolerance:
@@ -199,14 +204,6 @@ def _pair(value: PlainValue) -> tuple[PlainValue, PlainValue] | None:
     if isinstance(value, list) and len(value) == 2:
         return value[0], value[1]
     return None
-
-
-def _shown(value: PlainValue) -> str:
-    if isinstance(value, np.ndarray):
-        return f"one array of shape {value.shape}"
-    if isinstance(value, list):
-        return f"a sequence of {len(value)} item{'' if len(value) == 1 else 's'}"
-    return f"a {type(value).__name__}"
 
 
 def _values_problem(

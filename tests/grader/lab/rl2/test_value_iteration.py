@@ -99,8 +99,14 @@ def test_each_typical_mistake_is_named(changes: dict[str, Any], cause: str, frac
             lambda *args: (value_iteration(*args)[0], 7),
             "returned n = 7; the lab's value iteration from V = 0 makes 3 sweeps",
         ),
-        (lambda *args: value_iteration(*args)[0], "returned one array of shape (4,); expected (V, n)"),
-        (lambda *args: (list(value_iteration(*args)[0])[:-1], 3), "expected (V, n)"),
+        (
+            lambda *args: value_iteration(*args)[0],
+            "returned an array of shape (4,) and dtype float64; expected (V, n)",
+        ),
+        (
+            lambda *args: (list(value_iteration(*args)[0])[:-1], 3),
+            "returned (V, n) with V a sequence of 3 items and n an int",
+        ),
         (lambda *args: (value_iteration(*args)[0], 3.5), "expected (V, n)"),
     ],
     ids=["off-by-a-constant", "another-n", "V-alone", "V-too-short", "n-not-whole"],
