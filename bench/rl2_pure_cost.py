@@ -28,6 +28,15 @@ from grader.sandbox import IsolationPolicy
 
 ROOT = Path(__file__).resolve().parents[1]
 HEADING = "## Second lab: the cost of the pure problems (issue 35)"
+DESCRIPTION = (
+    "`python bench/rl2_pure_cost.py`: each file graded through the sandbox with its edition's default "
+    "configuration, 2 workers, on {cores} cores shared with other work. "
+    "Wall: the problem's child start, import, every call and judging; "
+    "student: seconds inside the submission's functions. "
+    "A problem's calls all run in its one child; "
+    "a call that times out (policy_iteration's zero start on the ring at discount 1, `call_seconds = 20`) "
+    "restarts it for the next call."
+)
 FILES = (
     ("v2024", "submissions/rl2/honest_v2024.py"),
     ("v2018", "submissions/rl2/honest_v2018.py"),
@@ -57,14 +66,7 @@ def main() -> None:
         [
             HEADING,
             "",
-            textwrap.fill(
-                f"`python bench/rl2_pure_cost.py`: each file graded through the sandbox with its edition's default "
-                f"configuration, 2 workers, on {os.cpu_count()} cores shared with other work. Wall: the problem's "
-                "child start, import, every call and judging; student: seconds inside the submission's functions. "
-                "A problem's calls all run in its one child; a call that times out (policy_iteration's zero start "
-                "on the ring at discount 1, `call_seconds = 20`) restarts it for the next call.",
-                width=105,
-            ),
+            textwrap.fill(DESCRIPTION.format(cores=os.cpu_count()), width=105),
             "",
             "| file | problem | status | calls | wall s | student s |",
             "|---|---|---|---|---|---|",
