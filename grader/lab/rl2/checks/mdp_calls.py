@@ -155,13 +155,18 @@ class Reading:
     norm: str
 
 
-READINGS = tuple(Reading(in_place, norm) for in_place in (False, True) for norm in ("max", "l2"))
+NORMS = ("max", "l2", "l1")
+"""The norms of `||V^{k+1} - V^k||`, which the texts do not name: `np.max(np.abs(...))`, `np.linalg.norm`
+and `np.sum(np.abs(...))`."""
+READINGS = tuple(Reading(in_place, norm) for in_place in (False, True) for norm in NORMS)
 """Every reading of "iterate until the change is below tol" the grader accepts (n may follow any)."""
 
 
 def stop_change(difference: FloatArray, norm: str) -> float:
     """The change between two sweeps in a reading's norm."""
-    return float(np.max(np.abs(difference))) if norm == "max" else float(np.linalg.norm(difference))
+    if norm == "max":
+        return float(np.max(np.abs(difference)))
+    return float(np.linalg.norm(difference)) if norm == "l2" else float(np.sum(np.abs(difference)))
 
 
 def iterate(

@@ -146,3 +146,22 @@ def test_the_2018_to_2022_texts_also_allow_counting_the_sweeps_that_changed_V() 
     assert verdict.status == "failed" and "makes 2 or 3 sweeps there" in verdict.feedback
     for edition in ("v2023", "v2024", "v2026"):
         assert judged(edition, "value_iteration", counts_changes).status == "failed"
+
+
+def test_a_1_norm_stop_is_a_reading_the_text_allows() -> None:
+    def one_norm(P: Any, nS: int, nA: int, beta: float = 1.0, tol: float = 1e-8, maxiter: int = 3000) -> Any:
+        V = np.zeros(nS)
+        for n in range(1, maxiter + 1):
+            new = np.array(
+                [
+                    max(sum(p * (r + beta * V[s1]) for p, s1, r, _ in P[s][a]) for a in range(nA))
+                    for s in range(nS)
+                ]
+            )
+            change, V = np.sum(np.abs(new - V)), new
+            if change < tol:
+                return V, n
+        return V, maxiter
+
+    verdict = judged("v2024", "value_iteration", one_norm)
+    assert verdict.status == "passed", verdict.feedback
