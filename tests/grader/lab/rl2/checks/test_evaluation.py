@@ -1,0 +1,99 @@
+"""The evaluation step's check (compute_policy_v to 2023, iter_policy_eval since 2024): one array, the
+policy's exact value within the tolerance tol earns; a tuple and each typical mistake named."""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import Any
+
+import numpy as np
+import pytest
+
+from grader.lab.rl2.checks.evaluation import points
+from reference.rl2 import solutions
+from tests.grader.lab.rl2.support import judged
+
+
+def evaluation(
+    P: Any,
+    nS: int,
+    nA: int,
+    policy: Any,
+    beta: float = 1.0,
+    tol: float = 1e-8,
+    *,
+    read: str = "all",
+    discount: bool = True,
+    start: float = 0.0,
+    in_place: bool = False,
+    with_count: bool = False,
+) -> Any:
+    factor = beta if discount else 1.0
+    V = np.full(nS, start)
+    for n in range(1, 200_000):  # at discount 1 a policy may have no value: stop as a maxiter would
+        new = V.copy() if in_place else np.zeros(nS)
+        for s in range(nS):
+            total = 0.0
+            outcomes = P[s][int(policy[s])]
+            for p, s1, r, _ in outcomes[:1] if read == "first" else outcomes:
+                term = p * (r + factor * (new if in_place else V)[s1])
+                total = term if read == "last" else total + term
+            new[s] = total
+        change = np.linalg.norm(new - V)
+        V = new
+        if change < tol:
+            return (V, n) if with_count else V
+    return (V, n) if with_count else V
+
+
+def test_the_policies_asked_have_finite_values_and_include_the_labs_start() -> None:
+    kinds = [point.kind for point in points()]
+    assert kinds.count("the all-ones policy") == 10 and len(kinds) == 30
+
+
+@pytest.mark.parametrize(
+    "function", [solutions.iter_policy_eval, evaluation, partial(evaluation, in_place=True)]
+)
+def test_the_reference_and_an_in_place_evaluation_pass(function: Any) -> None:
+    verdict = judged("v2024", "iter_policy_eval", function)
+    assert verdict.status == "passed", verdict.feedback
+
+
+def test_the_2018_name_is_graded_the_same() -> None:
+    assert judged("v2018", "compute_policy_v", solutions.iter_policy_eval).status == "passed"
+
+
+def test_a_tuple_where_one_array_is_asked_for_is_named() -> None:
+    verdict = judged("v2024", "iter_policy_eval", partial(evaluation, with_count=True))
+    assert verdict.status == "failed"
+    assert "returned a tuple where one array is asked for (30 of 30 calls)" in verdict.feedback
+
+
+@pytest.mark.parametrize(
+    ("changes", "cause"),
+    [
+        ({"discount": False}, "beta ignored"),
+        ({"read": "first"}, "first outcome only"),
+        ({"read": "last"}, "`=` where `+=` is meant"),
+        ({"start": 1.0}, "values initialised to ones"),
+    ],
+    ids=["beta-ignored", "first-outcome", "assigns", "ones"],
+)
+def test_each_typical_mistake_is_named(changes: dict[str, Any], cause: str) -> None:
+    verdict = judged("v2024", "iter_policy_eval", partial(evaluation, **changes))
+    assert verdict.status == "failed" and f"Likely cause: {cause}" in verdict.feedback, verdict.feedback
+
+
+@pytest.mark.parametrize(
+    ("function", "found"),
+    [
+        (lambda *args: evaluation(*args) + 0.01, "its exact value on"),
+        (lambda *args: np.array([1.0, 1.0, 1.0, 0.0]), "expected one array of the 16 values"),
+        (lambda *args: "values", "returned a str; expected one array"),
+    ],
+    ids=["off-by-a-constant", "the-examples-answer", "text"],
+)
+def test_a_wrong_value_fails_without_a_cause(function: Any, found: str) -> None:
+    verdict = judged("v2024", "iter_policy_eval", function)
+    assert verdict.status == "failed" and found in verdict.feedback, verdict.feedback
+    assert "Likely cause" not in verdict.feedback
