@@ -66,6 +66,7 @@ class Edition:
         default_config: The assignment configuration used when none is given.
         notebook_name: The file name its template gives students.
         not_graded: Functions the edition asks for that this grader does not grade yet, each with why.
+        lab: The lab it is an edition of (`grader.lab.labs.LABS`); the first lab's editions keep the default.
     """
 
     name: str
@@ -79,6 +80,7 @@ class Edition:
     default_config: Path
     notebook_name: str
     not_graded: tuple[tuple[str, str], ...] = ()
+    lab: str = "opengym"
 
     def function(self, name: str) -> ExpectedFunction | None:
         """The expected function with this name, or None."""
