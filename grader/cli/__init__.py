@@ -136,7 +136,9 @@ def _add_class_options(grade: argparse.ArgumentParser) -> None:
         help="also write this LMS's import CSV into --out (repeatable)",
     )
     grade.add_argument(
-        "--assignment-title", default="OpenGym AI lab", help="the assignment's title in gradebooks"
+        "--assignment-title",
+        default=None,
+        help="the assignment's title in gradebooks (default: the lab's, e.g. 'OpenGym AI lab', 'Policy Function Iteration lab')",  # noqa: E501
     )
     grade.add_argument(
         "--assignment-id",

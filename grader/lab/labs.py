@@ -54,6 +54,11 @@ class Lab:
         return EDITIONS[self.current]
 
     @property
+    def assignment_title(self) -> str:
+        """What a class's gradebooks call the assignment unless told (`--assignment-title`)."""
+        return f"{self.title} lab"
+
+    @property
     def label(self) -> str:
         """How a person reads it: `rl2 (Policy Function Iteration / Reinforcement Learning 2)`."""
         return f"{self.name} ({self.title} / {self.course_title})"

@@ -15,7 +15,7 @@ from grader.render.neutral import HIDDEN, MAX_DIAGNOSIS_CHARS
 from .support import OFF_BY_ONE, SHORT_POLE, STOOD_ON_N, all_passed, graded, report, result
 
 SUMMARY_KEYS = [
-    "format", "title", "students", "graded", "missing", "late", "overridden", "extended", "submission_errors",
+    "format", "title", "lab", "edition", "students", "graded", "missing", "late", "overridden", "extended", "submission_errors",
     "scores", "problems", "diagnoses", "diagnoses_left_off", "entries",
 ]  # fmt: skip
 
@@ -28,6 +28,7 @@ def test_an_empty_class_has_every_key_and_nothing_in_them() -> None:
         "full_marks": 0, "bins": [],
     }  # fmt: skip
     assert (summary["problems"], summary["diagnoses"], summary["entries"]) == ([], [], [])
+    assert (summary["lab"], summary["edition"]) == ("", ""), "nothing graded: no lab to name"
     json.dumps(summary, allow_nan=False)
 
 
