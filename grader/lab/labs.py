@@ -107,7 +107,7 @@ def edition_in_lab(lab: Lab, edition: Edition, *, lab_named: str, edition_named:
     other = lab_of_edition(edition)
     ours = ", ".join(found.name for found in lab.editions) or "(none installed)"
     raise LabConflict(
-        f"{edition_named} is edition {edition.name} of lab {other.label}, not of {lab_named} ({lab.label}): "
+        f"{edition_named} is an edition of lab {other.label}, but {lab_named} names lab {lab.label}: "
         f"name one of {lab.name}'s editions ({ours}), {remedy}"
     )
 
