@@ -55,22 +55,31 @@ def test_an_unknown_lab_says_which_labs_there_are() -> None:
         ({"lab": "rl2", "edition": "v2019"}, "v2019"),
         ({"edition": "v2024"}, "v2024"),
     ],
-    ids=["nothing-is-classic", "edition", "lab-alone-rl2", "lab-alone-opengym", "lab-and-edition", "edition-alone-rl2"],  # noqa: E501
+    ids=[
+        "nothing-is-classic",
+        "edition",
+        "lab-alone-rl2",
+        "lab-alone-opengym",
+        "lab-and-edition",
+        "edition-alone-rl2",
+    ],
 )
 def test_what_a_configuration_grades(data: dict[str, str], edition: str) -> None:
     assert configured_edition(data, where="a.toml").name == edition
 
 
-def test_a_configuration_naming_an_edition_of_another_lab_is_refused_with_what_to_write(tmp_path: Path) -> None:
+def test_a_configuration_naming_an_edition_of_another_lab_is_refused_with_what_to_write(
+    tmp_path: Path,
+) -> None:
     config = tmp_path / "assignment.toml"
     bundled = (REPOSITORY / "grader" / "lab" / "assignment.toml").read_text(encoding="utf-8")
     config.write_text('lab = "rl2"\nedition = "rl1"\n' + bundled, encoding="utf-8")
     with pytest.raises(LabConflict) as raised:
         load_config(config)
     assert str(raised.value) == (
-        f'{config}: edition = "rl1" is an edition of lab opengym (OpenGym AI / Reinforcement Learning 1), but '
-        f'{config}: lab = "rl2" names lab rl2 (Policy Function Iteration / Reinforcement Learning 2): name one '
-        "of rl2's editions (v2018, v2019, v2023, v2024, v2026), or write lab = \"opengym\", or leave lab out"
+        f'{config}: edition = "rl1" is an edition of lab opengym (OpenGym AI / Reinforcement Learning 1), but '  # noqa: E501
+        f'{config}: lab = "rl2" names lab rl2 (Policy Function Iteration / Reinforcement Learning 2): name one '  # noqa: E501
+        'of rl2\'s editions (v2018, v2019, v2023, v2024, v2026), or write lab = "opengym", or leave lab out'
     )
     config.write_text('lab = "nonsense"\n' + bundled, encoding="utf-8")
     with pytest.raises(ConfigError, match="lab: unknown lab 'nonsense'"):
@@ -90,12 +99,38 @@ def test_a_configuration_naming_its_lab_keeps_its_edition_and_lab() -> None:
         ("rl2", None, None, "v2026", "--lab rl2: its current edition"),
         ("opengym", None, None, "rl1", "--lab opengym: its current edition"),
         ("rl2", "v2019", None, "v2019", "chosen with --edition within --lab rl2"),
-        ("rl2", None, "rl2/honest_v2019.py", "v2019", "--lab rl2, detected from honest_v2019.py: its run_simulation"),  # noqa: E501
-        ("rl2", None, "classic_complete.py", "v2026", "--lab rl2: its current edition (classic_complete.py shows none of its editions' marks)"),  # noqa: E501
-        (None, None, "rl2/honest_v2024.py", "v2024", "detected from honest_v2024.py: it defines model_comparison(episodes)"),  # noqa: E501
+        (
+            "rl2",
+            None,
+            "rl2/honest_v2019.py",
+            "v2019",
+            "--lab rl2, detected from honest_v2019.py: its run_simulation",
+        ),
+        (
+            "rl2",
+            None,
+            "classic_complete.py",
+            "v2026",
+            "--lab rl2: its current edition (classic_complete.py shows none of its editions' marks)",
+        ),
+        (
+            None,
+            None,
+            "rl2/honest_v2024.py",
+            "v2024",
+            "detected from honest_v2024.py: it defines model_comparison(episodes)",
+        ),
         (None, "v2023", None, "v2023", "chosen with --edition"),
     ],
-    ids=["lab", "lab-opengym", "lab-and-edition", "lab-detected", "lab-not-shown", "detected-lab", "edition-of-rl2"],  # noqa: E501
+    ids=[
+        "lab",
+        "lab-opengym",
+        "lab-and-edition",
+        "lab-detected",
+        "lab-not-shown",
+        "detected-lab",
+        "edition-of-rl2",
+    ],
 )
 def test_the_command_lines_choice(
     lab: str | None, flag: str | None, submission: str | None, edition: str, reason: str

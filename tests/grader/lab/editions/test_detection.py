@@ -125,26 +125,106 @@ def test_every_second_lab_sample_is_detected_as_the_lab_and_edition_it_is_graded
 def test_every_file_of_the_second_labs_samples_shows_that_lab() -> None:
     files = sorted((SUBMISSIONS / "rl2").rglob("*.py"))
     assert len(files) >= 20
-    assert {path.name: detect_edition(path).edition.lab for path in files} == {path.name: "rl2" for path in files}
+    assert {path.name: detect_edition(path).edition.lab for path in files} == {
+        path.name: "rl2" for path in files
+    }
 
 
 @pytest.mark.parametrize(
     ("name", "source", "edition", "reason", "shown"),
     [
-        ("policy_iteration.py", "def model_comparison(episodes=1000):\n    pass\n", "v2024", "it defines model_comparison(episodes), which only the 2024 edition", True),  # noqa: E501
-        ("policy_iteration.py", "import model_free_RL\ndef value_iteration(P, nS, nA):\n    pass\n", "v2024", "it imports model_free_RL", True),  # noqa: E501
-        ("policy_iteration.py", "def frozenlake(basic_case=True, M=1000):\n    pass\n", "v2018", "it defines frozenlake(basic_case, M), the 2018 name", True),  # noqa: E501
-        ("policy_iteration.py", "def run_simulation(env, policy, render=True, beta=1.0):\n    pass\n", "v2019", "takes a render flag, as the 2019-2022 editions", True),  # noqa: E501
-        ("policy_iteration.py", "def iter_policy_eval(P, nS, nA, policy):\n    pass\n", "v2026", "it defines iter_policy_eval (the names since 2024) and no model_comparison", True),  # noqa: E501
-        ("policy_function_iteration.py", "def value_iteration(P, nS, nA):\n    pass\n", "v2026", "it is named policy_function_iteration.py, as the 2026 template", True),  # noqa: E501
-        ("policy_iteration.py", "import gymnasium as gym\ndef extract_policy(P, nS, nA, v):\n    pass\n", "v2023", "it defines extract_policy (the 2018-2023 names) and imports gymnasium", True),  # noqa: E501
-        ("policy_iteration.py", "import gym\ndef compute_policy_v(P, nS, nA, policy):\n    pass\n", "v2019", "it defines compute_policy_v (the 2018-2023 names) and imports gym", True),  # noqa: E501
-        ("mine.py", "def value_iteration(P, nS, nA):\n    pass\n", "v2026", "it defines value_iteration, so it was written for the Policy Function Iteration lab, but it shows none", False),  # noqa: E501
-        ("policy_iteration.py", "", "v2026", "it is named policy_iteration.py, so it was written for the Policy Function Iteration lab", False),  # noqa: E501
-        # Hostile: a file defining both labs' functions is the second lab's (its functions are no first-lab name).
-        ("opengym.py", "import gym\ndef blackjack(n=11):\n    pass\ndef value_iteration(P, nS, nA):\n    pass\n", "v2026", "it defines value_iteration", False),  # noqa: E501
+        (
+            "policy_iteration.py",
+            "def model_comparison(episodes=1000):\n    pass\n",
+            "v2024",
+            "it defines model_comparison(episodes), which only the 2024 edition",
+            True,
+        ),
+        (
+            "policy_iteration.py",
+            "import model_free_RL\ndef value_iteration(P, nS, nA):\n    pass\n",
+            "v2024",
+            "it imports model_free_RL",
+            True,
+        ),
+        (
+            "policy_iteration.py",
+            "def frozenlake(basic_case=True, M=1000):\n    pass\n",
+            "v2018",
+            "it defines frozenlake(basic_case, M), the 2018 name",
+            True,
+        ),
+        (
+            "policy_iteration.py",
+            "def run_simulation(env, policy, render=True, beta=1.0):\n    pass\n",
+            "v2019",
+            "takes a render flag, as the 2019-2022 editions",
+            True,
+        ),
+        (
+            "policy_iteration.py",
+            "def iter_policy_eval(P, nS, nA, policy):\n    pass\n",
+            "v2026",
+            "it defines iter_policy_eval (the names since 2024) and no model_comparison",
+            True,
+        ),
+        (
+            "policy_function_iteration.py",
+            "def value_iteration(P, nS, nA):\n    pass\n",
+            "v2026",
+            "it is named policy_function_iteration.py, as the 2026 template",
+            True,
+        ),
+        (
+            "policy_iteration.py",
+            "import gymnasium as gym\ndef extract_policy(P, nS, nA, v):\n    pass\n",
+            "v2023",
+            "it defines extract_policy (the 2018-2023 names) and imports gymnasium",
+            True,
+        ),
+        (
+            "policy_iteration.py",
+            "import gym\ndef compute_policy_v(P, nS, nA, policy):\n    pass\n",
+            "v2019",
+            "it defines compute_policy_v (the 2018-2023 names) and imports gym",
+            True,
+        ),
+        (
+            "mine.py",
+            "def value_iteration(P, nS, nA):\n    pass\n",
+            "v2026",
+            "it defines value_iteration, so it was written for the Policy Function Iteration lab",
+            False,
+        ),
+        (
+            "policy_iteration.py",
+            "",
+            "v2026",
+            "it is named policy_iteration.py, so it was written for the Policy Function Iteration lab",
+            False,
+        ),
+        # Hostile: a file defining both labs' functions is the second lab's (no first-lab name)
+        (
+            "opengym.py",
+            "import gym\ndef blackjack(n=11):\n    pass\ndef value_iteration(P, nS, nA):\n    pass\n",
+            "v2026",
+            "it defines value_iteration",
+            False,
+        ),
     ],
-    ids=["model_comparison", "model_free_RL", "frozenlake", "render", "2024-names", "2026-file-name", "gymnasium-old-names", "gym-old-names", "lab-only", "empty-named", "both-labs"],  # noqa: E501
+    ids=[
+        "model_comparison",
+        "model_free_RL",
+        "frozenlake",
+        "render",
+        "2024-names",
+        "2026-file-name",
+        "gymnasium-old-names",
+        "gym-old-names",
+        "lab-only",
+        "empty-named",
+        "both-labs",
+    ],
 )
 def test_the_second_labs_rules_and_their_reasons(
     tmp_path: Path, name: str, source: str, edition: str, reason: str, shown: bool
@@ -159,7 +239,11 @@ def test_the_second_labs_rules_and_their_reasons(
 
 @pytest.mark.parametrize(
     ("name", "source", "lab_shown"),
-    [("opengym.py", "", False), ("notes.py", "x = 1\n", False), ("opengym.py", "def blackjack(n=11):\n    pass\n", True)],  # noqa: E501
+    [
+        ("opengym.py", "", False),
+        ("notes.py", "x = 1\n", False),
+        ("opengym.py", "def blackjack(n=11):\n    pass\n", True),
+    ],
     ids=["empty", "nothing-of-a-lab", "a-first-lab-function"],
 )
 def test_a_file_showing_no_lab_is_told_apart_from_one_showing_the_first_lab(
@@ -176,10 +260,12 @@ def test_a_file_of_another_lab_is_told_so_whatever_it_shows_of_an_edition() -> N
     note = edition_note(EDITIONS["classic"], second)
     assert note is not None and note.startswith(
         "This file looks written for the lab rl2 (Policy Function Iteration / Reinforcement Learning 2): it "
-        "defines model_comparison(episodes), which only the 2024 edition asks for. Your assignment is the lab "
+        "defines model_comparison(episodes), which only the 2024 edition asks for. Your assignment is the lab "  # noqa: E501
         "opengym (OpenGym AI / Reinforcement Learning 1), edition classic"
     )
     first = detect_edition(SUBMISSIONS / "classic_complete.py")
     assert "written for the lab opengym" in (edition_note(EDITIONS["v2026"], first) or "")
-    assert edition_note(EDITIONS["v2019"], detect_edition(SUBMISSIONS / "rl2" / "honest_v2023.py")) is not None
+    assert (
+        edition_note(EDITIONS["v2019"], detect_edition(SUBMISSIONS / "rl2" / "honest_v2023.py")) is not None
+    )
     assert edition_note(EDITIONS["v2024"], second) is None

@@ -103,7 +103,7 @@ def test_a_file_claiming_the_second_lab_in_a_first_lab_class_stops_it_naming_who
         "the class's files were written for different labs (1 files showing no lab are not counted): "
         "opengym (OpenGym AI / Reinforcement Learning 1), 2: alice, bob; "
         "rl2 (Policy Function Iteration / Reinforcement Learning 2), 1: mallory. "
-        "What a student is graded on is the assignment's lab and edition, not the files': nothing was graded; "
+        "What a student is graded on is the assignment's lab and edition, not the files': nothing was graded; "  # noqa: E501
         "pass the assignment's lab (--lab opengym or --lab rl2), its edition (--edition NAME) or a "
         'configuration naming it (lab = "..."); a file written for another lab is then graded as the '
         "assignment and told so"
