@@ -22,6 +22,7 @@ from grader.lab.editions.errors import LabConflict, UnknownLab
 from grader.lab.editions.marks import Detection, Marks
 from grader.lab.editions.opengym_marks import opengym_edition
 from grader.lab.editions.rl2_marks import CURRENT as RL2_CURRENT
+from grader.lab.editions.rl2_marks import FILE_NAMES as RL2_FILE_NAMES
 from grader.lab.editions.rl2_marks import rl2_edition
 
 
@@ -35,6 +36,8 @@ class Lab:
         course_title: What the course calls it since 2024 (`Reinforcement Learning 1`).
         current: The edition graded when only the lab is named (today's).
         detect: Which of its editions a file's marks show (None: nothing of this lab).
+        file_names: The names its texts and templates give the student's file, most preferred first
+            (`grader.classroom.graded_file.LAB_FILE_NAMES` prefers them when choosing a student's file).
     """
 
     name: str
@@ -42,6 +45,7 @@ class Lab:
     course_title: str
     current: str
     detect: Callable[[Marks], Detection | None]
+    file_names: tuple[str, ...]
 
     @property
     def editions(self) -> tuple[Edition, ...]:
@@ -64,8 +68,22 @@ class Lab:
         return f"{self.name} ({self.title} / {self.course_title})"
 
 
-OPENGYM = Lab("opengym", "OpenGym AI", "Reinforcement Learning 1", "rl1", opengym_edition)
-RL2 = Lab("rl2", "Policy Function Iteration", "Reinforcement Learning 2", RL2_CURRENT, rl2_edition)
+OPENGYM = Lab(
+    "opengym",
+    "OpenGym AI",
+    "Reinforcement Learning 1",
+    "rl1",
+    opengym_edition,
+    ("opengym.py", "opengym.ipynb", "gymnasium.ipynb"),
+)
+RL2 = Lab(
+    "rl2",
+    "Policy Function Iteration",
+    "Reinforcement Learning 2",
+    RL2_CURRENT,
+    rl2_edition,
+    tuple(f"{stem}.py" for stem in RL2_FILE_NAMES),
+)
 
 LABS: dict[str, Lab] = {lab.name: lab for lab in (OPENGYM, RL2)}
 """Every lab, in the course's order."""

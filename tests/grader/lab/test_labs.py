@@ -164,3 +164,9 @@ def test_a_flag_edition_of_another_lab_is_refused_naming_both() -> None:
 )
 def test_the_services_choice_never_reads_an_upload(edition: str | None, lab: str | None, graded: str) -> None:
     assert service_edition(edition, lab).edition.name == graded
+
+
+def test_a_classs_file_choice_prefers_every_labs_own_file_names_first_labs_first() -> None:
+    from grader.classroom.graded_file import LAB_FILE_NAMES
+
+    assert tuple(name for lab in LABS.values() for name in lab.file_names) == LAB_FILE_NAMES
