@@ -78,7 +78,8 @@ def _rl2_report() -> Report:
     problem = ProblemResult(id="value_iteration", title="Problem 1: value_iteration", status="passed",
                             score=1.0, max_score=1.0, feedback="the optimal values")  # fmt: skip
     return Report(submission="policy_iteration.py", sha256="0" * 64, seed=3, lab="rl2", edition="v2024",
-                  gymnasium_version="1", grader_version="1", score=1.0, max_score=1.0, problems=[problem])  # fmt: skip
+                  gymnasium_version="1", grader_version="1", score=1.0, max_score=1.0,
+                  problems=[problem])  # fmt: skip
 
 
 def test_a_report_older_than_the_second_lab_reads_as_the_first_lab_and_keeps_its_other_keys() -> None:
