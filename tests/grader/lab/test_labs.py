@@ -170,3 +170,10 @@ def test_a_classs_file_choice_prefers_every_labs_own_file_names_first_labs_first
     from grader.classroom.graded_file import LAB_FILE_NAMES
 
     assert tuple(name for lab in LABS.values() for name in lab.file_names) == LAB_FILE_NAMES
+
+
+def test_a_gradebook_names_the_assignment_by_its_labs_title_unless_told() -> None:
+    from grader.classroom.gradebooks import Assignment
+
+    assert LABS["opengym"].assignment_title == Assignment().title == "OpenGym AI lab", "unchanged for the first"
+    assert LABS["rl2"].assignment_title == "Policy Function Iteration lab"
