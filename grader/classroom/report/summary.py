@@ -149,8 +149,8 @@ class ClassSummary(BaseModel):
     title: str
     lab: str = Field(
         default="",
-        description="The lab its reports were graded in, as a person reads it (several, comma-separated, "
-        "when kept reports of another lab are mixed in); empty when nothing was graded.",
+        description="The lab its reports were graded in, as a person reads it (several, comma-separated, when kept reports of another lab are mixed in); "  # noqa: E501
+        "empty when nothing was graded.",
     )
     edition: str = Field(default="", description="The edition its reports were graded in, as `lab`.")
     students: int

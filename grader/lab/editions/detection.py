@@ -49,8 +49,7 @@ def detected(marks: Marks) -> Detection:
             return found
     return Detection(
         first,
-        "it shows no edition: it imports no gym and defines none of a later edition's functions or render flags, "  # noqa: E501
-        "nor any lab's functions",
+        "it shows no edition: it imports no gym and defines none of a later edition's functions or render flags, nor any lab's functions",  # noqa: E501
         shown=False,
         lab_shown=False,
     )

@@ -87,8 +87,8 @@ def class_editions(files: Mapping[str, Path]) -> ClassEditions:
     if not shown:
         edition = default_edition_of(lab)
         reason = (
-            f"no --edition and no configuration; the files show the lab {lab.name} but none of the "
-            f"{len(detected)} shows one of its editions: its current edition"
+            "no --edition and no configuration; "
+            f"the files show the lab {lab.name} but none of the {len(detected)} shows one of its editions: its current edition"  # noqa: E501
         )
         return ClassEditions(EditionChoice(edition, default_config(edition), reason), detected)
     problem_sets = {id(found.edition.registry) for found in shown.values()}
