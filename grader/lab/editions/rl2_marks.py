@@ -2,7 +2,8 @@
 
 A file shows the lab when it defines one of the lab's functions (`FUNCTIONS`: the problem ids of every
 edition, names no other lab uses) or carries one of its file names (`policy_iteration.py`, the 2026 template's
-`policy_function_iteration.py`). Its edition, first rule that applies, each with the reason printed:
+`policy_function_iteration.py`) and defines no other lab's function. Its edition, first rule that applies,
+each with the reason printed:
 
 1. `model_comparison`, or `import model_free_RL` (the 2024 template's helper import): `v2024`;
 2. `frozenlake` (2018's name; later editions write `frozen_lake`): `v2018`;
@@ -45,8 +46,8 @@ def rl2_edition(marks: Marks) -> Detection | None:
     """The second lab's edition the marks show, or None when they show nothing of the second lab."""
     defined = [marks.functions[name] for name in FUNCTIONS if name in marks.functions]
     stem = marks.name.rsplit(".", 1)[0]
-    if not defined and stem not in FILE_NAMES:
-        return None
+    if not defined and (stem not in FILE_NAMES or _another_labs(marks)):
+        return None  # a name is weaker than what the file defines: another lab's functions decide
     functions = marks.functions
     shows = (
         f"it defines {', '.join(function.name for function in defined)}"
@@ -88,6 +89,16 @@ def rl2_edition(marks: Marks) -> Detection | None:
         current,
         f"{shows}, so it was written for the Policy Function Iteration lab, but it shows none of an edition's marks",  # noqa: E501
         shown=False,
+    )
+
+
+def _another_labs(marks: Marks) -> bool:
+    """Whether the file defines a function some other lab's edition asks for."""
+    return any(
+        edition.function(name)
+        for edition in EDITIONS.values()
+        if edition.lab != LAB
+        for name in marks.functions
     )
 
 

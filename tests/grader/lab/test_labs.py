@@ -175,5 +175,5 @@ def test_a_classs_file_choice_prefers_every_labs_own_file_names_first_labs_first
 def test_a_gradebook_names_the_assignment_by_its_labs_title_unless_told() -> None:
     from grader.classroom.gradebooks import Assignment
 
-    assert LABS["opengym"].assignment_title == Assignment().title == "OpenGym AI lab", "unchanged for the first"
+    assert LABS["opengym"].assignment_title == Assignment().title == "OpenGym AI lab", "the first's unchanged"
     assert LABS["rl2"].assignment_title == "Policy Function Iteration lab"

@@ -243,8 +243,15 @@ def test_the_second_labs_rules_and_their_reasons(
         ("opengym.py", "", False),
         ("notes.py", "x = 1\n", False),
         ("opengym.py", "def blackjack(n=11):\n    pass\n", True),
+        # Hostile: the second lab's file name does not outweigh the first lab's functions.
+        ("policy_iteration.py", "def blackjack(n=11):\n    pass\n", True),
     ],
-    ids=["empty", "nothing-of-a-lab", "a-first-lab-function"],
+    ids=[
+        "empty",
+        "nothing-of-a-lab",
+        "a-first-lab-function",
+        "first-lab-function-under-the-second-labs-name",
+    ],
 )
 def test_a_file_showing_no_lab_is_told_apart_from_one_showing_the_first_lab(
     tmp_path: Path, name: str, source: str, lab_shown: bool
