@@ -83,6 +83,8 @@ class Override(Base):
     reason: Mapped[str] = mapped_column(Text)
     author: Mapped[str] = mapped_column(String(100))
     created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
+
+
 class LtiKey(Base):
     """One of the tool's own RSA signing keys (LTI 1.3): the newest unretired one signs; retired ones stay
     published and accepted for ``LTI_KEY_GRACE_SECONDS`` so launches and platform caches in flight hold."""

@@ -134,6 +134,12 @@ class Settings(BrokerSettings):
         "Unset: the first edition, classic. "
         "Never detected from an upload; a file written for another edition's problems is told so in its report.",  # noqa: E501
     )
+    lab: str | None = Field(
+        default=None,
+        pattern=r"^[a-z][a-z0-9_]*$",
+        description="The course's lab, set once per assignment's service (grader/lab/labs.py: opengym, rl2): every upload is graded as its current edition, or as GYMGRADE_EDITION, which must then be one of its editions. "  # noqa: E501
+        "Unset: the lab of GYMGRADE_EDITION, else the first lab, opengym. Never detected from an upload.",
+    )
     nice: int = Field(default=10, ge=0, le=19, description="Niceness added to grading processes.")
     lease_seconds: float = Field(
         default=60.0,
@@ -192,6 +198,33 @@ class Settings(BrokerSettings):
         except UnknownEdition as error:
             raise ValueError(str(error)) from None
         return edition
+
+    @field_validator("lab")
+    @classmethod
+    def _known_lab(cls, lab: str | None) -> str | None:
+        if lab is None:
+            return None
+        from grader.lab.editions.errors import UnknownLab
+        from grader.lab.labs import lab_of  # the packs import the checks: only when a lab is set
+
+        try:
+            lab_of(lab, where="GYMGRADE_LAB")
+        except UnknownLab as error:
+            raise ValueError(str(error)) from None
+        return lab
+
+    @model_validator(mode="after")
+    def _edition_of_the_lab(self) -> Settings:
+        if self.lab is None or self.edition is None:
+            return self
+        from grader.lab.editions.choice import service_edition
+        from grader.lab.editions.errors import LabConflict
+
+        try:
+            service_edition(self.edition, self.lab)
+        except LabConflict as error:
+            raise ValueError(str(error)) from None
+        return self
 
     @field_validator("late_policy")
     @classmethod

@@ -20,6 +20,7 @@ from fastapi.templating import Jinja2Templates
 from grader.lab.assignment import AssignmentConfig, load_config
 from grader.lab.editions.choice import edition_config
 from grader.render.figures import Figure, problem_figures
+from grader.render.text import edition_name, lab_name
 from grader.report import ProblemResult
 
 TEMPLATES_DIR = Path(__file__).with_name("templates")
@@ -77,6 +78,8 @@ def _config(path: Path | None) -> AssignmentConfig:
 
 
 templates.env.globals["page_figures"] = page_figures
+templates.env.globals["lab_name"] = lab_name
+templates.env.globals["edition_name"] = edition_name
 
 
 def page_headers(frame_origins: str | None = None) -> dict[str, str]:

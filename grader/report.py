@@ -2,9 +2,10 @@
 
 In detail:
 
-- `grader/report.py`: pydantic `Report` (`format`, `submission`, `sha256`, `seed`, `config_sha256`, `edition`
-  (absent in older reports: `classic`), `gymnasium_version`, `grader_version`, `isolation`, `score`,
-  `max_score`, `submission_error`, `problems`, `notebook`, `grader_errors`, `execution_time`, `timings`) and
+- `grader/report.py`: pydantic `Report` (`format`, `submission`, `sha256`, `seed`, `config_sha256`,
+  `lab` (absent in older reports: `opengym`), `edition` (absent in older reports: `classic`),
+  `gymnasium_version`, `grader_version`, `isolation`, `score`, `max_score`, `submission_error`, `problems`,
+  `notebook`, `grader_errors`, `execution_time`, `timings`) and
   `ProblemResult` (`id`, `title`, `status`, `score`, `max_score`, `feedback`, `measurements`, `output`,
   `compat_events`, `seed`, `visibility`, `replay`, `timings`); a problem's run in a worker is a
   `ProblemRun(submission, result, isolation, internal_error)`. `ProblemRun.to_json()` is how a run crosses
@@ -44,6 +45,8 @@ only the instructor. The report always holds everything; the service's student v
 REPORT_FORMAT = 1
 FIRST_EDITION = "classic"
 """The edition a report that names none was graded in: every report written before editions existed."""
+FIRST_LAB = "opengym"
+"""The lab a report that names none was graded in: every report written before the second lab existed."""
 OUTPUT_CAP_CHARS = 8_000
 """Student output kept per problem in the report; the rest is replaced by a note saying how much was cut."""
 
@@ -258,6 +261,11 @@ class Report(BaseModel):
     seed: int = Field(description="The grading seed; the same bytes and seed give the same verdicts.")
     config_sha256: str = Field(
         default="", description="SHA-256 of the assignment configuration that graded the file (its JSON)."
+    )
+    lab: str = Field(
+        default=FIRST_LAB,
+        description="The lab graded (grader/lab/labs.py: opengym, rl2). "
+        "Absent in reports older than the second lab, all graded in the first, 'opengym'.",
     )
     edition: str = Field(
         default=FIRST_EDITION,

@@ -68,7 +68,7 @@ def main() -> int:
         path = Path(request["path"])
         config = Path(request["config"]) if request.get("config") else None
         if config is None:
-            config = _edition_config(request.get("edition"))
+            config = _edition_config(request.get("edition"), request.get("lab"))
         report = grader(
             path,
             seed=int(request["seed"]),
@@ -86,14 +86,16 @@ def main() -> int:
     return 0
 
 
-def _edition_config(edition: str | None) -> Path | None:
-    """The configuration of the edition every upload is graded as: the service's `GYMGRADE_EDITION`, else the
-    first edition; never detected from the upload (a student does not choose what they are graded on). None:
+def _edition_config(edition: str | None, lab: str | None = None) -> Path | None:
+    """The configuration of the edition every upload is graded as: the service's `GYMGRADE_EDITION` (of
+    `GYMGRADE_LAB`), else `GYMGRADE_LAB`'s current edition, else the first edition; never detected from the
+    upload (a student does not choose what they are graded on). None:
     the bundled (first edition's) one. Which edition and why goes to the job's stderr log; the report tells a
     file written for another edition's problems so."""
     from grader.lab.editions.choice import service_edition  # the grader is heavy: import it only here
 
-    choice = service_edition(edition)
+    choice = service_edition(edition, lab)
+    print(choice.lab_line, file=sys.stderr, flush=True)
     print(choice.line, file=sys.stderr, flush=True)
     return choice.config
 

@@ -90,6 +90,7 @@ def _send_request(
         "only": list(job.only) if job.only is not None else None,
         "config": str(config) if config is not None else None,
         "edition": settings.edition,
+        "lab": settings.lab,
         "workers": settings.grading_workers,
         "allow_weak_isolation": settings.allow_weak_isolation,
         "nice": settings.nice,

@@ -30,9 +30,10 @@ def choices() -> list[tuple[str, str]]:
     return [(edition.name, edition.title) for edition in EDITIONS.values()]
 
 
-def graded_edition(setting: str | None) -> str:
-    """The edition the service grades every upload as (GYMGRADE_EDITION, else the first)."""
-    return service_edition(setting).edition.name
+def graded_edition(setting: str | None, lab: str | None = None) -> str:
+    """The edition the service grades every upload as (GYMGRADE_EDITION, else GYMGRADE_LAB's current, else
+    the first)."""
+    return service_edition(setting, lab).edition.name
 
 
 def check_link_edition(custom: dict[str, object], graded: str) -> None:

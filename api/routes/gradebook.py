@@ -29,11 +29,12 @@ def get_gradebook(
     settings: SettingsDep,
     _instructor: InstructorDep,
     format: Annotated[str, Query(pattern=f"^({'|'.join(GRADEBOOK_FORMATS)})$")] = "gymgrade",
-    assignment_title: str = "OpenGym AI lab",
+    assignment_title: str | None = None,
     assignment_id: Annotated[str, Query(pattern=r"^\d*$")] = "",
 ) -> Response:
     """The gradebook as CSV: each student's latest or best graded submission (GYMGRADE_GRADEBOOK_POLICY),
-    in gymgrade's columns or an LMS's import format (``canvas`` needs ``assignment_id``)."""
+    in gymgrade's columns or an LMS's import format (``canvas`` needs ``assignment_id``); the assignment's
+    title is the graded lab's (`OpenGym AI lab`) unless given."""
     if format == "canvas" and not assignment_id:
         message = (
             "format=canvas needs assignment_id (the number in the assignment's Canvas URL .../assignments/ID)"
@@ -44,9 +45,15 @@ def get_gradebook(
             session,
             settings.gradebook_policy,
             format,
-            Assignment(assignment_title, assignment_id),
+            Assignment(assignment_title or _lab_title(settings.edition, settings.lab), assignment_id),
             late_policy_of(settings),
         ),
         media_type="text/csv; charset=utf-8",
         headers={"Content-Disposition": 'attachment; filename="gradebook.csv"'},
     )
+
+
+def _lab_title(edition: str | None, lab: str | None) -> str:
+    from grader.lab.editions.choice import service_edition  # the packs import the checks: only when asked
+
+    return service_edition(edition, lab).lab.assignment_title

@@ -89,14 +89,15 @@ def launch(
             "lti_picker.html",
             {
                 "choices": choices(),
-                "graded": graded_edition(settings.edition),
+                "graded": graded_edition(settings.edition, settings.lab),
                 "picker": token,
                 "session_query": "",
             },
             headers=page_headers(frame_origins(checked)),
         )
     custom = checked.claims.get(names.CUSTOM)
-    check_link_edition(custom if isinstance(custom, dict) else {}, graded_edition(settings.edition))
+    graded = graded_edition(settings.edition, settings.lab)
+    check_link_edition(custom if isinstance(custom, dict) else {}, graded)
     landing = accept_launch(session, checked, session_seconds=settings.lti_session_seconds)
     return RedirectResponse("/?" + urlencode({SESSION_PARAMETER: landing.token}), status_code=303)
 
@@ -116,7 +117,7 @@ def deep_link(
         picker,
         edition,
         urls.launch,
-        graded=graded_edition(settings.edition),
+        graded=graded_edition(settings.edition, settings.lab),
         grace_seconds=settings.lti_key_grace_seconds,
     )
     target = urlsplit(return_url)

@@ -44,10 +44,10 @@ def grade_class(args: argparse.Namespace) -> int:
     from grader.classroom.output import ClassGradebook
     from grader.classroom.roster import read_roster
     from grader.grading.plan import GradingPlan
+    from grader.lab.labs import lab_of
 
     roster = read_roster(args.roster) if args.roster is not None else None
-    assignment = Assignment(title=args.assignment_title, lms_id=args.assignment_id)
-    if "canvas" in args.gradebook and not assignment.lms_id:
+    if "canvas" in args.gradebook and not args.assignment_id:
         raise GradebookError(
             "--gradebook canvas needs --assignment-id ID (the number in the assignment's Canvas URL .../assignments/ID), so Canvas puts the scores in that assignment's column"  # noqa: E501
         )
@@ -64,6 +64,8 @@ def grade_class(args: argparse.Namespace) -> int:
             if asked != functions:  # the class's edition asks other functions: choose each file by them
                 download = submissions_of_all(reads, rule=GradedFileRule(functions=asked), due=args.due)
         plan = GradingPlan.load(args.config, args.only)
+        title = args.assignment_title or lab_of(plan.assignment.lab).assignment_title
+        assignment = Assignment(title=title, lms_id=args.assignment_id)
         print(class_summary(download), file=sys.stderr, flush=True)
         graded = [submission for submission in download.submissions if submission.graded_file is not None]
         if not download.submissions and roster is None:
@@ -153,6 +155,7 @@ def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> 
             print(terminal_line(line), file=sys.stderr, flush=True)
         print(terminal_line(f"gymgrade grade: {editions.disagreement}"), file=sys.stderr, flush=True)
         return None
+    print(editions.choice.lab_line, file=sys.stderr, flush=True)
     for line in editions.lines():
         print(terminal_line(line), file=sys.stderr, flush=True)
     args.config = editions.choice.config

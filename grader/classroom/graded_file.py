@@ -11,9 +11,13 @@ from pathlib import PurePosixPath
 
 from grader.classroom.model import SubmittedFile
 
-LAB_FILE_NAMES = ("opengym.py", "opengym.ipynb", "gymnasium.ipynb")
-"""The lab's own file names (its text says opengym.py; the notebook editions opengym.ipynb and
-gymnasium.ipynb), in order of preference."""
+LAB_FILE_NAMES = (
+    "opengym.py", "opengym.ipynb", "gymnasium.ipynb", "policy_iteration.py", "policy_function_iteration.py",
+)  # fmt: skip
+"""The labs' own file names, in order of preference: the first lab's (its text says opengym.py; the notebook
+editions opengym.ipynb and gymnasium.ipynb), then the second lab's (policy_iteration.py; the 2026 template's
+policy_function_iteration.py). `grader.lab.labs.Lab.file_names` declares them; a test holds this equal
+(imported here without the packs, which a class's file choice does not need)."""
 SOURCE_SUFFIXES = (".py", ".ipynb")
 MAX_SCAN_BYTES = 4 * 2**20
 _DEF = re.compile(r"^def\s+([A-Za-z_]\w*)\s*\(", re.MULTILINE)

@@ -169,7 +169,7 @@ def recorded_grading_differs(
         if report.seed != seed:
             return f"{shown} was graded with seed {report.seed}, this run grades with {seed}: pass --seed {report.seed} or leave out --seed"  # noqa: E501
         if report.config_sha256 != config_sha256:
-            return f"{shown} was graded with another assignment configuration: pass the same --config and --edition as the class's grading"  # noqa: E501
+            return f"{shown} was graded with another assignment configuration: pass the same --config, --lab and --edition as the class's grading"  # noqa: E501
         if tuple(result.id for result in report.problems) != tuple(problems):
             return f"{shown} was graded for {', '.join(r.id for r in report.problems)}: pass the same --only as the class's grading"  # noqa: E501
     return None

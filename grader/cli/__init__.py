@@ -28,6 +28,7 @@ from grader.errors import (
     GraderError,
 )
 from grader.lab.editions import EDITIONS, all_problem_ids
+from grader.lab.labs import LABS
 from grader.render.progress import result_line
 from grader.render.registry import FORMATS, format_help
 from grader.report import ProblemResult
@@ -87,11 +88,12 @@ def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
         metavar="ID[,ID...]",
         help=f"grade only these problems ({', '.join(all_problem_ids())}; each edition grades its own)",
     )
+    _add_lab(parser)
     parser.add_argument(
         "--edition",
         choices=tuple(EDITIONS),
         default=None,
-        help="the edition of the lab graded (default: the configuration's `edition`, else detected from the file for check, else classic)",  # noqa: E501
+        help="the edition of the lab graded (default: the configuration's `edition`, else detected from the file for check, else the --lab's current edition, else classic)",  # noqa: E501
     )
     parser.add_argument(
         "--config",
@@ -99,6 +101,18 @@ def _add_common(parser: argparse.ArgumentParser, seed_help: str) -> None:
         default=None,
         metavar="PATH",
         help="assignment configuration TOML (default: the bundled one)",
+    )
+
+
+def _add_lab(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--lab",
+        choices=tuple(LABS),
+        default=None,
+        help="the lab graded: "
+        + ", ".join(lab.label for lab in LABS.values())
+        + " (default: the configuration's `lab`, else the --edition's lab, else detected from the file for check, else opengym); "  # noqa: E501
+        "alone, its current edition",
     )
 
 
@@ -122,7 +136,9 @@ def _add_class_options(grade: argparse.ArgumentParser) -> None:
         help="also write this LMS's import CSV into --out (repeatable)",
     )
     grade.add_argument(
-        "--assignment-title", default="OpenGym AI lab", help="the assignment's title in gradebooks"
+        "--assignment-title",
+        default=None,
+        help="the assignment's title in gradebooks (default: the lab's, e.g. 'OpenGym AI lab', 'Policy Function Iteration lab')",  # noqa: E501
     )
     grade.add_argument(
         "--assignment-id",
@@ -249,6 +265,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bundle.add_argument("--out", type=Path, default=Path("autograder.zip"), metavar="ZIP")
     bundle.add_argument("--config", type=Path, default=None, metavar="PATH", help="assignment configuration")
+    _add_lab(bundle)
     bundle.add_argument(
         "--edition",
         choices=tuple(EDITIONS),
@@ -373,17 +390,19 @@ def _utf8_output() -> None:
 
 
 def _choose_edition(args: argparse.Namespace) -> None:
-    """Resolve `--edition`, the configuration's edition or detection into the configuration; say which."""
+    """Resolve `--lab`/`--edition`, the configuration's lab/edition or detection into the configuration; say
+    which lab and edition."""
     if args.command not in ("check", "grade", "gradescope-bundle"):
         return
     from grader.lab.editions.choice import choose_edition
 
-    if args.command == "grade" and args.edition is None and args.config is None:
+    if args.command == "grade" and args.edition is None and args.config is None and args.lab is None:
         args.detect_editions = True  # per submission, once the class's files are known (run_grade)
         return
     submission = args.file if args.command == "check" and args.file.is_file() else None
-    choice = choose_edition(args.edition, args.config, submission)
+    choice = choose_edition(args.edition, args.config, submission, args.lab)
     args.config = choice.config
+    print(choice.lab_line, file=sys.stderr, flush=True)
     print(choice.line, file=sys.stderr, flush=True)
 
 

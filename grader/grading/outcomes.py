@@ -246,6 +246,7 @@ def build_report(
         sha256=hashlib.sha256(data).hexdigest(),
         seed=seed,
         config_sha256=plan.config_sha256,
+        lab=plan.assignment.lab,
         edition=plan.edition,
         gymnasium_version=version("gymnasium"),
         grader_version=grader.__version__,

@@ -4,6 +4,10 @@ The file's shape derives from a `grader.lab.registry.Registry` (the lab's `grade
 unless told otherwise): one `[problems.<id>]` table per problem, parsed with the problem's own settings
 model, whose `title`, `points` and `enabled` default to the registry's; a problem disabled by default may
 be left out.
+
+Which lab and edition a file grades (`configured_edition`): `edition = "NAME"`, else the current edition of
+`lab = "NAME"`, else the first lab's first edition (`classic`: a file naming neither keeps its meaning); a
+file naming both must name an edition of that lab (`grader.lab.labs.edition_in_lab` says what to write).
 """
 
 from __future__ import annotations
@@ -27,7 +31,8 @@ from pydantic import (
 )
 
 from grader.errors import ConfigError, UnknownProblem
-from grader.lab.editions import DEFAULT_EDITION, edition_of
+from grader.lab.editions import DEFAULT_EDITION, EDITIONS, Edition, edition_of
+from grader.lab.labs import edition_in_lab, lab_of
 from grader.lab.problems import PROBLEMS
 from grader.lab.registry import Problem, ProblemId, Registry
 from grader.lab.settings import ProblemConfig, StrictModel
@@ -93,6 +98,11 @@ class AssignmentConfig(StrictModel):
     def edition(self) -> str:
         """The edition this configuration grades (`edition = "..."`; the first edition when it names none)."""
         return self._edition
+
+    @property
+    def lab(self) -> str:
+        """The lab of its edition (`grader.lab.labs.LABS`)."""
+        return EDITIONS[self._edition].lab
 
     def problem(self, problem_id: ProblemId) -> ProblemConfig:
         """The settings of one problem; `registry.problem(problem_id).settings(self)` gives them typed.
@@ -163,7 +173,14 @@ def assignment_file_model(registry: Registry) -> type[BaseModel]:
             str,
             Field(
                 default=DEFAULT_EDITION,
-                description="The edition graded (grader/lab/editions/), else the first.",
+                description="The edition graded (grader/lab/editions/), else the lab's current edition when `lab` is named, else the first.",  # noqa: E501
+            ),
+        ),
+        lab=(
+            str | None,
+            Field(
+                default=None,
+                description="The lab graded (grader/lab/labs.py: opengym, rl2); absent: the edition's lab (the first lab when no edition is named either).",  # noqa: E501
             ),
         ),
     )
@@ -235,17 +252,41 @@ def config_from_data(
     Raises:
         ConfigError: A field is invalid (the message names the field, what was expected and what was found).
     """
-    edition_name = data.get("edition", DEFAULT_EDITION)
+    edition = configured_edition(data, where=where)
     if registry is None:
-        registry = edition_of(edition_name, where=f"{where}: edition").registry
+        registry = edition.registry
     try:
         parsed = dict(assignment_file_model(registry).model_validate(data))
         config = AssignmentConfig(problems=dict(parsed["problems"]), sandbox=parsed["sandbox"])
     except ValidationError as error:
         raise ConfigError(_describe(error, where)) from None
     config._registry = registry
-    config._edition = parsed["edition"]
+    config._edition = edition.name
     return config
+
+
+def configured_edition(data: Mapping[str, Any], *, where: str) -> Edition:
+    """The edition an assignment file's data grades: `edition`, else `lab`'s current edition, else the
+    first edition.
+
+    Raises:
+        UnknownEdition, UnknownLab: A name no pack or lab has.
+        LabConflict: `edition` is not an edition of `lab` (the message says what to write).
+    """
+    named_edition, named_lab = data.get("edition"), data.get("lab")
+    lab = None if named_lab is None else lab_of(named_lab, where=f"{where}: lab")
+    if named_edition is None:
+        return EDITIONS[DEFAULT_EDITION] if lab is None else lab.current_edition
+    edition = edition_of(named_edition, where=f"{where}: edition")
+    if lab is None:
+        return edition
+    return edition_in_lab(
+        lab,
+        edition,
+        lab_named=f'{where}: lab = "{lab.name}"',
+        edition_named=f'{where}: edition = "{edition.name}"',
+        remedy=f'or write lab = "{edition.lab}", or leave lab out',
+    )
 
 
 def config_data(config: AssignmentConfig) -> dict[str, Any]:

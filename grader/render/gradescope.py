@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Annotated, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 from grader.render.neutral import display_block
-from grader.render.text import edition_name, isolation_lines, notebook_lines
+from grader.render.text import edition_name, isolation_lines, lab_name, notebook_lines
 from grader.report import SHOWN_AT_ONCE, Report, errors_shown, withheld_ids
 from grader.submission.gradescope_upload import UploadSeed
 
@@ -118,6 +118,7 @@ def results(
             )
     lines = [
         f"gymgrade {report.grader_version}, gymnasium {report.gymnasium_version}.",
+        f"Lab: {lab_name(report.lab)}.",
         f"Edition: {edition_name(report.edition)}.",
     ]
     if report.edition_note:

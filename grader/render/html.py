@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 from grader.render.csp import content_security_policy
 from grader.render.page import page_environment
-from grader.render.text import edition_name, isolation_lines
+from grader.render.text import edition_name, isolation_lines, lab_name
 from grader.report import Report
 
 if TYPE_CHECKING:
@@ -59,4 +59,5 @@ def render_html(
         style=STYLE,
         isolation=isolation,
         edition=edition_name(report.edition),
+        lab=lab_name(report.lab),
     )

@@ -37,6 +37,7 @@ def summary(report: Report) -> str:
         f"Score: {report.score:g} / {report.max_score:g}" + ("  (full marks)" if report.full_marks else "")
     )
     lines += instructor_lines(report)
+    lines.append(f"Lab: {lab_name(report.lab)}")
     lines.append(f"Edition: {edition_name(report.edition)}")
     if report.edition_note:
         lines.append(report.edition_note)
@@ -71,6 +72,13 @@ def edition_name(name: str) -> str:
     from grader.lab.editions import edition_label  # the packs import the checks: only when a report is shown
 
     return edition_label(name)
+
+
+def lab_name(name: str) -> str:
+    """How a report names its lab to a person: `opengym (OpenGym AI / Reinforcement Learning 1)`."""
+    from grader.lab.labs import lab_label  # the packs import the checks: only when a report is shown
+
+    return lab_label(name)
 
 
 def notebook_lines(notebook: NotebookSummary) -> list[str]:

@@ -124,3 +124,21 @@ def test_a_canvas_export_without_the_assignment_id_is_refused(client: TestClient
     response = client.get("/gradebook.csv", params={"format": "canvas"}, headers=instructor_headers())
     assert response.status_code == 422
     assert "format=canvas needs assignment_id" in response.text
+
+
+@pytest.mark.parametrize(
+    ("lab", "column"),
+    [(None, "OpenGym AI lab (77)"), ("rl2", "Policy Function Iteration lab (77)")],
+    ids=["first-lab-unchanged", "second-lab"],
+)
+def test_a_canvas_export_names_the_services_lab_unless_given_a_title(
+    make_settings: SettingsFactory, lab: str | None, column: str
+) -> None:
+    with TestClient(create_app(make_settings(lab=lab), run_workers=False)) as client:
+        ada = add_student(client, "1234")
+        _graded(client, ada, {"random_blackjack": 1.0})
+        response = client.get(
+            "/gradebook.csv", params={"format": "canvas", "assignment_id": "77"}, headers=instructor_headers()
+        )
+    assert response.status_code == 200, response.text
+    assert next(csv.reader(io.StringIO(response.text)))[-1] == column

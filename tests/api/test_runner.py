@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 from api_testing import SettingsFactory
@@ -231,3 +232,40 @@ def test_the_real_grader_grades_the_services_edition_never_the_uploads(
     assert ("epsilon_decay" in statuses) == (graded == "rl1")
     note = row.report["edition_note"]
     assert (note is None) if told is None else (f"This file looks written for {told}" in note), note
+
+
+RL2_HONEST = (Path(__file__).resolve().parents[2] / "submissions" / "rl2" / "honest_v2024.py").read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("lab", "upload", "filename", "graded", "missing", "told"),
+    [
+        (None, RL2_HONEST, "policy_iteration.py", ("opengym", "classic"), "random_blackjack", "the lab rl2"),
+        ("rl2", CLASSIC_TAXI_ONLY, "opengym.py", ("rl2", "v2026"), "value_iteration", "the lab opengym"),
+    ],
+    ids=["a-second-lab-upload-while-GYMGRADE_LAB-is-unset", "a-first-lab-upload-to-a-second-lab-service"],
+)
+def test_the_real_grader_grades_the_services_lab_never_the_uploads(
+    sessions: sessionmaker[Session],
+    make_settings: SettingsFactory,
+    lab: str | None,
+    upload: bytes,
+    filename: str,
+    graded: tuple[str, str],
+    missing: str,
+    told: str,
+) -> None:
+    # Hostile: an upload that looks written for another lab does not choose its lab; it is told so.
+    real = {
+        "grader": "grader.grading.grade:grade_submission",
+        "allow_weak_isolation": True,
+        "grading_workers": 1,
+    }
+    settings = make_settings(**real, lab=lab)
+    row = _grade(sessions, settings, upload, filename=filename)
+    assert row.status == "done", row.error
+    assert row.report is not None and (row.report["lab"], row.report["edition"]) == graded
+    statuses = {problem["id"]: problem["status"] for problem in row.report["problems"]}
+    assert statuses[missing] == "missing"
+    note = row.report["edition_note"]
+    assert note is not None and f"This file looks written for {told}" in note, note

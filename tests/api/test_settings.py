@@ -181,3 +181,39 @@ def test_an_edition_no_pack_has_is_refused_when_the_service_starts(monkeypatch: 
     )
     monkeypatch.setenv("GYMGRADE_EDITION", "rl1")
     assert Settings().edition == "rl1"
+
+
+@pytest.mark.parametrize(
+    ("lab", "edition", "message"),
+    [
+        (
+            "nonsense",
+            None,
+            "GYMGRADE_LAB: unknown lab 'nonsense'; expected one of opengym (OpenGym AI / Reinforcement Learning 1), rl2 (Policy Function Iteration / Reinforcement Learning 2)",
+        ),  # noqa: E501
+        (
+            "rl2",
+            "rl1",
+            "GYMGRADE_EDITION=rl1 is an edition of lab opengym (OpenGym AI / Reinforcement Learning 1), but GYMGRADE_LAB=rl2 names lab rl2 (Policy Function Iteration / Reinforcement Learning 2): name one of rl2's editions (v2018, v2019, v2023, v2024, v2026), or unset GYMGRADE_LAB",
+        ),  # noqa: E501
+    ],
+    ids=["unknown-lab", "edition-of-another-lab"],
+)
+def test_a_lab_the_service_cannot_grade_is_refused_when_it_starts(
+    monkeypatch: pytest.MonkeyPatch, lab: str, edition: str | None, message: str
+) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.setenv("GYMGRADE_LAB", lab)
+    if edition is not None:
+        monkeypatch.setenv("GYMGRADE_EDITION", edition)
+    with pytest.raises(ValidationError) as raised:
+        Settings()
+    assert message in str(raised.value)
+
+
+def test_a_lab_and_one_of_its_editions_are_accepted(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GYMGRADE_INSTRUCTOR_TOKEN", STRONG)
+    monkeypatch.setenv("GYMGRADE_LAB", "rl2")
+    assert (Settings().lab, Settings().edition) == ("rl2", None)
+    monkeypatch.setenv("GYMGRADE_EDITION", "v2019")
+    assert (Settings().lab, Settings().edition) == ("rl2", "v2019")

@@ -91,3 +91,22 @@ def test_while_grading_runs_a_problem_another_edition_declares_is_not_drawn_as_t
                          measurements=measurements)  # fmt: skip
     assert page_figures(_page_problems([taxi]), None) == {"taxi": []}
     assert page_figures(_page_problems([taxi]), "rl1") == {"taxi": []}
+
+
+@pytest.mark.parametrize(
+    ("report", "lab", "edition"),
+    [
+        ({"lab": "rl2", "edition": "v2024"}, "rl2 (Policy Function Iteration / Reinforcement Learning 2)",
+         "v2024 (Reinforcement Learning 2: Markov Decision Process (2024))"),
+        ({}, "opengym (OpenGym AI / Reinforcement Learning 1)", "classic (OpenGym AI (classic gym))"),
+    ],
+    ids=["second-lab", "a-report-older-than-labs"],
+)  # fmt: skip
+def test_the_students_page_names_the_lab_and_edition(report: dict[str, Any], lab: str, edition: str) -> None:
+    from api.web import templates
+
+    shown = {"score": 1, "max_score": 1, "problems": [], **report}
+    submission = {"status": "done", "progress": [], "report": shown, "overrides": [], "error": None}
+    page = templates.env.get_template("_live.html").render(submission=submission, final=True)
+    assert f'<p id="lab" class="meta">Lab: {lab}</p>' in page
+    assert f'<p id="edition" class="meta">Edition: {edition}</p>' in page

@@ -27,6 +27,8 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field
 
 from grader.classroom.report.entries import ClassEntry, EntryStatus
+from grader.lab.editions import edition_label
+from grader.lab.labs import lab_label
 from grader.render.neutral import (
     MAX_DIAGNOSIS_CHARS,
     MAX_IDENTITY_CHARS,
@@ -145,6 +147,12 @@ class ClassSummary(BaseModel):
 
     format: int = SUMMARY_FORMAT
     title: str
+    lab: str = Field(
+        default="",
+        description="The lab its reports were graded in, as a person reads it (several, comma-separated, when kept reports of another lab are mixed in); "  # noqa: E501
+        "empty when nothing was graded.",
+    )
+    edition: str = Field(default="", description="The edition its reports were graded in, as `lab`.")
     students: int
     graded: int
     missing: list[str] = Field(description="On the roster, no submission.")
@@ -198,6 +206,8 @@ def summarise(entries: Sequence[ClassEntry], *, title: str = "") -> ClassSummary
     graded = [entry for entry in ordered if entry.status == "graded" and entry.report is not None]
     return ClassSummary(
         title=display_text(title, MAX_NAME_CHARS),
+        lab=_named(lab_label(entry.report.lab) for entry in graded if entry.report is not None),
+        edition=_named(edition_label(entry.report.edition) for entry in graded if entry.report is not None),
         students=len(ordered),
         graded=len(graded),
         missing=[_identity(entry) for entry in ordered if entry.status == "missing"],
@@ -213,6 +223,11 @@ def summarise(entries: Sequence[ClassEntry], *, title: str = "") -> ClassSummary
     )
 
 
+def _named(labels: Iterable[str]) -> str:
+    """The distinct labels, sorted, comma-separated, one line, bounded (a kept report's text is untrusted)."""
+    return display_text(", ".join(sorted(set(labels))), MAX_NAME_CHARS)
+
+
 def class_summary(entries: Sequence[ClassEntry], *, title: str = "") -> dict[str, Any]:
     """The class summary as JSON-able data with stable keys (what ``class.json`` holds).
 
@@ -221,9 +236,10 @@ def class_summary(entries: Sequence[ClassEntry], *, title: str = "") -> dict[str
         title: What the class or assignment is called.
 
     Returns:
-        ``format``, ``title``, ``students``, ``graded``, ``missing``, ``late``, ``submission_errors``,
-        ``scores`` (distribution and histogram bins), ``problems`` (pass rates), ``diagnoses`` (most
-        common first, with the identities concerned), ``diagnoses_left_off`` and ``entries``.
+        ``format``, ``title``, ``lab``, ``edition``, ``students``, ``graded``, ``missing``, ``late``,
+        ``submission_errors``, ``scores`` (distribution and histogram bins), ``problems`` (pass rates),
+        ``diagnoses`` (most common first, with the identities concerned), ``diagnoses_left_off`` and
+        ``entries``.
     """
     return summarise(entries, title=title).model_dump(mode="json")
 

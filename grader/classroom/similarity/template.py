@@ -4,7 +4,9 @@ A function whose normalised tree equals one of the template's (its provided ``fi
 or a problem's untouched stub) is dropped whole; the template's fingerprints and comments are dropped
 from every document too, so a provided function a student edited still shares nothing through its
 unchanged lines (MOSS's base file). The bundled templates are in ``templates/``: the classic
-``opengym.py`` as handed out, and gymgrade's restatement of the gymnasium editions (EDITIONS.md).
+``opengym.py`` as handed out, gymgrade's restatement of the gymnasium editions (EDITIONS.md), and the second
+lab's templates of every edition (``rl2_<edition>.py.txt``, the packs' ``submissions/rl2/templates/`` as
+handed out; a test holds them equal), so a class of either lab is compared beyond what it was handed.
 """
 
 from __future__ import annotations

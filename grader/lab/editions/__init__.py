@@ -15,31 +15,39 @@ How an edition is carried, chosen and shown:
   an acceptance module `test_<id>.py` looks its problem up in its edition's registry
   (`RL1.registry.acceptance_problem(__name__)`), and `--only` accepts every edition's ids
   (`grader.lab.editions.all_problem_ids()`), the plan refusing those its edition does not grade.
-- **Choosing** (`grader/lab/editions/choice.py`, called once by `gymgrade check`/`grade` before their
-  handlers): `--edition NAME` (with no `--config`: the pack's default configuration; with one: it must grade
-  the same problems, else `EditionConflict` says what to write), else the configuration's `edition`, else
-  detection (`check`: the file; `grade`: each file, below), else `classic`. The command prints `Edition: NAME
-  (title): why` on stderr. What a student is graded on is the instructor's choice: detection alone chooses
-  only for a student's own `check`; `service_edition(GYMGRADE_EDITION)` for the service (unset: `classic`,
-  never the upload's).
-- **Detection** (`grader/lab/editions/detection.py`) reads the submission in the parent (without following
-  links) with `ast` only, within bounds (1 MB of source; a notebook's code cells come from the bounded reader,
-  `grader.submission.notebook.read_notebook`, so its JSON is never parsed in the parent; a file that cannot be
-  read or parsed shows no mark): a function only `rl1` asks for (`epsilon_decay`, `qlearn`, `sarsa0`,
+- **Choosing** (`grader/lab/editions/choice.py`, called once by `gymgrade check`/`grade`/`gradescope-bundle`
+  before their handlers): `--lab NAME` chooses the lab (`grader.lab.labs`; an edition named with it must be
+  one of its editions, else `LabConflict` names both), `--edition NAME` the edition (with no `--config`: the
+  pack's default configuration; with one: it must grade the same problems, else `EditionConflict` says what
+  to write), else the configuration's `edition` (or its `lab`'s current edition), else `--lab`'s edition the
+  file shows (`check`) or its current edition, else detection (`check`: the file; `grade`: each file, below),
+  else `classic`. The command prints `Lab: NAME (...)` and `Edition: NAME (title): why` on stderr. What a
+  student is graded on is the instructor's choice: detection alone chooses only for a student's own
+  `check`; `service_edition(GYMGRADE_EDITION, GYMGRADE_LAB)` for the service (both unset: `classic`, never
+  the upload's).
+- **Detection** (`grader/lab/editions/detection.py`) reads the submission's marks (`marks.py`) in the
+  parent (without following links) with `ast` only, within bounds (1 MB of source; a notebook's code cells
+  come from the bounded reader, `grader.submission.notebook.read_notebook`, so its JSON is never parsed in
+  the parent; a file that cannot be read or parsed shows no mark), and asks each lab's rules, the second
+  lab's first (`rl2_marks.py`: its functions or file names, then its edition). The first lab's
+  (`opengym_marks.py`): a function only `rl1` asks for (`epsilon_decay`, `qlearn`, `sarsa0`,
   `compare`) or a two-table `taxi` -> `rl1`; a `render` flag on `cartpole`/`car` or `import gymnasium` ->
   `volume2`; `gym_toytext` or gym 0.26's five-value `step` / two-value `reset` -> `gym026`; `import gym` ->
   `classic`; else the file shows no edition (`Detection.shown` False: taken as `classic`, counted by no
   class). Each reason names what it saw. `detect_source(bytes, name)` reads source already read;
-  `edition_note(graded, detection)` is what a report says (`Report.edition_note`) to a file written for other
-  problems than the edition graded: `grader.grading.grade` computes it for every graded file (a notebook from
-  the module built of its cells), so `check --edition`, `grade`, Gradescope and the service all tell it.
+  `edition_note(graded, detection)` is what a report says (`Report.edition_note`) to a file written for
+  another lab or other problems than the edition graded: `grader.grading.grade` computes it for every graded
+  file (a notebook from the module built of its cells), so `check --edition`, `grade`, Gradescope and the
+  service all tell it.
 
 - **The edition is in the report** (`Report.edition`; a report without it, written before editions, reads
-  as `classic`, `grader.report.FIRST_EDITION`). The text summary, the HTML report, the Gradescope output and
-  the service's page show it (`grader.render.text.edition_name`: `rl1 (Reinforcement Learning 1: Gymnasium)`);
+  as `classic`, `grader.report.FIRST_EDITION`), and so is its lab (`Report.lab`, absent: `opengym`). The
+  text summary, the HTML report, the Gradescope output and the service's page show both
+  (`grader.render.text.edition_name`: `rl1 (Reinforcement Learning 1: Gymnasium)`; `lab_name`);
   figures are drawn with the report's edition's configuration (`grader.lab.editions.choice.edition_config`).
-- **A class without `--edition` or a configuration** (`gymgrade grade`,
-  `grader/lab/editions/per_submission.py`): every graded file is detected; files showing no edition are left
+- **A class without `--lab`, `--edition` or a configuration** (`gymgrade grade`,
+  `grader/lab/editions/per_submission.py`): every graded file is detected; files showing different labs stop
+  the class (exit 2, naming each lab and whose files are behind it); files showing no edition are left
   out; when the others all ask the same problems the class is graded as their edition (of several names, the
   most common, a tie to the newer; none: `classic`), so its gradebook has one set of columns; `Edition: ...`
   then one line per submission (`identity: edition: reason`). When they ask different problems,

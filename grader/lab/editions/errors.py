@@ -1,4 +1,4 @@
-"""Errors of choosing an edition (both are configuration errors: what a person passed or wrote)."""
+"""Errors of choosing a lab and an edition (configuration errors: what a person passed or wrote)."""
 
 from grader.errors import ConfigError
 
@@ -9,3 +9,11 @@ class UnknownEdition(ConfigError):
 
 class EditionConflict(ConfigError):
     """Raised when `--edition` and the configuration given with it grade different problems."""
+
+
+class UnknownLab(ConfigError):
+    """Raised when `--lab`, `GYMGRADE_LAB` or a configuration's `lab = "..."` names no lab."""
+
+
+class LabConflict(ConfigError):
+    """Raised when an edition named (flag, setting or configuration) is not an edition of the lab named."""

@@ -69,7 +69,8 @@ class Edition:
         not_graded: Functions the edition asks for that this grader does not grade yet, each with why.
         lab: The lab it is an edition of: "opengym" (the OpenGym lab, "Reinforcement Learning 1" since
             2024: `grader.lab.editions`) or "rl2" ("Policy Function Iteration", "Reinforcement Learning 2"
-            since 2024: `grader.lab.rl2`). Edition names are unique across labs; `number` counts within one.
+            since 2024: `grader.lab.rl2`); its `grader.lab.labs.Lab`. Edition names are unique across labs;
+            `number` counts within one.
     """
 
     name: str

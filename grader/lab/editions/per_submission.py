@@ -1,11 +1,14 @@
-"""The edition of a class graded without `--edition` or a configuration: the one its files all show.
+"""The lab and edition of a class graded without `--lab`, `--edition` or a configuration: those its files all
+show.
 
 What a student is graded on is the instructor's assignment, never a majority of the class's files: each
-submission's graded file is read statically (`grader.lab.editions.detection`, never run), files that show no
-edition (empty, unreadable, a shared function without imports) are left out, and the class is graded as the
-edition the others show only when they all ask the same problems (editions 1-3 grade the same problems and
-agree). Otherwise `ClassEditions.disagreement` says which editions were found and whose files are behind
-each, and the command stops before grading so that the instructor names the assignment's edition.
+submission's graded file is read statically (`grader.lab.editions.detection`, never run). First the lab:
+files that show no lab (empty, unreadable, nothing of any lab) are left out, and when the others show
+different labs, `ClassEditions.disagreement` names each lab and whose files are behind it. Then the edition
+within the class's lab: files that show no edition are left out, and the class is graded as the edition the
+others show only when they all ask the same problems (the first lab's editions 1-3 grade the same problems
+and agree); otherwise `disagreement` says which editions were found and whose files are behind each. Either
+way the command stops before grading so that the instructor names the assignment's lab or edition.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from grader.lab.editions import DEFAULT_EDITION, EDITIONS
 from grader.lab.editions.choice import EditionChoice, default_config
 from grader.lab.editions.detection import Detection, detect_edition
 from grader.lab.editions.rl1 import RL1
+from grader.lab.labs import DEFAULT_LAB, LABS, default_edition_of
 
 MAX_NAMED = 20
 """Identities named per edition in a disagreement (the rest are counted)."""
@@ -49,26 +53,44 @@ class ClassEditions:
 
 
 def class_editions(files: Mapping[str, Path]) -> ClassEditions:
-    """Detect each submission's edition and choose the class's, or say why none can be chosen.
+    """Detect each submission's lab and edition and choose the class's, or say why none can be chosen.
 
     Args:
         files: Each submission's graded file, by identity.
 
     Returns:
-        The class's edition: the one every file showing an edition asks the problems of (of several names
-        for the same problems, the most common, a tie to the newer); the first edition when no file shows
-        one. With files showing editions of different problems, `disagreement` is set.
+        The class's edition: of the one lab its files show, the edition every file showing one asks the
+        problems of (of several names for the same problems, the most common, a tie to the newer); when no
+        file shows an edition, the lab's default (the first lab's first edition, another lab's current).
+        With files showing different labs, or editions of different problems, `disagreement` is set.
     """
     detected = {identity: detect_edition(path) for identity, path in files.items()}
-    shown = {identity: found for identity, found in detected.items() if found.shown}
+    labs = {found.edition.lab for found in detected.values() if found.lab_shown}
+    if len(labs) > 1:
+        first = EDITIONS[DEFAULT_EDITION]
+        reason = f"no --lab, --edition or configuration, and the files show different labs ({', '.join(sorted(labs))})"  # noqa: E501
+        return ClassEditions(EditionChoice(first, None, reason), detected, _lab_disagreement(detected))
+    lab = LABS[labs.pop()] if labs else LABS[DEFAULT_LAB]
+    shown = {
+        identity: found
+        for identity, found in detected.items()
+        if found.shown and found.edition.lab == lab.name
+    }
     unshown = len(detected) - len(shown)
-    if not shown:
+    if not shown and lab.name == DEFAULT_LAB:
         first = EDITIONS[DEFAULT_EDITION]
         reason = (
             f"no --edition and no configuration, and none of the {len(detected)} files shows an edition: "
             f"the first edition (--edition {RL1.name} grades today's)"
         )
         return ClassEditions(EditionChoice(first, None, reason), detected)
+    if not shown:
+        edition = default_edition_of(lab)
+        reason = (
+            "no --edition and no configuration; "
+            f"the files show the lab {lab.name} but none of the {len(detected)} shows one of its editions: its current edition"  # noqa: E501
+        )
+        return ClassEditions(EditionChoice(edition, default_config(edition), reason), detected)
     problem_sets = {id(found.edition.registry) for found in shown.values()}
     order = list(EDITIONS)
     names = Counter(found.edition.name for found in shown.values())
@@ -88,6 +110,31 @@ def class_editions(files: Mapping[str, Path]) -> ClassEditions:
     )
 
 
+def _lab_disagreement(detected: Mapping[str, Detection]) -> str:
+    """Which labs the files show, whose files are behind each, and what to do."""
+    by_lab: dict[str, list[str]] = {}
+    for identity, found in detected.items():
+        if found.lab_shown:
+            by_lab.setdefault(found.edition.lab, []).append(identity)
+    unshown = len(detected) - sum(len(who) for who in by_lab.values())
+    order = list(LABS)
+    names = sorted(by_lab, key=order.index)
+    parts = [f"{LABS[name].label}, {len(by_lab[name])}: {_listed(by_lab[name])}" for name in names]
+    left_out = f" ({unshown} files showing no lab are not counted)" if unshown else ""
+    choices = " or ".join(f"--lab {name}" for name in names)
+    return (
+        f"the class's files were written for different labs{left_out}: {'; '.join(parts)}. "
+        "What a student is graded on is the assignment's lab and edition, not the files': "
+        "nothing was graded; "
+        f'pass the assignment\'s lab ({choices}), its edition (--edition NAME) or a configuration naming it (lab = "..."); '  # noqa: E501
+        "a file written for another lab is then graded as the assignment and told so"
+    )
+
+
+def _listed(who: list[str]) -> str:
+    return ", ".join(who[:MAX_NAMED]) + (f" and {len(who) - MAX_NAMED} more" if len(who) > MAX_NAMED else "")
+
+
 def _disagreement(shown: Mapping[str, Detection], unshown: int) -> str:
     """Which editions the files show, whose files are behind each, and what to do."""
     by_edition: dict[str, list[str]] = {}
@@ -97,10 +144,7 @@ def _disagreement(shown: Mapping[str, Detection], unshown: int) -> str:
     parts = []
     for name in sorted(by_edition, key=order.index):
         who = by_edition[name]
-        listed = ", ".join(who[:MAX_NAMED]) + (
-            f" and {len(who) - MAX_NAMED} more" if len(who) > MAX_NAMED else ""
-        )
-        parts.append(f"{name} ({EDITIONS[name].title}, {len(who)}): {listed}")
+        parts.append(f"{name} ({EDITIONS[name].title}, {len(who)}): {_listed(who)}")
     left_out = f" ({unshown} files showing no edition are not counted)" if unshown else ""
     choices = " or ".join(f"--edition {name}" for name in sorted(by_edition, key=order.index))
     return (

@@ -101,7 +101,7 @@ def _report(seed: int, digest: str, problems: tuple[str, ...]) -> Report:
     [
         (_report(7, "c1", ("car",)), None),
         (_report(8, "c1", ("car",)), "bob was graded with seed 8, this run grades with 7: pass --seed 8 or leave out --seed"),  # noqa: E501
-        (_report(7, "c2", ("car",)), "bob was graded with another assignment configuration: pass the same --config and --edition as the class's grading"),  # noqa: E501
+        (_report(7, "c2", ("car",)), "bob was graded with another assignment configuration: pass the same --config, --lab and --edition as the class's grading"),  # noqa: E501
         (_report(7, "c1", ("car", "taxi")), "bob was graded for car, taxi: pass the same --only as the class's grading"),  # noqa: E501
     ],
     ids=["same", "other-seed", "other-configuration", "other-problems"],

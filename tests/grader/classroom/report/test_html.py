@@ -168,3 +168,12 @@ def test_the_summary_is_written_beside_the_page(tmp_path: Path) -> None:
     assert json.loads(summary_path(page).read_text(encoding="utf-8"))["graded"] == 1
     with pytest.raises(ValueError, match=r"expected an \.html file name"):
         write_class_report(tmp_path / "class.json", [])
+
+
+def test_the_class_page_names_the_lab_and_edition() -> None:
+    page = render_class_html([all_passed("alice")])
+    assert (
+        '<p class="meta" id="lab">Lab opengym (OpenGym AI / Reinforcement Learning 1) · edition classic '
+        "(OpenGym AI (classic gym))</p>"
+    ) in page
+    assert 'id="lab"' not in render_class_html([]), "nothing graded: no lab to name"

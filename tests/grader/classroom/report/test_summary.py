@@ -15,8 +15,8 @@ from grader.render.neutral import HIDDEN, MAX_DIAGNOSIS_CHARS
 from .support import OFF_BY_ONE, SHORT_POLE, STOOD_ON_N, all_passed, graded, report, result
 
 SUMMARY_KEYS = [
-    "format", "title", "students", "graded", "missing", "late", "overridden", "extended", "submission_errors",
-    "scores", "problems", "diagnoses", "diagnoses_left_off", "entries",
+    "format", "title", "lab", "edition", "students", "graded", "missing", "late", "overridden", "extended",
+    "submission_errors", "scores", "problems", "diagnoses", "diagnoses_left_off", "entries",
 ]  # fmt: skip
 
 
@@ -28,6 +28,7 @@ def test_an_empty_class_has_every_key_and_nothing_in_them() -> None:
         "full_marks": 0, "bins": [],
     }  # fmt: skip
     assert (summary["problems"], summary["diagnoses"], summary["entries"]) == ([], [], [])
+    assert (summary["lab"], summary["edition"]) == ("", ""), "nothing graded: no lab to name"
     json.dumps(summary, allow_nan=False)
 
 
@@ -272,3 +273,21 @@ def test_identities_keep_leading_zeros_and_rare_diagnoses_beyond_the_limit_are_c
     summary = class_summary(entries)
     assert summary["entries"][0]["identity"] == "00000"
     assert (len(summary["diagnoses"]), summary["diagnoses_left_off"]) == (MAX_DIAGNOSES, 3)
+
+
+def test_the_summary_names_the_lab_and_edition_of_its_reports() -> None:
+    first = class_summary([all_passed("alice"), graded("bob", result("blackjack", "failed"))])
+    assert (first["lab"], first["edition"]) == (
+        "opengym (OpenGym AI / Reinforcement Learning 1)",
+        "classic (OpenGym AI (classic gym))",
+    )
+    second = report(result("blackjack", "passed")).model_copy(update={"lab": "rl2", "edition": "v2024"})
+    mixed = class_summary([all_passed("alice"), ClassEntry(identity="carol", report=second)])
+    assert mixed["lab"] == (
+        "opengym (OpenGym AI / Reinforcement Learning 1), "
+        "rl2 (Policy Function Iteration / Reinforcement Learning 2)"
+    ), "kept reports of another lab are not hidden"
+    # Hostile: a kept report naming a lab no gymgrade has is shown as one bounded, inert line.
+    forged = report(result("blackjack", "passed")).model_copy(update={"lab": "x\u202e\n" * 200})
+    shown = class_summary([ClassEntry(identity="mallory", report=forged)])["lab"]
+    assert "\n" not in shown and "\u202e" not in shown and len(shown) <= 120

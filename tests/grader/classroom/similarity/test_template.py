@@ -54,3 +54,23 @@ def test_an_unreadable_template_says_what_to_pass(tmp_path: Path) -> None:
         TemplateError, match=r"expected the template .* to be a readable Python file, found SyntaxError"
     ):
         load_template((bad,))
+
+
+RL2_EDITIONS = ("v2018", "v2019", "v2023", "v2024", "v2026")
+
+
+@pytest.mark.parametrize("edition", RL2_EDITIONS)
+def test_each_second_lab_template_is_bundled_as_handed_out_and_leaves_nothing(edition: str) -> None:
+    from grader.lab.editions import EDITIONS
+
+    handed_out = EDITIONS[edition].template.read_text(encoding="utf-8")
+    assert (TEMPLATES / f"rl2_{edition}.py.txt").read_text(encoding="utf-8") == handed_out
+    assert _document(handed_out).fingerprints == {}
+
+
+def test_a_second_lab_function_a_student_wrote_is_still_compared() -> None:
+    template = (TEMPLATES / "rl2_v2026.py.txt").read_text(encoding="utf-8")
+    written = (ROOT / "submissions" / "rl2" / "policy_function_iteration.py").read_text(encoding="utf-8")
+    assert {"value_iteration", "policy_improvement", "iter_policy_eval"} <= set(load_template().names)
+    assert _document(written).fingerprints, "the student's own value_iteration is theirs, not the template's"
+    assert _document(template).fingerprints == {}

@@ -158,3 +158,91 @@ def test_the_gradescope_bundle_carries_the_editions_configuration(
     assert "Edition: rl1" in capsys.readouterr().err
     with zipfile.ZipFile(bundle) as archive:
         assert archive.read("assignment.toml") == RL1.default_config.read_bytes()
+
+
+RL2_SAMPLES = Path(__file__).resolve().parents[4] / "submissions" / "rl2"
+
+
+def test_lab_and_an_edition_of_another_lab_is_a_usage_error_naming_both(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    argv = ["check", str(RL2_SAMPLES / "honest_v2024.py"), "--lab", "rl2", "--edition", "rl1"]
+    assert cli.main(argv) == cli.EXIT_ERROR
+    assert capsys.readouterr().err == (
+        "gymgrade check: --edition rl1 is an edition of lab opengym (OpenGym AI / Reinforcement Learning 1), "
+        "but --lab rl2 names lab rl2 (Policy Function Iteration / Reinforcement Learning 2): name one of "
+        "rl2's editions (v2018, v2019, v2023, v2024, v2026), or drop --lab\n"
+    )
+
+
+@pytest.mark.parametrize("command", ["check", "grade", "gradescope-bundle"])
+def test_an_unknown_lab_is_refused_listing_the_labs(command: str, capsys: pytest.CaptureFixture[str]) -> None:
+    argv = {"check": ["check", "x.py"], "grade": ["grade", "x", "--out", "o"], "gradescope-bundle": [command]}
+    with pytest.raises(SystemExit) as raised:
+        cli.build_parser().parse_args([*argv[command], "--lab", "nonsense"])
+    assert raised.value.code == 2
+    assert (
+        "argument --lab: invalid choice: nonsense (choose from opengym, rl2)"
+        in capsys.readouterr().err.replace("'", "")
+    )
+
+
+def test_the_gradescope_bundle_of_a_lab_carries_its_current_editions_configuration(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from grader.cli.gradescope import bundle_config
+
+    out = tmp_path / "autograder.zip"
+    assert cli.main(["gradescope-bundle", "--lab", "rl2", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "Lab: rl2 (Policy Function Iteration / Reinforcement Learning 2).\nEdition: v2026" in err
+    assert bundle_config(out) == EDITIONS["v2026"].default_config.read_text(encoding="utf-8")
+
+
+@pytest.mark.slow  # a grading through the sandbox
+def test_a_second_lab_file_is_detected_and_its_report_names_the_lab(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    argv = ["check", str(RL2_SAMPLES / "honest_v2024.py"), "--only", "value_iteration", "--format", "json"]
+    assert cli.main([*argv, "--workers", "1"]) == cli.EXIT_FULL_MARKS
+    captured = capsys.readouterr()
+    assert captured.err.startswith(
+        "Lab: rl2 (Policy Function Iteration / Reinforcement Learning 2).\n"
+        "Edition: v2024 (Reinforcement Learning 2: Markov Decision Process (2024)): detected from "
+        "honest_v2024.py: it defines model_comparison(episodes)"
+    )
+    report = json.loads(captured.out)
+    assert (report["lab"], report["edition"], report["problems"][0]["status"]) == ("rl2", "v2024", "passed")
+
+
+@pytest.mark.slow  # reads a class through the CLI, then grades it
+def test_a_second_lab_file_in_a_first_lab_class_stops_it_until_the_lab_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Hostile: a file defining the second lab's functions cannot move (or hide in) a first-lab class.
+    inputs = _class(
+        tmp_path / "inputs",
+        alice=RL1.reference.read_bytes(),
+        bob=RL1.template.read_bytes(),
+        mallory=(RL2_SAMPLES / "honest_v2024.py").read_bytes(),
+    )
+    out = tmp_path / "out"
+    argv = ["grade", str(inputs), "--out", str(out), "--only", "epsilon_decay", "--workers", "1"]
+    assert cli.main(argv) == cli.EXIT_ERROR
+    err = capsys.readouterr().err
+    assert (
+        "gymgrade grade: the class's files were written for different labs: opengym (OpenGym AI / "
+        "Reinforcement Learning 1), 2: alice, bob; rl2 (Policy Function Iteration / Reinforcement Learning "
+        "2), 1: mallory."
+    ) in err
+    assert not out.exists() or not list(out.glob("*.json")), "nothing is graded"
+    assert cli.main([*argv, "--lab", "opengym"]) == 0
+    assert "Lab: opengym (OpenGym AI / Reinforcement Learning 1).\nEdition: rl1" in capsys.readouterr().err
+    reports = {path.stem: Report.model_validate_json(path.read_text()) for path in out.glob("*.json")}
+    assert {student: (report.lab, report.edition) for student, report in reports.items()} == dict.fromkeys(
+        reports, ("opengym", "rl1")
+    )
+    note = reports["mallory"].edition_note
+    assert note is not None and note.startswith(
+        "This file looks written for the lab rl2 (Policy Function Iteration / Reinforcement Learning 2)"
+    )

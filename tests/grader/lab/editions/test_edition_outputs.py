@@ -1,5 +1,7 @@
 """The edition travels in the report: JSON (old reports read as the first edition), text, HTML, Gradescope."""
 
+import json
+
 import pytest
 
 from grader.lab.assignment import load_config
@@ -67,3 +69,40 @@ def test_every_editions_report_renders_in_every_format(name: str) -> None:
     assert f"edition {label}" in render_html(report, load_config(edition_config(name)))
     assert f"Edition: {label}." in results(report).output
     assert Report.model_validate_json(report.to_json()).edition == name
+
+
+RL2_LABEL = "rl2 (Policy Function Iteration / Reinforcement Learning 2)"
+
+
+def _rl2_report() -> Report:
+    problem = ProblemResult(id="value_iteration", title="Problem 1: value_iteration", status="passed",
+                            score=1.0, max_score=1.0, feedback="the optimal values")  # fmt: skip
+    return Report(submission="policy_iteration.py", sha256="0" * 64, seed=3, lab="rl2", edition="v2024",
+                  gymnasium_version="1", grader_version="1", score=1.0, max_score=1.0,
+                  problems=[problem])  # fmt: skip
+
+
+def test_a_report_older_than_the_second_lab_reads_as_the_first_lab_and_keeps_its_other_keys() -> None:
+    from grader.report import FIRST_LAB
+
+    old = '{"submission": "opengym.py", "sha256": "00", "seed": 1, "gymnasium_version": "1", ' \
+        '"grader_version": "1", "score": 0, "max_score": 5, "edition": "rl1"}'  # fmt: skip
+    read = Report.model_validate_json(old)
+    assert (read.lab, read.edition) == (FIRST_LAB, "rl1") == ("opengym", "rl1")
+    keys = list(json.loads(_rl1_report().to_json()))
+    assert keys[keys.index("config_sha256") + 1 : keys.index("edition") + 1] == ["lab", "edition"]
+    again = Report.model_validate_json(_rl2_report().to_json())
+    assert again == _rl2_report() and again.lab == "rl2"
+
+
+def test_the_text_summary_html_page_and_gradescope_output_name_the_lab() -> None:
+    report = _rl2_report()
+    lines = summary(report).splitlines()
+    assert lines.index(f"Lab: {RL2_LABEL}") + 1 == lines.index(
+        "Edition: v2024 (Reinforcement Learning 2: Markov Decision Process (2024))"
+    )
+    page = render_html(report, load_config(EDITIONS["v2024"].default_config))
+    assert f"lab {RL2_LABEL} · edition v2024" in page
+    assert f"Lab: {RL2_LABEL}." in results(report).output
+    first = summary(_rl1_report()).splitlines()
+    assert "Lab: opengym (OpenGym AI / Reinforcement Learning 1)" in first

@@ -87,3 +87,47 @@ def test_an_empty_class_or_one_showing_no_edition_is_graded_as_the_first(tmp_pat
     ]
     blank = class_editions(_files(tmp_path, **NO_EDITION))
     assert blank.choice.edition is CLASSIC and blank.disagreement is None
+
+
+RL2_SAMPLES = Path(__file__).resolve().parents[4] / "submissions" / "rl2"
+
+
+def test_a_file_claiming_the_second_lab_in_a_first_lab_class_stops_it_naming_who_is_behind_each_lab(
+    tmp_path: Path,
+) -> None:
+    # Hostile: one file defining the second lab's functions among a first-lab class does not change the
+    # class's lab, nor is it outvoted: nothing is graded until the instructor names the lab.
+    sources = {"alice": RL1.reference, "bob": CLASSIC.reference, "mallory": RL2_SAMPLES / "honest_v2024.py"}
+    editions = class_editions(_files(tmp_path, **sources, z=b""))
+    assert editions.disagreement == (
+        "the class's files were written for different labs (1 files showing no lab are not counted): "
+        "opengym (OpenGym AI / Reinforcement Learning 1), 2: alice, bob; "
+        "rl2 (Policy Function Iteration / Reinforcement Learning 2), 1: mallory. "
+        "What a student is graded on is the assignment's lab and edition, not the files': nothing was graded; "  # noqa: E501
+        "pass the assignment's lab (--lab opengym or --lab rl2), its edition (--edition NAME) or a "
+        'configuration naming it (lab = "..."); a file written for another lab is then graded as the '
+        "assignment and told so"
+    )
+    assert editions.lines()[1:] == [
+        f"  {identity}: {found.edition.name if found.shown else 'no edition'}: {found.reason}"
+        for identity, found in editions.detected.items()
+    ]
+
+
+def test_a_class_of_the_second_lab_is_graded_as_the_edition_its_files_show(tmp_path: Path) -> None:
+    sources = {"a": RL2_SAMPLES / "honest_v2024.py", "b": RL2_SAMPLES / "templates" / "v2024.py"}
+    no_lab = {"empty": NO_EDITION["empty"], "not-python": NO_EDITION["not-python"]}
+    editions = class_editions(_files(tmp_path, **sources, **no_lab))
+    assert editions.disagreement is None and editions.choice.edition is EDITIONS["v2024"]
+    assert editions.choice.config == EDITIONS["v2024"].default_config
+    assert editions.choice.lab_line == "Lab: rl2 (Policy Function Iteration / Reinforcement Learning 2)."
+
+
+def test_second_lab_files_showing_no_edition_are_graded_as_its_current_edition(tmp_path: Path) -> None:
+    lab_only = b"def value_iteration(P, nS, nA, beta=1.0):\n    return None, 0\n"
+    editions = class_editions(_files(tmp_path, a=lab_only, b=lab_only, z=b""))
+    assert editions.disagreement is None and editions.choice.edition is EDITIONS["v2026"]
+    assert editions.choice.reason == (
+        "no --edition and no configuration; the files show the lab rl2 but none of the 3 shows one of its "
+        "editions: its current edition"
+    )
