@@ -189,13 +189,13 @@ def test_an_edition_no_pack_has_is_refused_when_the_service_starts(monkeypatch: 
         (
             "nonsense",
             None,
-            "GYMGRADE_LAB: unknown lab 'nonsense'; expected one of opengym (OpenGym AI / Reinforcement Learning 1), rl2 (Policy Function Iteration / Reinforcement Learning 2)",
-        ),  # noqa: E501
+            "GYMGRADE_LAB: unknown lab 'nonsense'; expected one of opengym (OpenGym AI / Reinforcement Learning 1), rl2 (Policy Function Iteration / Reinforcement Learning 2)",  # noqa: E501
+        ),
         (
             "rl2",
             "rl1",
-            "GYMGRADE_EDITION=rl1 is an edition of lab opengym (OpenGym AI / Reinforcement Learning 1), but GYMGRADE_LAB=rl2 names lab rl2 (Policy Function Iteration / Reinforcement Learning 2): name one of rl2's editions (v2018, v2019, v2023, v2024, v2026), or unset GYMGRADE_LAB",
-        ),  # noqa: E501
+            "GYMGRADE_EDITION=rl1 is an edition of lab opengym (OpenGym AI / Reinforcement Learning 1), but GYMGRADE_LAB=rl2 names lab rl2 (Policy Function Iteration / Reinforcement Learning 2): name one of rl2's editions (v2018, v2019, v2023, v2024, v2026), or unset GYMGRADE_LAB",  # noqa: E501
+        ),
     ],
     ids=["unknown-lab", "edition-of-another-lab"],
 )

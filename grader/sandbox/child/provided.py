@@ -42,9 +42,10 @@ def policy_improvement(
     look = np.zeros((nS, nA))
     for state in range(nS):
         for action in range(nA):
-            for probability, next_state, reward, _ in P[state][action]:
+            for probability, next_state, reward, _terminal in P[state][action]:
                 look[state, action] += probability * (reward + beta * values[next_state])
-    return np.argmax(look, axis=1).astype(np.int64)
+    greedy: np.ndarray = np.argmax(look, axis=1).astype(np.int64)
+    return greedy
 
 
 def extract_policy(P: Table, nS: int, nA: int, v: Any, beta: float = 1.0, *_: Any, **__: Any) -> np.ndarray:
@@ -64,7 +65,7 @@ def iter_policy_eval(
     while True:
         updated = np.zeros(nS)
         for state in range(nS):
-            for probability, next_state, reward, _ in P[state][int(actions[state])]:
+            for probability, next_state, reward, _terminal in P[state][int(actions[state])]:
                 updated[state] += probability * (reward + beta * values[next_state])
         change = float(np.max(np.abs(updated - values)))
         values = updated

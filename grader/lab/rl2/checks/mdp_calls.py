@@ -21,6 +21,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cache
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -125,7 +126,7 @@ def shown(value: PlainValue) -> str:
     return f"{'an' if name[0] in 'aeiou' else 'a'} {name}"
 
 
-def describe_values(values: Sequence[float] | FloatArray, limit: int = 6) -> str:
+def describe_values(values: Sequence[float] | npt.NDArray[Any], limit: int = 6) -> str:
     """A short readable list of values: `[0.9, 1, 1, 0]`, or the first `limit` and how many more."""
     listed = ", ".join(f"{float(value):.6g}" for value in list(values)[:limit])
     more = len(values) - limit
