@@ -1,0 +1,1 @@
+"""The second lab (Policy Function Iteration / Reinforcement Learning 2)."""
