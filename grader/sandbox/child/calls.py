@@ -13,8 +13,8 @@ from typing import Any
 
 import gymnasium
 
-from grader.compat import events as compat_events
 from grader.compat import ClassicEnv, register_envs, resolve_env_id
+from grader.compat import events as compat_events
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.cells import RUN_CELLS, run_cells
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError

@@ -68,9 +68,9 @@ made again with the env object (a student who changed the function to take one),
 kind `env_object` says so."""
 ENV_GYM_OBJECT = "gym_object"
 """`EnvArgument.form`: the child makes the env as `ENV_OBJECT` does and passes it behind the compatibility
-layer's `gym` API (`grader.compat.ClassicEnv`), which serves each call site the API its code expects (classic
-gym's `obs = env.reset()` and four-value `step`, or gym 0.26/gymnasium's two and five values): the second lab's
-`run_simulation(env, ...)` is written for the gym of its edition."""
+layer's `gym` API (`grader.compat.ClassicEnv`), which serves each call site the API its code expects
+(classic gym's `obs = env.reset()` and four-value `step`, or gym 0.26/gymnasium's two and five values): the
+second lab's `run_simulation(env, ...)` is written for the gym of its edition."""
 ENV_FORMS = (ENV_OBJECT, ENV_NAME, ENV_NAME_OR_OBJECT, ENV_GYM_OBJECT)
 ENV_KWARG_NAMES = frozenset({"map_name", "is_slippery"})
 """Constructor arguments an `EnvArgument` may carry (FrozenLake's map and slipperiness); values are plain

@@ -1,4 +1,4 @@
-"""The second lab's `run_simulation(env, policy, beta=1.0)`: one episode's discounted return, verified by replay.
+"""The second lab's `run_simulation(env, policy, beta=1.0)`: one episode's discounted return, replayed.
 
 The grader passes its own envs and policies (`CASES`): deterministic lakes (4x4 at beta 0.8 and 1, 8x8 at
 0.9), slippery lakes (4x4 with an optimal and a deliberately poor policy, 8x8 at discount 1) and Taxi (a
@@ -118,7 +118,8 @@ def _always_down() -> npt.NDArray[np.int64]:
 @cache
 def _taxi_policy() -> npt.NDArray[np.int64]:
     table = optimal_q_table(0.9) - 1e-6 * np.arange(6)  # tie-free: any argmax plays the same
-    return np.argmax(table, axis=1).astype(np.int64)
+    policy: npt.NDArray[np.int64] = np.argmax(table, axis=1).astype(np.int64)
+    return policy
 
 
 def _lake(map_name: str, slippery: bool) -> tuple[tuple[str, str | bool | int], ...]:
@@ -196,12 +197,16 @@ def planned_cases(settings: RunSimulationConfig) -> list[Case]:
     return [case for case in CASES for _ in range(settings.slippery_calls if case.slippery else 1)]
 
 
+def _limit(case: Case, settings: RunSimulationConfig) -> int | None:
+    """The time limit of the env passed: `time_limit` for the lakes; Taxi keeps its registered 200 steps."""
+    return None if case.game is TAXI else settings.time_limit
+
+
 def _arguments(
     case: Case, settings: RunSimulationConfig, info: FunctionInfo | None
 ) -> tuple[tuple[PlainValue, ...], dict[str, PlainValue]]:
     """(args, kwargs) as the student's signature orders them: 2019-2022's `render` gets False."""
-    limit = None if case.game is TAXI else settings.time_limit  # Taxi keeps its registered 200 steps
-    env = EnvArgument(case.env_id, limit, ENV_GYM_OBJECT, case.kwargs)
+    env = EnvArgument(case.env_id, _limit(case, settings), ENV_GYM_OBJECT, case.kwargs)
     policy = case.policy()
     names = [parameter.name for parameter in info.parameters] if info is not None else []
     if len(names) >= 4 and names[2] == "render":
@@ -222,7 +227,9 @@ MISTAKES: tuple[tuple[str, Callable[[Sequence[float], float], float]], ...] = (
     ),
     (
         "you square the discount after every step (`beta *= beta`): the weight of step k is beta**k, so multiply a running weight by beta, never beta by itself",  # noqa: E501
-        lambda rewards, beta: math.fsum(r * (1.0 if k == 0 else beta ** (2**k)) for k, r in enumerate(rewards)),
+        lambda rewards, beta: math.fsum(
+            r * (1.0 if k == 0 else beta ** (2**k)) for k, r in enumerate(rewards)
+        ),
     ),
     (
         "you square the discount after every step (`beta *= beta`): the weight of step k is beta**k, so multiply a running weight by beta, never beta by itself",  # noqa: E501
@@ -235,7 +242,7 @@ MISTAKES: tuple[tuple[str, Callable[[Sequence[float], float], float]], ...] = (
         lambda rewards, beta: rewards[-1] if rewards else 0.0,
     ),
     (
-        "you return the last reward only, discounted: the return adds every step's reward, sum beta**k * r_k",  # noqa: E501
+        "you return the last reward only, discounted: the return adds every step's reward, sum beta**k * r_k",
         lambda rewards, beta: beta ** (len(rewards) - 1) * rewards[-1] if rewards else 0.0,
     ),
 )
@@ -259,8 +266,8 @@ class RunSimulationCheck:
         calls = []
         for case in planned_cases(settings):
             args, kwargs = _arguments(case, settings, info)
-            limit = TAXI_STEPS if case.game is TAXI else settings.time_limit
-            calls.append(Call(FUNCTION, args, kwargs, budget=games_budget(1, limit)))
+            steps = _limit(case, settings) or TAXI_STEPS
+            calls.append(Call(FUNCTION, args, kwargs, budget=games_budget(1, steps)))
         return calls
 
     @paused_gc
@@ -288,7 +295,7 @@ class RunSimulationCheck:
             by_call[episode.call_index].append(episode)
         played: list[Episode] = []
         for number, (case, own) in enumerate(zip(cases, by_call, strict=True)):
-            wrong = _episode_problem(case, own, number)
+            wrong = _episode_problem(case, own, number, _limit(case, settings))
             if wrong:
                 return _fail(f"run_simulation on {case.text}: {wrong}")
             played.append(own[0])
@@ -328,7 +335,7 @@ def _not_reset(records: Sequence[CallRecord]) -> str | None:
         if skipped or refused:
             return (
                 "run_simulation stepped the env it was given before resetting it: the lab's run_simulation resets the env itself "  # noqa: E501
-                "(obs = env.reset(), or obs, info = env.reset() with gymnasium) and then plays one episode from there."
+                "(obs = env.reset(), or obs, info = env.reset() with gymnasium) and then plays one episode from there."  # noqa: E501
             )
     return None
 
@@ -337,8 +344,12 @@ def _closed(record: CallRecord) -> bool:
     return any(event.kind == ENV_CLOSED for event in record.outcome.compat_events)
 
 
-def _episode_problem(case: Case, episodes: Sequence[Episode], number: int) -> str | None:
-    """Why a call's episodes are not one episode of the env passed, played with the policy passed."""
+def _episode_problem(case: Case, episodes: Sequence[Episode], number: int, limit: int | None) -> str | None:
+    """Why a call's episodes are not one episode of the env passed, played with the policy passed.
+
+    The env is recognised by what makes the game: its id, map, slipperiness and time limit (an env made
+    anew with all of them equal plays the same game from the grader's seeds, and is not told apart).
+    """
     if not episodes:
         return (
             f"call {number + 1} returned a value without playing an episode in the env it was given. "
@@ -347,10 +358,13 @@ def _episode_problem(case: Case, episodes: Sequence[Episode], number: int) -> st
     if len(episodes) > 1:
         return f"call {number + 1} played {len(episodes)} episodes; run_simulation plays ONE episode and returns its discounted return."  # noqa: E501
     episode = episodes[0]
-    if episode.log.env_index != 0 or case.game.mismatch(episode.log) is not None:
+    made = {name: episode.log.env_kwargs.get(name) for name in (*dict(case.kwargs), "max_episode_steps")}
+    passed = {**dict(case.kwargs), "max_episode_steps": limit}
+    if episode.log.env_id not in case.game.gymnasium_ids or made != passed:
+        arguments = ", ".join(f"{name}={value!r}" for name, value in made.items() if value is not None)
         return (
-            f"call {number + 1} played its episode in an environment it made itself ({episode.log.requested_id!r}), not in the env it was given. "  # noqa: E501
-            "Play the env passed as the first argument: the caller chooses the lake."
+            f"call {number + 1} played its episode in an environment it made itself ({episode.log.requested_id!r}{', ' if arguments else ''}{arguments}), not in the env it was given. "  # noqa: E501
+            "Play the env passed as the first argument: the caller chooses the lake and its time limit."
         )
     policy = case.policy()
     for step, (state, action) in enumerate(episode.decisions()):
@@ -376,7 +390,7 @@ def _miss_text(
     number, case, episode, value, expected = miss
     where = (
         f"call {number + 1} on {case.text} played an episode of {episode.length} steps (rewards {describe(episode.rewards)}); "  # noqa: E501
-        f"its discounted return sum beta**k * r_k from k = 0 is {expected:.10g}, and you returned {value:.10g}"
+        f"its discounted return sum beta**k * r_k from k = 0 is {expected:.10g}, and you returned {value:.10g}"  # noqa: E501
     )
     for cause, mistaken in MISTAKES:
         if all(
@@ -384,9 +398,7 @@ def _miss_text(
             for one_case, one, returned in zip(cases, played, values, strict=True)
         ):
             return f"run_simulation: {where}: {cause}."
-    return (
-        f"run_simulation: {where}. Return the sum over the episode's steps of beta**k times the step's reward, k counted from 0 at the first step."  # noqa: E501
-    )
+    return f"run_simulation: {where}. Return the sum over the episode's steps of beta**k times the step's reward, k counted from 0 at the first step."  # noqa: E501
 
 
 def _fail(feedback: str, measurements: dict[str, PlainValue] | None = None) -> Verdict:

@@ -44,8 +44,6 @@ def records_of(
     return records
 
 
-def verdict_of(
-    submission: Path, check: ProblemCheck[Any], bound: ProblemConfig, *, seed: int = 7
-) -> Verdict:
+def verdict_of(submission: Path, check: ProblemCheck[Any], bound: ProblemConfig, *, seed: int = 7) -> Verdict:
     """The check's verdict on `submission`."""
     return check.judge(bound, records_of(submission, check, bound, seed=seed))
