@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 from pydantic import BaseModel, ConfigDict, Field
 
 from grader.sandbox.child.cells import RUN_CELLS
-from grader.sandbox.child.frames import ENV_NAME_OR_OBJECT, EnvArgument
+from grader.sandbox.child.frames import ENV_NAME_OR_OBJECT, EnvArgument, MdpArgument
 from grader.sandbox.child.provided import PROVIDED
 from grader.sandbox.limits import CallBudget
 
@@ -23,12 +23,14 @@ __all__ = [
     "CallOutcome",
     "EnvArgument",
     "FunctionInfo",
+    "MdpArgument",
     "OutcomeStatus",
     "ParameterInfo",
     "PlainValue",
 ]
 """`RUN_CELLS` (the call that runs a notebook's cells), `EnvArgument` (an env passed to a call by name or
-as an object the child makes; `ENV_NAME_OR_OBJECT`, the name first) and
+as an object the child makes; `ENV_NAME_OR_OBJECT`, the name first), `MdpArgument` (a finite MDP's table
+`P`, given to each call as a fresh dict of int keys and tuples) and
 `PROVIDED` (the grader's definitions a call may bind) are declared by the child, which imports nothing of
 the parent; the plans use them from here."""
 

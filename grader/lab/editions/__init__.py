@@ -62,6 +62,10 @@ first, by default); `qlearn` is a provided function, listed in `not_graded`). Te
 `submissions/template.py` (classic) and `submissions/templates/<edition>.py`; references are
 `submissions/*_complete.py` and `submissions/editions/rl1_complete.py`; `rl1`'s default configuration is
 `grader/lab/editions/rl1.toml` (the others use the bundled `grader/lab/assignment.toml`).
+
+The second lab's five editions (`v2018`, `v2019`, `v2023`, `v2024`, `v2026`; `Edition.lab` "rl2") are declared
+in `grader/lab/rl2/editions.py` and listed here after the first lab's; their configurations are
+`grader/lab/rl2/<edition>.toml`.
 """
 
 from grader.lab.editions.classic import CLASSIC
@@ -71,6 +75,7 @@ from grader.lab.editions.pack import Edition, ExpectedFunction
 from grader.lab.editions.rl1 import RL1
 from grader.lab.editions.volume2 import VOLUME2
 from grader.lab.ids import ProblemId
+from grader.lab.rl2.editions import EDITIONS as RL2_EDITIONS
 
 __all__ = [
     "DEFAULT_EDITION",
@@ -82,8 +87,11 @@ __all__ = [
     "edition_of",
 ]
 
-EDITIONS: dict[str, Edition] = {edition.name: edition for edition in (CLASSIC, GYM026, VOLUME2, RL1)}
-"""Every edition pack, oldest first."""
+EDITIONS: dict[str, Edition] = {
+    edition.name: edition for edition in (CLASSIC, GYM026, VOLUME2, RL1, *RL2_EDITIONS)
+}
+"""Every edition pack: the OpenGym lab's, oldest first, then the second lab's (`grader.lab.rl2`), oldest
+first. Names are unique across labs (`Edition.lab` says whose)."""
 DEFAULT_EDITION = CLASSIC.name
 
 

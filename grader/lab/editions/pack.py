@@ -4,7 +4,8 @@ An assignment grades one edition. Its pack names the problems graded (a `Registr
 declarations of `grader.lab.problems`, reused), every function the edition's template defines with its
 parameters (stubs the student writes and functions the template provides), the games it plays, its
 template, an honest reference solution in its API and its default assignment configuration. A later lab of
-the course is one more pack (one module in `grader/lab/editions/` and an entry in `EDITIONS`).
+the course is more packs with their own `lab` (the second lab's are declared in `grader/lab/rl2/editions.py`)
+and entries in `EDITIONS`.
 """
 
 from __future__ import annotations
@@ -66,6 +67,9 @@ class Edition:
         default_config: The assignment configuration used when none is given.
         notebook_name: The file name its template gives students.
         not_graded: Functions the edition asks for that this grader does not grade yet, each with why.
+        lab: The lab it is an edition of: "opengym" (the OpenGym lab, "Reinforcement Learning 1" since
+            2024: `grader.lab.editions`) or "rl2" ("Policy Function Iteration", "Reinforcement Learning 2"
+            since 2024: `grader.lab.rl2`). Edition names are unique across labs; `number` counts within one.
     """
 
     name: str
@@ -79,6 +83,7 @@ class Edition:
     default_config: Path
     notebook_name: str
     not_graded: tuple[tuple[str, str], ...] = ()
+    lab: str = "opengym"
 
     def function(self, name: str) -> ExpectedFunction | None:
         """The expected function with this name, or None."""

@@ -23,6 +23,7 @@ from grader.sandbox.child.frames import (
     ENV_NAME,
     ENV_NAME_OR_OBJECT,
     EnvArgument,
+    MdpArgument,
     decode_value,
     encode_value,
 )
@@ -323,7 +324,10 @@ def _report_object_form(name: str, request: CallRequest, error: BaseException) -
 
 
 def _passed(argument: Any, as_objects: bool) -> Any:
-    """What the function receives for one argument: an `EnvArgument` as its name or as an env object."""
+    """What the function receives for one argument: an `EnvArgument` as its name or as an env object, an
+    `MdpArgument` as a fresh table (so a call that changes `P` leaves the next call's untouched)."""
+    if type(argument) is MdpArgument:
+        return argument.as_table()
     if type(argument) is not EnvArgument:
         return argument
     if argument.form in (ENV_NAME, ENV_NAME_OR_OBJECT) and not as_objects:

@@ -8,7 +8,10 @@ accepted: a subclass of `float` with rigged comparisons is refused, not converte
 also hold ``{"$env": {"id": ..., "max_episode_steps": ..., "form": ..., "kwargs": {...}}}`` (`EnvArgument`):
 an environment the child passes to the call by name or makes for it (the learners of edition rl1 take `env`,
 the second lab's `run_simulation(env, policy, beta)` a FrozenLake env of the grader's); no return value or
-episode log may.
+episode log may. A call's arguments may also hold ``{"$mdp": {"name": ..., "table": ...}}``
+(`MdpArgument`): a finite MDP in the second lab's format, carried as plain lists and handed to the call as
+a fresh `{state: {action: [(probability, next_state, reward, terminal), ...]}}` (int keys, tuples), which
+a str-keyed frame cannot carry.
 """
 
 from __future__ import annotations
@@ -38,6 +41,13 @@ FLOAT_TAG = "$float"
 NDARRAY_TAG = "$ndarray"
 ENV_TAG = "$env"
 MAX_ENV_ID = 100
+MDP_TAG = "$mdp"
+MAX_MDP_STATES = 4096
+MAX_MDP_ACTIONS = 64
+MAX_MDP_OUTCOMES = 200_000
+"""Bounds of a decoded `MdpArgument`: states, actions per state, outcomes over the whole table (FrozenLake
+8x8 slippery has 64, 4 and 768)."""
+MAX_MDP_NAME = 200
 
 PLAIN_TYPES_HINT = "only plain data can be returned: None, bool, int, float, str, list, tuple, dict with str keys, numpy numbers and numpy arrays of bool/int/float"  # noqa: E501
 _NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
@@ -99,6 +109,45 @@ class EnvArgument:
             return repr(self.env_id)
         arguments = "".join(f", {name}={value!r}" for name, value in self.kwargs)
         return f"gym.make({self.env_id!r}{arguments})"
+
+
+MdpOutcome = tuple[float, int, float, bool]
+"""One entry of `P[s][a]`: (probability, next state, reward, terminal)."""
+
+
+@dataclass(frozen=True)
+class MdpArgument:
+    """An argument the child replaces by a fresh copy of a finite MDP's table, in the second lab's format.
+
+    Attributes:
+        name: How messages name it (e.g. "FrozenLake 4x4 (slippery)"); not passed to the function.
+        table: `table[s][a]` lists the outcomes (probability, next state, reward, terminal) in order; every
+            state has the same number of actions.
+    """
+
+    name: str
+    table: tuple[tuple[tuple[MdpOutcome, ...], ...], ...]
+
+    def __repr__(self) -> str:
+        return f"<P of {self.name}>"
+
+    @property
+    def n_states(self) -> int:
+        """`nS`."""
+        return len(self.table)
+
+    @property
+    def n_actions(self) -> int:
+        """`nA`."""
+        return len(self.table[0]) if self.table else 0
+
+    def as_table(self) -> dict[int, dict[int, list[MdpOutcome]]]:
+        """What the function receives: `{s: {a: [(p, s', r, done), ...]}}`, a new copy at every call (python
+        ints, floats and bools), so what one call does to it never reaches the next."""
+        return {
+            state: {action: list(outcomes) for action, outcomes in enumerate(actions)}
+            for state, actions in enumerate(self.table)
+        }
 
 
 @contextlib.contextmanager
@@ -199,7 +248,8 @@ def decode_value(data: Any, what: str = "the value", *, allow_envs: bool = False
     Args:
         data: The parsed JSON.
         what: How to name the value in error messages.
-        allow_envs: Accept `EnvArgument` tags (a call's arguments only, never a returned value).
+        allow_envs: Accept `EnvArgument` and `MdpArgument` tags (a call's arguments only, never a returned
+            value).
 
     Raises:
         InvalidValueError: the data does not have the layout `encode_value` produces.
@@ -257,6 +307,16 @@ class _Encoder:
             return _encode_array(value, self.what, where)
         if kind in _NUMPY_SCALARS:
             return self.encode(_NUMPY_SCALARS[kind](value), where, depth)
+        if kind is MdpArgument:
+            return {
+                MDP_TAG: {
+                    "name": value.name,
+                    "table": [
+                        [[[p, s, r, done] for p, s, r, done in outcomes] for outcomes in actions]
+                        for actions in value.table
+                    ],
+                }
+            }
         if kind is EnvArgument:
             return {
                 ENV_TAG: {
@@ -315,6 +375,8 @@ class _Decoder:
             return _decode_array(data[NDARRAY_TAG], self.what, where)
         if self.allow_envs and data.keys() == {ENV_TAG}:
             return _decode_env(data[ENV_TAG], self.what, where)
+        if self.allow_envs and data.keys() == {MDP_TAG}:
+            return _decode_mdp(data[MDP_TAG], self.what, where)
         raise _invalid(self.what, where, f"unknown tagged object with keys {sorted(data)}")
 
 
@@ -333,6 +395,53 @@ def _decode_env(spec: Any, what: str, where: str) -> EnvArgument:
     if limit is not None and (type(limit) is not int or not 0 < limit < 2**62):
         raise _invalid(what, where, f"max_episode_steps {limit!r} is not a positive int or null")
     return EnvArgument(env_id, limit, form, tuple(sorted(kwargs.items())))
+
+
+def _decode_mdp(spec: Any, what: str, where: str) -> MdpArgument:
+    """A `MdpArgument` from its wire form, every node checked and the whole bounded before it is built."""
+    if type(spec) is not dict or spec.keys() != {"name", "table"}:
+        raise _invalid(what, where, "an MDP argument needs exactly name and table")
+    name, rows = spec["name"], spec["table"]
+    if type(name) is not str or not 0 < len(name) <= MAX_MDP_NAME:
+        raise _invalid(what, where, f"an MDP's name must be a string of 1 to {MAX_MDP_NAME} characters")
+    if type(rows) is not list or not 0 < len(rows) <= MAX_MDP_STATES:
+        raise _invalid(what, where, f"an MDP's table must list 1 to {MAX_MDP_STATES} states")
+    width = len(rows[0]) if type(rows[0]) is list else 0
+    if not 0 < width <= MAX_MDP_ACTIONS:
+        raise _invalid(what, where, f"an MDP's states must list 1 to {MAX_MDP_ACTIONS} actions")
+    outcomes = 0
+    table = []
+    for state, actions in enumerate(rows):
+        if type(actions) is not list or len(actions) != width:
+            raise _invalid(what, f"{where}[{state}]", f"every state must list the same {width} actions")
+        built = []
+        for action, listed in enumerate(actions):
+            if type(listed) is not list:
+                raise _invalid(what, f"{where}[{state}][{action}]", "an action's outcomes must be a list")
+            outcomes += len(listed)
+            if outcomes > MAX_MDP_OUTCOMES:
+                raise _invalid(what, where, f"an MDP may hold at most {MAX_MDP_OUTCOMES} outcomes")
+            built.append(
+                tuple(_mdp_outcome(item, len(rows), what, f"{where}[{state}][{action}]") for item in listed)
+            )
+        table.append(tuple(built))
+    return MdpArgument(name, tuple(table))
+
+
+def _mdp_outcome(item: Any, n_states: int, what: str, where: str) -> MdpOutcome:
+    if type(item) is not list or len(item) != 4:
+        raise _invalid(what, where, "an outcome is [probability, next_state, reward, terminal]")
+    probability, next_state, reward, done = item
+    numbers = (probability, reward)
+    if not all(type(number) in (int, float) and math.isfinite(number) for number in numbers):
+        raise _invalid(what, where, "an outcome's probability and reward must be finite numbers")
+    if not 0 <= probability <= 1:
+        raise _invalid(what, where, f"an outcome's probability {probability!r} is not in [0, 1]")
+    if type(next_state) is not int or not 0 <= next_state < n_states:
+        raise _invalid(what, where, f"an outcome's next state {next_state!r} is not in 0..{n_states - 1}")
+    if type(done) is not bool:
+        raise _invalid(what, where, "an outcome's terminal flag must be a bool")
+    return (float(probability), next_state, float(reward), done)
 
 
 def _encode_array(array: np.ndarray, what: str, where: str) -> dict[str, Any]:

@@ -1,1 +1,1 @@
-"""The second lab's played problems: one module per problem (settings model and check), verified by replay."""
+"""The second lab's checks: one module per problem, the MDP calls and returned values shared in `mdp_calls`."""  # noqa: E501

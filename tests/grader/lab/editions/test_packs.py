@@ -21,7 +21,29 @@ def test_each_pack_is_complete(name: str) -> None:
     assert graded <= declared
     config = load_config(edition.default_config)
     assert config.registry is edition.registry
-    assert [number for number in (e.number for e in EDITIONS.values())] == [1, 2, 3, 4]
+    same_lab = [other.number for other in EDITIONS.values() if other.lab == edition.lab]
+    assert same_lab == list(range(1, len(same_lab) + 1)), "numbers count within a lab, oldest first"
+
+
+def test_the_labs_and_their_editions() -> None:
+    labs = {name: edition.lab for name, edition in EDITIONS.items()}
+    assert labs == {
+        "classic": "opengym", "gym026": "opengym", "volume2": "opengym", "rl1": "opengym",
+        "v2018": "rl2", "v2019": "rl2", "v2023": "rl2", "v2024": "rl2", "v2026": "rl2",
+    }  # fmt: skip
+    assert EDITIONS["v2018"].registry.ids == (
+        "value_iteration",
+        "extract_policy",
+        "compute_policy_v",
+        "policy_iteration",
+    )
+    assert EDITIONS["v2024"].registry.ids == (
+        "value_iteration", "policy_improvement", "iter_policy_eval", "policy_iteration"
+    )  # fmt: skip
+    for name in ("v2018", "v2019", "v2023", "v2024", "v2026"):
+        edition = EDITIONS[name]
+        template = {f.name for f in edition.functions}
+        assert {function for function, _ in edition.not_graded} | set(edition.registry.ids) == template
 
 
 def test_the_first_edition_is_the_default_and_grades_the_lab_registry() -> None:

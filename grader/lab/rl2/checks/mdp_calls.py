@@ -1,0 +1,207 @@
+"""What the second lab's pure problems share: the MDPs they are called on, how a returned value is read, and
+the tolerance the lab's own algorithm earns at the `tol` it is passed.
+
+The MDPs are `reference.oracles.mdps.grading_cases()` (the lab's example and the grader's own: FrozenLake
+4x4/8x8 slippery and deterministic, a windy corridor, a ring; discounts 1, 0.95, 0.9 and 0.8), each passed
+as an `MdpArgument` (the child hands the function a fresh `{s: {a: [(p, s', r, done), ...]}}`), with `nS`
+and `nA` as plain ints, positionally as the templates order the parameters.
+
+**Tolerance of a value** (`value_tolerance`): iterating to a tolerance stops short of the exact values. Below
+discount 1 the theorem bound holds: a sweep operator that is a beta-contraction in the max norm, stopped
+when a sweep changes V by less than `tol`, leaves V within `beta * tol / (1 - beta)` of its fixed point
+(the 2-norm is at least the max norm, so a 2-norm stop is as close). At discount 1 there is no contraction
+bound; the tolerance is then twice the largest error the lab's own algorithm makes at that `tol` on that
+MDP, over the readings the lab text allows (a sweep from the previous V or in place, stopped on the max
+norm, the loosest), computed by the exact oracle. Every tolerance adds `ROUNDING * (1 + max |V|)`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import cache
+
+import numpy as np
+import numpy.typing as npt
+
+from grader.lab.checks.integrity import NO_EPISODES
+from grader.sandbox.outcome import Call, MdpArgument, PlainValue
+from reference.oracles.mdp import Mdp
+from reference.oracles.mdps import GradingCase, grading_cases
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+ROUNDING = 1e-9
+"""Relative floating-point slack of every value compared (sums of a few hundred products in another order)."""
+DIAGNOSIS_TOLERANCE = 1e-5
+"""How close returned values must be to a typical mistake's values for the feedback to name it (the
+mistakes differ from the right values and from each other by 1e-2 or more on the graded MDPs)."""
+
+
+@cache
+def cases() -> tuple[GradingCase, ...]:
+    """The MDPs and discounts every pure problem is graded on, the lab's example first."""
+    return grading_cases()
+
+
+def mdp_argument(mdp: Mdp) -> MdpArgument:
+    """The table of `mdp` as a call's argument."""
+    return MdpArgument(mdp.name, mdp.table)
+
+
+def mdp_call(function: str, case: GradingCase, *rest: PlainValue) -> Call:
+    """`function(P, nS, nA, *rest)` on a case's MDP: one call, no episodes, a small result frame.
+
+    Recorded with a budget of no episodes, so the result frame is bounded by the sandbox's allowance for a
+    return value alone (4 MiB), and a function that plays an environment is refused.
+    """
+    mdp = case.mdp
+    return Call(
+        function,
+        (mdp_argument(mdp), mdp.n_states, mdp.n_actions, *rest),
+        record_episodes=True,
+        budget=NO_EPISODES,
+    )
+
+
+def call_text(call: Call) -> str:
+    """`value_iteration(P of FrozenLake 4x4 (slippery), 16, 4, 0.9, 1e-08, 3000)` for feedback."""
+    shown = []
+    for argument in call.args:
+        if isinstance(argument, np.ndarray):
+            shown.append(f"<array of {argument.size}>")
+        else:
+            shown.append(repr(argument))
+    return f"{call.function}({', '.join(shown)})"
+
+
+def as_vector(value: PlainValue, size: int) -> FloatArray | None:
+    """A returned value as `size` finite floats, or None when it is not one (a tuple, wrong length, text).
+
+    An array of any shape holding exactly `size` numbers is read flat (a column vector is still the values);
+    bools are not numbers.
+    """
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind not in "iuf" or value.size != size:
+            return None
+        flat = value.astype(np.float64).reshape(size)
+    elif isinstance(value, list) and len(value) == size:
+        if not all(type(item) in (int, float) for item in value):
+            return None
+        flat = np.array(value, dtype=np.float64)
+    else:
+        return None
+    return flat if bool(np.all(np.isfinite(flat))) else None
+
+
+def as_policy(value: PlainValue, mdp: Mdp) -> IntArray | None:
+    """A returned policy as one action number per state, or None (whole floats such as 2.0 count)."""
+    flat = as_vector(value, mdp.n_states)
+    if flat is None or np.any(flat != np.round(flat)):
+        return None
+    actions = flat.astype(np.int64)
+    return actions if bool(np.all((actions >= 0) & (actions < mdp.n_actions))) else None
+
+
+def as_count(value: PlainValue) -> int | None:
+    """A returned iteration count (an int, or a whole float), or None."""
+    if type(value) is int:
+        return value
+    if type(value) is float and math.isfinite(value) and value == round(value):
+        return int(value)
+    return None
+
+
+def describe_values(values: Sequence[float] | FloatArray, limit: int = 6) -> str:
+    """A short readable list of values: `[0.9, 1, 1, 0]`, or the first `limit` and how many more."""
+    shown = ", ".join(f"{float(value):.6g}" for value in list(values)[:limit])
+    more = len(values) - limit
+    return f"[{shown}{f', ... ({more} more)' if more > 0 else ''}]"
+
+
+def value_tolerance(case: GradingCase, tol: float, worst: float, optimum: FloatArray) -> float:
+    """How far returned values may lie from the exact ones (module docstring).
+
+    Args:
+        case: The MDP and discount.
+        tol: The tolerance the function was passed.
+        worst: The largest error of the lab's own algorithm at `tol` (over the readings the text allows).
+        optimum: The exact values.
+    """
+    rounding = ROUNDING * (1.0 + float(np.max(np.abs(optimum))))
+    theorem = case.beta * tol / (1.0 - case.beta) if case.beta < 1 else 0.0
+    return max(theorem, 2.0 * worst) + rounding
+
+
+@dataclass(frozen=True)
+class Reading:
+    """A way the lab's text may be read when iterating to a tolerance: sweep from the previous V (the
+    text's `V^{k+1}` from `V^k`) or update V in place; stop on the max norm or the 2-norm."""
+
+    in_place: bool
+    norm: str
+
+
+READINGS = tuple(Reading(in_place, norm) for in_place in (False, True) for norm in ("max", "l2"))
+"""Every reading of "iterate until the change is below tol" the grader accepts (n may follow any)."""
+
+
+def stop_change(difference: FloatArray, norm: str) -> float:
+    """The change between two sweeps in a reading's norm."""
+    return float(np.max(np.abs(difference))) if norm == "max" else float(np.linalg.norm(difference))
+
+
+def iterate(
+    sweep: Callable[[FloatArray, bool], FloatArray],
+    size: int,
+    tol: float,
+    maxiter: int,
+    reading: Reading,
+    start: FloatArray | None = None,
+) -> tuple[FloatArray, int]:
+    """Sweeps of `sweep(V, in_place)` from `start` (zeros) until the change is below `tol`: (V, sweeps made)."""  # noqa: E501
+    values = np.zeros(size) if start is None else start.copy()
+    for count in range(1, maxiter + 1):
+        updated = sweep(values, reading.in_place)
+        change = stop_change(updated - values, reading.norm)
+        values = updated
+        if change < tol:
+            return values, count
+    return values, maxiter
+
+
+def bellman_sweep(
+    mdp: Mdp, beta: float, policy: IntArray | None = None
+) -> Callable[[FloatArray, bool], FloatArray]:
+    """One sweep of the Bellman optimality update (or, with `policy`, of the policy's own equation)."""
+    rewards, moves = mdp.expected_rewards(), mdp.transitions()
+    states = np.arange(mdp.n_states)
+
+    def sweep(values: FloatArray, in_place: bool) -> FloatArray:
+        if not in_place:
+            look = rewards + beta * moves @ values
+            return look.max(axis=1) if policy is None else look[states, policy]
+        updated = values.copy()
+        for state in range(mdp.n_states):
+            look = rewards[state] + beta * moves[state] @ updated
+            updated[state] = look.max() if policy is None else look[policy[state]]
+        return updated
+
+    return sweep
+
+
+def first_outcomes(mdp: Mdp) -> Mdp:
+    """The MDP as read by `P[s][a][0]`: each move's first outcome only (probabilities as listed)."""
+    return Mdp(f"{mdp.name}, first outcomes", tuple(tuple(o[:1] for o in actions) for actions in mdp.table))
+
+
+def last_outcomes(mdp: Mdp) -> Mdp:
+    """The MDP as read by `q[a] = p * (...)` in a loop over outcomes (`=` for `+=`): the last one only."""
+    return Mdp(f"{mdp.name}, last outcomes", tuple(tuple(o[-1:] for o in actions) for actions in mdp.table))
+
+
+def close(values: FloatArray, other: FloatArray, tolerance: float = DIAGNOSIS_TOLERANCE) -> bool:
+    """Whether two value vectors agree within `tolerance` everywhere."""
+    return bool(np.max(np.abs(values - other)) <= tolerance)

@@ -1,0 +1,172 @@
+"""The second lab's problem 4: `policy_iteration(P, nS, nA, beta=1, tol=1e-8, maxiter=200)` returns
+`(V, policy, n)`.
+
+Called once on every MDP and discount of `mdp_calls.cases()` with `(P, nS, nA, beta, tol, maxiter)`
+positionally. The policy is judged by its exact value (`reference.oracles.mdp.judge_policy`: optimal in
+every state, ties allowed, never equality with one list); V against the exact optimal values within the
+tolerance an iterative evaluation of the returned policy earns at that tol
+(`evaluation.evaluation_tolerance`); n must be a whole number from 1 to maxiter (the texts fix no
+convention for it).
+
+**Which evaluation and improvement.** The student's policy_iteration calls its evaluation and improvement
+steps by name. With `helpers = "grader"` (the default) each call binds the grader's own (the lab's
+algorithms, `grader.sandbox.child.provided`) in their place, so a mistake there counts only in its own
+problem; with `helpers = "student"` the submission's own are used. The feedback says which.
+
+**A start that never converges.** At discount 1 a start policy that loops forever through costly moves
+(all zeros on the ring) has no finite value, so its iterative evaluation never stops: the call reaches its
+time limit (`call_seconds`) and the problem is `timeout`, named; the other problems are graded as usual.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import cache
+from typing import Literal
+
+import numpy as np
+from pydantic import Field
+
+from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.lab.rl2.checks.evaluation import evaluation_tolerance
+from grader.lab.rl2.checks.mdp_calls import (
+    FloatArray,
+    as_count,
+    as_policy,
+    as_vector,
+    call_text,
+    cases,
+    describe_values,
+    mdp_call,
+)
+from grader.lab.settings import ProblemConfig
+from grader.sandbox.outcome import Call, FunctionInfo, OutcomeStatus, PlainValue
+from reference.errors import UnboundedValueError
+from reference.oracles.mdp import judge_policy, optimal_solution, policy_value
+from reference.oracles.mdps import GradingCase
+
+FUNCTION = "policy_iteration"
+
+
+class PolicyIterationConfig(ProblemConfig):
+    """The settings of `policy_iteration(P, nS, nA, beta, tol, maxiter)`."""
+
+    tol: float = Field(default=1e-8, gt=0.0, le=1e-4, description="The tol passed (the lab's default 1e-8).")
+    maxiter: int = Field(
+        default=200, ge=10, le=10_000, description="The maxiter passed (the lab's default 200)."
+    )
+    helpers: Literal["grader", "student"] = Field(
+        default="grader",
+        description="'grader': each call binds the grader's own evaluation and improvement steps in place of the submission's, so a mistake there counts only in its own problem; 'student': the submission's own.",  # noqa: E501
+    )
+
+
+@cache
+def optimum(case: GradingCase) -> FloatArray:
+    """The exact optimal values of a case."""
+    return optimal_solution(case.mdp, case.beta).values
+
+
+@dataclass(frozen=True)
+class PolicyIterationCheck:
+    """One call per graded MDP; the policy judged by its exact value, V against the optimum.
+
+    Attributes:
+        evaluation: The edition's name of the evaluation step (bound to the grader's with helpers="grader").
+        improvement: The edition's name of the improvement step.
+    """
+
+    evaluation: str
+    improvement: str
+
+    def plan(self, settings: PolicyIterationConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+        """`policy_iteration(P, nS, nA, beta, tol, maxiter)` on every case, positionally."""
+        provided = (self.evaluation, self.improvement) if settings.helpers == "grader" else ()
+        calls = []
+        for case in cases():
+            call = mdp_call(FUNCTION, case, case.beta, settings.tol, settings.maxiter)
+            calls.append(
+                Call(call.function, call.args, record_episodes=True, budget=call.budget, provided=provided)
+            )
+        return calls
+
+    def _reading(self, settings: PolicyIterationConfig) -> str:
+        if settings.helpers == "grader":
+            return f"policy_iteration was called with the grader's own {self.evaluation} and {self.improvement} (the lab's algorithms) in place of yours, so a mistake in those counts only in their own problems."  # noqa: E501
+        return f"policy_iteration was called with your own {self.evaluation} and {self.improvement}."
+
+    @paused_gc
+    def judge(self, settings: PolicyIterationConfig, records: Sequence[CallRecord]) -> Verdict:
+        """Each policy optimal by its exact value, V the optimal values, n a whole number of iterations."""
+        reading = self._reading(settings)
+        early = outcome_verdict(records)
+        if early is not None:
+            if early.status == "timeout":
+                return self._timeout(early, records, reading)
+            return Verdict(early.status, early.fraction, f"{early.feedback} {reading}", early.measurements)
+        graded = list(zip(cases(), records, strict=True))
+        problems: list[str] = []
+        for case, record in graded:
+            problem = self._problem(case, record.outcome.call, record.outcome.value, settings)
+            if problem is not None:
+                problems.append(problem)
+        measurements: dict[str, PlainValue] = {
+            "mdps_graded": len(graded),
+            "calls_wrong": len(problems),
+            "helpers": settings.helpers,
+        }
+        if not problems:
+            return Verdict(
+                "passed",
+                1.0,
+                f"policy_iteration: an optimal policy (judged by its exact value, ties allowed) and the optimal values on all {len(graded)} MDPs and discounts. {reading}",  # noqa: E501
+                measurements,
+            )
+        more = f" ({len(problems)} of {len(graded)} MDPs wrong.)" if len(problems) > 1 else ""
+        return Verdict("failed", 0.0, f"{problems[0]}{more} {reading}", measurements)
+
+    def _problem(
+        self, case: GradingCase, call: Call, value: PlainValue, settings: PolicyIterationConfig
+    ) -> str | None:
+        mdp = case.mdp
+        parts = value if isinstance(value, list) and len(value) == 3 else None
+        values = None if parts is None else as_vector(parts[0], mdp.n_states)
+        policy = None if parts is None else as_policy(parts[1], mdp)
+        count = None if parts is None else as_count(parts[2])
+        if values is None or policy is None or count is None:
+            return f"{call_text(call)} returned {_shown(value)}; expected (V, policy, n): the {mdp.n_states} values, one action in 0..{mdp.n_actions - 1} per state, and the number of iterations"  # noqa: E501
+        judged = judge_policy(mdp, policy, case.beta)
+        if not judged.optimal:
+            state = int(np.argmax(judged.shortfall))
+            return f"{call_text(call)} returned the policy {describe_values(policy, 8)}, which is not optimal on {mdp.name} at beta = {case.beta:g}: its exact value in state {state} is {judged.values[state]:.6g}, the optimum {judged.optimal_values[state]:.6g}"  # noqa: E501
+        best = optimum(case)
+        try:
+            exact = policy_value(mdp, policy, case.beta)
+        except UnboundedValueError:  # judged optimal above, so finite; kept for the type checker
+            exact = best
+        tolerance = evaluation_tolerance(case, policy, exact, settings.tol)
+        if np.max(np.abs(values - best)) > tolerance:
+            state = int(np.argmax(np.abs(values - best)))
+            return f"{call_text(call)} returned an optimal policy but V = {describe_values(values)}; the optimal values are {describe_values(best)} (state {state}: {values[state]:.6g} against {best[state]:.6g}, tolerance {tolerance:.1e}); return the values of the last policy evaluated"  # noqa: E501
+        if not 1 <= count <= settings.maxiter:
+            return f"{call_text(call)} returned n = {count}; expected the number of iterations made, 1 to maxiter = {settings.maxiter}"  # noqa: E501
+        return None
+
+    def _timeout(self, early: Verdict, records: Sequence[CallRecord], reading: str) -> Verdict:
+        index = next(i for i, r in enumerate(records) if r.outcome.status is OutcomeStatus.TIMEOUT)
+        case = cases()[index]
+        if case.beta < 1:
+            return Verdict(early.status, early.fraction, f"{early.feedback}. {reading}", early.measurements)
+        cause = f"Likely cause: on {case.mdp.name} at beta = 1 your start policy never converges at discount 1: a policy whose moves loop forever through costly states (all zeros here walks the ring) has no finite value, so its iterative evaluation never stops. Start from the lab's all-ones policy (np.ones(nS, dtype=int)), which ends its episodes."  # noqa: E501
+        return Verdict(
+            early.status, early.fraction, f"{early.feedback}. {cause} {reading}", early.measurements
+        )
+
+
+def _shown(value: PlainValue) -> str:
+    if isinstance(value, np.ndarray):
+        return f"one array of shape {value.shape}"
+    if isinstance(value, list):
+        return f"a sequence of {len(value)} items"
+    return f"a {type(value).__name__}"
