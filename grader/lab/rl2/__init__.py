@@ -11,10 +11,11 @@ How its parts fit:
   `edition = "v2024"` work through the same machinery; the acceptance modules
   `grader/grading/cases/test_<id>.py` look their problem up in a registry that has it.
 - `grader/lab/rl2/checks/`: one module per pure problem (`value_iteration`, `improvement`, `evaluation`,
-  `policy_iteration`: settings model + check), sharing `mdp_calls`; and per played problem
-  (`run_simulation`, `frozen_lake`, `model_comparison`), whose episodes are replayed as the first lab's are (the grader's MDPs from
+  `policy_iteration`: settings model + check), sharing `mdp_calls` (the grader's MDPs from
   `reference.oracles.mdps.grading_cases()`, the call of one function on one MDP, how returned values are read,
-  the tolerance `tol` earns). Exact oracles: `reference.oracles.mdp`.
+  the tolerance `tol` earns). Exact oracles: `reference.oracles.mdp`. And one module per played problem
+  (`run_simulation`, `frozen_lake`, `model_comparison`), whose episodes are replayed in the grader's envs
+  (`grader.lab.games`: the FrozenLake games) as the first lab's are.
 - The MDP reaches the student's function as `grader.sandbox.outcome.MdpArgument` (declared by the child in
   `grader/sandbox/child/frames.py`): plain lists on the wire, a fresh `{s: {a: [(p, s', r, done), ...]}}` at
   every call. `policy_iteration` may call the grader's own evaluation and improvement steps

@@ -12,10 +12,13 @@ so a later slice adds the episode problems (`run_simulation`, `frozen_lake`/`fro
 from __future__ import annotations
 
 from grader.lab.editions.pack import REPOSITORY, Edition, ExpectedFunction
+from grader.lab.games import FROZEN_LAKE_GAMES, RUN_SIMULATION_GAMES
 from grader.lab.registry import Problem, Registry
 from grader.lab.rl2.checks.evaluation import EvaluationCheck, EvaluationConfig
+from grader.lab.rl2.checks.frozen_lake import FrozenLakeCheck, FrozenLakeConfig
 from grader.lab.rl2.checks.improvement import ImprovementCheck, ImprovementConfig
 from grader.lab.rl2.checks.policy_iteration import PolicyIterationCheck, PolicyIterationConfig
+from grader.lab.rl2.checks.run_simulation import RunSimulationCheck, RunSimulationConfig
 from grader.lab.rl2.checks.value_iteration import ValueIterationCheck, ValueIterationConfig
 
 LAB = "rl2"
@@ -73,6 +76,56 @@ POLICY_ITERATION_2024 = Problem(
     check=PolicyIterationCheck(evaluation="iter_policy_eval", improvement="policy_improvement"),
 )
 
+RUN_SIMULATION = Problem(
+    id="run_simulation",
+    title="Problem 6: run_simulation",
+    points=1.0,
+    config=RunSimulationConfig,
+    check=RunSimulationCheck(),
+    games=RUN_SIMULATION_GAMES,
+)
+RUN_SIMULATION_2026 = Problem(
+    id="run_simulation",
+    title="Problem 5: run_simulation",
+    points=1.0,
+    config=RunSimulationConfig,
+    check=RunSimulationCheck(),
+    games=RUN_SIMULATION_GAMES,
+)
+
+FROZENLAKE_2018 = Problem(
+    id="frozenlake",
+    title="Problem 5: frozenlake",
+    points=1.0,
+    config=FrozenLakeConfig,
+    check=FrozenLakeCheck("frozenlake", "five"),
+    games=FROZEN_LAKE_GAMES,
+)
+FROZEN_LAKE_2019 = Problem(
+    id="frozen_lake",
+    title="Problem 5: frozen_lake",
+    points=1.0,
+    config=FrozenLakeConfig,
+    check=FrozenLakeCheck("frozen_lake", "five"),
+    games=FROZEN_LAKE_GAMES,
+)
+FROZEN_LAKE_2024 = Problem(
+    id="frozen_lake",
+    title="Problem 5: frozen_lake",
+    points=1.0,
+    config=FrozenLakeConfig,
+    check=FrozenLakeCheck("frozen_lake", "six"),
+    games=FROZEN_LAKE_GAMES,
+)
+FROZEN_LAKE_2026 = Problem(
+    id="frozen_lake",
+    title="Problem 6: frozen_lake",
+    points=1.0,
+    config=FrozenLakeConfig,
+    check=FrozenLakeCheck("frozen_lake", "six"),
+    games=FROZEN_LAKE_GAMES,
+)
+
 PURE_2018 = (VALUE_ITERATION, EXTRACT_POLICY, COMPUTE_POLICY_V, POLICY_ITERATION_2018)
 """The pure problems of the 2018-2023 editions, in lab order."""
 PURE_2024 = (VALUE_ITERATION, POLICY_IMPROVEMENT, ITER_POLICY_EVAL, POLICY_ITERATION_2024)
@@ -99,7 +152,7 @@ V2018 = Edition(
     title="Policy Function Iteration (2018, gym 0.10)",
     api="classic",
     lab=LAB,
-    registry=Registry(PURE_2018),
+    registry=Registry((*PURE_2018, FROZENLAKE_2018, RUN_SIMULATION)),
     functions=(
         *_solvers("1", "extract_policy", "v", "compute_policy_v"),
         ExpectedFunction("frozenlake", ("basic_case=True", "M=1000"), env_ids=_CLASSIC_LAKES),
@@ -109,7 +162,6 @@ V2018 = Edition(
     reference=SUBMISSIONS / "honest_v2018.py",
     default_config=PACKAGE / "v2018.toml",
     notebook_name="policy_iteration.py",
-    not_graded=(("frozenlake", EPISODES_LATER), ("run_simulation", EPISODES_LATER)),
 )
 
 V2019 = Edition(
@@ -118,7 +170,7 @@ V2019 = Edition(
     title="Policy Function Iteration (2019-2022, gym)",
     api="classic",
     lab=LAB,
-    registry=Registry(PURE_2018),
+    registry=Registry((*PURE_2018, FROZEN_LAKE_2019, RUN_SIMULATION)),
     functions=(
         *_solvers("1", "extract_policy", "v", "compute_policy_v"),
         ExpectedFunction("frozen_lake", ("basic_case=True", "M=1000", "render=False"), env_ids=_LAKES),
@@ -128,7 +180,6 @@ V2019 = Edition(
     reference=SUBMISSIONS / "honest_v2019.py",
     default_config=PACKAGE / "v2019.toml",
     notebook_name="policy_iteration.py",
-    not_graded=(("frozen_lake", EPISODES_LATER), ("run_simulation", EPISODES_LATER)),
 )
 
 V2023 = Edition(
@@ -137,7 +188,7 @@ V2023 = Edition(
     title="Policy Function Iteration (2023, gymnasium)",
     api="gymnasium",
     lab=LAB,
-    registry=Registry(PURE_2018),
+    registry=Registry((*PURE_2018, FROZEN_LAKE_2019, RUN_SIMULATION)),
     functions=(
         *_solvers("1.0", "extract_policy", "v", "compute_policy_v"),
         ExpectedFunction("frozen_lake", ("basic_case=True", "M=1000", "render=False"), env_ids=_LAKES),
@@ -147,7 +198,6 @@ V2023 = Edition(
     reference=SUBMISSIONS / "honest_v2023.py",
     default_config=PACKAGE / "v2023.toml",
     notebook_name="policy_iteration.py",
-    not_graded=(("frozen_lake", EPISODES_LATER), ("run_simulation", EPISODES_LATER)),
 )
 
 V2024 = Edition(
@@ -156,7 +206,7 @@ V2024 = Edition(
     title="Reinforcement Learning 2: Markov Decision Process (2024)",
     api="gymnasium",
     lab=LAB,
-    registry=Registry(PURE_2024),
+    registry=Registry((*PURE_2024, FROZEN_LAKE_2024, RUN_SIMULATION)),
     functions=(
         *_solvers("1.0", "policy_improvement", "V", "iter_policy_eval"),
         ExpectedFunction("frozen_lake", ("basic_case=True", "M=1000", "render=False"), env_ids=_LAKES),
@@ -167,11 +217,7 @@ V2024 = Edition(
     reference=SUBMISSIONS / "honest_v2024.py",
     default_config=PACKAGE / "v2024.toml",
     notebook_name="policy_iteration.py",
-    not_graded=(
-        ("frozen_lake", EPISODES_LATER),
-        ("run_simulation", EPISODES_LATER),
-        ("model_comparison", EPISODES_LATER),
-    ),
+    not_graded=(("model_comparison", EPISODES_LATER),),
 )
 
 V2026 = Edition(
@@ -180,7 +226,7 @@ V2026 = Edition(
     title="Reinforcement Learning 2: Markov Decision Process (2026 template)",
     api="gymnasium",
     lab=LAB,
-    registry=Registry(PURE_2024),
+    registry=Registry((*PURE_2024, RUN_SIMULATION_2026, FROZEN_LAKE_2026)),
     functions=(
         *_solvers("1.0", "policy_improvement", "V", "iter_policy_eval"),
         ExpectedFunction("run_simulation", ("env", "policy", "beta=1.0"), env_ids=_LAKES),
@@ -190,7 +236,6 @@ V2026 = Edition(
     reference=SUBMISSIONS / "policy_function_iteration.py",
     default_config=PACKAGE / "v2026.toml",
     notebook_name="policy_function_iteration.py",
-    not_graded=(("run_simulation", EPISODES_LATER), ("frozen_lake", EPISODES_LATER)),
 )
 
 EDITIONS = (V2018, V2019, V2023, V2024, V2026)
