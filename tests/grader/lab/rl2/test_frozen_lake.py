@@ -190,10 +190,10 @@ def frozen_lake(basic_case=True, M=1000, render=False):
 
 def test_episodes_chosen_by_peeking_at_the_generator_fail_the_mean_test(tmp_path: Path) -> None:
     """Every reset's start is state 0, so no start can be chosen; this file copies the env (its generator
-    included) to see whether the game dealt will be won, and deals another when it will not. Every action is
-    the policy's, every mean the replay's: only the mean test can tell, and at the lab's M = 1 000 it does (the
-    4x4 mean under the 100-step limit, exactly 0.740, raised to about 0.86; Bernstein's half-width 0.082 at
-    alpha 1e-6; at M = 400 the half-width, 0.130, is too wide)."""
+    included) to see whether the game dealt will be won, and deals another when it will not. Every action
+    is the policy's, every mean the replay's: only the mean test can tell, and at the lab's M = 1 000 it does
+    (the 4x4 mean under the 100-step limit, exactly 0.740, raised to about 0.86; Bernstein's half-width
+    0.082 at alpha 1e-6; at M = 400 the half-width, 0.130, is too wide)."""
     path = tmp_path / "policy_function_iteration.py"
     path.write_text(_with(PEEKING), encoding="utf-8")
     wide = settings(FrozenLakeConfig, "frozen_lake", FROZEN_LAKE_GAMES, episodes=1000, call_seconds=60.0)
