@@ -13,7 +13,7 @@ from grader.lab.checks.base import Verdict
 from grader.lab.games import FROZEN_LAKE_GAMES
 from grader.lab.rl2.checks.frozen_lake import FrozenLakeCheck, FrozenLakeConfig, bernstein_half_width
 
-from .support import SAMPLES, settings, verdict_of
+from .played_support import SAMPLES, settings, verdict_of
 
 pytestmark = pytest.mark.slow  # each test grades both lakes through the sandbox (5-15 s)
 

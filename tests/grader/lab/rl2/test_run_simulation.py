@@ -21,7 +21,7 @@ from grader.lab.rl2.checks.run_simulation import (
     planned_cases,
 )
 
-from .support import SAMPLES, settings, verdict_of
+from .played_support import SAMPLES, settings, verdict_of
 
 pytestmark = pytest.mark.slow  # every test grades through the sandbox (about a second each)
 
