@@ -5,8 +5,7 @@ names), every function its template defines, its template, reference, default co
 (`grader/lab/rl2/<edition>.toml`) and file name. The pure problems are shared declarations
 (`VALUE_ITERATION`, the two namings of the improvement and evaluation steps, the two `policy_iteration`s
 bound to their edition's step names); an edition's registry is `Registry(PURE_2018 + ...)` built from them,
-so a later slice adds the episode problems (`run_simulation`, `frozen_lake`/`frozenlake`,
-`model_comparison`) by extending these tuples, and removes them from `not_graded`.
+and the played problems (`run_simulation`, `frozen_lake`/`frozenlake`, `model_comparison`) extend them.
 """
 
 from __future__ import annotations
@@ -17,6 +16,7 @@ from grader.lab.registry import Problem, Registry
 from grader.lab.rl2.checks.evaluation import EvaluationCheck, EvaluationConfig
 from grader.lab.rl2.checks.frozen_lake import FrozenLakeCheck, FrozenLakeConfig
 from grader.lab.rl2.checks.improvement import ImprovementCheck, ImprovementConfig
+from grader.lab.rl2.checks.model_comparison import ModelComparisonCheck, ModelComparisonConfig
 from grader.lab.rl2.checks.policy_iteration import PolicyIterationCheck, PolicyIterationConfig
 from grader.lab.rl2.checks.run_simulation import RunSimulationCheck, RunSimulationConfig
 from grader.lab.rl2.checks.value_iteration import ValueIterationCheck, ValueIterationConfig
@@ -126,13 +126,19 @@ FROZEN_LAKE_2026 = Problem(
     games=FROZEN_LAKE_GAMES,
 )
 
+MODEL_COMPARISON = Problem(
+    id="model_comparison",
+    title="Problem 7: model_comparison",
+    points=1.0,
+    config=ModelComparisonConfig,
+    check=ModelComparisonCheck(),
+    games=(FROZEN_LAKE_GAMES[1],),
+)
+
 PURE_2018 = (VALUE_ITERATION, EXTRACT_POLICY, COMPUTE_POLICY_V, POLICY_ITERATION_2018)
 """The pure problems of the 2018-2023 editions, in lab order."""
 PURE_2024 = (VALUE_ITERATION, POLICY_IMPROVEMENT, ITER_POLICY_EVAL, POLICY_ITERATION_2024)
 """The pure problems of the 2024 and 2026 editions, in lab order."""
-
-EPISODES_LATER = "graded by the episode checks (next slice)"
-
 
 def _solvers(beta: str, improvement: str, values: str, evaluation: str) -> tuple[ExpectedFunction, ...]:
     return (
@@ -206,7 +212,7 @@ V2024 = Edition(
     title="Reinforcement Learning 2: Markov Decision Process (2024)",
     api="gymnasium",
     lab=LAB,
-    registry=Registry((*PURE_2024, FROZEN_LAKE_2024, RUN_SIMULATION)),
+    registry=Registry((*PURE_2024, FROZEN_LAKE_2024, RUN_SIMULATION, MODEL_COMPARISON)),
     functions=(
         *_solvers("1.0", "policy_improvement", "V", "iter_policy_eval"),
         ExpectedFunction("frozen_lake", ("basic_case=True", "M=1000", "render=False"), env_ids=_LAKES),
@@ -217,7 +223,6 @@ V2024 = Edition(
     reference=SUBMISSIONS / "honest_v2024.py",
     default_config=PACKAGE / "v2024.toml",
     notebook_name="policy_iteration.py",
-    not_graded=(("model_comparison", EPISODES_LATER),),
 )
 
 V2026 = Edition(

@@ -329,7 +329,7 @@ def _mean_problem(
 ) -> Verdict | None:
     """None when `mean` is the replayed mean under either reading of the time limit (the reading noted)."""
     cut = math.fsum(episode.total_reward for episode in episodes) / len(episodes)
-    whole = _whole_mean(episodes)
+    whole = whole_mean(episodes)
     measurements[f"{key}_returned_mean"] = mean
     measurements[f"{key}_replayed_mean"] = cut
     for reading, value in (("up to the time limit", cut), ("to the end, past the time limit", whole)):
@@ -348,7 +348,7 @@ def _mean_problem(
     )
 
 
-def _whole_mean(episodes: Sequence[Episode]) -> float | None:
+def whole_mean(episodes: Sequence[Episode]) -> float | None:
     """The mean return with every episode the time limit cut replayed to its terminal state, or None when an
     episode was not continued to its end (then only the cut reading exists)."""
     totals = []

@@ -41,7 +41,7 @@ def test_the_labs_and_their_editions() -> None:
     )
     assert EDITIONS["v2024"].registry.ids == (
         "value_iteration", "policy_improvement", "iter_policy_eval", "policy_iteration", "frozen_lake",
-        "run_simulation",
+        "run_simulation", "model_comparison",
     )  # fmt: skip
     assert EDITIONS["v2026"].registry.ids[4:] == ("run_simulation", "frozen_lake")
     for name in ("v2018", "v2019", "v2023", "v2024", "v2026"):
