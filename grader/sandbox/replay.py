@@ -35,6 +35,9 @@ gymnasium and judges the replay, never the log:
   gymnasium's rules on plain lists; every batch's seeds are hashed at once, `draws.seeded_draws`, the
   streams of `np_random(seed)` without building a Generator; a batch is used only when the scalar env
   replays its longest, first and last episodes identically, and a batch of three or fewer is not played);
+  `replay_past_time_limit(log)` replays an episode that went on after gym.make's time limit cut it (classic
+  `gym.make(id).env`, a loop on `terminated` only: the second lab's FrozenLake) in the same env without the
+  limit, its truncation flags checked to be the limit's (`time_limit_of(log)`);
   `verify_reset_seeds(logs_of_one_call, call_seed) -> str | None` checks the logged reset seeds against
   the stream `grader.sandbox.child.seeding` prescribes (`derive_call_seed(seed, call_index)`,
   `reset_seeds(call_seed, n)`: pure functions). Every reset, seeded by the student or not, takes the next
