@@ -184,6 +184,13 @@ HOSTILE = {
         "failed",
         "abandoned",
     ),
+    "plays_two_whole_episodes": (
+        HONEST_BODY + "first = total\n" + HONEST_BODY + "return first\n",
+        "",
+        "failed",
+        "run_simulation plays ONE episode",
+    ),
+    "adds_a_constant": (HONEST_BODY + "return total + 0.5\n", "", "failed", "k counted from 0"),
     "discount_applied_to_the_policy_not_the_reward": (
         HONEST_BODY.replace("beta**k * reward", "reward * beta**(k + 1) / beta**0") + "return total\n",
         "",
