@@ -140,6 +140,7 @@ PURE_2018 = (VALUE_ITERATION, EXTRACT_POLICY, COMPUTE_POLICY_V, POLICY_ITERATION
 PURE_2024 = (VALUE_ITERATION, POLICY_IMPROVEMENT, ITER_POLICY_EVAL, POLICY_ITERATION_2024)
 """The pure problems of the 2024 and 2026 editions, in lab order."""
 
+
 def _solvers(beta: str, improvement: str, values: str, evaluation: str) -> tuple[ExpectedFunction, ...]:
     return (
         ExpectedFunction("value_iteration", ("P", "nS", "nA", f"beta={beta}", "tol=1e-8", "maxiter=3000")),
