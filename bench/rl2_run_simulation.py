@@ -137,8 +137,9 @@ def main() -> int:
     lines = [
         HEADING,
         "",
-        "`python bench/rl2_run_simulation.py` (issue 35, slice 1; the check itself is not wired into the",
-        "grader yet). The grader's policy (optimal at discount 1) on slippery 4x4 FrozenLake, played through",
+        "`python bench/rl2_run_simulation.py` (issue 35, slice 1, a design study: the grader's check",
+        "decides exactly, not by this statistic; see the played verdicts' section). The grader's policy",
+        "(optimal at discount 1) on slippery 4x4 FrozenLake, played through",
         f"run_simulation at beta = {BETA} under gym.make's 100-step limit: exact mean {moments.mean[0]:.6f},",
         f"variance {moments.variance[0]:.6f} (reference.oracles.mdp.return_moments). Statistic: z of the",
         f"mean of the returned values against the exact mean, failed at |z| > {Z_LIMIT:g} (normal two-sided",

@@ -18,6 +18,9 @@ longer forwards such reads, gym and gymnasium before 1.0 did, and the second lab
 ENV_OBJECT_PASSED = "env_object"
 """Not the lab's API but the grader's call: a function given an environment's name failed on it before
 making or playing anything, so it was called again with an env object (`EnvArgument`'s `name_or_object`)."""
+ENV_CLOSED = "env_closed"
+"""Not a tolerance but a fact the second lab grades: a function closed an environment (`env.close()`);
+its `run_simulation` is told not to close the env it is given."""
 
 KINDS = (
     STEP_BEFORE_RESET,
@@ -30,6 +33,7 @@ KINDS = (
     API_DETECTED,
     WRAPPER_ATTRIBUTE,
     ENV_OBJECT_PASSED,
+    ENV_CLOSED,
 )
 
 

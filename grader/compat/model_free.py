@@ -20,9 +20,12 @@ import random
 from pathlib import Path
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
+from gymnasium.envs.toy_text.frozen_lake import FrozenLakeEnv
+from gymnasium.wrappers import TimeLimit
 
+TRAINING_STEPS = 100
+"""The time limit of the training env: `gym.make('FrozenLake-v1', ...)`'s registered 100 steps."""
 Q_TABLE_FILE = "q_table.npy"
 """Where `run_qlearn` saves the table and `run_simulation_table` reads it: the working directory."""
 
@@ -63,7 +66,10 @@ def run_qlearn(
         decay: decay the exploration rate over the episodes with `epsilon_decay`.
         decay_type: 'linear' or 'exp'.
     """
-    lake = gym.make(env, desc=None, map_name="8x8", is_slippery=True)
+    # The training episodes are the helper's, not the student's: the env is built without gym.make, so a
+    # sandbox's recorder neither logs nor counts them (70 000 episodes; only the played ones are graded).
+    # The same game as gym.make(env, map_name="8x8", is_slippery=True): its 100-step limit included.
+    lake = TimeLimit(FrozenLakeEnv(desc=None, map_name="8x8", is_slippery=True), TRAINING_STEPS)
     n_actions = int(lake.action_space.n)  # type: ignore[attr-defined]
     table = np.zeros((int(lake.observation_space.n), n_actions))  # type: ignore[attr-defined]
     lake.reset(seed=random.randrange(2**32))

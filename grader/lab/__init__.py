@@ -25,7 +25,8 @@ How the lab's parts fit:
 - `grader/lab/games.py`: the environments problems may be played in, each declared once (`Game`s:
   `Blackjack-v0` = gymnasium `Blackjack-v1` with `sab=False`, `Blackjack-v1` with `sab=True` (`natural`
   free for both: it never changes a win), `CartPole-v0`, `CartPole-v1`, `MountainCar-v0`, `Taxi-v3`,
-  `GuessingGame-v0`; the lab's `*_GAMES` tuples); which a problem accepts is its declaration's `games`
+  `GuessingGame-v0`; the second lab's FrozenLake lakes, `frozen_lake_game(map_name, slippery=)`; the labs'
+  `*_GAMES` tuples); which a problem accepts is its declaration's `games`
   (the loader binds them to its settings), and `allowed_games(games, names=None, *, problem) -> GameRules`
   with `problem_with(log) -> str | None` (why an episode's env is none of them), `game_of(log)`,
   `played_game(logs) -> Game | str` (one game per problem). A problem's `accepted_envs` in the

@@ -96,6 +96,45 @@ TAXI = Game(
 )
 GUESSING_GAME = Game("GuessingGame-v0", ("GuessingGame-v0",), description="GuessingGame-v0")
 
+FROZEN_LAKE_FREE_KWARGS = frozenset({"max_episode_steps"})
+"""A FrozenLake episode may be cut by any time limit: the second lab's checks value a policy exactly under
+the limit actually played (`reference.oracles.mdp.return_moments(steps=...)`)."""
+
+
+def frozen_lake_game(map_name: str, *, slippery: bool) -> Game:
+    """The second lab's FrozenLake on one map, slippery or not (gymnasium's `FrozenLake-v1` and the 8x8 id).
+
+    The old ids `FrozenLake-v0` and `FrozenLake8x8-v0` resolve to these (`grader.compat.ids`); `desc` may be
+    passed as None only (a map of one's own is another game).
+    """
+    ids = ("FrozenLake-v1", "FrozenLake8x8-v1") if map_name == "8x8" else ("FrozenLake-v1",)
+    kind = "slippery" if slippery else "deterministic"
+    name = "FrozenLake8x8-v1" if map_name == "8x8" else "FrozenLake-v1"
+    return Game(
+        name if slippery else f"{name} (is_slippery=False)",
+        ids,
+        {
+            "desc": None,
+            "map_name": map_name,
+            "is_slippery": slippery,
+            "success_rate": 1.0 / 3.0,
+            "reward_schedule": (1, 0, 0),
+        },
+        FROZEN_LAKE_FREE_KWARGS,
+        f"FrozenLake {map_name} ({kind})",
+    )
+
+
+FROZEN_LAKE_4X4 = frozen_lake_game("4x4", slippery=True)
+FROZEN_LAKE_8X8 = frozen_lake_game("8x8", slippery=True)
+FROZEN_LAKE_4X4_STILL = frozen_lake_game("4x4", slippery=False)
+FROZEN_LAKE_8X8_STILL = frozen_lake_game("8x8", slippery=False)
+FROZEN_LAKE_GAMES = (FROZEN_LAKE_4X4, FROZEN_LAKE_8X8)
+"""The lakes the second lab plays (`frozen_lake`, `model_comparison`): slippery, as its texts make them."""
+RUN_SIMULATION_GAMES = (FROZEN_LAKE_4X4, FROZEN_LAKE_8X8, FROZEN_LAKE_4X4_STILL, FROZEN_LAKE_8X8_STILL, TAXI)
+"""The envs the grader passes to `run_simulation(env, policy, beta)`: both lakes, slippery and not, and Taxi
+(rewards on every step: a return of the last reward only shows)."""
+
 BLACKJACK_GAMES = (BLACKJACK_V0, BLACKJACK_V1)
 CARTPOLE_GAMES = (CARTPOLE_V0, CARTPOLE_V1)
 MOUNTAIN_CAR_GAMES = (MOUNTAIN_CAR,)

@@ -35,6 +35,9 @@ gymnasium and judges the replay, never the log:
   gymnasium's rules on plain lists; every batch's seeds are hashed at once, `draws.seeded_draws`, the
   streams of `np_random(seed)` without building a Generator; a batch is used only when the scalar env
   replays its longest, first and last episodes identically, and a batch of three or fewer is not played);
+  `replay_past_time_limit(log)` replays an episode that went on after gym.make's time limit cut it (classic
+  `gym.make(id).env`, a loop on `terminated` only: the second lab's FrozenLake) in the same env without the
+  limit, its truncation flags checked to be the limit's (`time_limit_of(log)`);
   `verify_reset_seeds(logs_of_one_call, call_seed) -> str | None` checks the logged reset seeds against
   the stream `grader.sandbox.child.seeding` prescribes (`derive_call_seed(seed, call_index)`,
   `reset_seeds(call_seed, n)`: pure functions). Every reset, seeded by the student or not, takes the next
@@ -44,6 +47,7 @@ gymnasium and judges the replay, never the log:
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import threading
@@ -168,6 +172,35 @@ def _replay_all(logs: Sequence[EpisodeLog]) -> list[Replay]:
         replay if replay is not None else replay_episode(log)
         for replay, log in zip(replays, logs, strict=True)
     ]
+
+
+def time_limit_of(log: EpisodeLog) -> int | None:
+    """The step limit of the env an episode was played in (`gym.make`'s `TimeLimit`), or None for none."""
+    limit = log.env_kwargs.get("max_episode_steps")
+    if limit is None:
+        register_envs()
+        spec = gymnasium.registry.get(log.env_id)
+        limit = None if spec is None else spec.max_episode_steps
+    return limit if type(limit) is int and limit > 0 else None
+
+
+def replay_past_time_limit(log: EpisodeLog) -> Replay:
+    """Replay an episode that went on after its env's time limit cut it, until the env itself ends it.
+
+    Classic `gym.make(id).env` (the env inside `TimeLimit`, served by `grader.compat`) and a loop that stops
+    on `terminated` only step on after the limit's `truncated`; the second lab counts such episodes to their
+    end. The log is replayed in the same env without the limit (`max_episode_steps=-1`); its truncation
+    flags must be the limit's: False before step `limit`, True from it on (as `TimeLimit` reports them, and
+    as the env without a limit never does). An episode the limit did not cut replays as `replay_episode`.
+    """
+    limit = time_limit_of(log)
+    if limit is None or log.steps < limit:
+        return replay_episode(log)
+    expected = [flag if number < limit else not flag for number, flag in enumerate(log.truncated, start=1)]
+    unlimited = dataclasses.replace(
+        log, env_kwargs={**log.env_kwargs, "max_episode_steps": -1}, truncated=expected
+    )
+    return replay_episode(unlimited)
 
 
 def not_replayed(reason: str) -> Replay:

@@ -13,7 +13,9 @@ How its parts fit:
 - `grader/lab/rl2/checks/`: one module per pure problem (`value_iteration`, `improvement`, `evaluation`,
   `policy_iteration`: settings model + check), sharing `mdp_calls` (the grader's MDPs from
   `reference.oracles.mdps.grading_cases()`, the call of one function on one MDP, how returned values are read,
-  the tolerance `tol` earns). Exact oracles: `reference.oracles.mdp`.
+  the tolerance `tol` earns). Exact oracles: `reference.oracles.mdp`. And one module per played problem
+  (`run_simulation`, `frozen_lake`, `model_comparison`), whose episodes are replayed in the grader's envs
+  (`grader.lab.games`: the FrozenLake games) as the first lab's are.
 - The MDP reaches the student's function as `grader.sandbox.outcome.MdpArgument` (declared by the child in
   `grader/sandbox/child/frames.py`): plain lists on the wire, a fresh `{s: {a: [(p, s', r, done), ...]}}` at
   every call. `policy_iteration` may call the grader's own evaluation and improvement steps

@@ -5,18 +5,21 @@ names), every function its template defines, its template, reference, default co
 (`grader/lab/rl2/<edition>.toml`) and file name. The pure problems are shared declarations (the two
 readings of value iteration's n, the two namings of the improvement and evaluation steps, the two
 `policy_iteration`s bound to their edition's step names); an edition's registry is built from a tuple of them
-(`PURE_2018`, `PURE_2023`, `PURE_2024`), so a later slice adds the episode problems (`run_simulation`,
-`frozen_lake`/`frozenlake`, `model_comparison`) by extending these tuples, and removes them from
-`not_graded`.
+(`PURE_2018`, `PURE_2023`, `PURE_2024`) and the played problems (`run_simulation`, `frozen_lake`/`frozenlake`,
+`model_comparison`).
 """
 
 from __future__ import annotations
 
 from grader.lab.editions.pack import REPOSITORY, Edition, ExpectedFunction
+from grader.lab.games import FROZEN_LAKE_GAMES, RUN_SIMULATION_GAMES
 from grader.lab.registry import Problem, Registry
 from grader.lab.rl2.checks.evaluation import EvaluationCheck, EvaluationConfig
+from grader.lab.rl2.checks.frozen_lake import FrozenLakeCheck, FrozenLakeConfig
 from grader.lab.rl2.checks.improvement import ImprovementCheck, ImprovementConfig
+from grader.lab.rl2.checks.model_comparison import ModelComparisonCheck, ModelComparisonConfig
 from grader.lab.rl2.checks.policy_iteration import PolicyIterationCheck, PolicyIterationConfig
+from grader.lab.rl2.checks.run_simulation import RunSimulationCheck, RunSimulationConfig
 from grader.lab.rl2.checks.value_iteration import ValueIterationCheck, ValueIterationConfig
 
 LAB = "rl2"
@@ -85,14 +88,71 @@ POLICY_ITERATION_2024 = Problem(
     check=PolicyIterationCheck(evaluation="iter_policy_eval", improvement="policy_improvement"),
 )
 
+RUN_SIMULATION = Problem(
+    id="run_simulation",
+    title="Problem 6: run_simulation",
+    points=1.0,
+    config=RunSimulationConfig,
+    check=RunSimulationCheck(),
+    games=RUN_SIMULATION_GAMES,
+)
+RUN_SIMULATION_2026 = Problem(
+    id="run_simulation",
+    title="Problem 5: run_simulation",
+    points=1.0,
+    config=RunSimulationConfig,
+    check=RunSimulationCheck(),
+    games=RUN_SIMULATION_GAMES,
+)
+
+FROZENLAKE_2018 = Problem(
+    id="frozenlake",
+    title="Problem 5: frozenlake",
+    points=1.0,
+    config=FrozenLakeConfig,
+    check=FrozenLakeCheck("frozenlake", "five"),
+    games=FROZEN_LAKE_GAMES,
+)
+FROZEN_LAKE_2019 = Problem(
+    id="frozen_lake",
+    title="Problem 5: frozen_lake",
+    points=1.0,
+    config=FrozenLakeConfig,
+    check=FrozenLakeCheck("frozen_lake", "five"),
+    games=FROZEN_LAKE_GAMES,
+)
+FROZEN_LAKE_2024 = Problem(
+    id="frozen_lake",
+    title="Problem 5: frozen_lake",
+    points=1.0,
+    config=FrozenLakeConfig,
+    check=FrozenLakeCheck("frozen_lake", "six"),
+    games=FROZEN_LAKE_GAMES,
+)
+FROZEN_LAKE_2026 = Problem(
+    id="frozen_lake",
+    title="Problem 6: frozen_lake",
+    points=1.0,
+    config=FrozenLakeConfig,
+    check=FrozenLakeCheck("frozen_lake", "six"),
+    games=FROZEN_LAKE_GAMES,
+)
+
+MODEL_COMPARISON = Problem(
+    id="model_comparison",
+    title="Problem 7: model_comparison",
+    points=1.0,
+    config=ModelComparisonConfig,
+    check=ModelComparisonCheck(),
+    games=(FROZEN_LAKE_GAMES[1],),
+)
+
 PURE_2018 = (VALUE_ITERATION_2018, EXTRACT_POLICY, COMPUTE_POLICY_V, POLICY_ITERATION_2018)
 """The pure problems of the 2018-2022 editions (v2018, v2019), in lab order."""
 PURE_2023 = (VALUE_ITERATION, EXTRACT_POLICY, COMPUTE_POLICY_V, POLICY_ITERATION_2018)
 """The pure problems of the 2023 edition: the 2018 names, the example counted to n = 3."""
 PURE_2024 = (VALUE_ITERATION, POLICY_IMPROVEMENT, ITER_POLICY_EVAL, POLICY_ITERATION_2024)
 """The pure problems of the 2024 and 2026 editions, in lab order."""
-
-EPISODES_LATER = "graded by the episode checks (next slice)"
 
 
 def _solvers(beta: str, improvement: str, values: str, evaluation: str) -> tuple[ExpectedFunction, ...]:
@@ -113,7 +173,7 @@ V2018 = Edition(
     title="Policy Function Iteration (2018, gym 0.10)",
     api="classic",
     lab=LAB,
-    registry=Registry(PURE_2018),
+    registry=Registry((*PURE_2018, FROZENLAKE_2018, RUN_SIMULATION)),
     functions=(
         *_solvers("1", "extract_policy", "v", "compute_policy_v"),
         ExpectedFunction("frozenlake", ("basic_case=True", "M=1000"), env_ids=_CLASSIC_LAKES),
@@ -123,7 +183,6 @@ V2018 = Edition(
     reference=SUBMISSIONS / "honest_v2018.py",
     default_config=PACKAGE / "v2018.toml",
     notebook_name="policy_iteration.py",
-    not_graded=(("frozenlake", EPISODES_LATER), ("run_simulation", EPISODES_LATER)),
 )
 
 V2019 = Edition(
@@ -132,7 +191,7 @@ V2019 = Edition(
     title="Policy Function Iteration (2019-2022, gym)",
     api="classic",
     lab=LAB,
-    registry=Registry(PURE_2018),
+    registry=Registry((*PURE_2018, FROZEN_LAKE_2019, RUN_SIMULATION)),
     functions=(
         *_solvers("1", "extract_policy", "v", "compute_policy_v"),
         ExpectedFunction("frozen_lake", ("basic_case=True", "M=1000", "render=False"), env_ids=_LAKES),
@@ -142,7 +201,6 @@ V2019 = Edition(
     reference=SUBMISSIONS / "honest_v2019.py",
     default_config=PACKAGE / "v2019.toml",
     notebook_name="policy_iteration.py",
-    not_graded=(("frozen_lake", EPISODES_LATER), ("run_simulation", EPISODES_LATER)),
 )
 
 V2023 = Edition(
@@ -151,7 +209,7 @@ V2023 = Edition(
     title="Policy Function Iteration (2023, gymnasium)",
     api="gymnasium",
     lab=LAB,
-    registry=Registry(PURE_2023),
+    registry=Registry((*PURE_2023, FROZEN_LAKE_2019, RUN_SIMULATION)),
     functions=(
         *_solvers("1.0", "extract_policy", "v", "compute_policy_v"),
         ExpectedFunction("frozen_lake", ("basic_case=True", "M=1000", "render=False"), env_ids=_LAKES),
@@ -161,7 +219,6 @@ V2023 = Edition(
     reference=SUBMISSIONS / "honest_v2023.py",
     default_config=PACKAGE / "v2023.toml",
     notebook_name="policy_iteration.py",
-    not_graded=(("frozen_lake", EPISODES_LATER), ("run_simulation", EPISODES_LATER)),
 )
 
 V2024 = Edition(
@@ -170,7 +227,7 @@ V2024 = Edition(
     title="Reinforcement Learning 2: Markov Decision Process (2024)",
     api="gymnasium",
     lab=LAB,
-    registry=Registry(PURE_2024),
+    registry=Registry((*PURE_2024, FROZEN_LAKE_2024, RUN_SIMULATION, MODEL_COMPARISON)),
     functions=(
         *_solvers("1.0", "policy_improvement", "V", "iter_policy_eval"),
         ExpectedFunction("frozen_lake", ("basic_case=True", "M=1000", "render=False"), env_ids=_LAKES),
@@ -181,11 +238,6 @@ V2024 = Edition(
     reference=SUBMISSIONS / "honest_v2024.py",
     default_config=PACKAGE / "v2024.toml",
     notebook_name="policy_iteration.py",
-    not_graded=(
-        ("frozen_lake", EPISODES_LATER),
-        ("run_simulation", EPISODES_LATER),
-        ("model_comparison", EPISODES_LATER),
-    ),
 )
 
 V2026 = Edition(
@@ -194,7 +246,7 @@ V2026 = Edition(
     title="Reinforcement Learning 2: Markov Decision Process (2026 template)",
     api="gymnasium",
     lab=LAB,
-    registry=Registry(PURE_2024),
+    registry=Registry((*PURE_2024, RUN_SIMULATION_2026, FROZEN_LAKE_2026)),
     functions=(
         *_solvers("1.0", "policy_improvement", "V", "iter_policy_eval"),
         ExpectedFunction("run_simulation", ("env", "policy", "beta=1.0"), env_ids=_LAKES),
@@ -204,7 +256,6 @@ V2026 = Edition(
     reference=SUBMISSIONS / "policy_function_iteration.py",
     default_config=PACKAGE / "v2026.toml",
     notebook_name="policy_function_iteration.py",
-    not_graded=(("run_simulation", EPISODES_LATER), ("frozen_lake", EPISODES_LATER)),
 )
 
 EDITIONS = (V2018, V2019, V2023, V2024, V2026)

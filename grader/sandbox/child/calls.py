@@ -13,14 +13,15 @@ from typing import Any
 
 import gymnasium
 
+from grader.compat import ClassicEnv, register_envs, resolve_env_id
 from grader.compat import events as compat_events
-from grader.compat import register_envs, resolve_env_id
 from grader.sandbox.child.budget import FrameLimits, WireBudget, frame_limits
 from grader.sandbox.child.cells import RUN_CELLS, run_cells
 from grader.sandbox.child.errors import FrameTooLargeError, InvalidValueError, ProtocolError
 from grader.sandbox.child.frames import (
+    ENV_GYM_OBJECT,
+    ENV_NAME,
     ENV_NAME_OR_OBJECT,
-    ENV_OBJECT,
     EnvArgument,
     MdpArgument,
     decode_value,
@@ -29,7 +30,7 @@ from grader.sandbox.child.frames import (
 from grader.sandbox.child.importer import describe_exception, shortened, student_traceback
 from grader.sandbox.child.log_block import NO_EPISODES, log_block
 from grader.sandbox.child.provided import PROVIDED
-from grader.sandbox.child.recorder import Recorder
+from grader.sandbox.child.recorder import Recorder, RecordingEnv
 from grader.sandbox.child.stubs import RAISING_STUB, stub_body
 
 MAX_COMPAT_EVENTS = 100
@@ -298,7 +299,7 @@ def _env_arguments(request: CallRequest) -> list[EnvArgument]:
 def _name_envs(recorder: Recorder, request: CallRequest) -> None:
     """Tell the recorder the names the call passes: an env made by one gets the argument's time limit."""
     for argument in _env_arguments(request):
-        if argument.form != ENV_OBJECT:
+        if argument.form in (ENV_NAME, ENV_NAME_OR_OBJECT):
             target = resolve_env_id(argument.env_id)
             recorder.named_envs[argument.env_id] = argument.max_episode_steps
             recorder.named_envs[target.gymnasium_id] = argument.max_episode_steps
@@ -329,7 +330,7 @@ def _passed(argument: Any, as_objects: bool) -> Any:
         return argument.as_table()
     if type(argument) is not EnvArgument:
         return argument
-    if argument.form != ENV_OBJECT and not as_objects:
+    if argument.form in (ENV_NAME, ENV_NAME_OR_OBJECT) and not as_objects:
         return argument.env_id
     return _made(argument)
 
@@ -343,9 +344,14 @@ def _made(argument: Any) -> Any:
         return argument
     register_envs()
     target = resolve_env_id(argument.env_id)
-    return gymnasium.make(
-        target.gymnasium_id, max_episode_steps=argument.max_episode_steps, **target.merged_kwargs({})
+    env = gymnasium.make(
+        target.gymnasium_id,
+        max_episode_steps=argument.max_episode_steps,
+        **target.merged_kwargs(dict(argument.kwargs)),
     )
+    if isinstance(env, RecordingEnv):
+        env.passed_by_grader = True
+    return ClassicEnv(env, argument.env_id) if argument.form == ENV_GYM_OBJECT else env
 
 
 def _signature_mismatch(name: str, function: Any, request: CallRequest) -> str:

@@ -5,9 +5,10 @@ Values travel as JSON with two tagged forms: ``{"$float": "nan" | "inf" | "-inf"
 floats and ``{"$ndarray": {"dtype": "<f8", "shape": [...], "data": base64}}`` for numeric numpy
 arrays (raw bytes read back with `numpy.frombuffer`, never pickle). Only exact built-in types are
 accepted: a subclass of `float` with rigged comparisons is refused, not converted. A call's arguments may
-also hold ``{"$env": {"id": ..., "max_episode_steps": ..., "form": ...}}`` (`EnvArgument`): an environment
-the child passes to the call by name or makes for it (the learners of edition rl1 take `env`); no return
-value or episode log may. A call's arguments may also hold ``{"$mdp": {"name": ..., "table": ...}}``
+also hold ``{"$env": {"id": ..., "max_episode_steps": ..., "form": ..., "kwargs": {...}}}`` (`EnvArgument`):
+an environment the child passes to the call by name or makes for it (the learners of edition rl1 take `env`,
+the second lab's `run_simulation(env, policy, beta)` a FrozenLake env of the grader's); no return value or
+episode log may. A call's arguments may also hold ``{"$mdp": {"name": ..., "table": ...}}``
 (`MdpArgument`): a finite MDP in the second lab's format, carried as plain lists and handed to the call as
 a fresh `{state: {action: [(probability, next_state, reward, terminal), ...]}}` (int keys, tuples), which
 a str-keyed frame cannot carry.
@@ -75,7 +76,15 @@ ENV_NAME_OR_OBJECT = "name_or_object"
 """`EnvArgument.form`: the name first; when the call fails on it before making or playing any env, it is
 made again with the env object (a student who changed the function to take one), and a compat event of
 kind `env_object` says so."""
-ENV_FORMS = (ENV_OBJECT, ENV_NAME, ENV_NAME_OR_OBJECT)
+ENV_GYM_OBJECT = "gym_object"
+"""`EnvArgument.form`: the child makes the env as `ENV_OBJECT` does and passes it behind the compatibility
+layer's `gym` API (`grader.compat.ClassicEnv`), which serves each call site the API its code expects
+(classic gym's `obs = env.reset()` and four-value `step`, or gym 0.26/gymnasium's two and five values): the
+second lab's `run_simulation(env, ...)` is written for the gym of its edition."""
+ENV_FORMS = (ENV_OBJECT, ENV_NAME, ENV_NAME_OR_OBJECT, ENV_GYM_OBJECT)
+ENV_KWARG_NAMES = frozenset({"map_name", "is_slippery"})
+"""Constructor arguments an `EnvArgument` may carry (FrozenLake's map and slipperiness); values are plain
+str, bool or int."""
 
 
 @dataclass(frozen=True)
@@ -87,14 +96,19 @@ class EnvArgument:
         max_episode_steps: The time limit of the env made (by the child, or by the function from the
             name); None keeps the registered one.
         form: One of `ENV_FORMS`: how the env reaches the function.
+        kwargs: Constructor arguments of the env made (`ENV_KWARG_NAMES`), as sorted (name, value) pairs.
     """
 
     env_id: str
     max_episode_steps: int | None = None
     form: str = ENV_OBJECT
+    kwargs: tuple[tuple[str, str | bool | int], ...] = ()
 
     def __repr__(self) -> str:
-        return repr(self.env_id) if self.form != ENV_OBJECT else f"gym.make({self.env_id!r})"
+        if self.form not in (ENV_OBJECT, ENV_GYM_OBJECT):
+            return repr(self.env_id)
+        arguments = "".join(f", {name}={value!r}" for name, value in self.kwargs)
+        return f"gym.make({self.env_id!r}{arguments})"
 
 
 MdpOutcome = tuple[float, int, float, bool]
@@ -309,6 +323,7 @@ class _Encoder:
                     "id": value.env_id,
                     "max_episode_steps": value.max_episode_steps,
                     "form": value.form,
+                    "kwargs": dict(value.kwargs),
                 }
             }
         raise _invalid(self.what, where, _found(value) + "; " + PLAIN_TYPES_HINT + _conversion_hint(value))
@@ -366,16 +381,20 @@ class _Decoder:
 
 
 def _decode_env(spec: Any, what: str, where: str) -> EnvArgument:
-    if type(spec) is not dict or spec.keys() != {"id", "max_episode_steps", "form"}:
-        raise _invalid(what, where, "an env argument needs exactly id, max_episode_steps and form")
-    env_id, limit, form = spec["id"], spec["max_episode_steps"], spec["form"]
+    if type(spec) is not dict or spec.keys() != {"id", "max_episode_steps", "form", "kwargs"}:
+        raise _invalid(what, where, "an env argument needs exactly id, max_episode_steps, form and kwargs")
+    env_id, limit, form, kwargs = spec["id"], spec["max_episode_steps"], spec["form"], spec["kwargs"]
+    if type(kwargs) is not dict or not set(kwargs) <= ENV_KWARG_NAMES:
+        raise _invalid(what, where, f"an env argument's kwargs are a dict of {sorted(ENV_KWARG_NAMES)}")
+    if any(type(value) not in (str, bool, int) for value in kwargs.values()):
+        raise _invalid(what, where, "an env argument's kwargs hold str, bool or int values only")
     if type(form) is not str or form not in ENV_FORMS:
         raise _invalid(what, where, f"an env argument's form must be one of {', '.join(ENV_FORMS)}")
     if type(env_id) is not str or not 0 < len(env_id) <= MAX_ENV_ID:
         raise _invalid(what, where, f"an env id must be a string of 1 to {MAX_ENV_ID} characters")
     if limit is not None and (type(limit) is not int or not 0 < limit < 2**62):
         raise _invalid(what, where, f"max_episode_steps {limit!r} is not a positive int or null")
-    return EnvArgument(env_id, limit, form)
+    return EnvArgument(env_id, limit, form, tuple(sorted(kwargs.items())))
 
 
 def _decode_mdp(spec: Any, what: str, where: str) -> MdpArgument:

@@ -254,6 +254,8 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         self.made = made
         self._episode: EpisodeRecord | None = None
         self._fresh = False
+        self.passed_by_grader = False
+        """Set by the child for an env it made for an `EnvArgument` (`grader.sandbox.child.calls`)."""
 
     def __getattr__(self, name: str) -> Any:
         """Read a public attribute of the wrapped envs (`env.P`, `env.nrow`), as gym and gymnasium before
@@ -276,6 +278,17 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
             f"the grader forwarded it (env.unwrapped.{name} works everywhere)",
         )
         return value
+
+    def close(self) -> None:
+        """Close the env; closing one the grader passed to the call is noted as a compat event (`env_closed`):
+        the second lab's `run_simulation` is told not to close the env it is given."""
+        if self.__dict__.get("passed_by_grader"):
+            compat_events.record(
+                compat_events.ENV_CLOSED,
+                self.made.requested_id,
+                "env.close() was called on the environment the grader passed",
+            )
+        super().close()
 
     def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset with the next seed of the grader's stream, whatever seed the student passed.

@@ -36,10 +36,14 @@ def test_the_labs_and_their_editions() -> None:
         "extract_policy",
         "compute_policy_v",
         "policy_iteration",
+        "frozenlake",
+        "run_simulation",
     )
     assert EDITIONS["v2024"].registry.ids == (
-        "value_iteration", "policy_improvement", "iter_policy_eval", "policy_iteration"
+        "value_iteration", "policy_improvement", "iter_policy_eval", "policy_iteration", "frozen_lake",
+        "run_simulation", "model_comparison",
     )  # fmt: skip
+    assert EDITIONS["v2026"].registry.ids[4:] == ("run_simulation", "frozen_lake")
     for name in ("v2018", "v2019", "v2023", "v2024", "v2026"):
         edition = EDITIONS[name]
         template = {f.name for f in edition.functions}
