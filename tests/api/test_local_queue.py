@@ -8,15 +8,13 @@ from collections.abc import Iterator
 from datetime import timedelta
 
 import pytest
-from api_testing import SettingsFactory
+from api_testing import BOTH_DATABASES, SettingsFactory
 from sqlalchemy.orm import Session, sessionmaker
 
 from api.database import make_engine, make_session_factory, migrate
 from api.jobs.local import DatabaseQueue
 from api.models import JobStatus, Student, Submission, utcnow
 from api.settings import Settings
-
-BOTH_DATABASES = pytest.mark.parametrize("database_url", ["sqlite", "postgresql"], indirect=True)
 
 
 @pytest.fixture
