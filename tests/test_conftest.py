@@ -103,7 +103,8 @@ def test_skips_under_ci(
 @pytest.mark.parametrize(
     ("arguments", "distributed"),
     [((), True), (("-m", ""), False), (("-m", "not sandbox"), False), (("test_module.py",), False),
-     (("-k", "plain"), True), (("-n", "2", "-m", ""), True)],
+     pytest.param(("-k", "plain"), True, marks=pytest.mark.slow),  # each starts an xdist session:
+     pytest.param(("-n", "2", "-m", ""), True, marks=pytest.mark.slow)],  # the default run has one
     ids=["bare", "everything", "another-selection", "a-file", "bare-with-k", "asked-for-workers"],
 )  # fmt: skip
 def test_only_the_default_run_is_distributed_by_n_auto(
