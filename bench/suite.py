@@ -5,9 +5,9 @@ gradings' sessions and sandbox children), and the load average before and after:
 wall time follows the load, while CPU time / cores is what an idle machine of that many cores would need at
 best. `--write` replaces the `## Test suite (issue 34)` section of bench/RESULTS.md with the figures.
 
-    python bench/suite.py                 # the default run, serial
-    python bench/suite.py -- -n 2         # the default run on two xdist workers
-    python bench/suite.py --all -- -n 2   # everything
+    python bench/suite.py                 # the default run (on xdist, -n auto: the machine's cores)
+    python bench/suite.py -- -n 0         # the default run in one process
+    python bench/suite.py --all           # everything, in one process (as .ci/run)
 """
 
 from __future__ import annotations

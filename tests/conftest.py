@@ -8,6 +8,11 @@ some machines (a Windows-only test on Linux, a root-only one run unprivileged) i
     @pytest.mark.expected_skip("ownership is a POSIX notion")
 
 The marker's text must start the skip's reason, so another skip of the same test still counts.
+
+The default run (a bare `pytest`: the `testpaths` and the mark expression of pyproject's `addopts`) is
+distributed over the machine's cores by pytest-xdist (`-n auto` in `addopts`); any other run (`-m ""` as
+.ci/run and the README run it, a file or a `-k` of one's own) stays in one process unless it asks for
+`-n N` itself. `pytest_xdist_auto_num_workers` below decides.
 """
 
 from __future__ import annotations
@@ -78,3 +83,18 @@ def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter, config: p
         f"(scripts/setup.sh), or declare the skip with "
         f'@pytest.mark.{EXPECTED_SKIP}("<start of its reason>").'
     )
+
+
+def _default_selection(config: pytest.Config) -> str | None:
+    """The mark expression pyproject's `addopts` gives the default run."""
+    addopts: list[str] = config.getini("addopts")
+    return addopts[addopts.index("-m") + 1] if "-m" in addopts[:-1] else None
+
+
+@pytest.hookimpl(optionalhook=True)  # xdist's hook: a run without xdist (test_conftest's) has none
+def pytest_xdist_auto_num_workers(config: pytest.Config) -> int | None:
+    """`-n auto`: xdist's count of the cores for the default run, 0 (one process) for any other."""
+    bare = config.args_source is pytest.Config.ArgsSource.TESTPATHS
+    if bare and config.option.markexpr == _default_selection(config):
+        return None  # xdist's own answer: the machine's cores
+    return 0

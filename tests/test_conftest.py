@@ -98,3 +98,24 @@ def test_skips_under_ci(
         assert any(line.startswith("SKIPPED (unexpected) test_module.py") and named in line
                    for line in result.stdout.lines), summary  # fmt: skip
         assert "declare the skip with @pytest.mark.expected_skip" in summary
+
+
+@pytest.mark.parametrize(
+    ("arguments", "distributed"),
+    [((), True), (("-m", ""), False), (("-m", "not sandbox"), False), (("test_module.py",), False),
+     pytest.param(("-k", "plain"), True, marks=pytest.mark.slow),  # each starts an xdist session:
+     pytest.param(("-n", "2", "-m", ""), True, marks=pytest.mark.slow)],  # the default run has one
+    ids=["bare", "everything", "another-selection", "a-file", "bare-with-k", "asked-for-workers"],
+)  # fmt: skip
+def test_only_the_default_run_is_distributed_by_n_auto(
+    pytester: pytest.Pytester, monkeypatch: pytest.MonkeyPatch, arguments: tuple[str, ...], distributed: bool
+) -> None:
+    monkeypatch.setenv("PYTEST_DISABLE_PLUGIN_AUTOLOAD", "1")
+    pytester.makeconftest(CONFTEST.read_text(encoding="utf-8"))
+    pytester.makeini('[pytest]\ntestpaths = .\naddopts = -p xdist.plugin -n auto -m "not slow"\n')
+    pytester.makepyfile(test_module="def test_plain():\n    pass\n")
+
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider", *arguments)
+
+    assert result.ret == 0, result.stdout.str()
+    assert ("created: " in result.stdout.str()) == distributed, result.stdout.str()

@@ -14,6 +14,7 @@ Read from the source with `ast`: every `import`, also inside functions and under
 from __future__ import annotations
 
 import ast
+import functools
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -39,8 +40,11 @@ GRADER_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
 only its own layer or those below it (a module of the same layer too, as long as no circle forms)."""
 
 
-def imported_modules(path: Path) -> set[str]:
-    """Every module a file imports by absolute name (relative imports resolved against its package)."""
+@functools.cache
+def imported_modules(path: Path) -> frozenset[str]:
+    """Every module a file imports by absolute name (relative imports resolved against its package).
+
+    Read once per file and run: every test here asks of the same files."""
     package_parts = path.relative_to(ROOT).with_suffix("").parts
     modules: set[str] = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
@@ -53,7 +57,7 @@ def imported_modules(path: Path) -> set[str]:
                 base = node.module or ""
             modules.add(base)
             modules.update(f"{base}.{alias.name}" for alias in node.names)
-    return modules
+    return frozenset(modules)
 
 
 def _within(module: str, package: str) -> bool:
@@ -116,8 +120,10 @@ def test_the_grader_package_root_is_import_light() -> None:
     ] == []
 
 
+@functools.cache
 def _module_files() -> dict[str, Path]:
-    """Every module of the project's packages by dotted name (a package by its ``__init__.py``)."""
+    """Every module of the project's packages by dotted name (a package by its ``__init__.py``); listed once
+    per run (read only)."""
     modules: dict[str, Path] = {}
     for package in PACKAGES:
         for path in _sources(package):

@@ -28,6 +28,7 @@ import numpy as np
 from grader.compat import resolve_env_id
 from grader.compat.events import ENV_OBJECT_PASSED
 from grader.lab.checks.base import CallRecord
+from grader.sandbox.child.envs import cheaper
 from grader.sandbox.child.episode_fields import EPISODE_COLUMNS, EPISODE_FIELDS
 from grader.sandbox.child.frames import ENV_NAME_OR_OBJECT, ENV_OBJECT, EnvArgument
 from grader.sandbox.child.seeding import SeedStream, Stream, space_seed
@@ -98,6 +99,7 @@ class LabEnv:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             self._env = gymnasium.make(self._env_id, disable_env_checker=True, **self._kwargs)
+        cheaper(self._env.unwrapped)  # the game as the sandbox child deals it: same steps, same draws
         self._index = len(lab.envs)
         lab.envs.append(self)
         self.action_space = self._env.action_space

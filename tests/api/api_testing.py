@@ -12,6 +12,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import pytest
 from fastapi.testclient import TestClient
 
 from api.settings import Settings
@@ -21,6 +22,12 @@ FAKE_GRADER = "fake_grader:grade_submission"
 INSTRUCTOR_TOKEN = "instructor-" + "x1y2z3w4v5u6t7s8r9q0"
 
 SettingsFactory = Callable[..., Settings]
+
+BOTH_DATABASES = pytest.mark.parametrize(
+    "database_url", ["sqlite", pytest.param("postgresql", marks=pytest.mark.slow)], indirect=True
+)
+"""Run a test on SQLite and on PostgreSQL. The PostgreSQL run is `slow`: the run's first one starts a cluster
+(initdb and pg_ctl, several seconds), so the default run covers the logic on SQLite and `-m ""` both."""
 
 
 def instructor_headers() -> dict[str, str]:

@@ -2,17 +2,16 @@
 
 from __future__ import annotations
 
-import pytest
 from alembic.autogenerate import compare_metadata
 from alembic.migration import MigrationContext
-from api_testing import SettingsFactory
+from api_testing import BOTH_DATABASES, SettingsFactory
 from sqlalchemy import text
 
 from api.database import make_engine, migrate
 from api.models import Base
 
 
-@pytest.mark.parametrize("database_url", ["sqlite", "postgresql"], indirect=True)
+@BOTH_DATABASES
 def test_migrations_match_the_models_and_can_run_twice(make_settings: SettingsFactory) -> None:
     engine = make_engine(make_settings())
     try:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import httpx
 import pytest
-from api_testing import instructor_headers
+from api_testing import BOTH_DATABASES, instructor_headers
 from live_server import (
     E2E_GRADER,
     PARTIAL_SOLUTION,
@@ -47,7 +47,7 @@ def test_upload_is_graded_and_reported(server: LiveProcess) -> None:
     assert gradebook.splitlines()[1].startswith(f"ada,{submission_id},")
 
 
-@pytest.mark.parametrize("database_url", ["sqlite", "postgresql"], indirect=True)
+@BOTH_DATABASES
 def test_a_separate_worker_process_grades_what_the_server_queues(
     tmp_path: Path, database_url: str | None
 ) -> None:

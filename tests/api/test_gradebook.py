@@ -6,7 +6,7 @@ import csv
 import io
 
 import pytest
-from api_testing import SettingsFactory, add_student, bearer, instructor_headers
+from api_testing import BOTH_DATABASES, SettingsFactory, add_student, bearer, instructor_headers
 from fastapi.testclient import TestClient
 
 from api.main import create_app
@@ -31,7 +31,7 @@ def _rows(client: TestClient) -> list[dict[str, str]]:
     return list(csv.DictReader(io.StringIO(response.text)))
 
 
-@pytest.mark.parametrize("database_url", ["sqlite", "postgresql"], indirect=True)
+@BOTH_DATABASES
 @pytest.mark.parametrize(
     ("policy", "expected_cartpole", "expected_total"),
     [("latest", "0", "1"), ("best", "1", "2")],

@@ -8,7 +8,14 @@ import csv
 import io
 
 import pytest
-from api_testing import SettingsFactory, add_student, bearer, graded_upload, instructor_headers
+from api_testing import (
+    BOTH_DATABASES,
+    SettingsFactory,
+    add_student,
+    bearer,
+    graded_upload,
+    instructor_headers,
+)
 from fastapi.testclient import TestClient
 
 from api.main import create_app
@@ -26,7 +33,7 @@ def _override(client: TestClient, name: str, headers: dict[str, str] | None = No
     return client.post(f"/students/{name}/overrides", json=body, headers=headers or instructor_headers())
 
 
-@pytest.mark.parametrize("database_url", ["sqlite", "postgresql"], indirect=True)
+@BOTH_DATABASES
 def test_an_override_is_kept_with_who_and_when_and_every_gradebook_shows_it(
     make_settings: SettingsFactory,
 ) -> None:

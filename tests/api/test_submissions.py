@@ -7,7 +7,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from api_testing import SettingsFactory, add_student, bearer, instructor_headers
+from api_testing import BOTH_DATABASES, SettingsFactory, add_student, bearer, instructor_headers
 from fastapi.testclient import TestClient
 
 from api.main import create_app
@@ -214,7 +214,7 @@ def test_healthz_reports_the_queue(client: TestClient) -> None:
     assert client.get("/healthz").json() == {"status": "ok", "database": "sqlite", "queued": 1, "running": 0}
 
 
-@pytest.mark.parametrize("database_url", ["sqlite", "postgresql"], indirect=True)
+@BOTH_DATABASES
 @pytest.mark.parametrize(
     ("path", "status"),
     [

@@ -6,7 +6,7 @@ from collections.abc import Iterator
 from datetime import timedelta
 
 import pytest
-from api_testing import SettingsFactory
+from api_testing import BOTH_DATABASES, SettingsFactory
 from sqlalchemy.orm import Session
 
 from api.database import make_engine, make_session_factory, migrate
@@ -93,7 +93,7 @@ def _as_sent(session: Session, member: LtiMember) -> None:
     session.commit()
 
 
-@pytest.mark.parametrize("database_url", ["sqlite", "postgresql"], indirect=True)
+@BOTH_DATABASES
 def test_a_regrade_that_changes_the_score_is_sent_again_and_one_that_does_not_is_not(
     session: Session,
 ) -> None:

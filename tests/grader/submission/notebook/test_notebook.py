@@ -22,7 +22,8 @@ from grader.grading.outcomes import with_notebook
 from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
 from grader.submission.notebook import NotebookModule, bounded, build_module
-from grader.submission.notebook.building import MAX_LISTED_SKIPPED, MAX_NOTED_GLOBALS
+from grader.submission.notebook.building import MAX_LISTED_SKIPPED, MAX_NOTED_GLOBALS, build_from_cells
+from grader.submission.notebook.reading import NotebookCells, read_cells
 from grader.submission.validation import FileVerdict
 
 
@@ -33,7 +34,15 @@ def notebook_bytes(*sources: str, markdown_first: bool = False) -> bytes:
 
 
 def built(*sources: str) -> NotebookModule:
-    module = build_module(notebook_bytes(*sources), "lab.ipynb", None)
+    """The module of a notebook of these cells, built by the reader's pure core in this process.
+
+    The rules of reading (what runs, what is skipped and said) are the core's; the tests below that call
+    `build_module` hold the bounded child that runs the same core (its reply, its verdicts, its limits).
+    """
+    data = notebook_bytes(*sources)
+    read = read_cells(data, "lab.ipynb")
+    assert isinstance(read, NotebookCells), read
+    module = build_from_cells(read, "lab.ipynb", None)
     assert isinstance(module, NotebookModule), module
     return module
 
