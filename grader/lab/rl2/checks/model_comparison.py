@@ -2,7 +2,7 @@
 
 The grader calls it once with `episodes` (100 by default). It trains a Q-table through the course's helper
 `model_free_RL.run_qlearn` (provided by the grader, `grader/compat/model_free.py`; its 70 000 training
-episodes are the helper's own, not recorded; about 130 s: `call_seconds` allows for it), saved as
+episodes are the helper's own, not recorded; about 80 s: `call_seconds` allows for more), saved as
 `q_table.npy` in the grading's own working directory, plays `episodes` episodes greedily on it
 (`run_simulation_table`) and `episodes` with value iteration's policy on slippery 8x8 FrozenLake.
 

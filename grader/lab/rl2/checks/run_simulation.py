@@ -334,8 +334,7 @@ def _not_reset(records: Sequence[CallRecord]) -> str | None:
         refused = outcome.status is OutcomeStatus.EXCEPTION and "ResetNeeded" in outcome.message
         if skipped or refused:
             return (
-                "run_simulation stepped the env it was given before resetting it: the lab's run_simulation resets the env itself "  # noqa: E501
-                "(obs = env.reset(), or obs, info = env.reset() with gymnasium) and then plays one episode from there."  # noqa: E501
+                "run_simulation stepped the env it was given before resetting it: the lab's run_simulation resets the env itself (obs = env.reset(), or obs, info = env.reset() with gymnasium) and then plays one episode from there."  # noqa: E501
             )
     return None
 
