@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from grader import cli
-from grader.lab.rl2.editions import EDITIONS
+from grader.lab.rl2.editions import EDITIONS, V2024
 
 ROOT = Path(__file__).resolve().parents[4]
 NAMES = [edition.name for edition in EDITIONS]
@@ -41,8 +41,8 @@ def test_gymgrade_check_grades_the_2024_honest_file_end_to_end(tmp_path: Path) -
         "Edition: v2024 (Reinforcement Learning 2: Markov Decision Process (2024)): chosen with --edition."
         in result.stderr
     )
-    assert "Score: 4 / 4  (full marks)" in result.stdout
-    for problem in ("value_iteration", "policy_improvement", "iter_policy_eval", "policy_iteration"):
+    assert "Score: 7 / 7  (full marks)" in result.stdout
+    for problem in V2024.registry.ids:
         assert f"{problem}: passed" in result.stdout
 
 
