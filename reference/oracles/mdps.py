@@ -150,7 +150,8 @@ def ring() -> Mdp:
 
 def random_mdp(draw: np.random.Generator, name: str) -> Mdp:
     """A random MDP: 6 to 14 states, 2 to 4 actions, the last 1 or 2 states terminal (a zero-reward self-loop
-    per action, as FrozenLake's holes and goal), every other move with 1 to 3 outcomes to distinct states.
+    per action, as FrozenLake's holes and goal), every other move with 1 to 3 outcomes to distinct states (2
+    or 3 for action 0, so every state has a stochastic move).
 
     Probabilities are Dirichlet(1) draws and rewards uniform on [-1, 1] (a terminal outcome's on [-1, 2]),
     continuous, so two actions tie only with probability 0: a correct greedy step has one answer. `done` is
@@ -166,8 +167,8 @@ def random_mdp(draw: np.random.Generator, name: str) -> Mdp:
             table.append(tuple(((1.0, state, 0.0, True),) for _ in range(n_actions)))
             continue
         actions: list[tuple[Outcome, ...]] = []
-        for _ in range(n_actions):
-            count = int(draw.integers(1, 4))
+        for action in range(n_actions):
+            count = int(draw.integers(2 if action == 0 else 1, 4))  # some move of every state is stochastic
             targets = draw.choice(n_states, size=count, replace=False)
             weights = draw.dirichlet(np.ones(count)) if count > 1 else np.ones(1)
             outcomes = []
