@@ -15,13 +15,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from functools import cache
+from functools import lru_cache
 
 import numpy as np
 from pydantic import Field
 
 from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.lab.rl2.checks.mdp_calls import (
+    CACHED,
     READINGS,
     FloatArray,
     IntArray,
@@ -82,7 +83,7 @@ def policies(case: GradingCase, seed: int) -> list[tuple[str, IntArray]]:
     ]
 
 
-@cache
+@lru_cache(maxsize=CACHED)
 def points(seed: int) -> tuple[Point, ...]:
     """Every (case, policy) of the seed whose value is finite, in case order."""
     graded = []
@@ -112,7 +113,7 @@ def evaluation_tolerance(case: GradingCase, policy: IntArray, exact: FloatArray,
     return _tolerance(case, tuple(int(action) for action in policy), tuple(exact.tolist()), tol)
 
 
-@cache
+@lru_cache(maxsize=CACHED)
 def _tolerance(case: GradingCase, policy: tuple[int, ...], exact: tuple[float, ...], tol: float) -> float:
     actions = np.array(policy, dtype=np.int64)
     sweep = bellman_sweep(case.mdp, case.beta, actions)

@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import cache
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -43,12 +43,15 @@ IntArray = npt.NDArray[np.int64]
 
 ROUNDING = 1e-9
 """Relative floating-point slack of every value compared (sums of a few hundred products in another order)."""
+CACHED = 512
+"""Entries each memo of the rl2 checks keeps (cases, draws, exact values, tolerances): a grading seed adds
+its own, so a long-running grader keeps the recent ones only, bounded."""
 DIAGNOSIS_TOLERANCE = 1e-5
 """How close returned values must be to a typical mistake's values for the feedback to name it (the
 mistakes differ from the right values and from each other by 1e-2 or more on the graded MDPs)."""
 
 
-@cache
+@lru_cache(maxsize=CACHED)
 def cases(seed: int | None = None) -> tuple[GradingCase, ...]:
     """The MDPs and discounts every pure problem is graded on under a problem's seed, the lab's example
     first, the held-out random MDPs last (without a seed, the public cases alone)."""
@@ -66,12 +69,12 @@ def called_case(call: Call, beta_at: int) -> GradingCase:
     return _case(argument.name, argument.table, float(call.args[beta_at]))
 
 
-@cache
+@lru_cache(maxsize=CACHED)
 def _case(name: str, table: Any, beta: float) -> GradingCase:
     return GradingCase(name, Mdp(name, table), beta, "read from the planned call")
 
 
-@cache
+@lru_cache(maxsize=CACHED)
 def optimum(case: GradingCase) -> FloatArray:
     """The exact optimal values of a case (do not change the array: it is shared)."""
     return optimal_solution(case.mdp, case.beta).values

@@ -17,13 +17,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from functools import cache
+from functools import lru_cache
 
 import numpy as np
 from pydantic import Field
 
 from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.lab.rl2.checks.mdp_calls import (
+    CACHED,
     READINGS,
     FloatArray,
     Reading,
@@ -82,7 +83,7 @@ class Expected:
     counts: tuple[int, ...]
 
 
-@cache
+@lru_cache(maxsize=CACHED)
 def expected(case: GradingCase, tol: float, maxiter: int) -> Expected:
     """The exact optimal values, the tolerance the lab's algorithm earns at `tol`, the accepted sweep counts."""  # noqa: E501
     best = optimum(case)
