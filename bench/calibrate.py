@@ -105,7 +105,7 @@ def run_job(job: Job) -> Result:
         }
     check = PROBLEMS.problem(problem).check
     started = time.perf_counter()
-    calls = check.plan(config, function_infos(functions))
+    calls = check.plan(config, function_infos(functions), 0)
     records = simulate_calls(calls, functions, job.seed, fast=problem in ("random_blackjack", "blackjack"))
     verdict = check.judge(config, records)
     matched = verdict.status == job.expected and job.feedback in verdict.feedback

@@ -116,7 +116,7 @@ def regrade(behaviour: str, index: int, settings: GuessingGameConfig) -> tuple[b
     functions = {"guessing_game": student}
     check = PROBLEMS.problem("guessing_game").check
     started = time.perf_counter()
-    calls = check.plan(settings, function_infos(functions))
+    calls = check.plan(settings, function_infos(functions), 0)
     seed = zlib.crc32(behaviour.encode()) * 1_000_003 + index
     verdict = check.judge(settings, simulate_calls(calls, functions, seed, replay=True))
     matched = verdict.status == expected and feedback in verdict.feedback

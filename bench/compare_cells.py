@@ -53,7 +53,7 @@ def _statuses(function: Any, regrades: int) -> Counter[str]:
     settings = CompareConfig.model_validate({**settings.model_dump(), "run_cells": True}).for_problem(
         "compare", problem.games
     )
-    calls = problem.check.plan(settings, {})
+    calls = problem.check.plan(settings, {}, 0)
     found: Counter[str] = Counter()
     for seed in range(regrades):
         records = simulate_calls(calls, {RUN_CELLS: students.cells, "compare": function}, seed)

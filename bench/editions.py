@@ -51,7 +51,7 @@ def _statuses(function: Any, regrades: int, **updates: Any) -> Counter[str]:
     settings = _settings(**updates)
     found: Counter[str] = Counter()
     for seed in range(regrades):
-        records = simulate_calls(problem.check.plan(settings, {}), {"epsilon_decay": function}, seed)
+        records = simulate_calls(problem.check.plan(settings, {}, 0), {"epsilon_decay": function}, seed)
         found[problem.check.judge(settings, records).status] += 1
     return found
 
@@ -76,7 +76,7 @@ def calibrate_taxi(regrades: int, mistake_regrades: int) -> None:
     """The two-table taxi: honest greedy play on fresh seeds, and each mistake (in-process, real check)."""
     problem = RL1.registry.problem("taxi")
     settings = load_config(RL1.default_config).problems["taxi"]
-    calls = problem.check.plan(settings, {})
+    calls = problem.check.plan(settings, {}, 0)
 
     def statuses(function: Any, count: int) -> Counter[str]:
         found: Counter[str] = Counter()

@@ -93,7 +93,7 @@ def regrade(calibration: Calibration, student: Callable[..., Any], seeds: range,
     edition = edition_of(calibration.edition)
     problem = edition.registry.problem(calibration.problem)
     settings = problem.settings(load_config(edition.default_config))
-    calls = problem.check.plan(settings, {})
+    calls = problem.check.plan(settings, {}, 0)
     tally = Tally(statuses=Counter())
     started = time.perf_counter()
     for seed in seeds:

@@ -235,7 +235,7 @@ def regrade(pattern: Pattern, seed: int) -> tuple[bool, float]:
     settings = _settings(pattern.problem)
     functions = {pattern.problem: _sized(pattern.function, settings)}
     check = PROBLEMS.problem(pattern.problem).check
-    calls = check.plan(settings, function_infos(functions))
+    calls = check.plan(settings, function_infos(functions), 0)
     records = simulate_calls(calls, functions, seed)
     verdict = check.judge(settings, records)
     tests = selection_tests(records)

@@ -30,7 +30,8 @@ ROOT = Path(__file__).resolve().parents[1]
 HEADING = "## Second lab: the cost of the pure problems (issue 35)"
 DESCRIPTION = (
     "`python bench/rl2_pure_cost.py`: each file graded through the sandbox with its edition's default "
-    "configuration, 2 workers, on {cores} cores shared with other work. "
+    "configuration, grading seed 35 (the ten public MDPs and three held-out random ones drawn from each "
+    "problem's seed), 2 workers, on {cores} cores shared with other work. "
     "Wall: the problem's child start, import, every call and judging; "
     "student: seconds inside the submission's functions. "
     "A problem's calls all run in its one child; "

@@ -139,7 +139,7 @@ def run_problem(
     records: list[CallRecord] = []
     stopped: str | None = None
     with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:
-        calls = check.plan(settings, FunctionsOnDemand(sandbox))
+        calls = check.plan(settings, FunctionsOnDemand(sandbox), seed)
         for call in calls:
             if call.function == RUN_CELLS:  # the cells are the submission's, known here, not to the plan
                 call = replace(call, args=(runnable_cells(submission),))

@@ -43,7 +43,8 @@ How the lab's parts fit:
   `grader/grading/plugin.py` in one **acceptance session per grading, in the calling process**
   (`grader/grading/session.py`; see `grader.grading`). `grader/lab/checks/base.py` is the contract:
   `CallRecord(outcome, replays)`, `Verdict(status, fraction, feedback, measurements)`, `ProblemCheck[ConfigT]`
-  with `.plan(settings: ConfigT, functions) -> list[Call]` / `.judge(settings: ConfigT, records) -> Verdict`
+  with `.plan(settings: ConfigT, functions, seed) -> list[Call]` (the problem's seed) /
+  `.judge(settings: ConfigT, records) -> Verdict`
   (a check never narrows its settings; the games its episodes must be played in are `settings.game_rules()`),
   and the shared outcome mapping. Every planned `Call` carries a `CallBudget`
   (`grader.lab.checks.integrity.games_budget`). `grader.grading.execution.run_problem` looks the problem up in

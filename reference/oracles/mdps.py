@@ -7,11 +7,20 @@ are `(1 - 1/3) / 2 = 0.33333333333333337`, the intended move `1/3`, outcomes lis
 move, the move, right of it, duplicates kept); a windy corridor (stochastic, rewards on every step,
 graded below discount 1) and a ring (stochastic, negative rewards, where the all-zeros start policy of
 policy iteration loops forever at discount 1 while the lab's all-ones start ends).
+
+Those ten cases are public (they are in this file), so a file could memorise their answers. A grading seed
+therefore adds held-out cases (`held_out_cases(seed)`): random MDPs of varied size drawn from the seed
+(`random_mdp`), each with terminal states, stochastic moves of one to three outcomes and rewards on every
+move, graded below discount 1 so that every policy has a finite value, value iteration contracts and no
+policy's evaluation can loop forever. `grading_cases(seed)` is the public cases followed by those.
 """
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
+
+import numpy as np
 
 from reference.oracles.mdp import Mdp, Outcome
 
@@ -139,6 +148,52 @@ def ring() -> Mdp:
     return Mdp("a ring with an exit", tuple(table))
 
 
+def random_mdp(draw: np.random.Generator, name: str) -> Mdp:
+    """A random MDP: 6 to 14 states, 2 to 4 actions, the last 1 or 2 states terminal (a zero-reward self-loop
+    per action, as FrozenLake's holes and goal), every other move with 1 to 3 outcomes to distinct states (2
+    or 3 for action 0, so every state has a stochastic move).
+
+    Probabilities are Dirichlet(1) draws and rewards uniform on [-1, 1] (a terminal outcome's on [-1, 2]),
+    continuous, so two actions tie only with probability 0: a correct greedy step has one answer. `done` is
+    True exactly on moves into a terminal state. Every row's probabilities sum to 1 up to rounding.
+    """
+    n_states = int(draw.integers(6, 15))
+    n_actions = int(draw.integers(2, 5))
+    n_terminal = int(draw.integers(1, 3))
+    terminal = set(range(n_states - n_terminal, n_states))
+    table: list[Actions] = []
+    for state in range(n_states):
+        if state in terminal:
+            table.append(tuple(((1.0, state, 0.0, True),) for _ in range(n_actions)))
+            continue
+        actions: list[tuple[Outcome, ...]] = []
+        for action in range(n_actions):
+            count = int(draw.integers(2 if action == 0 else 1, 4))  # some move of every state is stochastic
+            targets = draw.choice(n_states, size=count, replace=False)
+            weights = draw.dirichlet(np.ones(count)) if count > 1 else np.ones(1)
+            outcomes = []
+            for target, weight in zip(targets.tolist(), weights.tolist(), strict=True):
+                ends = target in terminal
+                reward = float(draw.uniform(-1.0, 2.0 if ends else 1.0))
+                outcomes.append((float(weight), int(target), reward, ends))
+            actions.append(tuple(outcomes))
+        table.append(tuple(actions))
+    return Mdp(name, tuple(table))
+
+
+HELD_OUT = 3
+"""Random MDPs a grading seed adds to the public cases."""
+HELD_OUT_DISCOUNTS = (0.8, 0.9, 0.95)
+"""The discounts a held-out MDP is graded at (one drawn per MDP): below 1, so every policy's value is finite
+and value iteration at tol 1e-8 needs at most about 470 sweeps (rewards within 2, 0.95**470 * 40 < 1e-8)."""
+
+
+def seeded_draw(seed: int, purpose: str) -> np.random.Generator:
+    """A generator for one purpose under one seed: a stable hash of both, so each purpose draws apart."""
+    digest = hashlib.sha256(f"gymgrade-rl2:{seed}:{purpose}".encode()).digest()
+    return np.random.default_rng(int.from_bytes(digest[:8], "big"))
+
+
 @dataclass(frozen=True)
 class GradingCase:
     """One MDP at one discount, as the grader passes it to a student's function.
@@ -156,8 +211,25 @@ class GradingCase:
     why: str
 
 
-def grading_cases() -> tuple[GradingCase, ...]:
-    """Every MDP and discount the second lab's pure functions are graded on, the lab's example first."""
+def held_out_cases(seed: int) -> tuple[GradingCase, ...]:
+    """The `HELD_OUT` random MDPs and discounts a grading seed adds (the same for the same seed)."""
+    cases = []
+    for index in range(HELD_OUT):
+        draw = seeded_draw(seed, f"mdp {index}")
+        mdp = random_mdp(draw, f"a random MDP ({index + 1} of {HELD_OUT} drawn from the grading seed)")
+        beta = HELD_OUT_DISCOUNTS[int(draw.integers(len(HELD_OUT_DISCOUNTS)))]
+        why = "held out: drawn from the grading seed, so no file can know it in advance"
+        cases.append(GradingCase(f"random{index + 1}_{beta:g}", mdp, beta, why))
+    return tuple(cases)
+
+
+def grading_cases(seed: int | None = None) -> tuple[GradingCase, ...]:
+    """Every MDP and discount the second lab's pure functions are graded on, the lab's example first.
+
+    Without a seed, the ten public cases; with a problem's seed, those and `held_out_cases(seed)`.
+    """
+    if seed is not None:
+        return (*grading_cases(), *held_out_cases(seed))
     example, corridor, circle = lab_example(), windy_corridor(), ring()
     lake4, lake8 = frozen_lake("4x4", slippery=True), frozen_lake("8x8", slippery=True)
     still4, still8 = frozen_lake("4x4", slippery=False), frozen_lake("8x8", slippery=False)

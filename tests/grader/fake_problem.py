@@ -30,8 +30,8 @@ class EchoConfig(ProblemConfig):
 class EchoCheck:
     """echo(answer) must return the answer; it plays no episodes."""
 
-    def plan(self, settings: EchoConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
-        """One unrecorded call echo(answer)."""
+    def plan(self, settings: EchoConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
+        """One unrecorded call echo(answer) (the seed unused)."""
         return [Call("echo", (settings.answer,), record_episodes=False, budget=NO_EPISODES)]
 
     def judge(self, settings: EchoConfig, records: Sequence[CallRecord]) -> Verdict:

@@ -72,12 +72,19 @@ class ProblemCheck(Protocol[ConfigT_contra]):
     `Problem.settings` hands it settings of exactly that model: a check never narrows its configuration.
     """
 
-    def plan(self, settings: ConfigT_contra, functions: Mapping[str, FunctionInfo]) -> list[Call]:
-        """The calls to run, given the functions the submission defines."""
+    def plan(self, settings: ConfigT_contra, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
+        """The calls to run, given the functions the submission defines and the problem's seed.
+
+        `seed` is the problem's sandbox seed (`grader.grading.execution.problem_seed(grading seed, problem)`):
+        a check whose inputs are drawn by the parent (the second lab's MDPs, values and policies) draws them
+        from it, so another grading seed grades on unseen inputs and the same seed plans the same calls.
+        Checks whose randomness is the episodes' (the first lab's) ignore it: the sandbox seeds those.
+        """
         ...
 
     def judge(self, settings: ConfigT_contra, records: Sequence[CallRecord]) -> Verdict:
-        """The verdict for the planned calls' records (same order as planned)."""
+        """The verdict for the planned calls' records (same order as planned; each record's `outcome.call` is
+        the parent's planned call, so what a call was asked can be read from it)."""
         ...
 
 

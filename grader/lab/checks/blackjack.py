@@ -130,7 +130,7 @@ def policy_deviation(decisions: Sequence[_Decision], n: int) -> str | None:
 class BlackjackCheck:
     """blackjack(n) for several n: the threshold rule in every replayed decision, exact win rates."""
 
-    def plan(self, settings: BlackjackConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: BlackjackConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
         """One call blackjack(n) per configured n."""
         budget = games_budget(settings.games_per_call, GAME_STEPS)
         return [Call("blackjack", (n,), budget=budget) for n in settings.thresholds]

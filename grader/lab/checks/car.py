@@ -28,7 +28,7 @@ class CarConfig(CountedStepsConfig):
 class CarCheck:
     """car() called many times: each return is its replayed length, every run reaches the goal, mean < bar."""
 
-    def plan(self, settings: CarConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: CarConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
         """The configured number of car() calls."""
         return one_game_calls("car", settings.calls, EPISODE_STEPS)
 

@@ -29,7 +29,7 @@ class CartpoleConfig(CountedStepsConfig):
 class CartpoleCheck:
     """cartpole() called many times: each return is its replayed episode's length; the lab's bar holds."""
 
-    def plan(self, settings: CartpoleConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: CartpoleConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
         """The configured number of cartpole() calls."""
         return one_game_calls("cartpole", settings.calls, EPISODE_STEPS)
 

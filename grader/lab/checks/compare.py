@@ -124,7 +124,7 @@ class NotebookTable:
 class CompareCheck:
     """The notebook's cells, then compare(): both halves replayed, greedy on notebook tables, exact means."""
 
-    def plan(self, settings: CompareConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: CompareConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
         """The cells call (own time limit, unrecorded), then a recorded compare(); none without run_cells."""
         if not settings.run_cells:
             return []

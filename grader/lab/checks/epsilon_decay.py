@@ -144,7 +144,9 @@ def returned_number(value: PlainValue) -> float | None:
 class EpsilonDecayCheck:
     """Every grid point called once (linear), plus once with decay_type='exp' when enabled."""
 
-    def plan(self, settings: EpsilonDecayConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(
+        self, settings: EpsilonDecayConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
         """One unrecorded call per grid point (and per grid point again with decay_type='exp')."""
         calls = [
             Call("epsilon_decay", point.args(), record_episodes=False, budget=NO_EPISODES) for point in GRID

@@ -44,7 +44,9 @@ class FindQvaluesConfig(ProblemConfig):
 class FindQvaluesCheck:
     """find_qvalues("Taxi-v3"): a finite (500, 6) table; its greedy policy's exact return is reported."""
 
-    def plan(self, settings: FindQvaluesConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(
+        self, settings: FindQvaluesConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
         """One unrecorded call (100 000 training episodes are not worth logging), or none when not called.
 
         No verdict needs the table unless the problem is worth points (``taxi(q_table)`` gets the grader's

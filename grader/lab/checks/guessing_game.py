@@ -257,7 +257,9 @@ def _stopping_hint(records: Sequence[CallRecord]) -> str:
 class GuessingGameCheck:
     """guessing_game() called many times: returns its replayed game's guesses; midpoint play; exact total."""
 
-    def plan(self, settings: GuessingGameConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(
+        self, settings: GuessingGameConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
         """The configured number of guessing_game() calls."""
         return one_game_calls("guessing_game", settings.calls, EPISODE_STEPS)
 

@@ -43,7 +43,9 @@ class RandomBlackjackConfig(PlayedProblemConfig):
 class RandomBlackjackCheck:
     """random_blackjack(n): n completed games, random actions, and the exact random-policy win rate."""
 
-    def plan(self, settings: RandomBlackjackConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(
+        self, settings: RandomBlackjackConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
         """One call, random_blackjack(games)."""
         games = settings.games
         return [Call("random_blackjack", (games,), budget=games_budget(games, GAME_STEPS))]

@@ -200,7 +200,7 @@ def _runs(settings: SarsaConfig) -> list[Run]:
 class SarsaCheck:
     """sarsa0 called with the grader's Taxi env and hyper-parameters; updates and exploration verified."""
 
-    def plan(self, settings: SarsaConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: SarsaConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
         """The sarsa0 calls, then (for the decay call) the student's epsilon_decay(i, N) for i = 1..N.
 
         The decay schedule is read first: the decay call is judged against the student's own values.

@@ -131,7 +131,7 @@ def _mismatch_cause(episodes: Sequence[Episode], random_mean: float, greedy_mean
 class TaxiCheck:
     """taxi: both scenarios backed by replay, each mean near its exact expectation, Q beats random."""
 
-    def plan(self, settings: TaxiConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: TaxiConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
         """taxi(optimal Q-table) when taxi takes a parameter, else taxi()."""
         games = 2 * settings.episodes_per_scenario
         evaluation = games_budget(games, EPISODE_STEPS)

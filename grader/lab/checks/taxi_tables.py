@@ -51,7 +51,9 @@ def grader_tables(gamma: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np
 class TaxiTablesCheck:
     """taxi(detour table, optimal table): both tables' episodes replayed, greedy, near their exact means."""
 
-    def plan(self, settings: TaxiTablesConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(
+        self, settings: TaxiTablesConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
         """One recorded call with the grader's two tables."""
         tables = grader_tables(settings.gamma)
         budget = games_budget(2 * settings.episodes_per_table, EPISODE_STEPS)

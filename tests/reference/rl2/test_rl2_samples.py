@@ -1,7 +1,8 @@
 """The second lab's samples (submissions/rl2/verdicts.toml) get their pinned statuses from the oracles.
 
 Each sample runs in a child through `python -m grader.compat` (classic `gym` for the old editions), judged
-by sample_judge.py on every MDP and discount of `reference.oracles.mdps.grading_cases()`. Only the pure
+by sample_judge.py on every MDP and discount of `reference.oracles.mdps.grading_cases(seed)` (the public
+cases and one seed's held-out random MDPs). Only the pure
 problems and run_simulation are judged here; frozen_lake and model_comparison need the grader's lab.
 """
 

@@ -1,8 +1,9 @@
 """The second lab's problem 3: `compute_policy_v(P, nS, nA, policy, beta=1.0, tol=1e-8)` (2018-2023) or
 `iter_policy_eval(...)` (2024 on) returns ONE array: the policy's values by iterative evaluation.
 
-Called on every MDP and discount of `mdp_calls.cases()` with three policies: an optimal one, the lab's
-all-ones start of policy iteration and a uniformly random one (seeded by the case's key), each whose value
+Called on every MDP and discount of `mdp_calls.cases(seed)` with three policies: an optimal one, the lab's
+all-ones start of policy iteration and a uniformly random one (drawn from the problem's seed and the case's
+key), each whose value
 is finite (at discount 1 a policy looping forever through costly moves has none and is not asked),
 positionally `(P, nS, nA, policy, beta, tol)`. The values must lie within `mdp_calls.value_tolerance` of the
 policy's exact value (`reference.oracles.mdp.policy_value`, a linear solve), the lab's own iterative
@@ -12,16 +13,16 @@ fails, named. A wrong V is compared with the typical mistakes, each named when i
 
 from __future__ import annotations
 
-import zlib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from functools import cache
+from functools import lru_cache
 
 import numpy as np
 from pydantic import Field
 
 from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.lab.rl2.checks.mdp_calls import (
+    CACHED,
     READINGS,
     FloatArray,
     IntArray,
@@ -29,6 +30,7 @@ from grader.lab.rl2.checks.mdp_calls import (
     as_vector,
     bellman_sweep,
     call_text,
+    called_case,
     cases,
     close,
     describe_values,
@@ -43,7 +45,7 @@ from grader.lab.settings import ProblemConfig
 from grader.sandbox.outcome import Call, FunctionInfo, PlainValue
 from reference.errors import UnboundedValueError
 from reference.oracles.mdp import Mdp, optimal_solution, policy_value
-from reference.oracles.mdps import GradingCase
+from reference.oracles.mdps import GradingCase, seeded_draw
 
 MAX_SWEEPS = 100_000
 """Sweeps the tolerance's measurement makes at most (the graded policies need at most about 1 200 at 1e-8)."""
@@ -65,23 +67,28 @@ class Point:
     exact: FloatArray
 
 
-def policies(case: GradingCase) -> list[tuple[str, IntArray]]:
-    """The policies asked of a case: an optimal one, all ones, a seeded random one."""
-    draw = np.random.default_rng(zlib.crc32(case.key.encode()))
+OPTIMAL, ALL_ONES, RANDOM = "an optimal policy", "the all-ones policy", "a random policy"
+BETA_AT, POLICY_AT = 4, 3
+"""Where beta and the policy are in a call's arguments `(P, nS, nA, policy, beta, tol)`."""
+
+
+def policies(case: GradingCase, seed: int) -> list[tuple[str, IntArray]]:
+    """The policies asked of a case: an optimal one, all ones, a random one drawn from `seed`."""
+    draw = seeded_draw(seed, f"policy {case.key}")
     size = case.mdp.n_states
     return [
-        ("an optimal policy", optimal_solution(case.mdp, case.beta).policy),
-        ("the all-ones policy", np.ones(size, dtype=np.int64)),
-        ("a random policy", draw.integers(0, case.mdp.n_actions, size).astype(np.int64)),
+        (OPTIMAL, optimal_solution(case.mdp, case.beta).policy),
+        (ALL_ONES, np.ones(size, dtype=np.int64)),
+        (RANDOM, draw.integers(0, case.mdp.n_actions, size).astype(np.int64)),
     ]
 
 
-@cache
-def points() -> tuple[Point, ...]:
-    """Every (case, policy) whose value is finite, in case order."""
+@lru_cache(maxsize=CACHED)
+def points(seed: int) -> tuple[Point, ...]:
+    """Every (case, policy) of the seed whose value is finite, in case order."""
     graded = []
-    for case in cases():
-        for kind, policy in policies(case):
+    for case in cases(seed):
+        for kind, policy in policies(case, seed):
             try:
                 exact = policy_value(case.mdp, policy, case.beta)
             except UnboundedValueError:
@@ -90,12 +97,23 @@ def points() -> tuple[Point, ...]:
     return tuple(graded)
 
 
+def asked(call: Call) -> Point:
+    """What a planned call asked: its MDP, discount and policy (with its exact value), read from the call."""
+    case = called_case(call, BETA_AT)
+    policy = np.asarray(call.args[POLICY_AT], dtype=np.int64)
+    if np.array_equal(policy, optimal_solution(case.mdp, case.beta).policy):
+        kind = OPTIMAL
+    else:
+        kind = ALL_ONES if bool(np.all(policy == 1)) else RANDOM
+    return Point(case, policy, kind, policy_value(case.mdp, policy, case.beta))
+
+
 def evaluation_tolerance(case: GradingCase, policy: IntArray, exact: FloatArray, tol: float) -> float:
     """How far an iterative evaluation of `policy` stopped at `tol` may lie from its exact value."""
     return _tolerance(case, tuple(int(action) for action in policy), tuple(exact.tolist()), tol)
 
 
-@cache
+@lru_cache(maxsize=CACHED)
 def _tolerance(case: GradingCase, policy: tuple[int, ...], exact: tuple[float, ...], tol: float) -> float:
     actions = np.array(policy, dtype=np.int64)
     sweep = bellman_sweep(case.mdp, case.beta, actions)
@@ -154,11 +172,13 @@ class EvaluationCheck:
 
     function: str
 
-    def plan(self, settings: EvaluationConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
-        """`function(P, nS, nA, policy, beta, tol)` for every point, positionally (the policy an int array)."""  # noqa: E501
+    def plan(
+        self, settings: EvaluationConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
+        """`function(P, nS, nA, policy, beta, tol)` for every point of the seed, positionally (the policy an int array)."""  # noqa: E501
         return [
             mdp_call(self.function, point.case, point.policy.copy(), point.case.beta, settings.tol)
-            for point in points()
+            for point in points(seed)
         ]
 
     @paused_gc
@@ -167,7 +187,7 @@ class EvaluationCheck:
         early = outcome_verdict(records)
         if early is not None:
             return early
-        graded = list(zip(points(), records, strict=True))
+        graded = [(asked(record.outcome.call), record) for record in records]
         tuples: list[Call] = []
         shapes: list[str] = []
         wrong: list[tuple[Point, Call, FloatArray, float]] = []

@@ -1,8 +1,9 @@
 """The second lab's problem 2: `extract_policy(P, nS, nA, v, beta=1.0)` (2018-2023) or
 `policy_improvement(P, nS, nA, V, beta=1.0)` (2024 on) returns the greedy policy for the values it is given.
 
-Called on every MDP and discount of `mdp_calls.cases()` twice: with the exact optimal values, and with
-values drawn uniformly from [-1, 1] (seeded by the case's key, so the same every grading), positionally.
+Called on every MDP and discount of `mdp_calls.cases(seed)` twice: with the exact optimal values, and with
+values drawn uniformly from [-1, 1] (drawn from the problem's seed and the case's key: another grading seed
+asks other values), positionally.
 A returned policy is right when, in every state, its action's one-step look-ahead
 `sum p * (r + beta * v[s'])` is the best there up to `ROUNDING` (`reference.oracles.mdp.greedy_gaps`): any of
 several tied actions is (FrozenLake's optimal actions tie in many states, the example's state 2 too), never
@@ -12,7 +13,6 @@ every wrong policy.
 
 from __future__ import annotations
 
-import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -25,17 +25,19 @@ from grader.lab.rl2.checks.mdp_calls import (
     IntArray,
     as_policy,
     call_text,
+    called_case,
     cases,
     describe_values,
     first_outcomes,
     last_outcomes,
     mdp_call,
+    optimum,
     shown,
 )
 from grader.lab.settings import ProblemConfig
 from grader.sandbox.outcome import Call, FunctionInfo, PlainValue
-from reference.oracles.mdp import Mdp, greedy_gaps, optimal_solution, q_values
-from reference.oracles.mdps import GradingCase
+from reference.oracles.mdp import Mdp, greedy_gaps, q_values
+from reference.oracles.mdps import GradingCase, seeded_draw
 
 
 class ImprovementConfig(ProblemConfig):
@@ -51,14 +53,27 @@ class Point:
     kind: str
 
 
-def points() -> tuple[Point, ...]:
-    """The optimal values and seeded random values of every case."""
+OPTIMAL_VALUES, RANDOM_VALUES = "the optimal values", "random values"
+BETA_AT, VALUES_AT = 4, 3
+"""Where beta and V are in a call's arguments `(P, nS, nA, V, beta)`."""
+
+
+def points(seed: int) -> tuple[Point, ...]:
+    """The optimal values and random values (drawn from `seed`) of every case of the seed."""
     graded = []
-    for case in cases():
-        graded.append(Point(case, optimal_solution(case.mdp, case.beta).values, "the optimal values"))
-        draw = np.random.default_rng(zlib.crc32(case.key.encode()))
-        graded.append(Point(case, draw.uniform(-1.0, 1.0, case.mdp.n_states), "random values"))
+    for case in cases(seed):
+        graded.append(Point(case, optimum(case), OPTIMAL_VALUES))
+        draw = seeded_draw(seed, f"values {case.key}")
+        graded.append(Point(case, draw.uniform(-1.0, 1.0, case.mdp.n_states), RANDOM_VALUES))
     return tuple(graded)
+
+
+def asked(call: Call) -> Point:
+    """What a planned call asked: its MDP, discount and values, read from the call."""
+    case = called_case(call, BETA_AT)
+    values = np.asarray(call.args[VALUES_AT], dtype=np.float64)
+    kind = OPTIMAL_VALUES if np.array_equal(values, optimum(case)) else RANDOM_VALUES
+    return Point(case, values, kind)
 
 
 def greedy_for(mdp: Mdp, values: FloatArray, beta: float, policy: IntArray) -> bool:
@@ -99,10 +114,13 @@ class ImprovementCheck:
 
     function: str
 
-    def plan(self, settings: ImprovementConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
-        """`function(P, nS, nA, V, beta)` for every point, positionally (V a fresh float array)."""
+    def plan(
+        self, settings: ImprovementConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
+        """`function(P, nS, nA, V, beta)` for every point of the seed, positionally (V a fresh array)."""
         return [
-            mdp_call(self.function, point.case, point.values.copy(), point.case.beta) for point in points()
+            mdp_call(self.function, point.case, point.values.copy(), point.case.beta)
+            for point in points(seed)
         ]
 
     @paused_gc
@@ -111,7 +129,7 @@ class ImprovementCheck:
         early = outcome_verdict(records)
         if early is not None:
             return early
-        graded = list(zip(points(), records, strict=True))
+        graded = [(asked(record.outcome.call), record) for record in records]
         wrong: list[tuple[Point, Call, PlainValue, IntArray | None]] = []
         for point, record in graded:
             policy = as_policy(record.outcome.value, point.case.mdp)

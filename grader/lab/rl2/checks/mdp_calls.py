@@ -1,8 +1,9 @@
 """What the second lab's pure problems share: the MDPs they are called on, how a returned value is read, and
 the tolerance the lab's own algorithm earns at the `tol` it is passed.
 
-The MDPs are `reference.oracles.mdps.grading_cases()` (the lab's example and the grader's own: FrozenLake
-4x4/8x8 slippery and deterministic, a windy corridor, a ring; discounts 1, 0.95, 0.9 and 0.8), each passed
+The MDPs are `reference.oracles.mdps.grading_cases(seed)` (the lab's example and the grader's own: FrozenLake
+4x4/8x8 slippery and deterministic, a windy corridor, a ring; discounts 1, 0.95, 0.9 and 0.8; then random
+MDPs drawn from the problem's seed, held out), each passed
 as an `MdpArgument` (the child hands the function a fresh `{s: {a: [(p, s', r, done), ...]}}`), with `nS`
 and `nA` as plain ints, positionally as the templates order the parameters.
 
@@ -13,6 +14,12 @@ when a sweep changes V by less than `tol`, leaves V within `beta * tol / (1 - be
 bound; the tolerance is then twice the largest error the lab's own algorithm makes at that `tol` on that
 MDP, over the readings the lab text allows (a sweep from the previous V or in place, stopped on the max
 norm, the loosest), computed by the exact oracle. Every tolerance adds `ROUNDING * (1 + max |V|)`.
+
+**Seeded plans, judged from the calls.** A check's `plan(settings, functions, seed)` draws its cases, values
+and policies from the problem's seed (`cases(seed)`, `reference.oracles.mdps.seeded_draw`); its `judge`
+reads what each call was asked from the call itself (`called_case`: each record's `outcome.call` is the
+parent's planned `Call`, never anything the child sent), so plan and judge cannot disagree and the parent
+knows every MDP it judges against.
 """
 
 from __future__ import annotations
@@ -20,7 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import cache
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -28,7 +35,7 @@ import numpy.typing as npt
 
 from grader.lab.checks.integrity import NO_EPISODES
 from grader.sandbox.outcome import Call, MdpArgument, PlainValue
-from reference.oracles.mdp import Mdp
+from reference.oracles.mdp import Mdp, optimal_solution
 from reference.oracles.mdps import GradingCase, grading_cases
 
 FloatArray = npt.NDArray[np.float64]
@@ -36,15 +43,41 @@ IntArray = npt.NDArray[np.int64]
 
 ROUNDING = 1e-9
 """Relative floating-point slack of every value compared (sums of a few hundred products in another order)."""
+CACHED = 512
+"""Entries each memo of the rl2 checks keeps (cases, draws, exact values, tolerances): a grading seed adds
+its own, so a long-running grader keeps the recent ones only, bounded."""
 DIAGNOSIS_TOLERANCE = 1e-5
 """How close returned values must be to a typical mistake's values for the feedback to name it (the
 mistakes differ from the right values and from each other by 1e-2 or more on the graded MDPs)."""
 
 
-@cache
-def cases() -> tuple[GradingCase, ...]:
-    """The MDPs and discounts every pure problem is graded on, the lab's example first."""
-    return grading_cases()
+@lru_cache(maxsize=CACHED)
+def cases(seed: int | None = None) -> tuple[GradingCase, ...]:
+    """The MDPs and discounts every pure problem is graded on under a problem's seed, the lab's example
+    first, the held-out random MDPs last (without a seed, the public cases alone)."""
+    return grading_cases(seed)
+
+
+def called_case(call: Call, beta_at: int) -> GradingCase:
+    """The MDP and discount a planned call was asked about, read from the call (`P` first, beta at `beta_at`).
+
+    Its key is the MDP's name (the seeds of the draws are the plan's business, not the judge's).
+    """
+    argument = call.args[0]
+    if not isinstance(argument, MdpArgument):
+        raise TypeError(f"{call.function}: the first argument planned is not an MDP table: {argument!r}")
+    return _case(argument.name, argument.table, float(call.args[beta_at]))
+
+
+@lru_cache(maxsize=CACHED)
+def _case(name: str, table: Any, beta: float) -> GradingCase:
+    return GradingCase(name, Mdp(name, table), beta, "read from the planned call")
+
+
+@lru_cache(maxsize=CACHED)
+def optimum(case: GradingCase) -> FloatArray:
+    """The exact optimal values of a case (do not change the array: it is shared)."""
+    return optimal_solution(case.mdp, case.beta).values
 
 
 def mdp_argument(mdp: Mdp) -> MdpArgument:

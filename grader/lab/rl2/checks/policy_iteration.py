@@ -1,7 +1,7 @@
 """The second lab's problem 4: `policy_iteration(P, nS, nA, beta=1, tol=1e-8, maxiter=200)` returns
 `(V, policy, n)`.
 
-Called once on every MDP and discount of `mdp_calls.cases()` with `(P, nS, nA, beta, tol, maxiter)`
+Called once on every MDP and discount of `mdp_calls.cases(seed)` with `(P, nS, nA, beta, tol, maxiter)`
 positionally. The policy is judged by its exact value (`reference.oracles.mdp.judge_policy`: optimal in
 every state, ties allowed, never equality with one list); V against the exact optimal values within the
 tolerance an iterative evaluation of the returned policy earns at that tol
@@ -22,7 +22,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from functools import cache
 from typing import Literal
 
 import numpy as np
@@ -31,20 +30,21 @@ from pydantic import Field
 from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.lab.rl2.checks.evaluation import evaluation_tolerance
 from grader.lab.rl2.checks.mdp_calls import (
-    FloatArray,
     as_count,
     as_policy,
     as_vector,
     call_text,
+    called_case,
     cases,
     describe_values,
     mdp_call,
+    optimum,
     shown,
 )
 from grader.lab.settings import ProblemConfig
 from grader.sandbox.outcome import Call, FunctionInfo, OutcomeStatus, PlainValue
 from reference.errors import UnboundedValueError
-from reference.oracles.mdp import judge_policy, optimal_solution, policy_value
+from reference.oracles.mdp import judge_policy, policy_value
 from reference.oracles.mdps import GradingCase
 
 FUNCTION = "policy_iteration"
@@ -63,10 +63,8 @@ class PolicyIterationConfig(ProblemConfig):
     )
 
 
-@cache
-def optimum(case: GradingCase) -> FloatArray:
-    """The exact optimal values of a case."""
-    return optimal_solution(case.mdp, case.beta).values
+BETA_AT = 3
+"""Where beta is in a call's arguments `(P, nS, nA, beta, tol, maxiter)`."""
 
 
 @dataclass(frozen=True)
@@ -81,11 +79,13 @@ class PolicyIterationCheck:
     evaluation: str
     improvement: str
 
-    def plan(self, settings: PolicyIterationConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(
+        self, settings: PolicyIterationConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
         """`policy_iteration(P, nS, nA, beta, tol, maxiter)` on every case, positionally."""
         provided = (self.evaluation, self.improvement) if settings.helpers == "grader" else ()
         calls = []
-        for case in cases():
+        for case in cases(seed):
             call = mdp_call(FUNCTION, case, case.beta, settings.tol, settings.maxiter)
             calls.append(
                 Call(call.function, call.args, record_episodes=True, budget=call.budget, provided=provided)
@@ -106,7 +106,7 @@ class PolicyIterationCheck:
             if early.status == "timeout":
                 return self._timeout(early, records, reading)
             return Verdict(early.status, early.fraction, f"{early.feedback} {reading}", early.measurements)
-        graded = list(zip(cases(), records, strict=True))
+        graded = [(called_case(record.outcome.call, BETA_AT), record) for record in records]
         problems: list[str] = []
         for case, record in graded:
             problem = self._problem(case, record.outcome.call, record.outcome.value, settings)
@@ -156,7 +156,7 @@ class PolicyIterationCheck:
 
     def _timeout(self, early: Verdict, records: Sequence[CallRecord], reading: str) -> Verdict:
         index = next(i for i, r in enumerate(records) if r.outcome.status is OutcomeStatus.TIMEOUT)
-        case = cases()[index]
+        case = called_case(records[index].outcome.call, BETA_AT)
         if case.beta < 1:
             return Verdict(early.status, early.fraction, f"{early.feedback}. {reading}", early.measurements)
         cause = f"Likely cause: on {case.mdp.name} at beta = 1 your start policy never converges at discount 1: a policy whose moves loop forever through costly states (all zeros walks the ring at a cost forever) has no finite value, so its iterative evaluation never stops. Start from a policy that ends its episodes, such as the all-ones start of the 2023 and later texts (np.ones(nS, dtype=int))."  # noqa: E501

@@ -260,7 +260,7 @@ def discounted_return(rewards: Sequence[float], beta: float) -> float:
 class RunSimulationCheck:
     """run_simulation on the grader's envs and policies: one replayed episode per call, its return exact."""
 
-    def plan(self, settings: RunSimulationConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
+    def plan(self, settings: RunSimulationConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
         """One call per case (`slippery_calls` per slippery case), arguments in the student's order."""
         info = functions.get(FUNCTION)
         calls = []

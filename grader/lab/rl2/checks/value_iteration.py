@@ -1,6 +1,6 @@
 """The second lab's problem 1: `value_iteration(P, nS, nA, beta=1, tol=1e-8, maxiter=3000)` returns `(V, n)`.
 
-Called once on every MDP and discount of `mdp_calls.cases()` with `(P, nS, nA, beta, tol, maxiter)`
+Called once on every MDP and discount of `mdp_calls.cases(seed)` with `(P, nS, nA, beta, tol, maxiter)`
 positionally. V must lie within `mdp_calls.value_tolerance` of the exact optimal values
 (`reference.oracles.mdp.optimal_solution`); n must be the number of sweeps the lab's algorithm makes from
 V = 0 at that tol, the sweep that found the change below tol included (the example: V1, V2, V3 = V2, so
@@ -17,13 +17,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from functools import cache
+from functools import lru_cache
 
 import numpy as np
 from pydantic import Field
 
 from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.lab.rl2.checks.mdp_calls import (
+    CACHED,
     READINGS,
     FloatArray,
     Reading,
@@ -31,6 +32,7 @@ from grader.lab.rl2.checks.mdp_calls import (
     as_vector,
     bellman_sweep,
     call_text,
+    called_case,
     cases,
     close,
     describe_values,
@@ -38,16 +40,18 @@ from grader.lab.rl2.checks.mdp_calls import (
     iterate,
     last_outcomes,
     mdp_call,
+    optimum,
     shown,
     value_tolerance,
 )
 from grader.lab.settings import ProblemConfig, Share
 from grader.sandbox.outcome import Call, FunctionInfo, PlainValue
-from reference.oracles.mdp import optimal_solution
 from reference.oracles.mdps import GradingCase
 
 FUNCTION = "value_iteration"
 JACOBI_MAX = Reading(in_place=False, norm="max")
+BETA_AT = 3
+"""Where beta is in a call's arguments `(P, nS, nA, beta, tol, maxiter)`."""
 
 
 class ValueIterationConfig(ProblemConfig):
@@ -79,19 +83,15 @@ class Expected:
     counts: tuple[int, ...]
 
 
-@cache
+@lru_cache(maxsize=CACHED)
 def expected(case: GradingCase, tol: float, maxiter: int) -> Expected:
     """The exact optimal values, the tolerance the lab's algorithm earns at `tol`, the accepted sweep counts."""  # noqa: E501
-    optimum = optimal_solution(case.mdp, case.beta).values
+    best = optimum(case)
     sweep = bellman_sweep(case.mdp, case.beta)
     runs = [(reading, *iterate(sweep, case.mdp.n_states, tol, maxiter, reading)) for reading in READINGS]
     # The max norm is the smallest, so its stop is the loosest: the other norms' values are closer.
-    worst = max(
-        float(np.max(np.abs(values - optimum))) for reading, values, _ in runs if reading.norm == "max"
-    )
-    return Expected(
-        optimum, value_tolerance(case, tol, worst, optimum), tuple(sorted({n for _, _, n in runs}))
-    )
+    worst = max(float(np.max(np.abs(values - best))) for reading, values, _ in runs if reading.norm == "max")
+    return Expected(best, value_tolerance(case, tol, worst, best), tuple(sorted({n for _, _, n in runs})))
 
 
 Mistake = Callable[[GradingCase, float, int], FloatArray]
@@ -138,9 +138,13 @@ class ValueIterationCheck:
     changes_counted: bool = False
     function: str = FUNCTION
 
-    def plan(self, settings: ValueIterationConfig, functions: Mapping[str, FunctionInfo]) -> list[Call]:
-        """`value_iteration(P, nS, nA, beta, tol, maxiter)` on every case, positionally."""
-        return [mdp_call(self.function, case, case.beta, settings.tol, settings.maxiter) for case in cases()]
+    def plan(
+        self, settings: ValueIterationConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
+        """`value_iteration(P, nS, nA, beta, tol, maxiter)` on every case of the seed, positionally."""
+        return [
+            mdp_call(self.function, case, case.beta, settings.tol, settings.maxiter) for case in cases(seed)
+        ]
 
     def accepted(self, want: Expected) -> tuple[int, ...]:
         """The counts of n accepted for a call: the lab's sweep counts (one less where the text allows)."""
@@ -154,7 +158,7 @@ class ValueIterationCheck:
         early = outcome_verdict(records)
         if early is not None:
             return early
-        graded = list(zip(cases(), records, strict=True))
+        graded = [(called_case(record.outcome.call, BETA_AT), record) for record in records]
         shape_problems: list[str] = []
         wrong_values: list[tuple[GradingCase, Call, FloatArray, Expected]] = []
         wrong_counts: list[tuple[GradingCase, Call, int, Expected]] = []

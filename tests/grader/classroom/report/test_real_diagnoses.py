@@ -68,7 +68,7 @@ def _judged(behaviour: Behaviour, seed: int) -> ProblemResult:
     functions = {name: sized(function) for name, function in behaviour.functions.items()}
     check = PROBLEMS.problem(problem).check
     verdict = check.judge(
-        settings, simulate_calls(check.plan(settings, function_infos(functions)), functions, seed)
+        settings, simulate_calls(check.plan(settings, function_infos(functions), 0), functions, seed)
     )
     return ProblemResult(
         id=problem, title=problem, status=verdict.status, score=0.0, max_score=1.0, feedback=verdict.feedback

@@ -54,7 +54,7 @@ def simulate(
     (`replay`), or judge them as played (`fast`: Blackjack's cards from Python's generator)."""
     settings = settings or small_config(problem)
     sized = {name: _sized(function, settings) for name, function in functions.items()}
-    calls = PROBLEMS.problem(problem).check.plan(settings, function_infos(sized))
+    calls = PROBLEMS.problem(problem).check.plan(settings, function_infos(sized), 0)
     return simulate_calls(calls, sized, seed, replay=replay and not fast, fast=fast)
 
 

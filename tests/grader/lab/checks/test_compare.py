@@ -29,12 +29,12 @@ def _settings(**fields: Any) -> CompareConfig:
 
 def _judge(function: Any, seed: int, cells: Any = students.cells) -> Verdict:
     settings = _settings()
-    calls = PROBLEM.check.plan(settings, {})
+    calls = PROBLEM.check.plan(settings, {}, 0)
     return PROBLEM.check.judge(settings, simulate_calls(calls, {RUN_CELLS: cells, "compare": function}, seed))
 
 
 def test_the_plan_runs_the_cells_with_their_own_limit_then_records_compare() -> None:
-    cells, compare = PROBLEM.check.plan(_settings(cells_seconds=123.0), {})
+    cells, compare = PROBLEM.check.plan(_settings(cells_seconds=123.0), {}, 0)
     assert (cells.function, cells.seconds, cells.record_episodes) == (RUN_CELLS, 123.0, False)
     assert cells.kwargs == {"then": "compare"}  # a missing or stub compare() runs no cell
     assert (compare.function, compare.seconds, compare.record_episodes) == ("compare", None, True)
@@ -50,7 +50,7 @@ def test_the_default_configuration_runs_the_cells_for_its_points() -> None:
 def test_without_run_cells_compare_is_not_gradable_and_worth_nothing() -> None:
     settings = _settings(run_cells=False)
     assert (settings.run_cells, settings.points) == (False, 0.0)
-    assert PROBLEM.check.plan(settings, {}) == []
+    assert PROBLEM.check.plan(settings, {}, 0) == []
     verdict = PROBLEM.check.judge(settings, [])
     assert (verdict.status, verdict.fraction, verdict.feedback) == ("skipped", 0.0, NOT_GRADABLE)
 
@@ -111,7 +111,7 @@ def test_a_failing_cell_is_the_result(error: BaseException, status: str, words: 
 
 def test_cells_out_of_time_are_a_timeout() -> None:
     settings = _settings(cells_seconds=30.0)
-    calls = PROBLEM.check.plan(settings, {})
+    calls = PROBLEM.check.plan(settings, {}, 0)
     records = simulate_calls(calls[:1], {RUN_CELLS: students.cells}, 1)
     outcome = records[0].outcome
     timed_out = type(records[0])(

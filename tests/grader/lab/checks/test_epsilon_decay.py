@@ -23,7 +23,7 @@ def _settings(**updates: Any) -> EpsilonDecayConfig:
 def _judge(function: Any, **updates: Any) -> Verdict:
     settings = _settings(**updates)
     functions = {"epsilon_decay": function} if function is not None else {}
-    calls = PROBLEM.check.plan(settings, {})
+    calls = PROBLEM.check.plan(settings, {}, 0)
     return PROBLEM.check.judge(settings, simulate_calls(calls, functions, seed=0))
 
 
@@ -62,9 +62,9 @@ def test_the_message_says_what_was_expected_and_found() -> None:
 
 
 def test_the_exponential_decay_is_graded_only_when_enabled() -> None:
-    assert len(PROBLEM.check.plan(_settings(), {})) == len(GRID)
+    assert len(PROBLEM.check.plan(_settings(), {}, 0)) == len(GRID)
     enabled = _settings(grade_exp=True)
-    calls = PROBLEM.check.plan(enabled, {})
+    calls = PROBLEM.check.plan(enabled, {}, 0)
     assert len(calls) == 2 * len(GRID)
     assert all(call.kwargs == {"decay_type": "exp"} for call in calls[len(GRID) :])
     assert _judge(students.honest, grade_exp=True).status == "passed"

@@ -14,7 +14,7 @@ from .support import small_config
 
 def _judge(value: object):  # type: ignore[no-untyped-def]
     settings = small_config("find_qvalues", run="always")
-    (call,) = PROBLEMS.problem("find_qvalues").check.plan(settings, {})
+    (call,) = PROBLEMS.problem("find_qvalues").check.plan(settings, {}, 0)
     assert (call.function, call.args, call.record_episodes) == ("find_qvalues", ("Taxi-v3",), False)
     outcome = CallOutcome(
         Call("find_qvalues", ("Taxi-v3",), record_episodes=False),
@@ -73,7 +73,7 @@ def test_find_qvalues_is_called_only_when_scored_or_asked_for(
     updates: dict[str, object], called: bool
 ) -> None:
     settings = small_config("find_qvalues", **updates)
-    calls = PROBLEMS.problem("find_qvalues").check.plan(settings, {})
+    calls = PROBLEMS.problem("find_qvalues").check.plan(settings, {}, 0)
     assert [call.function for call in calls] == (["find_qvalues"] if called else [])
 
 

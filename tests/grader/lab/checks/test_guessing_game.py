@@ -75,7 +75,7 @@ def judge(student: Callable[[Lab], Any], seed: int, settings: GuessingGameConfig
     settings = settings or _settings()
     functions = {"guessing_game": student}
     check = PROBLEMS.problem("guessing_game").check
-    calls = check.plan(settings, function_infos(functions))
+    calls = check.plan(settings, function_infos(functions), 0)
     return check.judge(settings, simulate_calls(calls, functions, seed, replay=True))
 
 
@@ -285,7 +285,7 @@ def test_the_first_guess_off_the_midpoint_is_found(
 
 def test_a_missing_function_is_missing_before_anything_is_judged() -> None:
     settings = _settings(calls=2)
-    calls = PROBLEMS.problem("guessing_game").check.plan(settings, {})
+    calls = PROBLEMS.problem("guessing_game").check.plan(settings, {}, 0)
     assert [(call.function, call.budget) for call in calls] == [("guessing_game", games_budget(1, 400))] * 2
     outcome = CallOutcome(calls[0], OutcomeStatus.MISSING_FUNCTION, None, [], [], "", "",
                           "your file defines no function named `guessing_game`", 0.0, 1)  # fmt: skip

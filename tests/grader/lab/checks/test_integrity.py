@@ -95,7 +95,7 @@ def test_two_episodes_in_one_cartpole_call_fail(seed: int) -> None:
 
 
 def test_plans_name_the_functions() -> None:
-    calls = PROBLEMS.problem("cartpole").check.plan(small_config("cartpole"), {})
+    calls = PROBLEMS.problem("cartpole").check.plan(small_config("cartpole"), {}, 0)
     assert [call.function for call in calls] == ["cartpole"] * 100
     assert velocity_policy([0, 0, 0, 0.1]) == 1
 
@@ -242,5 +242,5 @@ def test_an_honest_call_does_not_settle_the_verdict(seed: int) -> None:
 
 def test_budgets_leave_room_for_diagnoses() -> None:
     assert games_budget(1, 1_000) == CallBudget(max_episodes=10, max_steps=9_000)
-    calls = PROBLEMS.problem("car").check.plan(small_config("car"), {})
+    calls = PROBLEMS.problem("car").check.plan(small_config("car"), {}, 0)
     assert {call.budget for call in calls} == {games_budget(1, 1_000)}

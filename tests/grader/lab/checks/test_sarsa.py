@@ -29,7 +29,7 @@ def _settings() -> SarsaConfig:
 
 def _judge(function: Any, seed: int, decay: Any = students.epsilon_decay) -> Verdict:
     settings = _settings()
-    calls = PROBLEM.check.plan(settings, {})
+    calls = PROBLEM.check.plan(settings, {}, 0)
     functions = {"sarsa0": function, "epsilon_decay": decay}
     return PROBLEM.check.judge(settings, simulate_calls(calls, functions, seed))
 
@@ -51,7 +51,7 @@ FORM_WORDS = {
 
 
 def test_the_plan_passes_the_environments_name_first() -> None:
-    call = PROBLEM.check.plan(_settings(), {})[0]
+    call = PROBLEM.check.plan(_settings(), {}, 0)[0]
     (env,) = [argument for argument in call.args if isinstance(argument, EnvArgument)]
     assert (env.env_id, env.form, repr(env)) == ("Taxi-v3", ENV_NAME_OR_OBJECT, "'Taxi-v3'")
 
@@ -102,7 +102,7 @@ def test_a_wrong_epsilon_decay_is_not_counted_again(seed: int) -> None:
 
 def test_a_missing_epsilon_decay_leaves_the_constant_call_graded(seed: int) -> None:
     settings = _settings()
-    calls = PROBLEM.check.plan(settings, {})
+    calls = PROBLEM.check.plan(settings, {}, 0)
     records = simulate_calls(calls[:2], {"sarsa0": students.HONEST["lab_loop"]}, seed)
     verdict = PROBLEM.check.judge(settings, records)
     assert verdict.status == "passed", verdict.feedback

@@ -39,7 +39,7 @@ def test_plan_passes_the_optimal_table_only_when_taxi_takes_one(
     functions: dict[str, FunctionInfo], takes: bool
 ) -> None:
     assert takes_q_table(functions) is takes
-    (call,) = PROBLEMS.problem("taxi").check.plan(small_config("taxi"), functions)
+    (call,) = PROBLEMS.problem("taxi").check.plan(small_config("taxi"), functions, 0)
     assert call.function == "taxi"
     if takes:
         np.testing.assert_array_equal(call.args[0], optimal_q_table(0.6))

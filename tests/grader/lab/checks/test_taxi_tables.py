@@ -21,7 +21,7 @@ PROBLEM = RL1.registry.problem("taxi")
 def _judge(function: Any, seed: int) -> Verdict:
     settings = load_config(RL1.default_config).problems["taxi"]
     assert isinstance(settings, TaxiTablesConfig)
-    calls = PROBLEM.check.plan(settings, {})
+    calls = PROBLEM.check.plan(settings, {}, 0)
     return PROBLEM.check.judge(settings, simulate_calls(calls, {"taxi": function}, seed))
 
 

@@ -37,7 +37,7 @@ def records_of(
     rules = bound.game_rules()
     limits = Limits(call_seconds=bound.call_seconds)
     with Sandbox(submission, seed=seed, limits=limits, policy=IsolationPolicy.ALLOW_FALLBACK) as sandbox:
-        for call in check.plan(bound, sandbox.functions):
+        for call in check.plan(bound, sandbox.functions, seed):
             records.append(replay_call(sandbox.call(call), rules))
             if settled_by(records[-1], rules) is not None:
                 break

@@ -14,6 +14,9 @@ from grader.lab.editions import edition_of
 from grader.sandbox.child.frames import MdpArgument, decode_value, encode_value
 from grader.sandbox.outcome import CallOutcome, OutcomeStatus
 
+SEED = 0
+"""The problem seed the in-process tests plan with (the public cases and three held-out random MDPs)."""
+
 
 def settings(edition: str, problem: str, **changes: Any) -> Any:
     """The problem's settings in the edition's default configuration, with `changes`."""
@@ -33,22 +36,24 @@ def wire(value: Any) -> Any:
     return decode_value(json.loads(json.dumps(encode_value(value, "the value"))), "the value")
 
 
-def judged(edition: str, problem: str, function: Callable[..., Any], **changes: Any) -> Verdict:
-    """The verdict of `problem` on `function`, every planned call made here."""
+def judged(
+    edition: str, problem: str, function: Callable[..., Any], *, seed: int = SEED, **changes: Any
+) -> Verdict:
+    """The verdict of `problem` on `function`, every planned call made here (planned with `seed`)."""
     entry = edition_of(edition).registry.problem(problem)
     chosen = settings(edition, problem, **changes)
     records = []
-    for call in entry.check.plan(chosen, {}):
+    for call in entry.check.plan(chosen, {}, seed):
         args = [arg.as_table() if isinstance(arg, MdpArgument) else arg for arg in call.args]
         records.append(CallRecord(outcome(call, wire(function(*args))), []))
     return entry.check.judge(chosen, records)
 
 
 def judged_outcomes(
-    edition: str, problem: str, outcomes: Callable[[Any], CallOutcome], **changes: Any
+    edition: str, problem: str, outcomes: Callable[[Any], CallOutcome], *, seed: int = SEED, **changes: Any
 ) -> Verdict:
     """The verdict of `problem` when each planned call ends as `outcomes(call)` says."""
     entry = edition_of(edition).registry.problem(problem)
     chosen = settings(edition, problem, **changes)
-    records = [CallRecord(outcomes(call), []) for call in entry.check.plan(chosen, {})]
+    records = [CallRecord(outcomes(call), []) for call in entry.check.plan(chosen, {}, seed)]
     return entry.check.judge(chosen, records)

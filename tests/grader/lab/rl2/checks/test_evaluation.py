@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from grader.lab.rl2.checks.evaluation import points
+from grader.lab.rl2.checks.mdp_calls import cases
 from reference.rl2 import solutions
-from tests.grader.lab.rl2.support import judged
+from tests.grader.lab.rl2.support import SEED, judged
 
 
 def evaluation(
@@ -47,8 +48,12 @@ def evaluation(
 
 
 def test_the_policies_asked_have_finite_values_and_include_the_labs_start() -> None:
-    kinds = [point.kind for point in points()]
-    assert kinds.count("the all-ones policy") == 10 and len(kinds) == 30
+    asked = points(SEED)
+    kinds = [point.kind for point in asked]
+    assert kinds.count("the all-ones policy") == len(cases(SEED)) == 13
+    assert all(bool(np.all(np.isfinite(point.exact))) for point in asked)
+    held_out = [point for point in asked if point.case.key.startswith("random")]
+    assert len(held_out) == 9  # below discount 1 every policy has a value: all three asked
 
 
 @pytest.mark.parametrize(
@@ -66,7 +71,7 @@ def test_the_2018_name_is_graded_the_same() -> None:
 def test_a_tuple_where_one_array_is_asked_for_is_named() -> None:
     verdict = judged("v2024", "iter_policy_eval", partial(evaluation, with_count=True))
     assert verdict.status == "failed"
-    assert "returned a tuple where one array is asked for (30 of 30 calls)" in verdict.feedback
+    assert "returned a tuple where one array is asked for (38 of 38 calls)" in verdict.feedback
 
 
 @pytest.mark.parametrize(

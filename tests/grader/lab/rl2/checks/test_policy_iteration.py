@@ -13,10 +13,10 @@ from grader.lab.rl2.checks.mdp_calls import cases
 from grader.sandbox.outcome import OutcomeStatus
 from reference.oracles.mdp import optimal_solution
 from reference.rl2 import solutions
-from tests.grader.lab.rl2.support import judged, judged_outcomes, outcome, settings, wire
+from tests.grader.lab.rl2.support import SEED, judged, judged_outcomes, outcome, settings, wire
 
-RING = next(index for index, case in enumerate(cases()) if case.key == "ring")
-RING_DISCOUNTED = next(index for index, case in enumerate(cases()) if case.key == "ring_0.8")
+RING = next(index for index, case in enumerate(cases(SEED)) if case.key == "ring")
+RING_DISCOUNTED = next(index for index, case in enumerate(cases(SEED)) if case.key == "ring_0.8")
 
 
 def test_the_reference_passes_and_the_feedback_names_the_graders_helpers() -> None:
@@ -40,13 +40,15 @@ def _plan(edition: str, **changes: Any) -> list[Any]:
     return (
         edition_of(edition)
         .registry.problem("policy_iteration")
-        .check.plan(settings(edition, "policy_iteration", **changes), {})
+        .check.plan(settings(edition, "policy_iteration", **changes), {}, SEED)
     )
 
 
 def _optimal(P: Any, nS: int, nA: int, beta: float = 1.0, *rest: Any) -> Any:
     case = next(
-        case for case in cases() if case.mdp.n_states == nS and case.beta == beta and case.mdp.as_dict() == P
+        case
+        for case in cases(SEED)
+        if case.mdp.n_states == nS and case.beta == beta and case.mdp.as_dict() == P
     )
     solved = optimal_solution(case.mdp, beta)
     return solved.values, solved.policy, 2
@@ -78,7 +80,7 @@ def test_another_optimal_policy_among_ties_passes() -> None:
 
 def _timing_out(index: int) -> Any:
     """Outcomes in plan order (one call per case): the call at `index` timed out, the others optimal."""
-    made = iter(range(len(cases())))
+    made = iter(range(len(cases(SEED))))
 
     def outcomes(call: Any) -> Any:
         position = next(made)
@@ -88,7 +90,7 @@ def _timing_out(index: int) -> Any:
                 status=OutcomeStatus.TIMEOUT,
                 message="policy_iteration() did not return within 20 seconds",
             )
-        solved = optimal_solution(cases()[position].mdp, cases()[position].beta)
+        solved = optimal_solution(cases(SEED)[position].mdp, cases(SEED)[position].beta)
         return outcome(call, wire((solved.values, solved.policy, 3)))
 
     return outcomes
@@ -115,7 +117,7 @@ def test_a_timeout_below_discount_1_is_not_blamed_on_the_start() -> None:
 def test_the_graders_improvement_step_takes_its_editions_parameter_names(name: str, keyword: str) -> None:
     from grader.sandbox.child.provided import PROVIDED
 
-    example = cases()[0].mdp
+    example = cases(SEED)[0].mdp
     policy = PROVIDED[name](example.as_dict(), 4, 4, **{keyword: np.array([1.0, 1.0, 1.0, 0.0])}, beta=1.0)
     assert policy.tolist() == [2, 1, 2, 0]  # the lab's stated policy (first best action)
     values = PROVIDED["compute_policy_v"](
