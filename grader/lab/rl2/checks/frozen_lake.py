@@ -131,7 +131,9 @@ class FrozenLakeCheck:
     function: str = "frozen_lake"
     shape: Shape = "six"
 
-    def plan(self, settings: FrozenLakeConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
+    def plan(
+        self, settings: FrozenLakeConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
         """Both lakes' frozen_lake calls, then the student's own solvers on each lake (pure calls)."""
         info = functions.get(self.function)
         names = [parameter.name for parameter in info.parameters] if info is not None else []

@@ -51,7 +51,9 @@ class ModelComparisonConfig(PlayedProblemConfig):
 class ModelComparisonCheck:
     """model_comparison: both means the replayed ones, value iteration's play greedy on the exact values."""
 
-    def plan(self, settings: ModelComparisonConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
+    def plan(
+        self, settings: ModelComparisonConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
         """One call; the budget covers 2 x episodes games (the helper's training is not recorded)."""
         budget = games_budget(2 * settings.episodes, LAKE_STEPS * 10)
         return [Call(FUNCTION, (settings.episodes,), budget=budget)]

@@ -260,7 +260,9 @@ def discounted_return(rewards: Sequence[float], beta: float) -> float:
 class RunSimulationCheck:
     """run_simulation on the grader's envs and policies: one replayed episode per call, its return exact."""
 
-    def plan(self, settings: RunSimulationConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
+    def plan(
+        self, settings: RunSimulationConfig, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
         """One call per case (`slippery_calls` per slippery case), arguments in the student's order."""
         info = functions.get(FUNCTION)
         calls = []
@@ -333,9 +335,7 @@ def _not_reset(records: Sequence[CallRecord]) -> str | None:
         skipped = any(event.kind == STEP_BEFORE_RESET for event in outcome.compat_events)
         refused = outcome.status is OutcomeStatus.EXCEPTION and "ResetNeeded" in outcome.message
         if skipped or refused:
-            return (
-                "run_simulation stepped the env it was given before resetting it: the lab's run_simulation resets the env itself (obs = env.reset(), or obs, info = env.reset() with gymnasium) and then plays one episode from there."  # noqa: E501
-            )
+            return "run_simulation stepped the env it was given before resetting it: the lab's run_simulation resets the env itself (obs = env.reset(), or obs, info = env.reset() with gymnasium) and then plays one episode from there."  # noqa: E501
     return None
 
 
