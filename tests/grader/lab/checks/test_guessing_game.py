@@ -20,6 +20,7 @@ from grader.lab.checks.guessing_game import (
     MIDPOINT_SLACK,
     GuessingGameConfig,
     _guess_value,
+    deviation_cause,
     first_deviation,
     total_acceptance,
 )
@@ -184,6 +185,7 @@ def test_a_count_with_one_guess_too_many_is_off_by_one(seed: int) -> None:
     verdict = judge(lambda lab: play(lab, counted_from=1), seed)
     assert verdict.status == "failed"
     assert "it is off by one" in verdict.feedback
+    assert "stop on `done`" not in verdict.feedback  # no game went on after it was won: no stopping hint
 
 
 def test_guessing_on_until_exactly_equal_is_named(seed: int) -> None:
@@ -294,3 +296,18 @@ def test_a_missing_function_is_missing_before_anything_is_judged() -> None:
         "missing",
         "your file defines no function named `guessing_game`",
     )
+
+
+@pytest.mark.parametrize(
+    ("guesses", "observations", "cause"),
+    [
+        ([[0.0], ["500"]], [1, 2], "each guess must be one number (or a one-element list or array)"),
+        ([[0.0], [300.0]], [1, 1], "guess the midpoint (low + high) / 2 of the interval the target is still in"),
+    ],
+    ids=["not-a-number", "two-guesses-are-no-linear-search"],
+)
+def test_the_cause_of_a_hand_made_deviation(guesses: list[Any], observations: list[int], cause: str) -> None:
+    """A guess that is no number is named as such; two guesses are too few to call a linear search."""
+    deviation = first_deviation(_episode(guesses, observations))
+    assert deviation is not None
+    assert deviation_cause(deviation) == cause
