@@ -138,7 +138,7 @@ def reads_target(lab: Lab) -> int:
         ),
         (
             lambda lab: play(lab, lambda _low, _high, _made, lab: lab.random.uniform(-10_000, 10_000)),
-            "lie outside the interval the target is still in, as random guesses would",
+            "lie outside the interval the target is still in, as random guesses",
         ),
         (
             lambda lab: play(lab, low=-10_000, high=10_000),
@@ -302,12 +302,51 @@ def test_a_missing_function_is_missing_before_anything_is_judged() -> None:
     ("guesses", "observations", "cause"),
     [
         ([[0.0], ["500"]], [1, 2], "each guess must be one number (or a one-element list or array)"),
-        ([[0.0], [300.0]], [1, 1], "guess the midpoint (low + high) / 2 of the interval the target is still in"),
+        (
+            [[0.0], [300.0]],
+            [1, 1],
+            "guess the midpoint (low + high) / 2 of the interval the target is still in",
+        ),
+        (
+            [[0.0], [300.0], [100.0], [200.0]],
+            [1, 1, 1, 1],
+            "2 of the game's 4 guesses lie outside the interval the target is still in, as random guesses",
+        ),
+        (
+            [[0.0], [-300.0], [-100.0], [-200.0]],
+            [3, 3, 3, 3],
+            "2 of the game's 4 guesses lie outside the interval the target is still in, as random guesses",
+        ),
+        (
+            [[0.0], [300.0], [2000.0], [-2000.0], [3000.0]],
+            [1, 1, 3, 1, 3],
+            "3 of the game's 5 guesses lie outside the interval the target is still in, as random guesses",
+        ),
     ],
-    ids=["not-a-number", "two-guesses-are-no-linear-search"],
+    ids=[
+        "not-a-number",
+        "two-guesses-are-no-linear-search",
+        "later-guesses-below-a-raised-low",
+        "later-guesses-above-a-lowered-high",
+        "later-guesses-outside-the-targets",
+    ],
 )
 def test_the_cause_of_a_hand_made_deviation(guesses: list[Any], observations: list[int], cause: str) -> None:
-    """A guess that is no number is named as such; two guesses are too few to call a linear search."""
+    """A guess that is no number is named as such; two guesses are too few to call a linear search; the
+    guesses outside the interval are counted over the whole game, each end moved by the observations."""
     deviation = first_deviation(_episode(guesses, observations))
     assert deviation is not None
-    assert deviation_cause(deviation) == cause
+    assert deviation_cause(deviation).startswith(cause)
+
+
+def test_a_call_that_raised_gets_no_stopping_hint(seed: int) -> None:
+    """An error stays the sandbox's message alone, even when the call's game went on after it was won."""
+
+    def raises_after_playing(lab: Lab) -> int:
+        play(lab, until_equal=True)
+        raise ValueError("after the game")
+
+    verdict = judge(raises_after_playing, seed, _settings(calls=2))
+    assert verdict.status == "error", verdict.feedback
+    assert "ValueError" in verdict.feedback
+    assert "stop on `done`" not in verdict.feedback
