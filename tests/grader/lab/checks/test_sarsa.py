@@ -20,15 +20,15 @@ from grader.simulated_students.simulation import Lab, simulate_calls
 PROBLEM = RL1.registry.problem("sarsa0")
 
 
-def _settings() -> SarsaConfig:
+def _settings(**updates: Any) -> SarsaConfig:
     """The default settings with fewer episodes (the verdicts do not depend on them; the tests run faster)."""
     settings = load_config(RL1.default_config).problems["sarsa0"]
     assert isinstance(settings, SarsaConfig)
-    return settings.model_copy(update={"episodes": 25, "decay_episodes": 10})
+    return settings.model_copy(update={"episodes": 25, "decay_episodes": 10, **updates})
 
 
-def _judge(function: Any, seed: int, decay: Any = students.epsilon_decay) -> Verdict:
-    settings = _settings()
+def _judge(function: Any, seed: int, decay: Any = students.epsilon_decay, **updates: Any) -> Verdict:
+    settings = _settings(**updates)
     calls = PROBLEM.check.plan(settings, {})
     functions = {"sarsa0": function, "epsilon_decay": decay}
     return PROBLEM.check.judge(settings, simulate_calls(calls, functions, seed))
@@ -147,3 +147,21 @@ def test_an_epsilon_decay_returning_no_number_is_not_counted_again(seed: int) ->
     verdict = _judge(crashes_on_decay, seed, decay=no_number)
     assert verdict.status == "passed", verdict.feedback
     assert "The decay=True call is not counted" in verdict.feedback
+
+
+@pytest.mark.parametrize(
+    ("name", "status", "words"),
+    [
+        ("lab_loop", "passed", "the decay=True call (N=10): "),
+        ("ignores_decay", "failed", "you explored less than the decayed schedule asks"),
+    ],
+)
+def test_with_the_grader_s_schedule_the_decay_call_s_exploration_is_judged(
+    name: str, status: str, words: str, seed: int
+) -> None:
+    """decay_schedule = "grader": the decay call is judged against the lab's formula (no student values)."""
+    learner = students.HONEST.get(name) or students.MISTAKES[name][0]
+    verdict = _judge(learner, seed, decay_schedule="grader")
+    assert verdict.status == status, verdict.feedback
+    assert words in verdict.feedback
+    assert "nan" not in verdict.feedback
