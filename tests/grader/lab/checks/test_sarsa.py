@@ -165,3 +165,17 @@ def test_with_the_grader_s_schedule_the_decay_call_s_exploration_is_judged(
     assert verdict.status == status, verdict.feedback
     assert words in verdict.feedback
     assert "nan" not in verdict.feedback
+
+
+def test_a_call_that_returns_no_table_fails_with_what_it_returned(seed: int) -> None:
+    def returns_a_name(lab: Lab, *args: Any) -> Any:
+        students.HONEST["lab_loop"](lab, *args)
+        return "q_table"
+
+    verdict = _judge(returns_a_name, seed)
+    assert (verdict.status, verdict.feedback) == (
+        "failed",
+        "sarsa0 must return the Q-table, a finite 500 x 6 array (one row per Taxi state), or (table, "
+        "penalties); the call with epsilon constant (N=25) returned 'q_table'. (The grader called sarsa0 "
+        "with the environment's name, 'Taxi-v3', as the template's `env = gym.make(env)` expects.)",
+    )
