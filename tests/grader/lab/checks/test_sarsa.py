@@ -179,3 +179,49 @@ def test_a_call_that_returns_no_table_fails_with_what_it_returned(seed: int) -> 
         "penalties); the call with epsilon constant (N=25) returned 'q_table'. (The grader called sarsa0 "
         "with the environment's name, 'Taxi-v3', as the template's `env = gym.make(env)` expects.)",
     )
+
+
+def test_a_game_abandoned_before_training_fails_the_integrity_check(seed: int) -> None:
+    def abandons_a_game(lab: Lab, env: Any, *args: Any) -> Any:
+        game = lab.make(env)
+        game.reset()
+        game.step(0)  # then on to training, the game left unfinished
+        return students.HONEST["lab_loop"](lab, env, *args)
+
+    verdict = _judge(abandons_a_game, seed)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith(
+        "sarsa0, the call with epsilon constant (N=25): 1 game(s) were abandoned before they ended"
+    )
+
+
+def test_a_missing_sarsa0_is_missing_with_the_sandbox_s_message_alone(seed: int) -> None:
+    settings = _settings()
+    calls = PROBLEM.check.plan(settings, {})
+    verdict = PROBLEM.check.judge(
+        settings, simulate_calls(calls, {"epsilon_decay": students.epsilon_decay}, seed)
+    )
+    assert verdict.status == "missing"
+    assert "The grader called sarsa0" not in verdict.feedback
+
+
+def test_exploring_more_than_epsilon_is_named(seed: int) -> None:
+    def explores_at_half(lab: Lab, env: Any, alpha: float, gamma: float, _epsilon: float, *rest: Any) -> Any:
+        return students.HONEST["lab_loop"](lab, env, alpha, gamma, 0.5, *rest)
+
+    verdict = _judge(explores_at_half, seed)
+    assert verdict.status == "failed"
+    assert "you explored more than epsilon asks" in verdict.feedback
+
+
+def test_a_decay_call_without_the_student_s_schedule_is_judged_on_its_updates_alone(seed: int) -> None:
+    """epsilon_decay returns no number but sarsa0 decays on its own: the decay call's table is verified,
+    its exploration is not judged (no schedule to judge it against)."""
+
+    def no_number(lab: Any, episode: int, n: int) -> None:
+        return None
+
+    verdict = _judge(students.HONEST["lab_loop"], seed, decay=no_number)
+    assert verdict.status == "passed", verdict.feedback
+    assert verdict.measurements["decay_updates"] > 0
+    assert np.isnan(verdict.measurements["decay_tolerance"])
