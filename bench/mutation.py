@@ -352,6 +352,10 @@ EQUIVALENT: dict[str, str] = {
     "taxi: Q beats random dropped": "once the random mean passes its z-test (about -771) and the Q-table "
     "mean its test or floor (above 7), the Q-table mean cannot be at or below the random one; the "
     "condition is redundant, not untested",
+    "sarsa: never `any((not episode.reached_terminal for episode in episodes))`": "an episode that is "
+    "neither terminated nor truncated already fails `integrity_problem` (abandoned), and one truncated "
+    "cannot be recorded: the env's time limit (max_steps + 1) lies beyond the call's step budget "
+    "(max_steps), and a call over its budget ends as episode_limit before any episode is judged",
 }
 """Surviving mutants that no test can kill, with the reason: the mutated code behaves as the original."""
 

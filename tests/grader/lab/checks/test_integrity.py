@@ -16,6 +16,7 @@ from grader.lab.checks.integrity import (
 from grader.lab.games import allowed_games
 from grader.lab.problems import PROBLEMS
 from grader.sandbox.limits import CallBudget
+from grader.sandbox.outcome import OutcomeStatus
 from grader.sandbox.replay import replay_episode
 from grader.simulated_students.behaviours import cartpole, velocity_policy
 
@@ -244,3 +245,23 @@ def test_budgets_leave_room_for_diagnoses() -> None:
     assert games_budget(1, 1_000) == CallBudget(max_episodes=10, max_steps=9_000)
     calls = PROBLEMS.problem("car").check.plan(small_config("car"), {})
     assert {call.budget for call in calls} == {games_budget(1, 1_000)}
+
+
+@pytest.mark.parametrize(
+    ("status", "env_id", "reason"),
+    [
+        (OutcomeStatus.TIMEOUT, "CartPole-v0", "it did not return in time"),
+        (OutcomeStatus.MEMORY_LIMIT, "CartPole-v0", "it ended with memory limit"),
+        (OutcomeStatus.OK, "Acrobot-v1", "it broke a rule of the game"),
+        (OutcomeStatus.OK, "CartPole-v0", None),
+    ],
+    ids=["timeout", "memory-limit", "another-game", "honest"],
+)
+def test_why_a_call_settles_the_verdict(
+    status: OutcomeStatus, env_id: str, reason: str | None, seed: int
+) -> None:
+    records = simulate("cartpole", {"cartpole": cartpole}, seed, replay=False)
+    outcome = records[0].outcome
+    episodes = [dataclasses.replace(log, env_id=env_id, requested_id=env_id) for log in outcome.episodes]
+    record = replay_call(dataclasses.replace(outcome, status=status, episodes=episodes), CARTPOLE_RULES)
+    assert settled_by(record, CARTPOLE_RULES) == reason
