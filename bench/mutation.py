@@ -299,7 +299,9 @@ BRANCH_MODULES: dict[str, tuple[str, ...]] = {
         "test_guessing_game.py",
         students=_LENGTH_STUDENTS,
     ),
-    "lengths": _files("test_lengths.py", "test_guessing_game.py", students=_LENGTH_STUDENTS),
+    "lengths": _files(
+        "test_lengths.py", "test_guessing_game.py", "test_integrity.py", students=_LENGTH_STUDENTS
+    ),
     "truncation": _files("test_taxi.py", students="taxi"),
     "starts": _files("test_starts.py", "test_integrity.py", students="car and not cartpole"),
     "episodes": _files("test_integrity.py", "test_lengths.py"),
