@@ -117,8 +117,10 @@ def test_a_missing_epsilon_decay_leaves_the_constant_call_graded(seed: int) -> N
         ("table", "'table'"),
         ([[0.0] * 6] * 499, "[[0.0"),
         (np.zeros((500, 6), dtype=bool), "dtype bool"),
+        ([[0.0] * 6] * 499 + [[0.0] * 5], "[[0.0"),
+        ([["a"] * 6] + [[0.0] * 6] * 499, "[['a'"),
     ],
-    ids=["shape", "nan", "str", "short-list", "bool"],
+    ids=["shape", "nan", "str", "short-list", "bool", "short-row", "text-cells"],
 )
 def test_a_returned_value_that_is_no_table_is_refused(value: Any, found: str) -> None:
     table, _, wrong = returned_table(value)
