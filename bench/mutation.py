@@ -14,6 +14,7 @@ cannot see, unless it is listed in `EQUIVALENT` with the reason no test can see 
     python bench/mutation.py --only taxi        # the mutants whose name contains "taxi" (--only repeats)
     python bench/mutation.py --write            # and records the table in bench/RESULTS.md
     python bench/mutation.py --list             # the mutants' names, without running them
+    python bench/mutation.py --survivors        # again the mutants whose latest logged result is survived
 """
 
 from __future__ import annotations
@@ -518,6 +519,9 @@ def main() -> None:
         default=[],
         help="run the mutants whose name contains this text (repeatable)",
     )
+    parser.add_argument(
+        "--survivors", action="store_true", help="run only the chosen mutants whose logged result is survived"
+    )
     parser.add_argument("--list", action="store_true", help="print the chosen mutants' names and stop")
     parser.add_argument(
         "--write", action="store_true", help="record the table of the logged results in bench/RESULTS.md"
@@ -531,6 +535,9 @@ def main() -> None:
         for mutant in MUTANTS
         if not arguments.only or any(text in mutant.name for text in arguments.only)
     ]
+    if arguments.survivors:
+        logged = recorded(RESULTS_LOG)
+        chosen = [mutant for mutant in chosen if logged.get(mutant.name, ("",))[0] == "survived"]
     if arguments.list:
         print("\n".join(mutant.name for mutant in chosen))
         return
