@@ -265,3 +265,10 @@ def test_why_a_call_settles_the_verdict(
     episodes = [dataclasses.replace(log, env_id=env_id, requested_id=env_id) for log in outcome.episodes]
     record = replay_call(dataclasses.replace(outcome, status=status, episodes=episodes), CARTPOLE_RULES)
     assert settled_by(record, CARTPOLE_RULES) == reason
+
+
+def test_a_call_without_episodes_of_a_problem_without_games_does_not_settle_it(seed: int) -> None:
+    """epsilon_decay, find_qvalues: no game (rules None), no episode logged, nothing to refuse."""
+    records = simulate("cartpole", {"cartpole": cartpole}, seed, replay=False)
+    record = replay_call(dataclasses.replace(records[0].outcome, episodes=[]), None)
+    assert (record.replays, settled_by(record, None)) == ([], None)
