@@ -303,3 +303,15 @@ def test_a_table_is_labelled_by_its_names_and_learner_call(
 ) -> None:
     table = NotebookTable(names, learner, decay, episodes, np.zeros((500, 6)))
     assert table.label == label
+
+
+def test_two_decayed_tables_of_one_learner_are_no_constant_epsilon_table(seed: int) -> None:
+    """A notebook that kept a copy of its decayed Q-learning table (two decay=True tables of qlearn)."""
+
+    def cells_with_a_copy(*args: Any, **kwargs: Any) -> dict[str, Any]:
+        value = students.cells(*args, **kwargs)
+        copy = {**value["tables"][0], "names": ["q_table_decay_copy"]}
+        return {**value, "tables": [*value["tables"], copy]}
+
+    verdict = _judge(students.honest, seed, cells=cells_with_a_copy)
+    assert verdict.status == "passed", verdict.feedback
