@@ -18,7 +18,10 @@ from grader.lab.problems import PROBLEMS
 from grader.sandbox.limits import CallBudget
 from grader.sandbox.outcome import OutcomeStatus
 from grader.sandbox.replay import replay_episode
-from grader.simulated_students.behaviours import cartpole, velocity_policy
+from grader.simulated_students.behaviours import (
+    cartpole,
+    velocity_policy,
+)
 
 from .support import grade, simulate, small_config
 
@@ -272,3 +275,33 @@ def test_a_call_without_episodes_of_a_problem_without_games_does_not_settle_it(s
     records = simulate("cartpole", {"cartpole": cartpole}, seed, replay=False)
     record = replay_call(dataclasses.replace(records[0].outcome, episodes=[]), None)
     assert (record.replays, settled_by(record, None)) == ([], None)
+
+
+def _falls_then_steps(counted: bool):  # type: ignore[no-untyped-def]
+    """Pushes right until the pole falls, then 10 more steps; returns the steps until it fell (or all)."""
+
+    def cartpole(lab):  # type: ignore[no-untyped-def]
+        env = lab.make("CartPole-v0")
+        env.reset()
+        steps, done = 0, False
+        while not done:
+            _, _, terminated, truncated, _ = env.step(1)
+            steps, done = steps + 1, terminated or truncated
+        for _ in range(10):
+            env.step(1)
+        return steps + (10 if counted else 0)
+
+    return cartpole
+
+
+def test_steps_after_done_are_noted_on_a_passing_verdict_only(seed: int) -> None:
+    """The note on steps after a game ended goes with a pass (less its deduction), not with a failure."""
+    settings = small_config(
+        "cartpole", calls=5, min_mean_steps=0.0, min_steps=0, post_terminal_steps_deduction=0.1
+    )
+    passed = grade("cartpole", {"cartpole": _falls_then_steps(counted=False)}, seed, settings)
+    assert (passed.status, passed.fraction) == ("passed", 0.9)
+    assert "Note: 5 game(s) kept stepping after the game was over (50 step(s) in all" in passed.feedback
+    failed = grade("cartpole", {"cartpole": _falls_then_steps(counted=True)}, seed, settings)
+    assert (failed.status, failed.fraction) == ("failed", 0.0)
+    assert "Note:" not in failed.feedback
