@@ -359,6 +359,10 @@ EQUIVALENT: dict[str, str] = {
     "neither terminated nor truncated already fails `integrity_problem` (abandoned), and one truncated "
     "cannot be recorded: the env's time limit (max_steps + 1) lies beyond the call's step budget "
     "(max_steps), and a call over its budget ends as episode_limit before any episode is judged",
+    "lengths: never `not shortfalls or any((shortfall is None for shortfall in shortfalls))`": "a None "
+    "shortfall (a count that is no number) returns None below all the same (`first is None`, or "
+    "`shortfall != first`); an empty list needs a judgement of no calls, and every length problem plans "
+    "`calls` >= 1",
 }
 """Surviving mutants that no test can kill, with the reason: the mutated code behaves as the original."""
 

@@ -295,7 +295,8 @@ def _falls_then_steps(counted: bool):  # type: ignore[no-untyped-def]
 
 
 def test_steps_after_done_are_noted_on_a_passing_verdict_only(seed: int) -> None:
-    """The note on steps after a game ended goes with a pass (less its deduction), not with a failure."""
+    """The note on steps after a game ended goes with a pass (less its deduction), not with a failure; without
+    such steps nothing is deducted."""
     settings = small_config(
         "cartpole", calls=5, min_mean_steps=0.0, min_steps=0, post_terminal_steps_deduction=0.1
     )
@@ -305,3 +306,6 @@ def test_steps_after_done_are_noted_on_a_passing_verdict_only(seed: int) -> None
     failed = grade("cartpole", {"cartpole": _falls_then_steps(counted=True)}, seed, settings)
     assert (failed.status, failed.fraction) == ("failed", 0.0)
     assert "Note:" not in failed.feedback
+    stopped = grade("cartpole", {"cartpole": cartpole}, seed, settings)  # no step after the end: no deduction
+    assert (stopped.status, stopped.fraction) == ("passed", 1.0)
+    assert "Note:" not in stopped.feedback and "steps_after_done" not in stopped.measurements
