@@ -6,6 +6,7 @@ passing tests: the exact `false_fail` of each acceptance (below 1e-6, asserted).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from typing import Any
 
@@ -341,12 +342,15 @@ def test_the_cause_of_a_hand_made_deviation(guesses: list[Any], observations: li
 
 def test_a_call_that_raised_gets_no_stopping_hint(seed: int) -> None:
     """An error stays the sandbox's message alone, even when the call's game went on after it was won."""
-
-    def raises_after_playing(lab: Lab) -> int:
-        play(lab, until_equal=True)
-        raise ValueError("after the game")
-
-    verdict = judge(raises_after_playing, seed, _settings(calls=2))
+    register_envs()
+    settings = _settings(calls=2)
+    functions = {"guessing_game": lambda lab: play(lab, until_equal=True)}
+    check = PROBLEMS.problem("guessing_game").check
+    records = simulate_calls(check.plan(settings, function_infos(functions)), functions, seed, replay=True)
+    assert any(replay.steps_after_done > 0 for replay in records[0].replays)
+    raised = dataclasses.replace(
+        records[0].outcome, status=OutcomeStatus.EXCEPTION, value=None, message="ValueError: after the game"
+    )
+    verdict = check.judge(settings, [CallRecord(raised, records[0].replays), *records[1:]])
     assert verdict.status == "error", verdict.feedback
-    assert "ValueError" in verdict.feedback
-    assert "stop on `done`" not in verdict.feedback
+    assert verdict.feedback.endswith("ValueError: after the game")
