@@ -363,6 +363,10 @@ EQUIVALENT: dict[str, str] = {
     "shortfall (a count that is no number) returns None below all the same (`first is None`, or "
     "`shortfall != first`); an empty list needs a judgement of no calls, and every length problem plans "
     "`calls` >= 1",
+    "starts: never `any((u is None for u in scaled))`": "a rank is None only when a feature of a start "
+    "cannot be computed from its replay (a reset that was not replayed); `integrity_problem` refuses such "
+    "logs before it runs the selection test, and every reset that reaches the test was replayed from the "
+    "grader's seed, so its start and features exist: the branch is a guard, not a decision",
 }
 """Surviving mutants that no test can kill, with the reason: the mutated code behaves as the original."""
 

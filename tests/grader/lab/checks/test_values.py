@@ -77,6 +77,7 @@ def test_same_number_accepts_float_rounding_only_to_two_decimals_or_finer() -> N
     assert same_number(0.1 + 0.2, 0.3)
     assert same_number(41.29, 41.2903)
     assert not same_number(41.3, 41.2903)
+    assert same_number(2_000_000 * (1 + 1e-11), 2_000_000.0)  # relative rounding of a large total
 
 
 @pytest.mark.parametrize(
