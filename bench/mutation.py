@@ -367,6 +367,10 @@ EQUIVALENT: dict[str, str] = {
     "cannot be computed from its replay (a reset that was not replayed); `integrity_problem` refuses such "
     "logs before it runs the selection test, and every reset that reaches the test was replayed from the "
     "grader's seed, so its start and features exist: the branch is a guard, not a decision",
+    "values: never `math.isclose(returned, recomputed, rel_tol=1e-09, abs_tol=1e-12)`": "the rounding "
+    "loop below ends with round(recomputed, 15), within 5e-16 of the recomputed number, compared by "
+    "math.isclose with its default rel_tol (1e-9) and the same abs_tol: the same tolerance, so only a "
+    "value within 5e-16 of the tolerance's edge could be judged differently",
 }
 """Surviving mutants that no test can kill, with the reason: the mutated code behaves as the original."""
 
