@@ -486,6 +486,10 @@ def _module(mutant: Mutant) -> str:
 def table(results: dict[str, tuple[str, float]]) -> str:
     """The RESULTS.md section: totals per module, then every mutant (not yet run: `-`)."""
     rows = [(mutant, *results.get(mutant.name, ("-", 0.0))) for mutant in MUTANTS]
+    rows = [  # a survivor listed in EQUIVALENT since its run is reported as such
+        (mutant, "equivalent" if verdict == "survived" and mutant.name in EQUIVALENT else verdict, seconds)
+        for mutant, verdict, seconds in rows
+    ]
     per_module: dict[str, Counter[str]] = {}
     for mutant, verdict, _ in rows:
         kind = verdict.split(" ")[0] if verdict != "-" else "not run"
