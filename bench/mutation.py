@@ -507,7 +507,8 @@ def table(results: dict[str, tuple[str, float]]) -> str:
         "why no test can see it. History: of the 43 hand-written mutants of the first run, 16 survived "
         "until their samples were added (this file's history has that table); of the branch mutants, the "
         "survivors of the first run were given tests (tests/grader/lab/checks/) and run again with "
-        "`--survivors`.",
+        "`--survivors`. Seconds are wall times on the shared two-core machine (load 6 to 13 during the "
+        "2026-11-28 runs), not a benchmark.",
         "",
         f"{len(rows)} mutants: {total['killed']} killed, {total['equivalent']} equivalent, "
         f"{total['survived']} survived" + (f", {total['not run']} not run" if total["not run"] else "") + ".",
