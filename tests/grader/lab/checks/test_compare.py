@@ -1,16 +1,17 @@
 """compare() (edition rl1): after the notebook's cells, honest play passes and each mistake is named."""
 
+import dataclasses
 from typing import Any
 
 import numpy as np
 import pytest
 
 from grader.lab.assignment import load_config
-from grader.lab.checks.base import Verdict
-from grader.lab.checks.compare import NOT_GRADABLE, CompareConfig
+from grader.lab.checks.base import CallRecord, Verdict
+from grader.lab.checks.compare import NOT_GRADABLE, CompareConfig, NotebookTable
 from grader.lab.editions.rl1 import RL1
 from grader.sandbox.child.cells import RUN_CELLS, NotAttemptedError, NotebookCellError
-from grader.sandbox.outcome import OutcomeStatus
+from grader.sandbox.outcome import IMPORT_TIMEOUT, OutcomeStatus
 from grader.simulated_students import compare as students
 from grader.simulated_students.simulation import simulate_calls
 from grader.submission.notebook.cells import RAN_CELLS
@@ -201,3 +202,116 @@ def test_a_mean_off_its_tables_exact_one_fails_on_the_means_alone(seed: int) -> 
         "a mean beyond its tolerance (false-fail probability 1e-06 each) means the episodes were not played "
         "from env.reset() without a seed until they ended."
     ), verdict.feedback
+
+
+def _records(compare: Any, seed: int, cells: Any = students.cells) -> tuple[CompareConfig, list[CallRecord]]:
+    settings = _settings()
+    calls = PROBLEM.check.plan(settings, {})
+    return settings, simulate_calls(calls, {RUN_CELLS: cells, "compare": compare}, seed)
+
+
+def test_cells_without_a_compare_call_are_an_error(seed: int) -> None:
+    settings, records = _records(students.honest, seed)
+    verdict = PROBLEM.check.judge(settings, records[:1])
+    assert verdict.status == "error"
+    assert verdict.feedback.endswith("then called compare(); compare() was not called.")
+
+
+def test_a_compare_over_its_game_budget_is_told_to_play_the_trained_tables(seed: int) -> None:
+    settings, records = _records(students.honest, seed)
+    outcome = dataclasses.replace(records[1].outcome, status=OutcomeStatus.EPISODE_LIMIT, value=None)
+    verdict = PROBLEM.check.judge(settings, [records[0], CallRecord(outcome, records[1].replays)])
+    assert verdict.status == "failed"
+    assert "training inside compare() plays thousands of games (the cells left `q_table_decay`" in (
+        verdict.feedback
+    )
+
+
+def test_a_compare_that_raises_with_tables_left_is_an_error(seed: int) -> None:
+    def raises(_lab: Any) -> Any:
+        raise ValueError("no means today")
+
+    verdict = _judge(raises, seed)
+    assert verdict.status == "error"
+    assert "ValueError: no means today" in verdict.feedback
+    assert "left no Taxi Q-table" not in verdict.feedback
+
+
+@pytest.mark.parametrize("value", ["means", (1.0,), (1.0, None)], ids=["str", "one", "none"])
+def test_a_compare_that_returns_no_pair_of_numbers_fails(value: Any, seed: int) -> None:
+    def returns(lab: Any) -> Any:
+        students.honest(lab)
+        return value
+
+    verdict = _judge(returns, seed)
+    assert verdict.status == "failed"
+    assert "expected two numbers (mean total reward with the Q-learning table, with the SARSA table)" in (
+        verdict.feedback
+    )
+
+
+def test_a_game_abandoned_in_compare_fails_the_integrity_check(seed: int) -> None:
+    def abandons(lab: Any) -> tuple[float, float]:
+        env = lab.make("Taxi-v3")
+        env.reset()
+        env.step(0)
+        return students.honest(lab)
+
+    verdict = _judge(abandons, seed)
+    assert verdict.status == "failed"
+    assert "1 game(s) were abandoned before they ended" in verdict.feedback
+
+
+@pytest.mark.parametrize(
+    "value",
+    [
+        ["not", "a", "dict"],
+        {"cells": [{"cell": 2}], "tables": [{"names": ["q"], "table": np.full((500, 6), np.nan)}]},
+    ],
+    ids=["not-a-dict", "nan-table"],
+)
+def test_cells_values_that_leave_no_usable_table(value: Any, seed: int) -> None:
+    verdict = _judge(students.honest, seed, cells=lambda *_args, **_kwargs: value)
+    assert verdict.status == "failed"
+    assert "your cells left no Taxi Q-table (a 500 x 6 array)" in verdict.feedback
+
+
+def test_a_file_that_does_not_import_in_time_keeps_the_runner_s_message() -> None:
+    settings = _settings()
+    calls = PROBLEM.check.plan(settings, {})
+    records = simulate_calls(calls[:1], {RUN_CELLS: students.cells}, 1)
+    message = f"{IMPORT_TIMEOUT} 60 s: move the training under `if __name__ == '__main__':`"
+    outcome = dataclasses.replace(
+        records[0].outcome, status=OutcomeStatus.TIMEOUT, value=None, message=message
+    )
+    verdict = PROBLEM.check.judge(settings, [CallRecord(outcome, [])])
+    assert (verdict.status, verdict.feedback) == ("timeout", message)
+
+
+@pytest.mark.parametrize(
+    ("names", "learner", "decay", "episodes", "label"),
+    [
+        (("q_table",), None, None, None, "`q_table`"),
+        ((), None, True, 10, "a table"),
+        (("a", "b"), "sarsa0", None, None, "`a` / `b` (from sarsa0())"),
+        (("q",), "qlearn", False, 5, "`q` (from qlearn(decay=False, N=5))"),
+    ],
+    ids=["name-only", "nameless", "learner-only", "learner-and-arguments"],
+)
+def test_a_table_is_labelled_by_its_names_and_learner_call(
+    names: tuple[str, ...], learner: str | None, decay: bool | None, episodes: int | None, label: str
+) -> None:
+    table = NotebookTable(names, learner, decay, episodes, np.zeros((500, 6)))
+    assert table.label == label
+
+
+def test_two_decayed_tables_of_one_learner_are_no_constant_epsilon_table(seed: int) -> None:
+    """A notebook that kept a copy of its decayed Q-learning table (two decay=True tables of qlearn)."""
+
+    def cells_with_a_copy(*args: Any, **kwargs: Any) -> dict[str, Any]:
+        value = students.cells(*args, **kwargs)
+        copy = {**value["tables"][0], "names": ["q_table_decay_copy"]}
+        return {**value, "tables": [*value["tables"], copy]}
+
+    verdict = _judge(students.honest, seed, cells=cells_with_a_copy)
+    assert verdict.status == "passed", verdict.feedback

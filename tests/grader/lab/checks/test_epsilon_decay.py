@@ -95,3 +95,4 @@ def test_a_value_that_is_no_number_fails(value: object) -> None:
     verdict = _judge(lambda _lab, *args: value)
     assert verdict.status == "failed"
     assert "returned no finite number" in verdict.feedback
+    assert verdict.feedback.endswith("argument sets wrong). Return a float.")

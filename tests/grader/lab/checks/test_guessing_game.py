@@ -6,6 +6,7 @@ passing tests: the exact `false_fail` of each acceptance (below 1e-6, asserted).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from typing import Any
 
@@ -20,6 +21,7 @@ from grader.lab.checks.guessing_game import (
     MIDPOINT_SLACK,
     GuessingGameConfig,
     _guess_value,
+    deviation_cause,
     first_deviation,
     total_acceptance,
 )
@@ -137,7 +139,7 @@ def reads_target(lab: Lab) -> int:
         ),
         (
             lambda lab: play(lab, lambda _low, _high, _made, lab: lab.random.uniform(-10_000, 10_000)),
-            "lie outside the interval the target is still in, as random guesses would",
+            "lie outside the interval the target is still in, as random guesses",
         ),
         (
             lambda lab: play(lab, low=-10_000, high=10_000),
@@ -184,6 +186,7 @@ def test_a_count_with_one_guess_too_many_is_off_by_one(seed: int) -> None:
     verdict = judge(lambda lab: play(lab, counted_from=1), seed)
     assert verdict.status == "failed"
     assert "it is off by one" in verdict.feedback
+    assert "stop on `done`" not in verdict.feedback  # no game went on after it was won: no stopping hint
 
 
 def test_guessing_on_until_exactly_equal_is_named(seed: int) -> None:
@@ -294,3 +297,60 @@ def test_a_missing_function_is_missing_before_anything_is_judged() -> None:
         "missing",
         "your file defines no function named `guessing_game`",
     )
+
+
+@pytest.mark.parametrize(
+    ("guesses", "observations", "cause"),
+    [
+        ([[0.0], ["500"]], [1, 2], "each guess must be one number (or a one-element list or array)"),
+        (
+            [[0.0], [300.0]],
+            [1, 1],
+            "guess the midpoint (low + high) / 2 of the interval the target is still in",
+        ),
+        (
+            [[0.0], [300.0], [100.0], [200.0]],
+            [1, 1, 1, 1],
+            "2 of the game's 4 guesses lie outside the interval the target is still in, as random guesses",
+        ),
+        (
+            [[0.0], [-300.0], [-100.0], [-200.0]],
+            [3, 3, 3, 3],
+            "2 of the game's 4 guesses lie outside the interval the target is still in, as random guesses",
+        ),
+        (
+            [[0.0], [300.0], [2000.0], [-2000.0], [3000.0]],
+            [1, 1, 3, 1, 3],
+            "3 of the game's 5 guesses lie outside the interval the target is still in, as random guesses",
+        ),
+    ],
+    ids=[
+        "not-a-number",
+        "two-guesses-are-no-linear-search",
+        "later-guesses-below-a-raised-low",
+        "later-guesses-above-a-lowered-high",
+        "later-guesses-outside-the-targets",
+    ],
+)
+def test_the_cause_of_a_hand_made_deviation(guesses: list[Any], observations: list[int], cause: str) -> None:
+    """A guess that is no number is named as such; two guesses are too few to call a linear search; the
+    guesses outside the interval are counted over the whole game, each end moved by the observations."""
+    deviation = first_deviation(_episode(guesses, observations))
+    assert deviation is not None
+    assert deviation_cause(deviation).startswith(cause)
+
+
+def test_a_call_that_raised_gets_no_stopping_hint(seed: int) -> None:
+    """An error stays the sandbox's message alone, even when the call's game went on after it was won."""
+    register_envs()
+    settings = _settings(calls=2)
+    functions = {"guessing_game": lambda lab: play(lab, until_equal=True)}
+    check = PROBLEMS.problem("guessing_game").check
+    records = simulate_calls(check.plan(settings, function_infos(functions)), functions, seed, replay=True)
+    assert any(replay.steps_after_done > 0 for replay in records[0].replays)
+    raised = dataclasses.replace(
+        records[0].outcome, status=OutcomeStatus.EXCEPTION, value=None, message="ValueError: after the game"
+    )
+    verdict = check.judge(settings, [CallRecord(raised, records[0].replays), *records[1:]])
+    assert verdict.status == "error", verdict.feedback
+    assert verdict.feedback.endswith("ValueError: after the game")

@@ -16,8 +16,12 @@ from grader.lab.checks.integrity import (
 from grader.lab.games import allowed_games
 from grader.lab.problems import PROBLEMS
 from grader.sandbox.limits import CallBudget
+from grader.sandbox.outcome import OutcomeStatus
 from grader.sandbox.replay import replay_episode
-from grader.simulated_students.behaviours import cartpole, velocity_policy
+from grader.simulated_students.behaviours import (
+    cartpole,
+    velocity_policy,
+)
 
 from .support import grade, simulate, small_config
 
@@ -244,3 +248,64 @@ def test_budgets_leave_room_for_diagnoses() -> None:
     assert games_budget(1, 1_000) == CallBudget(max_episodes=10, max_steps=9_000)
     calls = PROBLEMS.problem("car").check.plan(small_config("car"), {}, 0)
     assert {call.budget for call in calls} == {games_budget(1, 1_000)}
+
+
+@pytest.mark.parametrize(
+    ("status", "env_id", "reason"),
+    [
+        (OutcomeStatus.TIMEOUT, "CartPole-v0", "it did not return in time"),
+        (OutcomeStatus.MEMORY_LIMIT, "CartPole-v0", "it ended with memory limit"),
+        (OutcomeStatus.OK, "Acrobot-v1", "it broke a rule of the game"),
+        (OutcomeStatus.OK, "CartPole-v0", None),
+    ],
+    ids=["timeout", "memory-limit", "another-game", "honest"],
+)
+def test_why_a_call_settles_the_verdict(
+    status: OutcomeStatus, env_id: str, reason: str | None, seed: int
+) -> None:
+    records = simulate("cartpole", {"cartpole": cartpole}, seed, replay=False)
+    outcome = records[0].outcome
+    episodes = [dataclasses.replace(log, env_id=env_id, requested_id=env_id) for log in outcome.episodes]
+    record = replay_call(dataclasses.replace(outcome, status=status, episodes=episodes), CARTPOLE_RULES)
+    assert settled_by(record, CARTPOLE_RULES) == reason
+
+
+def test_a_call_without_episodes_of_a_problem_without_games_does_not_settle_it(seed: int) -> None:
+    """epsilon_decay, find_qvalues: no game (rules None), no episode logged, nothing to refuse."""
+    records = simulate("cartpole", {"cartpole": cartpole}, seed, replay=False)
+    record = replay_call(dataclasses.replace(records[0].outcome, episodes=[]), None)
+    assert (record.replays, settled_by(record, None)) == ([], None)
+
+
+def _falls_then_steps(counted: bool):  # type: ignore[no-untyped-def]
+    """Pushes right until the pole falls, then 10 more steps; returns the steps until it fell (or all)."""
+
+    def cartpole(lab):  # type: ignore[no-untyped-def]
+        env = lab.make("CartPole-v0")
+        env.reset()
+        steps, done = 0, False
+        while not done:
+            _, _, terminated, truncated, _ = env.step(1)
+            steps, done = steps + 1, terminated or truncated
+        for _ in range(10):
+            env.step(1)
+        return steps + (10 if counted else 0)
+
+    return cartpole
+
+
+def test_steps_after_done_are_noted_on_a_passing_verdict_only(seed: int) -> None:
+    """The note on steps after a game ended goes with a pass (less its deduction), not with a failure; without
+    such steps nothing is deducted."""
+    settings = small_config(
+        "cartpole", calls=5, min_mean_steps=0.0, min_steps=0, post_terminal_steps_deduction=0.1
+    )
+    passed = grade("cartpole", {"cartpole": _falls_then_steps(counted=False)}, seed, settings)
+    assert (passed.status, passed.fraction) == ("passed", 0.9)
+    assert "Note: 5 game(s) kept stepping after the game was over (50 step(s) in all" in passed.feedback
+    failed = grade("cartpole", {"cartpole": _falls_then_steps(counted=True)}, seed, settings)
+    assert (failed.status, failed.fraction) == ("failed", 0.0)
+    assert "Note:" not in failed.feedback
+    stopped = grade("cartpole", {"cartpole": cartpole}, seed, settings)  # no step after the end: no deduction
+    assert (stopped.status, stopped.fraction) == ("passed", 1.0)
+    assert "Note:" not in stopped.feedback and "steps_after_done" not in stopped.measurements

@@ -64,3 +64,40 @@ def test_counts_short_by_different_amounts_stay_a_failure(seed: int) -> None:
     verdict = grade("car", {"car": uneven}, seed, small_config("car", calls=4))
     assert verdict.status == "failed"
     assert "call 2 of car() returned" in verdict.feedback and "it is off by one" in verdict.feedback
+
+
+def _car_length(lab):  # type: ignore[no-untyped-def]
+    return _episode_length(lab.make("MountainCar-v0"), car_policy)
+
+
+def test_a_count_that_is_no_number_is_named(seed: int) -> None:
+    def says_it(lab):  # type: ignore[no-untyped-def]
+        return f"{_car_length(lab)} steps"
+
+    verdict = grade("car", {"car": says_it}, seed, small_config("car", calls=2))
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith("call 1 of car() returned '")
+    assert verdict.feedback.endswith("steps (replayed); expected a number.")
+
+
+def test_counts_short_by_more_than_a_slip_stay_a_failure(seed: int) -> None:
+    """Every count short by the same 4 steps: more than the lab-era slip of steps before the counted loop."""
+
+    def four_short(lab):  # type: ignore[no-untyped-def]
+        return _car_length(lab) - 4
+
+    verdict = grade("car", {"car": four_short}, seed, small_config("car", calls=3))
+    assert verdict.status == "failed"
+    assert "it is not the length of the episode the call played" in verdict.feedback
+
+
+def test_episodes_of_two_versions_of_the_game_fail(seed: int) -> None:
+    calls = iter(range(10))
+
+    def alternating(lab):  # type: ignore[no-untyped-def]
+        env_id = ("CartPole-v0", "CartPole-v1")[next(calls) % 2]
+        return _episode_length(lab.make(env_id), lambda observation: 1 if observation[3] > 0 else 0)
+
+    verdict = grade("cartpole", {"cartpole": alternating}, seed, small_config("cartpole", calls=2))
+    assert verdict.status == "failed"
+    assert "each problem is graded against one game's exact results" in verdict.feedback

@@ -20,15 +20,15 @@ from grader.simulated_students.simulation import Lab, simulate_calls
 PROBLEM = RL1.registry.problem("sarsa0")
 
 
-def _settings() -> SarsaConfig:
+def _settings(**updates: Any) -> SarsaConfig:
     """The default settings with fewer episodes (the verdicts do not depend on them; the tests run faster)."""
     settings = load_config(RL1.default_config).problems["sarsa0"]
     assert isinstance(settings, SarsaConfig)
-    return settings.model_copy(update={"episodes": 25, "decay_episodes": 10})
+    return settings.model_copy(update={"episodes": 25, "decay_episodes": 10, **updates})
 
 
-def _judge(function: Any, seed: int, decay: Any = students.epsilon_decay) -> Verdict:
-    settings = _settings()
+def _judge(function: Any, seed: int, decay: Any = students.epsilon_decay, **updates: Any) -> Verdict:
+    settings = _settings(**updates)
     calls = PROBLEM.check.plan(settings, {}, 0)
     functions = {"sarsa0": function, "epsilon_decay": decay}
     return PROBLEM.check.judge(settings, simulate_calls(calls, functions, seed))
@@ -117,8 +117,10 @@ def test_a_missing_epsilon_decay_leaves_the_constant_call_graded(seed: int) -> N
         ("table", "'table'"),
         ([[0.0] * 6] * 499, "[[0.0"),
         (np.zeros((500, 6), dtype=bool), "dtype bool"),
+        ([[0.0] * 6] * 499 + [[0.0] * 5], "[[0.0"),
+        ([["a"] * 6] + [[0.0] * 6] * 499, "[['a'"),
     ],
-    ids=["shape", "nan", "str", "short-list", "bool"],
+    ids=["shape", "nan", "str", "short-list", "bool", "short-row", "text-cells"],
 )
 def test_a_returned_value_that_is_no_table_is_refused(value: Any, found: str) -> None:
     table, _, wrong = returned_table(value)
@@ -147,3 +149,81 @@ def test_an_epsilon_decay_returning_no_number_is_not_counted_again(seed: int) ->
     verdict = _judge(crashes_on_decay, seed, decay=no_number)
     assert verdict.status == "passed", verdict.feedback
     assert "The decay=True call is not counted" in verdict.feedback
+
+
+@pytest.mark.parametrize(
+    ("name", "status", "words"),
+    [
+        ("lab_loop", "passed", "the decay=True call (N=10): "),
+        ("ignores_decay", "failed", "you explored less than the decayed schedule asks"),
+    ],
+)
+def test_with_the_grader_s_schedule_the_decay_call_s_exploration_is_judged(
+    name: str, status: str, words: str, seed: int
+) -> None:
+    """decay_schedule = "grader": the decay call is judged against the lab's formula (no student values)."""
+    learner = students.HONEST.get(name) or students.MISTAKES[name][0]
+    verdict = _judge(learner, seed, decay_schedule="grader")
+    assert verdict.status == status, verdict.feedback
+    assert words in verdict.feedback
+    assert "nan" not in verdict.feedback
+
+
+def test_a_call_that_returns_no_table_fails_with_what_it_returned(seed: int) -> None:
+    def returns_a_name(lab: Lab, *args: Any) -> Any:
+        students.HONEST["lab_loop"](lab, *args)
+        return "q_table"
+
+    verdict = _judge(returns_a_name, seed)
+    assert (verdict.status, verdict.feedback) == (
+        "failed",
+        "sarsa0 must return the Q-table, a finite 500 x 6 array (one row per Taxi state), or (table, "
+        "penalties); the call with epsilon constant (N=25) returned 'q_table'. (The grader called sarsa0 "
+        "with the environment's name, 'Taxi-v3', as the template's `env = gym.make(env)` expects.)",
+    )
+
+
+def test_a_game_abandoned_before_training_fails_the_integrity_check(seed: int) -> None:
+    def abandons_a_game(lab: Lab, env: Any, *args: Any) -> Any:
+        game = lab.make(env)
+        game.reset()
+        game.step(0)  # then on to training, the game left unfinished
+        return students.HONEST["lab_loop"](lab, env, *args)
+
+    verdict = _judge(abandons_a_game, seed)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith(
+        "sarsa0, the call with epsilon constant (N=25): 1 game(s) were abandoned before they ended"
+    )
+
+
+def test_a_missing_sarsa0_is_missing_with_the_sandbox_s_message_alone(seed: int) -> None:
+    settings = _settings()
+    calls = PROBLEM.check.plan(settings, {})
+    verdict = PROBLEM.check.judge(
+        settings, simulate_calls(calls, {"epsilon_decay": students.epsilon_decay}, seed)
+    )
+    assert verdict.status == "missing"
+    assert "The grader called sarsa0" not in verdict.feedback
+
+
+def test_exploring_more_than_epsilon_is_named(seed: int) -> None:
+    def explores_at_half(lab: Lab, env: Any, alpha: float, gamma: float, _epsilon: float, *rest: Any) -> Any:
+        return students.HONEST["lab_loop"](lab, env, alpha, gamma, 0.5, *rest)
+
+    verdict = _judge(explores_at_half, seed)
+    assert verdict.status == "failed"
+    assert "you explored more than epsilon asks" in verdict.feedback
+
+
+def test_a_decay_call_without_the_student_s_schedule_is_judged_on_its_updates_alone(seed: int) -> None:
+    """epsilon_decay returns no number but sarsa0 decays on its own: the decay call's table is verified,
+    its exploration is not judged (no schedule to judge it against)."""
+
+    def no_number(lab: Any, episode: int, n: int) -> None:
+        return None
+
+    verdict = _judge(students.HONEST["lab_loop"], seed, decay=no_number)
+    assert verdict.status == "passed", verdict.feedback
+    assert verdict.measurements["decay_updates"] > 0
+    assert np.isnan(verdict.measurements["decay_tolerance"])

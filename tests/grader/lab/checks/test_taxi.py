@@ -3,17 +3,21 @@
 False-fail probability of each passing test: 3e-6 (two z-tests and one chi-square test at 1e-6).
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
 
+from grader.lab.checks.base import CallRecord
 from grader.lab.checks.taxi import takes_q_table
 from grader.lab.problems import PROBLEMS
 from grader.sandbox.outcome import FunctionInfo, ParameterInfo
-from grader.simulated_students.behaviours import taxi
+from grader.sandbox.replay import replay_episode
+from grader.simulated_students.behaviours import _taxi_ignoring_truncation, taxi
 from reference.oracles import optimal_q_table
 from reference.oracles.taxi import detour_q_table
 
-from .support import deal_only_hard_starts, grade, small_config
+from .support import deal_only_hard_starts, grade, simulate, small_config
 
 
 def _info(*kinds: str) -> dict[str, FunctionInfo]:
@@ -291,3 +295,19 @@ def test_a_greedy_mean_off_the_given_tables_fails_on_that_mean_alone(seed: int) 
         "taxi: the optimal table averages 7.930 ± 0.896 and beats random actions; "
         "your Q-table episodes averaged "
     ), verdict.feedback
+
+
+def test_an_altered_episode_is_named_before_a_loop_that_ignored_truncated(seed: int) -> None:
+    """Episodes that ran past the time limit, one of them with forged rewards: the episode that does not
+    replay is named (the truncation diagnosis is only made on episodes that all replayed as logged)."""
+    records = simulate("taxi", {"taxi": _taxi_ignoring_truncation}, seed)
+    first = records[0]
+    forged = dataclasses.replace(
+        first.outcome.episodes[0], rewards=[5.0] * len(first.outcome.episodes[0].rewards)
+    )
+    outcome = dataclasses.replace(first.outcome, episodes=[forged, *first.outcome.episodes[1:]])
+    altered = [CallRecord(outcome, [replay_episode(forged), *first.replays[1:]])]
+    assert any(replay.steps_after_done > 0 for replay in first.replays[1:])  # the loop ignored truncated
+    verdict = PROBLEMS.problem("taxi").check.judge(small_config("taxi"), altered)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith("taxi: episode 1 of call 1 did not replay")

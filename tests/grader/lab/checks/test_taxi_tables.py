@@ -84,3 +84,26 @@ def test_a_mean_off_its_tables_exact_one_fails_on_the_means_alone(seed: int) -> 
     assert verdict.status == "failed", verdict.feedback
     assert verdict.feedback.startswith("taxi: "), verdict.feedback
     assert "beyond the tolerance (false-fail probability 1e-06 each)" in verdict.feedback, verdict.feedback
+
+
+@pytest.mark.parametrize("value", ["means", (5.7,), (5.7, None)], ids=["str", "one", "none"])
+def test_a_call_that_returns_no_pair_of_numbers_fails(value: Any, seed: int) -> None:
+    def returns(lab: Any, q_table: Any, q_table_decay: Any) -> Any:
+        students.honest(lab, q_table, q_table_decay)
+        return value
+
+    verdict = _judge(returns, seed)
+    assert verdict.status == "failed"
+    assert "expected two numbers (mean total reward with q_table, with q_table_decay)" in verdict.feedback
+
+
+def test_a_game_abandoned_before_the_tables_episodes_fails_the_integrity_check(seed: int) -> None:
+    def abandons(lab: Any, q_table: Any, q_table_decay: Any) -> tuple[float, float]:
+        env = lab.make("Taxi-v3")
+        env.reset()
+        env.step(0)
+        return students.honest(lab, q_table, q_table_decay)
+
+    verdict = _judge(abandons, seed)
+    assert verdict.status == "failed"
+    assert verdict.feedback.startswith("taxi: 1 game(s) were abandoned before they ended")

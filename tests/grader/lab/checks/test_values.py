@@ -7,6 +7,7 @@ from grader.lab.checks.values import (
     GameCounts,
     as_number,
     chance_text,
+    describe,
     rate_mismatch_cause,
     read_rate,
     same_number,
@@ -76,6 +77,7 @@ def test_same_number_accepts_float_rounding_only_to_two_decimals_or_finer() -> N
     assert same_number(0.1 + 0.2, 0.3)
     assert same_number(41.29, 41.2903)
     assert not same_number(41.3, 41.2903)
+    assert same_number(2_000_000 * (1 + 1e-11), 2_000_000.0)  # relative rounding of a large total
 
 
 @pytest.mark.parametrize(
@@ -118,3 +120,12 @@ def test_a_single_precision_rate_is_the_replayed_rate(wins: int) -> None:
     rate = wins / 10_000
     assert same_number(float(np.float32(rate)), rate)
     assert not same_number(float(np.float32(rate + 1e-4)), rate)
+
+
+@pytest.mark.parametrize(
+    ("value", "shown"),
+    [(0.1 + 0.2, "0.3"), (1 / 3, "0.333333"), (7, "7"), ("x" * 70, "'" + "x" * 56 + "..."), (None, "None")],
+    ids=["float-rounding", "float-digits", "int", "long-text", "none"],
+)
+def test_describe(value: object, shown: str) -> None:
+    assert describe(value) == shown
