@@ -206,7 +206,7 @@ def test_a_mean_off_its_tables_exact_one_fails_on_the_means_alone(seed: int) -> 
 
 def _records(compare: Any, seed: int, cells: Any = students.cells) -> tuple[CompareConfig, list[CallRecord]]:
     settings = _settings()
-    calls = PROBLEM.check.plan(settings, {})
+    calls = PROBLEM.check.plan(settings, {}, 0)
     return settings, simulate_calls(calls, {RUN_CELLS: cells, "compare": compare}, seed)
 
 
@@ -278,7 +278,7 @@ def test_cells_values_that_leave_no_usable_table(value: Any, seed: int) -> None:
 
 def test_a_file_that_does_not_import_in_time_keeps_the_runner_s_message() -> None:
     settings = _settings()
-    calls = PROBLEM.check.plan(settings, {})
+    calls = PROBLEM.check.plan(settings, {}, 0)
     records = simulate_calls(calls[:1], {RUN_CELLS: students.cells}, 1)
     message = f"{IMPORT_TIMEOUT} 60 s: move the training under `if __name__ == '__main__':`"
     outcome = dataclasses.replace(

@@ -346,7 +346,7 @@ def test_a_call_that_raised_gets_no_stopping_hint(seed: int) -> None:
     settings = _settings(calls=2)
     functions = {"guessing_game": lambda lab: play(lab, until_equal=True)}
     check = PROBLEMS.problem("guessing_game").check
-    records = simulate_calls(check.plan(settings, function_infos(functions)), functions, seed, replay=True)
+    records = simulate_calls(check.plan(settings, function_infos(functions), 0), functions, seed, replay=True)
     assert any(replay.steps_after_done > 0 for replay in records[0].replays)
     raised = dataclasses.replace(
         records[0].outcome, status=OutcomeStatus.EXCEPTION, value=None, message="ValueError: after the game"

@@ -199,7 +199,7 @@ def test_a_game_abandoned_before_training_fails_the_integrity_check(seed: int) -
 
 def test_a_missing_sarsa0_is_missing_with_the_sandbox_s_message_alone(seed: int) -> None:
     settings = _settings()
-    calls = PROBLEM.check.plan(settings, {})
+    calls = PROBLEM.check.plan(settings, {}, 0)
     verdict = PROBLEM.check.judge(
         settings, simulate_calls(calls, {"epsilon_decay": students.epsilon_decay}, seed)
     )
