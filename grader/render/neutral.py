@@ -166,7 +166,7 @@ def file_name(name: str) -> str:
     """
     leaf = name.replace("\\", "/").rstrip("/").rsplit("/", 1)[-1]
     shown = display_text(leaf, MAX_FILE_NAME_CHARS) or BLANK
-    return "'" + shown if _runs_as_formula(shown) else shown
+    return "'" + bounded(shown, MAX_FILE_NAME_CHARS - 1) if _runs_as_formula(shown) else shown
 
 
 def safe_cell(value: object) -> str:
