@@ -162,6 +162,7 @@ def grade_files(
         session = SessionPlan(
             grading=plan,
             submissions=tuple(submission.module.resolve() for submission in collector.graded),
+            names=tuple(_sandbox_name(submission) for submission in collector.graded),
             seed=seed,
             policy=policy,
         )
@@ -200,6 +201,15 @@ def _prepare(
     write_cells(module, built.cells)
     note = _edition_note(built.source.encode("utf-8"), shown, plan)
     return Submission(path, data, module, built, edition_note=note, name=shown)
+
+
+def _sandbox_name(submission: Submission) -> str:
+    """The name the sandbox's messages give a file (``--name``), or "" to let them name its copy as before:
+    given only when the file is shown by another name than its own (a class's zip is read into numbered
+    copies), as its copy would be called (a notebook's module is ``<notebook>.py``)."""
+    if not submission.name or submission.name == submission.path.name:
+        return ""
+    return f"{submission.name}.py" if submission.notebook is not None else submission.name
 
 
 def _edition_note(source: bytes, name: str, plan: GradingPlan) -> str | None:

@@ -13,7 +13,9 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from grading_support import FAST_OVERRIDES, write_config
 
+from grader import cli
 from grader.classroom import GradedFileRule, command, discover
 from grader.classroom.output import ClassGradebook
 from grader.classroom.similarity.run import run_similarity
@@ -184,3 +186,38 @@ def test_the_similarity_check_names_a_zips_files_as_the_download_does(tmp_path: 
     reasons = " ".join(entry.reason for entry in report.unreadable)
     assert f"{BROKEN_ENTRY} is not valid Python" in reasons
     assert f"{NOTEBOOK_ENTRY} " in reasons
+
+
+RAISES_ENTRY = "raiserosa_3005_7005_opengym.py"
+
+
+@pytest.mark.slow  # a grading through the sandbox
+def test_gymgrade_grade_names_a_canvas_zips_files_as_the_download_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The real command: the honest file, the broken one, the notebook and a file raising at import (whose
+    message comes from the sandbox) are each reported under the name the download gives them."""
+    config = write_config(tmp_path / "fast.toml", FAST_OVERRIDES)
+    download = _canvas_zip(tmp_path / "download" / "submissions.zip")
+    with zipfile.ZipFile(download, "a") as bundle:
+        bundle.writestr(RAISES_ENTRY, b"raise RuntimeError('boom at import')\n")
+    out = tmp_path / "out"
+    argv = ["grade", str(download), "--out", str(out), "--only", "random_blackjack", "--seed", "11"]
+    argv += ["--config", str(config), "--allow-weak-isolation", "--due", DUE.isoformat()]
+    assert cli.main(argv) == 0
+    capsys.readouterr()
+    reports = {path.stem: json.loads(path.read_text("utf-8")) for path in out.glob("*.json")}
+    assert {identity: report["submission"] for identity, report in reports.items()} == {
+        "3001": BROKEN_ENTRY,
+        "3002": NOTEBOOK_ENTRY,
+        "3003": HONEST_ENTRY,
+        "3004": file_name(HOSTILE_FILE),
+        "3005": RAISES_ENTRY,
+    }
+    assert reports["3003"]["score"] == reports["3003"]["max_score"]
+    assert str(reports["3001"]["submission_error"]).startswith(f"{BROKEN_ENTRY} is not valid Python")
+    (raised,) = reports["3005"]["problems"]
+    feedback = str(raised["feedback"])
+    assert f"importing {RAISES_ENTRY} raised RuntimeError: boom at import" in feedback
+    assert f'File "/submission/{RAISES_ENTRY}", line 1, in <module>' in feedback
+    assert not re.search(r"(?<![\w-])\d+\.py", feedback), feedback
