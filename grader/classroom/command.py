@@ -167,7 +167,8 @@ def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> 
         for submission in download.submissions
         if submission.graded_file is not None
     }
-    editions = class_editions(files)
+    shown = file_names_of(download.submissions)
+    editions = class_editions(files, {identity: shown[path] for identity, path in files.items()})
     if editions.disagreement is not None:
         for line in editions.lines()[1:]:  # each file's edition and why
             print(terminal_line(line), file=sys.stderr, flush=True)

@@ -221,3 +221,19 @@ def test_gymgrade_grade_names_a_canvas_zips_files_as_the_download_does(
     assert f"importing {RAISES_ENTRY} raised RuntimeError: boom at import" in feedback
     assert f'File "/submission/{RAISES_ENTRY}", line 1, in <module>' in feedback
     assert not re.search(r"(?<![\w-])\d+\.py", feedback), feedback
+
+
+def test_edition_detection_names_a_zips_files_as_the_download_does(tmp_path: Path) -> None:
+    from grader.lab.editions.per_submission import class_editions
+
+    download = discover(
+        _canvas_zip(tmp_path / "download" / "submissions.zip"),
+        rule=RULE,
+        scratch=tmp_path / "scratch",
+        due=DUE,
+    )
+    files = {s.identity: s.graded_file.path for s in download.submissions if s.graded_file}
+    shown = command.file_names_of(download.submissions)
+    lines = class_editions(files, {identity: shown[path] for identity, path in files.items()}).lines()
+    assert any(f"{BROKEN_ENTRY} could not be read as Python" in line for line in lines), lines
+    assert not any(re.search(r"(?<![\w-])\d+\.py", line) for line in lines), lines
