@@ -14,7 +14,7 @@ import logging
 import time
 import tomllib
 import uuid
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -110,9 +110,18 @@ class CeleryExecutor:
         return describe(self.settings)
 
     def grade(
-        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
+        self,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        *,
+        seed: int,
+        listener: GradingListener,
+        file_names: Mapping[Path, str] | None = None,
     ) -> None:
         """Send every file to the cluster and hand each report over as it arrives.
+
+        ``file_names`` (each file's own name as shown) is not yet carried to the cluster: its workers name
+        a file by ``path.name``, so a class read from a zip shows the numbered names there.
 
         A broker restart during the batch loses its queued tasks: once the broker answers again, every
         file still outstanding is sent again (a report that arrives twice is taken once).
@@ -135,7 +144,15 @@ class CeleryExecutor:
             try:
                 data = read_untrusted(path, limit=READ_LIMIT)
             except UnsafeFile:  # a link or unreadable: refused without any grading, no need for the cluster
-                grade_files([path], plan, seed=seed, workers=1, policy=self.policy, listener=listener)
+                grade_files(
+                    [path],
+                    plan,
+                    seed=seed,
+                    workers=1,
+                    policy=self.policy,
+                    listener=listener,
+                    names=file_names,
+                )
                 continue
             key = str(index)
             contents[key], pending[key] = data, path

@@ -23,7 +23,7 @@ from grader.seeds import held_out_seed
 
 if TYPE_CHECKING:
     from grader.classroom.kept import InstructorData
-    from grader.classroom.model import ClassDownload
+    from grader.classroom.model import ClassDownload, Submission
     from grader.classroom.output import ClassGradebook
     from grader.classroom.roster import Roster
     from grader.grading.batch import BatchExecutor
@@ -106,10 +106,28 @@ def grade_class(args: argparse.Namespace) -> int:
             assignment,
             decisions=instructor.decisions,
         )
-        code = _grade_class(args, list(identities), identities, gradebook, regrade, instructor)
+        code = _grade_class(
+            args, list(identities), identities, gradebook, regrade, instructor, file_names_of(graded)
+        )
         if args.similarity and code != EXIT_INTERRUPTED:
             return _similarity_beside_grading(args, download) or code
         return code
+
+
+def file_names_of(submissions: Sequence[Submission]) -> dict[Path, str]:
+    """Each graded file's own name as the download gives it (``graded_file.relative``'s last part,
+    neutralised and bounded by `grader.render.neutral.file_name`), for what a person reads of its grading.
+
+    A zip's entries are read into numbered files (``6.py``), so that no name a student or an LMS chose ever
+    reaches the file system; this name is only shown, never used as a path. A folder's files keep their own
+    names, so for them it is their ``path.name``."""
+    from grader.render.neutral import file_name
+
+    return {
+        submission.graded_file.path: file_name(submission.graded_file.relative)
+        for submission in submissions
+        if submission.graded_file is not None
+    }
 
 
 def _instructor_data(
@@ -149,7 +167,8 @@ def _detect_class_edition(args: argparse.Namespace, download: ClassDownload) -> 
         for submission in download.submissions
         if submission.graded_file is not None
     }
-    editions = class_editions(files)
+    shown = file_names_of(download.submissions)
+    editions = class_editions(files, {identity: shown[path] for identity, path in files.items()})
     if editions.disagreement is not None:
         for line in editions.lines()[1:]:  # each file's edition and why
             print(terminal_line(line), file=sys.stderr, flush=True)
@@ -249,6 +268,7 @@ def _grade_class(
     gradebook: ClassGradebook,
     regrade: set[Path] | None = None,
     instructor: InstructorData | None = None,
+    file_names: dict[Path, str] | None = None,
 ) -> int:
     from grader.classroom.kept import regrade_refusal
     from grader.grading.batch import BatchOutcome, grade_many
@@ -306,6 +326,7 @@ def _grade_class(
             names=identities,
             gradebook=gradebook,
             regrade=regrade,
+            file_names=file_names,
         )
     except BatchInterrupted as interruption:
         print(

@@ -69,10 +69,17 @@ class BatchExecutor(Protocol):
     """Grades files and hands over each report as soon as that file is done (in any order)."""
 
     def grade(
-        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
+        self,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        *,
+        seed: int,
+        listener: GradingListener,
+        file_names: Mapping[Path, str] | None = None,
     ) -> None:
         """Grade ``paths`` with ``seed`` under ``plan``; tell ``listener`` each result (progress) and each
-        file's report once, as it finishes.
+        file's report once, as it finishes. ``file_names``: each file's own name as shown (see
+        ``grade_files``' ``names``), ``path.name`` for a file without one.
 
         Raises:
             KeyboardInterrupt: The batch was interrupted; reports already handed over are kept.
@@ -93,12 +100,26 @@ class LocalExecutor:
     policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL
 
     def grade(
-        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
+        self,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        *,
+        seed: int,
+        listener: GradingListener,
+        file_names: Mapping[Path, str] | None = None,
     ) -> None:
         """Grade ``paths`` locally; see :class:`BatchExecutor`."""
         for start in range(0, len(paths), CHUNK_SUBMISSIONS):
             chunk = paths[start : start + CHUNK_SUBMISSIONS]
-            grade_files(chunk, plan, seed=seed, workers=self.workers, policy=self.policy, listener=listener)
+            grade_files(
+                chunk,
+                plan,
+                seed=seed,
+                workers=self.workers,
+                policy=self.policy,
+                listener=listener,
+                names=file_names,
+            )
 
 
 def report_names(paths: Sequence[Path]) -> dict[Path, str]:
@@ -293,6 +314,7 @@ def grade_many(
     names: Mapping[Path, str] | None = None,
     gradebook: GradebookWriter | None = None,
     regrade: Collection[Path] | None = None,
+    file_names: Mapping[Path, str] | None = None,
 ) -> BatchOutcome:
     """Grade many submissions; keep ``<name>.json`` per submission and ``grades.csv`` in ``out_dir``.
 
@@ -318,6 +340,8 @@ def grade_many(
         regrade: Grade exactly these files, whatever their reports say; every other file's report in
             ``out_dir`` is taken as it is (never graded, never rewritten; left out when there is none).
             None: grade what is stale.
+        file_names: Each file's own name as a person reads it, neutralised (a class's zip is read into
+            numbered files); its messages and its report's ``submission`` say it. ``path.name`` when None.
 
     Returns:
         Every report in the order of ``paths`` (with ``regrade``, those that exist), and which files were
@@ -353,7 +377,7 @@ def grade_many(
     if outcome.graded:
         try:
             (executor or LocalExecutor(workers, policy)).grade(
-                outcome.graded, plan, seed=seed, listener=output
+                outcome.graded, plan, seed=seed, listener=output, file_names=file_names
             )
         except KeyboardInterrupt as interruption:
             raise BatchInterrupted(len(output.reports), len(paths)) from interruption

@@ -111,6 +111,7 @@ def run_problem(
     config: AssignmentConfig,
     grading_seed: int,
     policy: IsolationPolicy,
+    shown_name: str = "",
 ) -> ProblemRun:
     """Run one problem's planned calls in a fresh sandbox, replay every episode and judge.
 
@@ -138,7 +139,7 @@ def run_problem(
     games = settings.game_rules()
     records: list[CallRecord] = []
     stopped: str | None = None
-    with Sandbox(submission, seed=seed, limits=limits, policy=policy) as sandbox:
+    with Sandbox(submission, seed=seed, limits=limits, policy=policy, shown_name=shown_name) as sandbox:
         calls = check.plan(settings, FunctionsOnDemand(sandbox), seed)
         for call in calls:
             if call.function == RUN_CELLS:  # the cells are the submission's, known here, not to the plan

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import tempfile
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 from grader.grading.outcomes import GradingListener, OnResult, Outcomes, Silent, Submission
@@ -108,6 +108,7 @@ def grade_files(
     workers: int | None,
     policy: IsolationPolicy,
     listener: GradingListener | None = None,
+    names: Mapping[Path, str] | None = None,
 ) -> list[Report]:
     """Grade several files in one acceptance session (work spread over all workers), a report per file.
 
@@ -120,6 +121,10 @@ def grade_files(
         listener: Hears each problem's result as its check finishes, and each file's report as soon as
             its last check finishes (at once for a file refused without running), so a batch can keep
             each report the moment it exists.
+        names: Each file's own name as shown to a person, already neutralised (a class's zip is read
+            into numbered files: ``6.py`` on disk is ``policy_iteration.py`` in the download): its
+            messages and its report's ``submission`` say it. Only ever shown, never a path; a file's
+            ``path.name`` when it has none.
 
     Returns:
         One report per path, in the order given.
@@ -134,9 +139,10 @@ def grade_files(
         prepared: dict[Path, tuple[bytes | None, Submission | FileVerdict]] = {}
         for index, path in enumerate(files):
             read = _read(path)
+            shown = (names or {}).get(path) or path.name
             prepared[path] = (
                 read if isinstance(read, bytes) else None,
-                _prepare(path, read, Path(modules_dir) / str(index), plan),
+                _prepare(path, read, Path(modules_dir) / str(index), plan, shown),
             )
         graded = sum(1 for _, submission in prepared.values() if isinstance(submission, Submission))
         worker_count = min(workers or default_workers(), max(graded * len(plan.problems), 1))
@@ -145,7 +151,7 @@ def grade_files(
         )
         for path, (data, submission) in prepared.items():
             if isinstance(submission, FileVerdict):
-                collector.reject(path, data or b"", submission)
+                collector.reject(path, data or b"", submission, (names or {}).get(path) or path.name)
             else:
                 collector.expect(submission)
         if not collector.graded or not plan.problems:
@@ -156,6 +162,7 @@ def grade_files(
         session = SessionPlan(
             grading=plan,
             submissions=tuple(submission.module.resolve() for submission in collector.graded),
+            names=tuple(_sandbox_name(submission) for submission in collector.graded),
             seed=seed,
             policy=policy,
         )
@@ -167,32 +174,42 @@ def grade_files(
 
 
 def _prepare(
-    path: Path, data: bytes | FileVerdict, module_dir: Path, plan: GradingPlan
+    path: Path, data: bytes | FileVerdict, module_dir: Path, plan: GradingPlan, shown: str
 ) -> Submission | FileVerdict:
     """The file the sandbox imports for a submission, in ``module_dir`` (the grader's own folder): a copy of
     the bytes read once, or the module built from a notebook; a verdict when it cannot be graded.
 
     The student's file is never read again after `_read`: a file swapped or linked in meanwhile, or a
-    ``<name>.cells.json`` planted beside it, is not what is graded."""
+    ``<name>.cells.json`` planted beside it, is not what is graded. ``shown`` is the file's own name in
+    what a person reads; its kind (notebook or not) and its copies on disk follow ``path.name``."""
     if isinstance(data, FileVerdict):
         return data
     if not is_notebook(path.name):
-        verdict = check_source(data, path.name)
+        verdict = check_source(data, shown)
         if verdict is not None:
             return verdict
         module_dir.mkdir()
         module = module_dir / path.name
         module.write_bytes(data)
-        return Submission(path, data, module, edition_note=_edition_note(data, path.name, plan))
-    built = build_module(data, path.name, plan.problems)
+        return Submission(path, data, module, edition_note=_edition_note(data, shown, plan), name=shown)
+    built = build_module(data, shown, plan.problems)
     if isinstance(built, FileVerdict):
         return built
     module = module_dir / f"{path.name}.py"
     module_dir.mkdir()
     module.write_text(built.source, encoding="utf-8")
     write_cells(module, built.cells)
-    note = _edition_note(built.source.encode("utf-8"), path.name, plan)
-    return Submission(path, data, module, built, edition_note=note)
+    note = _edition_note(built.source.encode("utf-8"), shown, plan)
+    return Submission(path, data, module, built, edition_note=note, name=shown)
+
+
+def _sandbox_name(submission: Submission) -> str:
+    """The name the sandbox's messages give a file (``--name``), or "" to let them name its copy as before:
+    given only when the file is shown by another name than its own (a class's zip is read into numbered
+    copies), as its copy would be called (a notebook's module is ``<notebook>.py``)."""
+    if not submission.name or submission.name == submission.path.name:
+        return ""
+    return f"{submission.name}.py" if submission.notebook is not None else submission.name
 
 
 def _edition_note(source: bytes, name: str, plan: GradingPlan) -> str | None:

@@ -93,6 +93,8 @@ class Submission:
     module: Path
     notebook: NotebookModule | None = None
     edition_note: str | None = None
+    name: str = ""
+    """The file's own name as shown to a person (`grade_files`' ``names``); ``path.name`` when empty."""
 
 
 class Outcomes:
@@ -126,8 +128,9 @@ class Outcomes:
         self.reports: dict[Path, Report] = {}
         self.unavailable: list[str] = []
 
-    def reject(self, path: Path, data: bytes, verdict: FileVerdict) -> None:
-        """A file refused before anything ran (unreadable, empty, not Python, too large): its report now."""
+    def reject(self, path: Path, data: bytes, verdict: FileVerdict, name: str = "") -> None:
+        """A file refused before anything ran (unreadable, empty, not Python, too large): its report now
+        (``name``: the file's own name as shown, ``path.name`` when empty)."""
         results = [
             ProblemResult(
                 id=problem,
@@ -141,7 +144,9 @@ class Outcomes:
             )
             for problem in self.plan.problems
         ]
-        report = build_report(path, data, self.seed, self.plan, results, submission_error=verdict.message)
+        report = build_report(
+            path, data, self.seed, self.plan, results, name=name, submission_error=verdict.message
+        )
         for result in results:
             self.listener.result(path, result)
         self._finish(path, report)
@@ -213,6 +218,7 @@ class Outcomes:
             self.seed,
             self.plan,
             results,
+            name=submission.name,
             isolation=next((run.isolation for run in runs if run.isolation), None),
             edition_note=submission.edition_note,
             grader_errors=[
@@ -236,13 +242,16 @@ def build_report(
     seed: int,
     plan: GradingPlan,
     results: Sequence[ProblemResult],
+    *,
+    name: str = "",
     **grading: Any,
 ) -> Report:
     """The report of a file from its problems' results (in the plan's order): what every report states of
     the file, the grading and the grader, the score, and ``grading``'s further fields of `Report`
-    (``isolation``, ``grader_errors``, ``timings``, ``submission_error``, ...)."""
+    (``isolation``, ``grader_errors``, ``timings``, ``submission_error``, ...). ``name`` is the file's own
+    name as shown (a class's download names it, its copy on disk may be numbered); ``path.name`` if empty."""
     return Report(
-        submission=path.name,
+        submission=name or path.name,
         sha256=hashlib.sha256(data).hexdigest(),
         seed=seed,
         config_sha256=plan.config_sha256,

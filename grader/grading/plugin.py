@@ -70,6 +70,9 @@ class SessionPlan:
     submissions: tuple[Path, ...]
     seed: int
     policy: IsolationPolicy
+    names: tuple[str, ...] = ()
+    """Each submission's own name as shown (``grade_files``' ``names``), in ``submissions``' order; the
+    sandbox's messages say it (its copy may be numbered). Empty: each file's own name."""
 
     @property
     def problems(self) -> tuple[ProblemId, ...]:
@@ -91,6 +94,7 @@ class SessionPlan:
             "submissions": [str(path) for path in self.submissions],
             "seed": self.seed,
             "policy": self.policy.value,
+            "names": list(self.names),
         }
         # json.dumps escapes the lone surrogates a file name that is not UTF-8 decodes to.
         return f"{PLAN_OPTION}={json.dumps(data)}"
@@ -104,6 +108,7 @@ class SessionPlan:
             submissions=tuple(Path(path) for path in data["submissions"]),
             seed=int(data["seed"]),
             policy=IsolationPolicy(data["policy"]),
+            names=tuple(str(name) for name in data.get("names", ())),
         )
 
 
@@ -179,6 +184,7 @@ class GradingSession:
                 config=self.assignment,
                 grading_seed=self.plan.seed,
                 policy=self.plan.policy,
+                shown_name=self.plan.names[case.index] if case.index < len(self.plan.names) else "",
             )
         except Exception as error:
             return GraderFailure.of(error)

@@ -148,6 +148,27 @@ def inert(text: str) -> str:
     )
 
 
+MAX_FILE_NAME_CHARS = 120
+"""Characters of a submitted file's own name shown (the longest a common file system allows is 255 bytes)."""
+
+
+def file_name(name: str) -> str:
+    """A submitted file's own name as a person reads it: the last component of its path in the download
+    (``/`` or ``\\`` separated, so ``../`` shows nothing of where it claims to be), as ``display_text``
+    (``MAX_FILE_NAME_CHARS``), with an apostrophe before a formula start as in ``safe_cell``; ``(blank)``
+    when nothing is left. Only ever shown: it never names anything on disk.
+
+    Args:
+        name: The name (or ``/``-separated path) the student or the LMS gave the file: any string.
+
+    Returns:
+        One bounded line, e.g. ``smithjohn_12345_678_policy_iteration-1.py``.
+    """
+    leaf = name.replace("\\", "/").rstrip("/").rsplit("/", 1)[-1]
+    shown = display_text(leaf, MAX_FILE_NAME_CHARS) or BLANK
+    return "'" + bounded(shown, MAX_FILE_NAME_CHARS - 1) if _runs_as_formula(shown) else shown
+
+
 def safe_cell(value: object) -> str:
     """A spreadsheet cell's text: ``inert``, with an apostrophe before a start that a spreadsheet would run
     (``=``, ``+``, ``-``, ``@``, a leading tab or carriage return, any of them after blanks, or their

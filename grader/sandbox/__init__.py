@@ -41,7 +41,7 @@ The sandbox's contract, beyond the types the code declares:
   under xdist or alone gives identical outcomes. Calls never share RNG state.
 - The child harness (`grader/sandbox/child/`, stdlib + numpy + gymnasium + `grader.compat` only) starts as
   `python -I -B <root>/grader/sandbox/child/__main__.py --submission P --requests FD --results FD
-  [--max-frame BYTES] [--seed IMPORT_SEED] [--max-recorded-steps N]` (or `runpy.run_module(
+  [--max-frame BYTES] [--seed IMPORT_SEED] [--max-recorded-steps N] [--name SHOWN]` (or `runpy.run_module(
   "grader.sandbox.child", run_name="__main__")` with `sys.path` prepared); frames and plain-data
   encoding are `grader/sandbox/child/frames.py`, used by both sides. The harness tree the child imports
   from (`filesystem.harness_tree()`, one per grader process, read-only in the child) carries the bytecode

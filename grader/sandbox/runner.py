@@ -78,6 +78,7 @@ class Sandbox:
         limits: Limits | None = None,
         policy: IsolationPolicy = IsolationPolicy.REQUIRE_FULL,
         isolation: IsolationReport | None = None,
+        shown_name: str = "",
     ) -> None:
         """Prepares the sandbox (the child starts with the first call or `functions`).
 
@@ -88,6 +89,8 @@ class Sandbox:
             policy: Whether missing isolation layers are refused (`REQUIRE_FULL`) or reported.
             isolation: The layers to apply, from `probe_isolation(disable=...)` (default: every layer
                 this machine offers).
+            shown_name: The file's own name in the child's messages (a class's zip is graded from numbered
+                copies); plain data, never a path. The submission's file name when empty.
 
         Raises:
             IsolationUnavailable: `policy` is REQUIRE_FULL and a required layer is missing.
@@ -98,6 +101,7 @@ class Sandbox:
         self.limits = limits or Limits()
         self._source = submission.read_bytes()
         self._name = _file_name(submission)
+        self._shown_name = shown_name
         self._next_index = 0
         self._child: ChildProcess | None = None
         self._functions: dict[str, FunctionInfo] = {}
@@ -273,6 +277,7 @@ class Sandbox:
                 requests_fd=requests_fd,
                 results_fd=results_fd,
                 import_seed=derive_call_seed(self.seed, IMPORT_SEED_INDEX),
+                shown_name=self._shown_name,
             )
 
         try:

@@ -6,7 +6,7 @@ files, numbering lines as in `document_lines`, and drops what the lab's template
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -98,12 +98,15 @@ class Document:
     notes: list[str] = field(default_factory=list)
 
 
-def read_files(files: list[Path]) -> tuple[list[SourceText], list[Unreadable]]:
-    """The readable files' texts and the unreadable files' reasons, in the given order."""
+def read_files(
+    files: list[Path], names: Mapping[Path, str] | None = None
+) -> tuple[list[SourceText], list[Unreadable]]:
+    """The readable files' texts and the unreadable files' reasons, in the given order (``names``: each
+    file's own name as shown, see ``ClassSources.names``)."""
     texts: list[SourceText] = []
     unreadable: list[Unreadable] = []
     for path in files:
-        source = read_source(path)
+        source = read_source(path, (names or {}).get(path, ""))
         (texts if isinstance(source, SourceText) else unreadable).append(source)  # type: ignore[arg-type]
     return texts, unreadable
 
@@ -114,7 +117,7 @@ def document_lines(texts: list[SourceText]) -> list[str]:
         return texts[0].text.splitlines()
     lines: list[str] = []
     for source in texts:
-        lines.append(FILE_HEADER.format(name=source.path.name))
+        lines.append(FILE_HEADER.format(name=source.shown_name))
         lines.extend(source.text.splitlines())
     return lines
 
@@ -125,6 +128,7 @@ def build_document(
     indexed: list[tuple[Path, IndexedFile]],
     template: Template,
     notes: Sequence[str] = (),
+    names: Mapping[Path, str] | None = None,
 ) -> Document:
     """Join one submission's indexed files, dropping the template's functions, fingerprints and remarks."""
     document = Document(identity, is_reference, [path for path, _ in indexed])
@@ -136,7 +140,8 @@ def build_document(
             offset += file.lines + (1 if len(indexed) > 1 else 0)
             continue
         if file.truncated:
-            document.notes.append(f"{path.name} is very long: only its first part was compared.")
+            shown = (names or {}).get(path) or path.name
+            document.notes.append(f"{shown} is very long: only its first part was compared.")
         kept_units = set()
         for number, (shape, name) in enumerate(zip(file.shapes, file.unit_names, strict=True)):
             if shape in template.shapes:

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from grader.classroom.similarity.behaviour import WrongResults
@@ -42,10 +42,12 @@ class Outcome:
 
     report: SimilarityReport
     files: dict[str, list[Path]]
+    names: dict[Path, str] = field(default_factory=dict)
+    """Each file's own name as shown, where it is not ``path.name`` (``ClassSources.names``)."""
 
     def lines_of(self, identity: str) -> list[str]:
         """The compared text of one identity, line by line, as the report's line numbers count them."""
-        texts, _ = read_files(self.files.get(identity, []))
+        texts, _ = read_files(self.files.get(identity, []), self.names)
         return document_lines(texts)
 
 
@@ -76,14 +78,15 @@ def run_similarity(
     """
     template = template or load_template()
     sources = class_dir if isinstance(class_dir, ClassSources) else submissions_from(class_dir)
+    names = sources.names
     unreadable: list[UnreadableFile] = list(sources.skipped)
     jobs: list[tuple[str, bool, list[Path]]] = []
     for identity, paths in sources.submissions:
         unreadable.extend(
             UnreadableFile(
                 identity=identity,
-                file=extra.name,
-                reason=f"{identity} has more than {MAX_FILES_PER_SUBMISSION} Python files: {extra.name} was not read.",  # noqa: E501
+                file=names.get(extra) or extra.name,
+                reason=f"{identity} has more than {MAX_FILES_PER_SUBMISSION} Python files: {names.get(extra) or extra.name} was not read.",  # noqa: E501
             )
             for extra in paths[MAX_FILES_PER_SUBMISSION:]
         )
@@ -99,7 +102,7 @@ def run_similarity(
         for start in range(0, len(jobs), BATCH):
             batch = jobs[start : start + BATCH]
             for (identity, _, paths), document in zip(
-                batch, _documents(batch, template, cache, unreadable, pool, workers), strict=True
+                batch, _documents(batch, template, cache, unreadable, pool, workers, names), strict=True
             ):
                 if document is not None:
                     documents.append(document)
@@ -109,7 +112,7 @@ def run_similarity(
             pool.shutdown()
     cache_notes = cache.notes if cache is not None else []
     report = build_report(documents, unreadable, behaviour, template.names, [*notes, *cache_notes])
-    return Outcome(report, files)
+    return Outcome(report, files, names)
 
 
 BATCH = 64
@@ -123,6 +126,7 @@ def _documents(
     unreadable: list[UnreadableFile],
     pool: ProcessPoolExecutor | None,
     readers: int,
+    names: Mapping[Path, str],
 ) -> list[Document | None]:
     """Read a batch of documents (``readers`` at a time), index the files not cached (in the pool, if
     any), and build them."""
@@ -132,7 +136,7 @@ def _documents(
     # A notebook is read by a bounded child process (grader.submission.notebook): `readers` threads wait for
     # those children, one document each.
     with ThreadPoolExecutor(readers) as threads:
-        reads = list(threads.map(read_files, [paths for _, _, paths in jobs]))
+        reads = list(threads.map(lambda paths: read_files(paths, names), [paths for _, _, paths in jobs]))
     for number, ((identity, is_reference, _), (readable, failures)) in enumerate(
         zip(jobs, reads, strict=True)
     ):
@@ -144,7 +148,7 @@ def _documents(
                 missing.append((number, position, source))
             else:
                 indexed[(number, position)] = entry
-    arguments = ([source.text for _, _, source in missing], [source.path.name for _, _, source in missing])
+    arguments = ([source.text for _, _, source in missing], [source.shown_name for _, _, source in missing])
     results = (
         pool.map(index_text, *arguments, chunksize=4) if pool is not None else map(index_text, *arguments)
     )
@@ -159,14 +163,15 @@ def _documents(
         ]
         for path, entry in entries:
             if entry.reason is not None:
-                unreadable.append(UnreadableFile(identity=identity, file=path.name, reason=entry.reason))
+                shown = names.get(path) or path.name
+                unreadable.append(UnreadableFile(identity=identity, file=shown, reason=entry.reason))
         if all(entry.reason is not None for _, entry in entries):
             documents.append(None)
         else:
             notes = [note for source in texts[number] for note in source.notes]
-            documents.append(build_document(identity, is_reference, entries, template, notes))
+            documents.append(build_document(identity, is_reference, entries, template, notes, names))
     return documents
 
 
 def _listed(identity: str, failure: Unreadable) -> UnreadableFile:
-    return UnreadableFile(identity=identity, file=failure.path.name, reason=failure.reason)
+    return UnreadableFile(identity=identity, file=failure.shown_name, reason=failure.reason)

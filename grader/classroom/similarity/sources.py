@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import ast
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from grader.classroom import ClassDownload, GradedFileRule, discover
@@ -47,11 +47,18 @@ class SourceText:
         path: The file.
         text: Its Python source; the line numbers of this text are the ones reports cite.
         notes: What was left out of it (a notebook's cells that are not Python).
+        name: Its own name as shown (a class's zip is read into numbered files); ``path.name`` when empty.
     """
 
     path: Path
     text: str
     notes: tuple[str, ...] = ()
+    name: str = ""
+
+    @property
+    def shown_name(self) -> str:
+        """The file's name as a person reads it."""
+        return self.name or self.path.name
 
 
 @dataclass(frozen=True)
@@ -61,10 +68,17 @@ class Unreadable:
     Attributes:
         path: The file.
         reason: What was expected, what was found, what to do.
+        name: Its own name as shown; ``path.name`` when empty.
     """
 
     path: Path
     reason: str
+    name: str = ""
+
+    @property
+    def shown_name(self) -> str:
+        """The file's name as a person reads it."""
+        return self.name or self.path.name
 
 
 @dataclass
@@ -75,11 +89,14 @@ class ClassSources:
         layout: The layout the download was read as ("canvas", "plain", ...).
         submissions: ``(identity, files)`` per student with at least one candidate file, sorted by identity.
         skipped: Files refused, not attributable, or of a student with nothing to compare (with reasons).
+        names: Each file's own name as shown, where it is not ``path.name`` (a zip's entries are read into
+            numbered files): ``grader.render.neutral.file_name`` of its place in the download. Only shown.
     """
 
     layout: str
     submissions: list[tuple[str, list[Path]]] = field(default_factory=list)
     skipped: list[UnreadableFile] = field(default_factory=list)
+    names: dict[Path, str] = field(default_factory=dict)
 
     @property
     def identities(self) -> list[str]:
@@ -130,6 +147,8 @@ def submissions_from(
 def sources_of(download: ClassDownload) -> ClassSources:
     """The documents of an already discovered class download (``gymgrade grade --similarity`` reuses the
     batch's): each student's candidate files, the graded one first; the rest listed with a reason."""
+    from grader.render.neutral import file_name
+
     sources = ClassSources(layout=download.layout)
     claimed: set[str] = set()
     for submission in download.submissions:
@@ -142,6 +161,7 @@ def sources_of(download: ClassDownload) -> ClassSources:
             candidates.insert(0, submission.graded_file)
         if candidates:
             sources.submissions.append((submission.identity, [file.path for file in candidates]))
+            sources.names.update((file.path, file_name(file.relative)) for file in candidates)
             continue
         sources.skipped += [
             UnreadableFile(
@@ -215,15 +235,22 @@ def references_from(path: Path) -> list[tuple[str, Path]]:
     ]
 
 
-def read_source(path: Path) -> SourceText | Unreadable:
+def read_source(path: Path, name: str = "") -> SourceText | Unreadable:
     """Read one submitted file as Python text, bounded in size, never executing or importing it, never
-    following a link; a notebook's code cells come from the bounded reader (`grader.submission.notebook`)."""
+    following a link; a notebook's code cells come from the bounded reader (`grader.submission.notebook`).
+    ``name`` is the file's own name as its messages show it (``path.name`` when empty); its kind follows
+    ``path``."""
+    result = _read_source(path, name or path.name)
+    return replace(result, name=name) if name else result
+
+
+def _read_source(path: Path, shown: str) -> SourceText | Unreadable:
     if path.is_dir() and not path.is_symlink():
-        return Unreadable(path, f"{path.name} holds no .py or .ipynb file: nothing to compare.")
+        return Unreadable(path, f"{shown} holds no .py or .ipynb file: nothing to compare.")
     if not _has_source_suffix(path):
         return Unreadable(
             path,
-            f"{path.name} is neither a .py nor an .ipynb file: only Python sources and notebooks are compared.",  # noqa: E501
+            f"{shown} is neither a .py nor an .ipynb file: only Python sources and notebooks are compared.",
         )
     notebook = path.suffix.lower() == ".ipynb"
     limit = MAX_NOTEBOOK_BYTES if notebook else MAX_COMPARED_BYTES
@@ -233,25 +260,25 @@ def read_source(path: Path) -> SourceText | Unreadable:
         return Unreadable(path, f"{error} Left out.")
     if len(data) > limit:
         return Unreadable(
-            path, f"{path.name} is larger than {limit:,} bytes: too large to be a lab solution, left out."
+            path, f"{shown} is larger than {limit:,} bytes: too large to be a lab solution, left out."
         )
     if not data.strip():
-        return Unreadable(path, f"{path.name} is empty: nothing to compare.")
+        return Unreadable(path, f"{shown} is empty: nothing to compare.")
     if b"\0" in data:
-        return Unreadable(path, f"{path.name} is binary (it contains NUL bytes), not Python text: left out.")
+        return Unreadable(path, f"{shown} is binary (it contains NUL bytes), not Python text: left out.")
     if notebook:  # read (its UTF-8 too) by the bounded reader: the parent never decodes it whole
-        return _notebook_code(path, data)
+        return _notebook_code(path, data, shown)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         return Unreadable(
-            path, f"{path.name} is not UTF-8 text (byte {error.start} cannot be decoded): left out."
+            path, f"{shown} is not UTF-8 text (byte {error.start} cannot be decoded): left out."
         )
     return SourceText(path, text)
 
 
-def _notebook_code(path: Path, data: bytes) -> SourceText | Unreadable:
-    read = read_notebook(data, path.name)
+def _notebook_code(path: Path, data: bytes, shown: str) -> SourceText | Unreadable:
+    read = read_notebook(data, shown)
     if isinstance(read, FileVerdict):
         return Unreadable(path, f"left out: {read.message}")
     chunks: list[str] = []
@@ -260,17 +287,17 @@ def _notebook_code(path: Path, data: bytes) -> SourceText | Unreadable:
         lines = [_without_magic(line) for line in cell.source.splitlines()]
         if not _parses("\n".join(lines)):
             # one broken cell (a half-typed line) must not hide the rest of the notebook
-            notes.append(f"{path.name}: cell {cell.number} is not valid Python and was not compared.")
+            notes.append(f"{shown}: cell {cell.number} is not valid Python and was not compared.")
             lines = [""] * len(lines)
         chunks.append("\n".join(lines))
     code = "\n\n".join(chunks)
     if len(code.encode()) > MAX_COMPARED_BYTES:
         return Unreadable(
             path,
-            f"{path.name}'s code cells hold more than {MAX_COMPARED_BYTES:,} bytes: too large, left out.",
+            f"{shown}'s code cells hold more than {MAX_COMPARED_BYTES:,} bytes: too large, left out.",
         )
     if not code.strip():
-        return Unreadable(path, f"{path.name} has no code cells: nothing to compare.")
+        return Unreadable(path, f"{shown} has no code cells: nothing to compare.")
     return SourceText(path, code + "\n", tuple(notes))
 
 

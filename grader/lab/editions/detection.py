@@ -25,10 +25,10 @@ from grader.submission.notebook import MAX_NOTEBOOK_BYTES
 __all__ = ["MAX_NOTEBOOK_BYTES", "Detection", "detect_edition", "detect_source", "edition_note"]
 
 
-def detect_edition(path: Path) -> Detection:
+def detect_edition(path: Path, name: str | None = None) -> Detection:
     """The lab and edition of a `.py` or `.ipynb` submission, from the functions it defines, what it imports
-    and its name."""
-    return detected(read_marks(path))
+    and its name (``name``: the file's own name where its copy on disk is numbered; else ``path.name``)."""
+    return detected(read_marks(path, name))
 
 
 def detect_source(source: bytes, name: str) -> Detection:

@@ -67,9 +67,10 @@ class Marks:
     readable: bool = True
 
 
-def read_marks(path: Path) -> Marks:
-    """The marks of a `.py` or `.ipynb` submission (read without following links, within bounds)."""
-    return _marks(_parse(path), path.name)
+def read_marks(path: Path, name: str | None = None) -> Marks:
+    """The marks of a `.py` or `.ipynb` submission (read without following links, within bounds), named
+    ``name`` (the file's own name, where its copy on disk is numbered) or ``path.name``."""
+    return _marks(_parse(path), name or path.name)
 
 
 def source_marks(source: bytes, name: str) -> Marks:

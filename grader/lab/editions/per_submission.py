@@ -52,11 +52,12 @@ class ClassEditions:
         return lines
 
 
-def class_editions(files: Mapping[str, Path]) -> ClassEditions:
+def class_editions(files: Mapping[str, Path], names: Mapping[str, str] | None = None) -> ClassEditions:
     """Detect each submission's lab and edition and choose the class's, or say why none can be chosen.
 
     Args:
         files: Each submission's graded file, by identity.
+        names: Each file's own name, by identity, where its copy on disk is numbered (a class's zip).
 
     Returns:
         The class's edition: of the one lab its files show, the edition every file showing one asks the
@@ -64,7 +65,9 @@ def class_editions(files: Mapping[str, Path]) -> ClassEditions:
         file shows an edition, the lab's default (the first lab's first edition, another lab's current).
         With files showing different labs, or editions of different problems, `disagreement` is set.
     """
-    detected = {identity: detect_edition(path) for identity, path in files.items()}
+    detected = {
+        identity: detect_edition(path, (names or {}).get(identity)) for identity, path in files.items()
+    }
     labs = {found.edition.lab for found in detected.values() if found.lab_shown}
     if len(labs) > 1:
         first = EDITIONS[DEFAULT_EDITION]

@@ -43,6 +43,9 @@ def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:
         "--seed", type=int, default=0, help="seeds randomness while the submission is imported"
     )
     parser.add_argument("--max-recorded-steps", type=int, default=DEFAULT_MAX_RECORDED_STEPS)
+    parser.add_argument(
+        "--name", default=None, help="the file's own name in messages (the submission's file name by default)"
+    )
     return parser.parse_args(argv)
 
 
@@ -59,7 +62,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     recorder = Recorder(arguments.seed, arguments.max_recorded_steps)
     install(recorder)
     recorder.begin_import(arguments.seed)
-    loaded = import_submission(submission)
+    loaded = import_submission(submission, arguments.name)
     recorder.finish_import(vars(loaded) if isinstance(loaded, ModuleType) else {})
     _flush_student_output()
     if isinstance(loaded, ImportFailure):

@@ -26,16 +26,19 @@ class ImportFailure:
     traceback: str
 
 
-def import_submission(path: Path) -> ModuleType | ImportFailure:
+def import_submission(path: Path, name: str | None = None) -> ModuleType | ImportFailure:
     """Execute the file at `path` as module "submission" (so `if __name__ == "__main__":` is skipped).
 
-    Returns the module, or an `ImportFailure` whose traceback starts at the student's file.
+    Returns the module, or an `ImportFailure` whose traceback starts at the student's file; its message
+    names the file `name` (the file's own name as the grader shows it: the sandbox's copy may be numbered),
+    `path.name` when None.
     `SystemExit` is not caught: exiting at import ends the child and the runner reports it.
     Any other exception, `KeyboardInterrupt` and student-defined `BaseException`s included, fails.
     """
+    shown = name or path.name
     spec = importlib.util.spec_from_file_location(MODULE_NAME, path)
     if spec is None or spec.loader is None:
-        return ImportFailure(f"{path.name} cannot be loaded as a Python module", "")
+        return ImportFailure(f"{shown} cannot be loaded as a Python module", "")
     module = importlib.util.module_from_spec(spec)
     sys.modules[MODULE_NAME] = module
     try:
@@ -47,14 +50,19 @@ def import_submission(path: Path) -> ModuleType | ImportFailure:
         if isinstance(error, SyntaxError) and error.filename == str(path):
             detail = "".join(traceback.format_exception_only(type(error), error))
             return ImportFailure(
-                shortened(f"{path.name} is not valid Python: {error.msg} (line {error.lineno})"),
-                shortened(detail),
+                shortened(f"{shown} is not valid Python: {error.msg} (line {error.lineno})"),
+                shortened(_renamed(detail, path, name)),
             )
         return ImportFailure(
-            shortened(f"importing {path.name} raised {describe_exception(error)}"),
-            shortened(student_traceback(error, path)),
+            shortened(f"importing {shown} raised {describe_exception(error)}"),
+            shortened(_renamed(student_traceback(error, path), path, name)),
         )
     return module
+
+
+def _renamed(text: str, path: Path, name: str | None) -> str:
+    """A traceback's frames in the file shown as ``name`` (in the file's folder), not as its copy's name."""
+    return text.replace(f'File "{path}"', f'File "{path.parent}/{name}"') if name else text
 
 
 MISSING_MODULE_HINT = (

@@ -19,8 +19,11 @@ def build_launch(
     requests_fd: int,
     results_fd: int,
     import_seed: int,
+    shown_name: str = "",
 ) -> Launch:
     """The command starting one child: every active layer of `report` applied in order, outermost first.
+    ``shown_name`` (the file's own name in the child's messages, plain data, never a path) is passed as
+    ``--name`` when given.
 
     Raises:
         OSError: when a layer that was probed as active fails now (the caller reports a sandbox error).
@@ -39,6 +42,7 @@ def build_launch(
             str(limits.frame_bytes),
             "--seed",
             str(import_seed),
+            *(("--name", shown_name) if shown_name else ()),
         ]
         return spec.compose(harness_argv)
     except BaseException:

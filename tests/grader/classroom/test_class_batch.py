@@ -6,7 +6,7 @@ from __future__ import annotations
 import csv
 import hashlib
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,7 +36,13 @@ class FakeExecutor:
     asked: list[list[Path]] = field(default_factory=list)
 
     def grade(
-        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
+        self,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        *,
+        seed: int,
+        listener: GradingListener,
+        file_names: Mapping[Path, str] | None = None,
     ) -> None:
         self.asked.append(list(paths))
         for path in paths:
@@ -56,7 +62,7 @@ class FakeExecutor:
             listener.report(
                 path,
                 Report(
-                    submission=path.name,
+                    submission=(file_names or {}).get(path) or path.name,
                     sha256=hashlib.sha256(data).hexdigest(),
                     seed=seed,
                     gymnasium_version="1.4.0",

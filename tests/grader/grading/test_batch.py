@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import csv
 import hashlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -84,7 +84,13 @@ class FakeExecutor:
     asked: list[list[str]] = field(default_factory=list)
 
     def grade(
-        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
+        self,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        *,
+        seed: int,
+        listener: GradingListener,
+        file_names: Mapping[Path, str] | None = None,
     ) -> None:
         self.asked.append([path.name for path in paths])
         for done, path in enumerate(paths):

@@ -322,6 +322,29 @@ def test_import_errors_report_the_students_traceback_only(
         assert client.close() == 0
 
 
+@pytest.mark.parametrize(
+    ("source", "message"),
+    [
+        (
+            "def broken(:\n    pass\n",
+            "smithjohn_1_2_opengym-1.py is not valid Python: invalid syntax (line 1)",
+        ),
+        ("raise RuntimeError('boom')\n", "importing smithjohn_1_2_opengym-1.py raised RuntimeError: boom"),
+    ],
+    ids=["syntax", "exception"],
+)
+def test_import_errors_name_the_file_by_the_name_it_is_shown_by(
+    tmp_path: Path, source: str, message: str
+) -> None:
+    """A class's zip is graded from numbered copies: ``--name`` is what the messages call the file."""
+    arguments = ("--name", "smithjohn_1_2_opengym-1.py")
+    with ChildClient(write_submission(tmp_path, source), extra_args=arguments) as client:
+        frame = client.first_frame
+
+        assert frame is not None and frame["type"] == "import_error"
+        assert frame["message"] == message
+
+
 def test_lab_only_ids_and_clear_output_work_at_import(tmp_path: Path) -> None:
     source = "import gym\nfrom IPython.display import clear_output\nenv = gym.make('NChain-v0')\n"
 

@@ -12,7 +12,7 @@ import os
 import stat
 import tempfile
 import zipfile
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -153,7 +153,13 @@ class PlannedExecutor:
     rates: dict[bytes, float]
 
     def grade(
-        self, paths: Sequence[Path], plan: GradingPlan, *, seed: int, listener: GradingListener
+        self,
+        paths: Sequence[Path],
+        plan: GradingPlan,
+        *,
+        seed: int,
+        listener: GradingListener,
+        file_names: Mapping[Path, str] | None = None,
     ) -> None:
         for path in paths:
             data = path.read_bytes()
@@ -172,7 +178,7 @@ class PlannedExecutor:
             listener.report(
                 path,
                 Report(
-                    submission=path.name,
+                    submission=(file_names or {}).get(path) or path.name,
                     sha256=hashlib.sha256(data).hexdigest(),
                     seed=seed,
                     gymnasium_version="1.4.0",
