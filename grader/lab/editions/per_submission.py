@@ -96,10 +96,10 @@ def class_editions(files: Mapping[str, Path], names: Mapping[str, str] | None = 
         return ClassEditions(EditionChoice(edition, default_config(edition), reason), detected)
     problem_sets = {id(found.edition.registry) for found in shown.values()}
     order = list(EDITIONS)
-    names = Counter(found.edition.name for found in shown.values())
-    named = max(names, key=lambda name: (names[name], order.index(name)))
+    tally = Counter(found.edition.name for found in shown.values())
+    named = max(tally, key=lambda name: (tally[name], order.index(name)))
     edition = EDITIONS[named]
-    counts = ", ".join(f"{name} {count}" for name, count in names.most_common())
+    counts = ", ".join(f"{name} {count}" for name, count in tally.most_common())
     left_out = f"; {unshown} showing no edition not counted" if unshown else ""
     if len(problem_sets) == 1:
         reason = (
