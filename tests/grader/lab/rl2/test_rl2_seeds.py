@@ -18,6 +18,19 @@ from reference.rl2.editions import EDITIONS
 from tests.grader.lab.rl2.support import judged
 
 SUBMISSIONS = Path(__file__).resolve().parents[4] / "submissions" / "rl2"
+PURE = frozenset(
+    {
+        "value_iteration",
+        "extract_policy",
+        "policy_improvement",
+        "compute_policy_v",
+        "iter_policy_eval",
+        "policy_iteration",
+    }
+)
+"""The problems judged in this process: the played ones (run_simulation, frozen_lake, model_comparison) play
+episodes that only the sandbox records and replays (and 2019's render in a window), so they are graded
+through the sandbox below."""
 SEEDS = (1, 2, 3, 4, 5)
 """Grading seeds (each draws three held-out MDPs and the random inputs of every case)."""
 HONEST = {
@@ -39,7 +52,7 @@ def _verdicts(report: Report) -> list[tuple[str, str, float, str, object, int]]:
 @pytest.mark.parametrize("edition", EDITIONS)
 def test_each_editions_reference_passes_under_the_seed(edition: str, seed: int) -> None:
     solution = importlib.import_module(f"reference.rl2.editions.{edition}")
-    for problem in edition_of(edition).registry.ids:
+    for problem in [id for id in edition_of(edition).registry.ids if id in PURE]:
         verdict = judged(edition, problem, getattr(solution, problem), seed=seed)
         assert verdict.status == "passed", (problem, verdict.feedback)
 
