@@ -11,6 +11,8 @@ readings of value iteration's n, the two namings of the improvement and evaluati
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from grader.lab.editions.pack import REPOSITORY, Edition, ExpectedFunction
 from grader.lab.games import FROZEN_LAKE_GAMES, RUN_SIMULATION_GAMES
 from grader.lab.registry import Problem, Registry
@@ -96,14 +98,8 @@ RUN_SIMULATION = Problem(
     check=RunSimulationCheck(),
     games=RUN_SIMULATION_GAMES,
 )
-RUN_SIMULATION_2026 = Problem(
-    id="run_simulation",
-    title="Problem 5: run_simulation",
-    points=1.0,
-    config=RunSimulationConfig,
-    check=RunSimulationCheck(),
-    games=RUN_SIMULATION_GAMES,
-)
+RUN_SIMULATION_2026 = replace(RUN_SIMULATION, title="Problem 5: run_simulation")
+"""The 2026 template swaps the numbers of run_simulation and frozen_lake; nothing else differs."""
 
 FROZENLAKE_2018 = Problem(
     id="frozenlake",
@@ -129,14 +125,7 @@ FROZEN_LAKE_2024 = Problem(
     check=FrozenLakeCheck("frozen_lake", "six"),
     games=FROZEN_LAKE_GAMES,
 )
-FROZEN_LAKE_2026 = Problem(
-    id="frozen_lake",
-    title="Problem 6: frozen_lake",
-    points=1.0,
-    config=FrozenLakeConfig,
-    check=FrozenLakeCheck("frozen_lake", "six"),
-    games=FROZEN_LAKE_GAMES,
-)
+FROZEN_LAKE_2026 = replace(FROZEN_LAKE_2024, title="Problem 6: frozen_lake")
 
 MODEL_COMPARISON = Problem(
     id="model_comparison",
