@@ -30,6 +30,7 @@ from scipy import stats
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from grader.lab.rl2.checks.frozen_lake import bernstein_half_width
 from reference.oracles.mdp import Mdp, optimal_solution, return_moments, terminal_states
 from reference.oracles.mdps import TIME_LIMITS, frozen_lake
 
@@ -90,15 +91,6 @@ def _episodes(
     return last_reward, steps
 
 
-def bernstein_margin(variance: float, episodes: int, alpha: float = ALPHA, value_range: float = 1.0) -> float:
-    """Bernstein's inequality: P(|mean - mu| >= t) <= alpha for returns within `value_range` of their mean.
-
-    t = sqrt(2 var log(2/alpha) / n) + value_range log(2/alpha) / (3 n). A FrozenLake return lies in [0, 1].
-    """
-    log_term = np.log(2 / alpha)
-    return float(np.sqrt(2 * variance * log_term / episodes) + value_range * log_term / (3 * episodes))
-
-
 def calibrate(episodes: int, checks: int, seed: int) -> dict[str, tuple[int, int, int]]:
     """Return, per function, the checks failed at |z| > 5, at |z| > 3 and by Bernstein's margin."""
     lake = frozen_lake("4x4", slippery=True)
@@ -107,7 +99,7 @@ def calibrate(episodes: int, checks: int, seed: int) -> dict[str, tuple[int, int
     moments = return_moments(lake, policy, BETA, steps=limit)
     mu, spread = moments.mean[0], np.sqrt(moments.variance[0] / episodes)
     choice = np.random.default_rng(seed)
-    margin = bernstein_margin(float(moments.variance[0]), episodes)
+    margin = bernstein_half_width(float(moments.variance[0]), episodes, ALPHA)
     failed = {name: [0, 0, 0] for name in FUNCTIONS}
     batch = max(1, 200_000 // episodes)
     done = 0
@@ -154,7 +146,7 @@ def main() -> int:
     ]
     start = time.perf_counter()
     for episodes in (100, 300, 1000):
-        margin = bernstein_margin(float(moments.variance[0]), episodes)
+        margin = bernstein_half_width(float(moments.variance[0]), episodes, ALPHA)
         for name, (high, low, bound) in calibrate(episodes, args.checks, args.seed + episodes).items():
             lines.append(
                 f"| {episodes} | {name} | {high}/{args.checks} | {low}/{args.checks} | "
