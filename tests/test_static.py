@@ -1,4 +1,4 @@
-"""The project's static checks, run by the suite so that CI holds them: ruff's lint rules and mypy's types.
+"""The static checks, run by the suite so that CI holds them: ruff's lint rules and format, mypy's types.
 
 Both tools are development dependencies (pyproject's `dev` extra, installed by scripts/setup.sh). The
 configuration is pyproject's (`[tool.ruff]`, `[tool.mypy]`); these tests only run them on the whole tree.
@@ -26,6 +26,13 @@ def _run(*command: str) -> subprocess.CompletedProcess[str]:
 def test_ruff_finds_nothing() -> None:
     found = _run("ruff", "check", "--no-cache", ".")
     assert found.returncode == 0, f"expected no lint finding; ruff found:\n{found.stdout}{found.stderr}"
+
+
+def test_ruff_format_would_change_nothing() -> None:
+    found = _run("ruff", "format", "--check", "--no-cache", ".")
+    assert found.returncode == 0, (
+        f"expected every file formatted; run `ruff format .`:\n{found.stdout}{found.stderr}"
+    )
 
 
 @pytest.mark.slow

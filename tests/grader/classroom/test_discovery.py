@@ -192,7 +192,7 @@ def test_a_submissions_why_names_a_few_refused_files_and_counts_the_rest(tmp_pat
     with zipfile.ZipFile(folder / "mallory" / "links.zip", "w") as bundle:
         for number in range(2_000):
             link = zipfile.ZipInfo(f"l{number}.py")
-            link.external_attr = (0o120777 << 16)
+            link.external_attr = 0o120777 << 16
             bundle.writestr(link, "/etc/passwd")
     download = discover(folder, rule=RULE, scratch=tmp_path / "scratch")
     (mallory,) = download.submissions

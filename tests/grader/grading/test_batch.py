@@ -256,7 +256,10 @@ def test_a_report_that_cannot_be_written_is_that_students_grader_error(
     outcome = grade_many(inputs, out, seed=4, only=ONLY, executor=FakeExecutor())
     assert [report.grader_errors for report in outcome.reports] == [
         [],
-        ["its report could not be written to bob.json (Is a directory); its scores are in the gradebook, and the next run grades it again"],  # noqa: E501
+        [
+            "its report could not be written to bob.json (Is a directory); "
+            "its scores are in the gradebook, and the next run grades it again"
+        ],
         [],
     ]
     assert _rows(out) == ["alice", "bob", "carol"]

@@ -100,8 +100,7 @@ def test_grade_refuses_a_page_that_would_overwrite_a_report_before_grading(
     out = tmp_path / "out"
     arguments = ["grade", str(tmp_path / "class.py"), "--out", str(out), "--html", str(out / "class.html")]
     assert cli.main(arguments) == cli.EXIT_ERROR
-    assert (
-        f"would write {out / 'class.json'} over the report of student class; put the page outside"
-        in (capsys.readouterr().err)
+    assert f"would write {out / 'class.json'} over the report of student class; put the page outside" in (
+        capsys.readouterr().err
     )
     assert not out.exists()

@@ -87,7 +87,9 @@ TRUE = index_text(SOLUTION, "opengym_solution.py")
             "unit shapes but 1 unit names",
         ),
         (
-            CacheEntry(sha256=text_digest(SOLUTION), index=TRUE.model_copy(update={"fingerprints": [(1, 999, 1, 2)]})),  # noqa: E501
+            CacheEntry(
+                sha256=text_digest(SOLUTION), index=TRUE.model_copy(update={"fingerprints": [(1, 999, 1, 2)]})
+            ),
             "a fingerprint of unit 999",
         ),
         (CacheEntry(sha256=text_digest("x = 1\n"), index=EMPTY), "it is the index of another text"),
