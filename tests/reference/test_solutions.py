@@ -35,6 +35,7 @@ def test_blackjack_wins_as_often_as_the_oracle_says(n: int, seed: int) -> None:
     assert abs(_win_z(fraction, 5_000, threshold_policy_outcome(n).win)) < Z_LIMIT
 
 
+@pytest.mark.slow
 def test_blackjack_returns_a_fraction_of_10000_games() -> None:
     fraction = solutions.blackjack(seed=7)
     assert 0.0 <= fraction <= 1.0
@@ -50,6 +51,7 @@ def test_same_seed_same_result(seed: int) -> None:
     assert solutions.cartpole(seed=seed) == solutions.cartpole(seed=seed)
 
 
+@pytest.mark.slow
 def test_cartpole_meets_the_labs_bar_on_every_seed() -> None:
     # The lab: "at least 120 and on average about 180" (CartPole-v0 stops at 200).
     steps = [solutions.cartpole(seed=seed) for seed in range(300)]
@@ -58,6 +60,7 @@ def test_cartpole_meets_the_labs_bar_on_every_seed() -> None:
     assert max(steps) == 200
 
 
+@pytest.mark.slow
 def test_car_reaches_the_goal_in_fewer_than_180_steps_on_every_seed() -> None:
     # MountainCar-v0 truncates at 200, so fewer than 180 steps means the flag was reached.
     steps = [solutions.car(seed=seed) for seed in range(300)]

@@ -61,6 +61,7 @@ def test_lists_what_only_tests_read_and_what_nothing_reads(unused: ModuleType, t
     }
 
 
+@pytest.mark.slow
 def test_every_name_the_project_leaves_unread_is_one_a_framework_reaches(unused: ModuleType) -> None:
     unexplained = [
         f"{definition.path.name}: {definition.name} read by {where}"

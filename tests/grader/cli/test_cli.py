@@ -146,6 +146,7 @@ def test_check_runs_with_weaker_isolation_and_says_so(
     assert "  - bubblewrap: bubblewrap (bwrap) is not installed" in out
 
 
+@pytest.mark.slow
 @pytest.mark.usefixtures("without_bubblewrap")
 def test_grade_refuses_weaker_isolation_unless_allowed(
     fast_config: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]

@@ -73,6 +73,7 @@ print("ok")
     assert (result.returncode, result.stdout.strip()) == (0, "ok"), result.stderr
 
 
+@pytest.mark.slow
 def test_the_layer_works_alone_from_a_read_only_copy(tmp_path: Path) -> None:
     """grader/compat bound alone (empty grader/__init__.py), no bytecode written, no other project code."""
     copy = tmp_path / "bound" / "grader"

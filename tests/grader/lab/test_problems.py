@@ -35,6 +35,7 @@ def _sources() -> list[Path]:
     return sorted(path for package in ("grader", "api") for path in (ROOT / package).rglob("*.py"))
 
 
+@pytest.mark.slow
 def test_no_source_lists_every_problem_but_the_registry() -> None:
     """A list of all the ids anywhere else (a tuple, a dict's keys, a Literal, a description) would drift."""
     lists = [

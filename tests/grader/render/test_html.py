@@ -69,6 +69,7 @@ def report() -> Report:
     )  # fmt: skip
 
 
+@pytest.mark.slow
 def test_every_problem_gets_its_plot_and_the_three_games_their_replay(report: Report) -> None:
     figures = all_figures(report.problems, load_config(None))
     assert {problem: [figure.mime for figure in drawn] for problem, drawn in figures.items()} == {
@@ -93,6 +94,7 @@ def test_replays_are_small_capped_animations(report: Report, index: int, tmp_pat
     assert len(gif) < 100_000
 
 
+@pytest.mark.slow
 def test_the_page_is_self_contained_and_escapes_student_text(report: Report) -> None:
     page = render_html(report, load_config(None))
     assert f'content="{CSP}"' in page

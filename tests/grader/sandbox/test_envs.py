@@ -116,6 +116,7 @@ def test_taxi_state_set_by_hand_and_masks_are_fresh() -> None:
         _same(stock_mask, _call(cheap.unwrapped, "action_mask", state), f"mask of {state!r}")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("natural", [False, True])
 @pytest.mark.parametrize("sab", [False, True])
 def test_blackjack_plays_gymnasiums_game(natural: bool, sab: bool) -> None:

@@ -161,6 +161,7 @@ def test_refusal_message_names_the_function_and_the_fix() -> None:
     )
 
 
+@pytest.mark.slow
 def test_huge_lists_are_refused() -> None:
     with pytest.raises(InvalidValueError, match="more than 2000000 elements"):
         frames.encode_value([0] * (frames.MAX_NODES + 1))

@@ -54,6 +54,7 @@ def test_the_lab_calls_print_what_ipython_prints_without_loading_it(code: str) -
     assert light.stderr == real.stderr
 
 
+@pytest.mark.slow
 def test_anything_else_of_ipython_is_the_real_one() -> None:
     facts = _facts("""
         from IPython.display import clear_output

@@ -126,6 +126,7 @@ def test_a_multi_file_student_is_one_document_whose_lines_cite_each_file(tmp_pat
     assert lines[eve_first - 1] == GOOD.splitlines()[fay_first - 1]
 
 
+@pytest.mark.slow
 def test_indexing_in_a_process_pool_gives_the_report_of_indexing_in_process(tmp_path: Path) -> None:
     from grader.classroom.similarity.run import BATCH
 

@@ -135,6 +135,7 @@ def test_the_random_policy_win_probability_is_derived_independently() -> None:
     assert random_policy_outcome().win == pytest.approx(_win_probability(0, coin=True), abs=1e-12)
 
 
+@pytest.mark.slow
 def test_fixed_threshold_student_is_told_to_use_n(seed: int) -> None:
     def blackjack(lab, n, games=1000):  # type: ignore[no-untyped-def]
         env = lab.make("Blackjack-v0")
@@ -164,6 +165,7 @@ def test_too_few_games_fail_with_the_lab_number(seed: int) -> None:
     )
 
 
+@pytest.mark.slow
 def test_measurements_hold_both_curves(seed: int) -> None:
     from grader.simulated_students.behaviours import REFERENCE
 
@@ -174,6 +176,7 @@ def test_measurements_hold_both_curves(seed: int) -> None:
     assert len(verdict.measurements["exact_curve"]) == 22  # type: ignore[arg-type]
 
 
+@pytest.mark.slow
 def test_a_failing_student_still_gets_the_whole_curve(seed: int) -> None:
     from grader.simulated_students.behaviours import MISTAKES
 

@@ -155,6 +155,7 @@ def _honest_reset_patterns():  # type: ignore[no-untyped-def]
     }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pattern", list(_honest_reset_patterns()))
 def test_the_lab_s_unplayed_resets_are_tolerated(pattern: str, seed: int) -> None:
     function = _honest_reset_patterns()[pattern]
@@ -192,6 +193,7 @@ def _centre_scout(lab):  # type: ignore[no-untyped-def]
     return _velocity_run(env, observation)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "function", [_scouting, _scouting_many_envs, _centre_scout], ids=["scouting", "many envs", "centre scout"]
 )

@@ -98,6 +98,7 @@ def test_a_double_reset_in_taxi_passes_and_a_taxi_scout_fails(seed: int) -> None
     assert "by the optimal value of the start" in scout.feedback
 
 
+@pytest.mark.slow
 def test_a_scout_is_failed_on_the_cheap_features_before_any_reference_rollout(seed: int) -> None:
     records = simulate("car", {"car": _scouting}, seed, small_config("car", calls=100))
     costly = {feature.name for feature in features_of("MountainCar-v0") if feature.costly}

@@ -51,6 +51,7 @@ def test_plan_passes_the_optimal_table_only_when_taxi_takes_one(
         assert call.args == ()
 
 
+@pytest.mark.slow
 def test_interleaved_scenarios_are_found(seed: int) -> None:
     def interleaved(lab, q_table, episodes=200):  # type: ignore[no-untyped-def]
         env = lab.make("Taxi-v3")
@@ -70,6 +71,7 @@ def test_interleaved_scenarios_are_found(seed: int) -> None:
     assert verdict.status == "passed", verdict.feedback
 
 
+@pytest.mark.slow
 def test_q_episodes_must_follow_the_given_table(seed: int) -> None:
     def worst_action(lab, q_table, episodes=200):  # type: ignore[no-untyped-def]
         return taxi(lab, -np.asarray(q_table), episodes=episodes)
@@ -79,6 +81,7 @@ def test_q_episodes_must_follow_the_given_table(seed: int) -> None:
     assert "act with np.argmax(q_table[state]) on the table you were given" in verdict.feedback
 
 
+@pytest.mark.slow
 def test_taxi_training_its_own_table_is_judged_against_the_optimum(seed: int) -> None:
     table = optimal_q_table(0.6)
 

@@ -351,6 +351,7 @@ def test_a_file_the_reader_cannot_take_is_that_submissions_error(sample: str, me
     assert verdict.message.startswith(message)
 
 
+@pytest.mark.slow
 def test_cells_that_nest_too_deeply_or_are_too_large_are_left_out_with_a_note() -> None:
     module = build_module((HOSTILE / "deep_nesting.ipynb").read_bytes(), "deep.ipynb", ["cartpole"])
     assert isinstance(module, NotebookModule), module
@@ -365,6 +366,7 @@ def test_cells_that_nest_too_deeply_or_are_too_large_are_left_out_with_a_note() 
     )
 
 
+@pytest.mark.slow
 def test_thousands_of_functions_are_read_and_the_graded_ones_analysed() -> None:
     module = build_module((HOSTILE / "thousands_of_functions.ipynb").read_bytes(), "many.ipynb", ["cartpole"])
     assert isinstance(module, NotebookModule), module
