@@ -1,6 +1,6 @@
 """Model answers to the OpenGym AI lab, written on gymnasium 1.4's API.
 
-The lab's environment ids map to gymnasium as follows (see ARCHITECTURE.md):
+The lab's environment ids map to gymnasium as follows (`grader/compat/ids.py` gives each its reason):
 `Blackjack-v0` is `gym.make("Blackjack-v1", natural=False, sab=False)` (the registered default
 `sab=True` is a different game), `Taxi-v3` is `Taxi-v4`; `CartPole-v0` and `MountainCar-v0` are unchanged
 (both with a 200-step time limit). `GuessingGame-v0` is no longer part of gym or gymnasium: `guessing_game`
