@@ -63,7 +63,7 @@ MODULE_SKIP = """
         (NEEDS_REDIS, "", (), 0, None),
         (NEEDS_REDIS, "false", (), 0, None),
         (DECLARED, "true", (), 0, None),
-        pytest.param(DECLARED, "true", XDIST, 0, None, marks=pytest.mark.slow),  # an xdist session (the default run keeps one)
+        pytest.param(DECLARED, "true", XDIST, 0, None, marks=pytest.mark.slow),  # xdist: slow
         (DECLARED_FOR_ANOTHER_REASON, "true", (), 1, "test_as_root: needs a Debian machine"),
         (XFAIL, "true", (), 0, None),
         (MODULE_SKIP, "true", (), 1, "test_module.py: pip install a_module_nobody_has"),
