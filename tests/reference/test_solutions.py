@@ -28,6 +28,7 @@ def test_random_blackjack_wins_as_often_as_the_oracle_says(seed: int) -> None:
     assert abs(_win_z(fraction, 5_000, random_policy_outcome().win)) < Z_LIMIT
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n", [4, 11, 13, 17, 20], ids=lambda n: f"n={n}")
 def test_blackjack_wins_as_often_as_the_oracle_says(n: int, seed: int) -> None:
     # One z-test at 5 sigma over 5000 games: false-fail probability 5.7e-7 per n.

@@ -87,6 +87,7 @@ def test_outcome_matches_monte_carlo_on_the_real_environment(name: str, seed: in
         assert abs(_z(count, games, probability)) < Z_LIMIT, (name, dict(rewards), outcome)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("showing_card", range(1, 11), ids=lambda card: f"showing-{card}")
 def test_dealer_final_scores_match_the_dealer_hands_of_the_real_environment(
     showing_card: int, seed: int

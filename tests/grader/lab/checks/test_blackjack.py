@@ -247,6 +247,7 @@ def _reset_options(lab, n, games=1000):  # type: ignore[no-untyped-def]
     return blackjack(lab, n, games)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("function", "diagnosis"),
     [

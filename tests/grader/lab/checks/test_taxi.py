@@ -233,6 +233,7 @@ def _two_tables(lab, episodes=200):  # type: ignore[no-untyped-def]
     return means
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("function", "diagnosis"),
     [
