@@ -3,8 +3,9 @@
 Directives in the file (one per line):
     ``# fake-grader: sleep=SECONDS``  wait this long before each problem finishes (a cost, never a window
                                       a test's verdict depends on: for that, ``hold``);
-    ``# fake-grader: hold=PATH``      wait before the first problem until the file PATH exists: the test
-                                      sees the grading under way, acts, then makes PATH (see :func:`release`);
+    ``# fake-grader: hold=PATH``      wait until the file PATH exists, before the first problem or the one
+                                      ``# fake-grader: hold-before=PROBLEM_ID`` names: the test sees the
+                                      grading under way, acts, then makes PATH (`held`, `release`);
     ``# fake-grader: crash``          kill the grading process (as a crash would);
     ``# fake-grader: fail``           raise, as a broken grader would;
     ``# fake-grader: internal-error`` return a report that lists a failure of the grader itself.
@@ -52,9 +53,12 @@ HOLD_SECONDS = 300.0
 """Bounds a hold that is never released (a broken test): the grading then fails, saying so."""
 
 
-def held(path: Path) -> bytes:
-    """The directive that holds a grading until :func:`release` (``path``: a file that does not exist yet)."""
-    return f"# fake-grader: hold={path}\n".encode()
+def held(path: Path, before: str | None = None) -> bytes:
+    """The directives that hold a grading until :func:`release` (``path``: a file that does not exist yet),
+    before its first problem or the problem ``before``."""
+    return f"# fake-grader: hold={path}\n".encode() + (
+        f"# fake-grader: hold-before={before}\n".encode() if before else b""
+    )
 
 
 def release(path: Path) -> None:
@@ -115,11 +119,12 @@ def grade_submission(
             ],
         )
     hold = _directive(source, "hold")
-    if hold:
-        _hold(Path(hold))
+    hold_before = _directive(source, "hold-before") or (chosen[0][0] if chosen else None)
     delay = float(_directive(source, "sleep") or 0.0)
     problems = []
     for problem_id, title in chosen:
+        if hold and problem_id == hold_before:
+            _hold(Path(hold))
         time.sleep(delay)
         defined = re.search(rf"^def {problem_id}\(", source, flags=re.MULTILINE) is not None
         result = ProblemResult(

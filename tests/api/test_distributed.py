@@ -16,6 +16,7 @@ import httpx
 import pytest
 import redis
 from api_testing import FAKE_GRADER, PostgresServer, RedisServer, free_port, instructor_headers
+from fake_grader import held, release
 from live_server import LiveProcess, create_student, service_environment, upload, wait_for
 from sqlalchemy import create_engine, select
 
@@ -33,7 +34,8 @@ RECONCILE_SECONDS = 1.0
 
 
 def fake_submission(index: int, sleep: float) -> bytes:
-    """A file the fake grader takes about 3 x ``sleep`` seconds on (3 problems), unique by ``index``."""
+    """A file the fake grader takes about 3 x ``sleep`` seconds on (3 problems), unique by ``index`` (the
+    sleep is a cost, no test's verdict depends on it)."""
     return f"# fake-grader: sleep={sleep}\n# {index}\ndef random_blackjack(n):\n    return n\n".encode()
 
 
@@ -117,7 +119,9 @@ def _owner_pid(cluster: Cluster, submission_id: int) -> int | None:
 def test_a_worker_killed_mid_grading_loses_nothing(cluster: Cluster) -> None:
     first, second = cluster.start_worker(), cluster.start_worker()
     token = create_student(cluster.server.url, "ada")
-    slow = upload(cluster.server.url, token, fake_submission(0, sleep=1.0))
+    hold = cluster.tmp_path / "release"
+    slow = upload(cluster.server.url, token, held(hold) + fake_submission(0, sleep=0.0))
+    # The job is held until its worker is killed: the kill lands mid-grading whatever the machine's speed.
     deadline = time.monotonic() + WAIT_SECONDS
     while _owner_pid(cluster, slow) is None:
         assert time.monotonic() < deadline, "no worker took the job"
@@ -126,6 +130,7 @@ def test_a_worker_killed_mid_grading_loses_nothing(cluster: Cluster) -> None:
         w for w in (first, second) if w.process is not None and w.process.pid == _owner_pid(cluster, slow)
     )
     victim.kill()
+    release(hold)  # the other worker's attempt may go on
     quick = [upload(cluster.server.url, token, fake_submission(i, sleep=0.05)) for i in range(1, 5)]
     views = _wait_all(cluster, token, [slow, *quick])  # bounded by WAIT_SECONDS (bench/ times recovery)
     assert views[0]["attempts"] == 2, "the killed worker's job was graded again by the other"
