@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 import time
 from collections.abc import Iterator
+from datetime import timedelta
 from pathlib import Path
 from typing import Any
 
@@ -18,10 +19,10 @@ import redis
 from api_testing import FAKE_GRADER, PostgresServer, RedisServer, free_port, instructor_headers
 from fake_grader import held, release
 from live_server import LiveProcess, create_student, service_environment, upload, wait_for
-from sqlalchemy import create_engine, select
+from sqlalchemy import create_engine, select, update
 
 from api.jobs.distributed import QUEUE, CeleryDispatcher
-from api.models import Submission
+from api.models import Submission, utcnow
 from api.settings import BrokerSettings
 
 pytestmark = pytest.mark.e2e
@@ -29,7 +30,9 @@ pytestmark = pytest.mark.e2e
 WAIT_SECONDS = 60.0
 """Bounds a hang only: every wait polls for its event and ends as soon as it happens."""
 DUPLICATE_SKIPPED = "skipped: already graded, failed, or being graded by a live worker"
-LEASE_SECONDS = 2.0
+LEASE_SECONDS = 300.0
+"""Long: a live worker's lease never runs out by accident on a loaded machine (its renewals late); the test
+that needs a lease run out, its worker killed, sets the expiry in the past itself (:func:`expire_lease`)."""
 RECONCILE_SECONDS = 1.0
 
 
@@ -111,6 +114,20 @@ def _wait_all(cluster: Cluster, token: str, ids: list[int]) -> list[dict[str, An
     return views
 
 
+def expire_lease(cluster: Cluster, submission_id: int) -> None:
+    """The row's lease runs out, as the clock would leave it once its worker stopped renewing it."""
+    engine = create_engine(cluster.database_url)
+    try:
+        with engine.begin() as connection:
+            connection.execute(
+                update(Submission)
+                .where(Submission.id == submission_id)
+                .values(lease_expires_at=utcnow() - timedelta(seconds=1))
+            )
+    finally:
+        engine.dispose()
+
+
 def _owner_pid(cluster: Cluster, submission_id: int) -> int | None:
     owner = cluster.rows()[submission_id].lease_owner
     return int(owner.split(":")[1]) if owner else None
@@ -130,7 +147,8 @@ def test_a_worker_killed_mid_grading_loses_nothing(cluster: Cluster) -> None:
         w for w in (first, second) if w.process is not None and w.process.pid == _owner_pid(cluster, slow)
     )
     victim.kill()
-    release(hold)  # the other worker's attempt may go on
+    expire_lease(cluster, slow)  # the reconciler hands the job to the other worker
+    release(hold)  # whose attempt may go on
     quick = [upload(cluster.server.url, token, fake_submission(i, sleep=0.05)) for i in range(1, 5)]
     views = _wait_all(cluster, token, [slow, *quick])  # bounded by WAIT_SECONDS (bench/ times recovery)
     assert views[0]["attempts"] == 2, "the killed worker's job was graded again by the other"
