@@ -105,8 +105,9 @@ class Health(BaseModel):
     database: str
     queued: int
     running: int
-    grading_workers: int = Field(
-        description="Gradings this server process runs at once (0: `gymgrade worker` or the cluster grades)."
+    workers: int = Field(
+        description="Gradings this server process runs at once (GYMGRADE_WORKERS; 0: `gymgrade worker` "
+        "or the cluster grades)."
     )
 
 

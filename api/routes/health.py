@@ -20,5 +20,5 @@ def get_health(session: SessionDep, context: ContextDep) -> Health:
         database=session.get_bind().dialect.name,
         queued=counts.get(JobStatus.QUEUED.value, 0),
         running=counts.get(JobStatus.RUNNING.value, 0),
-        grading_workers=context.pool.running() if context.pool is not None else 0,
+        workers=context.pool.running() if context.pool is not None else 0,
     )

@@ -35,7 +35,7 @@ def server(tmp_path: Path) -> Iterator[LiveProcess]:
 
 
 def test_upload_is_graded_and_reported(server: LiveProcess) -> None:
-    assert httpx.get(server.url + "/healthz").json()["grading_workers"] == 1
+    assert httpx.get(server.url + "/healthz").json()["workers"] == 1
     token = create_student(server.url, "ada")
     submission_id = upload(server.url, token, PARTIAL_SOLUTION)
     view = wait_for(server.url, token, submission_id, {"done", "failed"})
@@ -59,7 +59,7 @@ def test_a_separate_worker_process_grades_what_the_server_queues(
     try:
         # No clock stands in for "the server grades nothing": the server counts no grading worker of its own
         # (GET /healthz), and the job is queued when looked at once (timeout 0: one look, no wait).
-        assert httpx.get(server.url + "/healthz").json()["grading_workers"] == 0
+        assert httpx.get(server.url + "/healthz").json()["workers"] == 0
         token = create_student(server.url, "ada")
         submission_id = upload(server.url, token, SYNTAX_ERROR)
         assert wait_for(server.url, token, submission_id, set(), timeout=0)["status"] == "queued"

@@ -216,15 +216,15 @@ def test_healthz_reports_the_queue(client: TestClient) -> None:
         "database": "sqlite",
         "queued": 1,
         "running": 0,
-        "grading_workers": 0,
+        "workers": 0,
     }
 
 
-def test_healthz_counts_the_grading_workers_this_process_runs(make_settings: SettingsFactory) -> None:
+def test_healthz_counts_the_workers_this_process_grades_with(make_settings: SettingsFactory) -> None:
     with TestClient(create_app(make_settings(workers=2))) as running:
-        assert running.get("/healthz").json()["grading_workers"] == 2
+        assert running.get("/healthz").json()["workers"] == 2
     with TestClient(create_app(make_settings(workers=2), run_workers=False)) as not_grading:
-        assert not_grading.get("/healthz").json()["grading_workers"] == 0
+        assert not_grading.get("/healthz").json()["workers"] == 0
 
 
 @BOTH_DATABASES
