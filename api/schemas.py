@@ -105,6 +105,10 @@ class Health(BaseModel):
     database: str
     queued: int
     running: int
+    workers: int = Field(
+        description="Gradings this server process runs at once (GYMGRADE_WORKERS; 0: `gymgrade worker` "
+        "or the cluster grades)."
+    )
 
 
 class FieldProblem(BaseModel):

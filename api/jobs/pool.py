@@ -36,6 +36,10 @@ class WorkerPool:
             for index in range(size)
         ]
 
+    def running(self) -> int:
+        """How many of the worker threads run now."""
+        return sum(thread.is_alive() for thread in self._threads)
+
     def start(self) -> None:
         """Start the worker threads."""
         for thread in self._threads:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import logging
 import threading
 from dataclasses import dataclass
-from datetime import timedelta
+from datetime import datetime, timedelta
 from typing import Any
 
 from sqlalchemy import func, select, update
@@ -239,7 +239,11 @@ def publishing_status(session: Session) -> list[dict[str, Any]]:
 
 
 class ScorePublisher:
-    """The server's publishing thread: :func:`sync_outbox` then :func:`send_due`, every period."""
+    """The server's publishing thread: :func:`sync_outbox` then :func:`send_due`, every period.
+
+    It counts its finished rounds (:meth:`progress`, ``GET /lti/publisher``): an operator sees that publishing
+    is alive, and a round that began after a change has seen that change.
+    """
 
     def __init__(self, sessions: sessionmaker[Session], settings: Settings) -> None:
         self._sessions = sessions
@@ -248,6 +252,9 @@ class ScorePublisher:
         self._tokens = AccessTokens()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="gymgrade-lti-publisher", daemon=True)
+        self._lock = threading.Lock()
+        self._rounds = 0
+        self._last_round_at: datetime | None = None
 
     def start(self) -> None:
         """Start publishing."""
@@ -265,9 +272,23 @@ class ScorePublisher:
             sync_outbox(session, self._policy.gradebook)
             return send_due(session, self._tokens, self._policy)
 
+    def progress(self) -> dict[str, Any]:
+        """Whether the thread runs, its period, the rounds finished (failed ones too), the last one's end."""
+        with self._lock:
+            rounds, last = self._rounds, self._last_round_at
+        return {
+            "running": self._thread.is_alive(),
+            "period_seconds": self._period,
+            "rounds": rounds,
+            "last_round_at": last,
+        }
+
     def _run(self) -> None:
         while not self._stop.wait(self._period):
             try:
                 self.run_once()
             except Exception:
                 log.exception("LTI score publishing round failed; trying again next round")
+            with self._lock:
+                self._rounds += 1
+                self._last_round_at = utcnow()

@@ -283,6 +283,14 @@ def post_roster(
     return {"learners": found.learners, "staff": found.staff, "skipped": found.skipped}
 
 
+@router.get("/lti/publisher")
+def get_publisher(context: ContextDep, _instructor: InstructorDep) -> dict[str, Any]:
+    """This server's publishing thread: running, its period, the rounds it finished, the last one's end."""
+    if context.publisher is None:
+        return {"running": False, "period_seconds": None, "rounds": 0, "last_round_at": None}
+    return context.publisher.progress()
+
+
 @router.get("/lti/scores")
 def get_scores(session: SessionDep, _instructor: InstructorDep) -> list[dict[str, Any]]:
     """Each student's score publishing to the LMS: kept score, the one the LMS holds, state, last error."""

@@ -1,7 +1,11 @@
 """A fast stand-in for grader.grading.grade.grade_submission whose behaviour the uploaded file itself chooses.
 
 Directives in the file (one per line):
-    ``# fake-grader: sleep=SECONDS``  wait this long before each problem finishes;
+    ``# fake-grader: sleep=SECONDS``  wait this long before each problem finishes (a cost, never a window
+                                      a test's verdict depends on: for that, ``hold``);
+    ``# fake-grader: hold=PATH``      wait until the file PATH exists, before the first problem or the one
+                                      ``# fake-grader: hold-before=PROBLEM_ID`` names: the test sees the
+                                      grading under way, acts, then makes PATH (`held`, `release`);
     ``# fake-grader: crash``          kill the grading process (as a crash would);
     ``# fake-grader: fail``           raise, as a broken grader would;
     ``# fake-grader: internal-error`` return a report that lists a failure of the grader itself.
@@ -43,6 +47,31 @@ def _directive(source: str, name: str) -> str | None:
     if match is None:
         return None
     return match.group(1) or ""
+
+
+HOLD_SECONDS = 300.0
+"""Bounds a hold that is never released (a broken test): the grading then fails, saying so."""
+
+
+def held(path: Path, before: str | None = None) -> bytes:
+    """The directives that hold a grading until :func:`release` (``path``: a file that does not exist yet),
+    before its first problem or the problem ``before``."""
+    return f"# fake-grader: hold={path}\n".encode() + (
+        f"# fake-grader: hold-before={before}\n".encode() if before else b""
+    )
+
+
+def release(path: Path) -> None:
+    """Let every grading held on ``path`` go on."""
+    path.touch()
+
+
+def _hold(path: Path) -> None:
+    deadline = time.monotonic() + HOLD_SECONDS
+    while not path.exists():
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"the fake grader was held on {path} and not released within {HOLD_SECONDS} s")
+        time.sleep(0.02)
 
 
 def grade_submission(
@@ -89,9 +118,13 @@ def grade_submission(
                 for problem_id, title in chosen
             ],
         )
+    hold = _directive(source, "hold")
+    hold_before = _directive(source, "hold-before") or (chosen[0][0] if chosen else None)
     delay = float(_directive(source, "sleep") or 0.0)
     problems = []
     for problem_id, title in chosen:
+        if hold and problem_id == hold_before:
+            _hold(Path(hold))
         time.sleep(delay)
         defined = re.search(rf"^def {problem_id}\(", source, flags=re.MULTILINE) is not None
         result = ProblemResult(

@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 import time
 from collections.abc import Iterator
+from datetime import timedelta
 from pathlib import Path
 from typing import Any
 
@@ -16,11 +17,12 @@ import httpx
 import pytest
 import redis
 from api_testing import FAKE_GRADER, PostgresServer, RedisServer, free_port, instructor_headers
+from fake_grader import held, release
 from live_server import LiveProcess, create_student, service_environment, upload, wait_for
-from sqlalchemy import create_engine, select
+from sqlalchemy import create_engine, select, update
 
 from api.jobs.distributed import QUEUE, CeleryDispatcher
-from api.models import Submission
+from api.models import Submission, utcnow
 from api.settings import BrokerSettings
 
 pytestmark = pytest.mark.e2e
@@ -28,12 +30,15 @@ pytestmark = pytest.mark.e2e
 WAIT_SECONDS = 60.0
 """Bounds a hang only: every wait polls for its event and ends as soon as it happens."""
 DUPLICATE_SKIPPED = "skipped: already graded, failed, or being graded by a live worker"
-LEASE_SECONDS = 2.0
+LEASE_SECONDS = 300.0
+"""Long: a live worker's lease never runs out by accident on a loaded machine (its renewals late); the test
+that needs a lease run out, its worker killed, sets the expiry in the past itself (:func:`expire_lease`)."""
 RECONCILE_SECONDS = 1.0
 
 
 def fake_submission(index: int, sleep: float) -> bytes:
-    """A file the fake grader takes about 3 x ``sleep`` seconds on (3 problems), unique by ``index``."""
+    """A file the fake grader takes about 3 x ``sleep`` seconds on (3 problems), unique by ``index`` (the
+    sleep is a cost, no test's verdict depends on it)."""
     return f"# fake-grader: sleep={sleep}\n# {index}\ndef random_blackjack(n):\n    return n\n".encode()
 
 
@@ -109,6 +114,20 @@ def _wait_all(cluster: Cluster, token: str, ids: list[int]) -> list[dict[str, An
     return views
 
 
+def expire_lease(cluster: Cluster, submission_id: int) -> None:
+    """The row's lease runs out, as the clock would leave it once its worker stopped renewing it."""
+    engine = create_engine(cluster.database_url)
+    try:
+        with engine.begin() as connection:
+            connection.execute(
+                update(Submission)
+                .where(Submission.id == submission_id)
+                .values(lease_expires_at=utcnow() - timedelta(seconds=1))
+            )
+    finally:
+        engine.dispose()
+
+
 def _owner_pid(cluster: Cluster, submission_id: int) -> int | None:
     owner = cluster.rows()[submission_id].lease_owner
     return int(owner.split(":")[1]) if owner else None
@@ -117,7 +136,9 @@ def _owner_pid(cluster: Cluster, submission_id: int) -> int | None:
 def test_a_worker_killed_mid_grading_loses_nothing(cluster: Cluster) -> None:
     first, second = cluster.start_worker(), cluster.start_worker()
     token = create_student(cluster.server.url, "ada")
-    slow = upload(cluster.server.url, token, fake_submission(0, sleep=1.0))
+    hold = cluster.tmp_path / "release"
+    slow = upload(cluster.server.url, token, held(hold) + fake_submission(0, sleep=0.0))
+    # The job is held until its worker is killed: the kill lands mid-grading whatever the machine's speed.
     deadline = time.monotonic() + WAIT_SECONDS
     while _owner_pid(cluster, slow) is None:
         assert time.monotonic() < deadline, "no worker took the job"
@@ -126,6 +147,8 @@ def test_a_worker_killed_mid_grading_loses_nothing(cluster: Cluster) -> None:
         w for w in (first, second) if w.process is not None and w.process.pid == _owner_pid(cluster, slow)
     )
     victim.kill()
+    expire_lease(cluster, slow)  # the reconciler hands the job to the other worker
+    release(hold)  # whose attempt may go on
     quick = [upload(cluster.server.url, token, fake_submission(i, sleep=0.05)) for i in range(1, 5)]
     views = _wait_all(cluster, token, [slow, *quick])  # bounded by WAIT_SECONDS (bench/ times recovery)
     assert views[0]["attempts"] == 2, "the killed worker's job was graded again by the other"

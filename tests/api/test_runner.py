@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from api_testing import SettingsFactory
+from fake_grader import held
 from sqlalchemy import select
 from sqlalchemy.orm import Session, sessionmaker
 
@@ -144,8 +145,11 @@ def test_an_unknown_grader_fails_the_job_with_the_setting_named(
     assert row.error is not None and row.error.startswith("GYMGRADE_GRADER names module 'no_such_module'")
 
 
-def test_a_stopping_worker_puts_its_job_back(sessions: sessionmaker[Session], settings: Settings) -> None:
-    row = _grade(sessions, settings, b"# fake-grader: sleep=5\n" + SOLUTION, stop=True)
+def test_a_stopping_worker_puts_its_job_back(
+    sessions: sessionmaker[Session], settings: Settings, tmp_path: Path
+) -> None:
+    # Held on a file never made: the grading cannot end by itself, only the stop ends it (no clock races it).
+    row = _grade(sessions, settings, held(tmp_path / "never") + SOLUTION, stop=True)
     assert (row.status, row.attempts, row.lease_owner) == ("queued", 0, None)
 
 

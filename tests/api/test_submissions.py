@@ -211,7 +211,20 @@ def test_upload_without_content_length_is_refused(client: TestClient) -> None:
 def test_healthz_reports_the_queue(client: TestClient) -> None:
     token = add_student(client, "ada")
     _upload(client, token)
-    assert client.get("/healthz").json() == {"status": "ok", "database": "sqlite", "queued": 1, "running": 0}
+    assert client.get("/healthz").json() == {
+        "status": "ok",
+        "database": "sqlite",
+        "queued": 1,
+        "running": 0,
+        "workers": 0,
+    }
+
+
+def test_healthz_counts_the_workers_this_process_grades_with(make_settings: SettingsFactory) -> None:
+    with TestClient(create_app(make_settings(workers=2))) as running:
+        assert running.get("/healthz").json()["workers"] == 2
+    with TestClient(create_app(make_settings(workers=2), run_workers=False)) as not_grading:
+        assert not_grading.get("/healthz").json()["workers"] == 0
 
 
 @BOTH_DATABASES

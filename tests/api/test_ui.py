@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import re
 import time
+from pathlib import Path
 
 import pytest
 from api_testing import INSTRUCTOR_TOKEN, SettingsFactory, add_student
+from fake_grader import held, release
 from fastapi.testclient import TestClient
 
 from api.main import create_app
@@ -81,13 +83,14 @@ def test_the_instructor_sees_everyone_and_the_gradebook_link(client: TestClient)
 
 
 @pytest.mark.slow  # a grading through the sandbox
-def test_upload_then_watch_the_checks_complete(make_settings: SettingsFactory) -> None:
+def test_upload_then_watch_the_checks_complete(make_settings: SettingsFactory, tmp_path: Path) -> None:
     settings = make_settings(workers=1)
+    hold = tmp_path / "release"
     with TestClient(create_app(settings)) as client:
         _sign_in(client, add_student(client, "ada"))
         upload = client.post(
             "/ui/submissions",
-            files={"file": ("opengym.py", b"# fake-grader: sleep=0.3\n" + SOLUTION)},
+            files={"file": ("opengym.py", held(hold, before="cartpole") + SOLUTION)},
             follow_redirects=False,
         )
         page_url = upload.headers["location"]
@@ -95,6 +98,8 @@ def test_upload_then_watch_the_checks_complete(make_settings: SettingsFactory) -
         assert 'data-src="' + page_url + '/live"' in page and 'data-final="false"' in page
         seen_statuses = set()
         figures_while_running: set[str] = set()
+        # The grading is held before cartpole until the page shows it running with blackjack's plot (the
+        # event); then it may finish. The deadline bounds a hang only.
         deadline = time.monotonic() + GRADING_WAIT_SECONDS
         live = ""
         while 'data-final="true"' not in live and time.monotonic() < deadline:
@@ -103,6 +108,8 @@ def test_upload_then_watch_the_checks_complete(make_settings: SettingsFactory) -
             seen_statuses.add(status)
             if status == "running":
                 figures_while_running.update(re.findall(FIGURE, live))
+                if BLACKJACK_PLOT in figures_while_running:
+                    release(hold)
             time.sleep(0.1)
         assert "Score: 2 / 3" in live
         assert "running" in seen_statuses, "the live fragment should show the grading while it runs"

@@ -6,7 +6,6 @@ from __future__ import annotations
 import html
 import re
 import sqlite3
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -14,6 +13,7 @@ from typing import Any
 import httpx
 import pytest
 from api_testing import instructor_headers
+from fake_grader import held, release
 from live_server import LiveProcess, create_student
 from live_server import upload as upload_with_token
 from lti_platform import (
@@ -86,6 +86,22 @@ def graded(tool: LiveProcess, submission_id: int) -> bool:
     return row is not None and row[0] == "done"
 
 
+def publishing_rounds(tool: LiveProcess) -> int:
+    """The rounds the server's publisher has finished (GET /lti/publisher)."""
+    response = httpx.get(tool.url + "/lti/publisher", headers=instructor_headers())
+    assert response.status_code == 200, response.text
+    progress = response.json()
+    assert progress["running"] and progress["period_seconds"] == PUBLISH_SECONDS, progress
+    return int(progress["rounds"])
+
+
+def two_publishing_rounds(tool: LiveProcess) -> None:
+    """Wait until two more rounds have finished: the second began after this call, so it saw every change made
+    before it (the first may have begun earlier). Anything it would send has been sent when this returns."""
+    before = publishing_rounds(tool)
+    wait(lambda: publishing_rounds(tool) >= before + 2, "two publishing rounds")
+
+
 def test_a_learner_lands_signed_in_and_each_grading_reaches_the_gradebook_once(
     platform: LtiPlatform, tool: LiveProcess
 ) -> None:
@@ -106,7 +122,7 @@ def test_a_learner_lands_signed_in_and_each_grading_reaches_the_gradebook_once(
         assert (sent[0]["activityProgress"], sent[0]["gradingProgress"]) == ("Completed", "FullyGraded")
         items = [item for item in platform.line_items.values() if item["resourceLinkId"] == "link-1"]
         assert len(items) == 1 and items[0]["resourceId"] == "gymgrade"
-        time.sleep(10 * PUBLISH_SECONDS)
+        two_publishing_rounds(tool)  # "nothing was sent again": the rounds that would have sent it ended
         assert len(scores_for(platform, person.sub)) == 1, "the same score was sent twice"
 
         # A regrade of the same bytes (the row queued again) gives the same score: nothing new is sent.
@@ -115,8 +131,8 @@ def test_a_learner_lands_signed_in_and_each_grading_reaches_the_gradebook_once(
                 "UPDATE submissions SET status = 'queued', attempts = 0 WHERE id = ?", (first,)
             )
         wait(lambda: graded(tool, first), "the regrade")
-        time.sleep(10 * PUBLISH_SECONDS)
-        assert len(scores_for(platform, person.sub)) == 1
+        two_publishing_rounds(tool)
+        assert len(scores_for(platform, person.sub)) == 1, "the regrade's same score was sent again"
 
         upload(client, tool.url, token, TWO_PROBLEMS)
         wait(lambda: len(scores_for(platform, person.sub)) == 2, "the better score")
@@ -229,6 +245,7 @@ def test_a_student_cannot_publish_scores_or_read_another_students_work(
         assert other.status_code == 404
         for method, path in [
             ("GET", "/lti/scores"),
+            ("GET", "/lti/publisher"),
             ("POST", "/lti/links/1/roster"),
             ("POST", "/lti/platforms"),
             ("POST", "/lti/keys/rotate"),
@@ -246,7 +263,7 @@ def test_scores_refused_by_the_platform_are_sent_again_and_shown_to_the_instruct
     platform: LtiPlatform, tool: LiveProcess
 ) -> None:
     person = platform.add_person("learner-grace", "Grace", LEARNER)
-    platform.score_failures[person.sub] = 4
+    platform.score_failures[person.sub] = 10**9  # the gradebook is down until the test brings it back
     refused_before = platform.refused_scores
     with httpx.Client() as client:
         token, _ = landed(client, tool.url, platform.launch(client, LaunchSpec(person, "link-2")))
@@ -254,16 +271,19 @@ def test_scores_refused_by_the_platform_are_sent_again_and_shown_to_the_instruct
 
         def shown() -> list[dict[str, Any]]:
             rows = httpx.get(tool.url + "/lti/scores", headers=instructor_headers()).json()
-            return [
-                row for row in rows if row["student"] == "Grace" and row["status"] in ("retrying", "failed")
-            ]
+            return [row for row in rows if row["student"] == "Grace" and row["status"] == "failed"]
 
-        failing = wait(shown, "the instructor to see the refused score")
-        assert "the LMS answered 500" in failing[0]["error"]
+        # The event: refused as many times as GYMGRADE_LTI_PUBLISH_ATTEMPTS (3), the row shows as failed.
+        # Only then does the platform recover: no retry schedule races the test's polling.
+        failing = wait(shown, "the instructor to see the refused score as failed")
+        assert failing[0]["attempts"] >= 3 and "the LMS answered 500" in failing[0]["error"]
         assert graded(tool, submission), "a refused score never holds up the grading"
+        with platform.lock:
+            refused = platform.refused_scores - refused_before
+            platform.score_failures[person.sub] = 0
         sent = wait(lambda: scores_for(platform, person.sub), "the score once the platform recovers")
     assert len(sent) == 1
-    assert platform.refused_scores - refused_before == 4
+    assert refused >= failing[0]["attempts"] >= 3, "each attempt was a send the platform refused"
     rows = httpx.get(tool.url + "/lti/scores", headers=instructor_headers()).json()
     assert [(row["status"], row["error"]) for row in rows if row["student"] == "Grace"] == [("sent", None)]
     teacher = platform.add_person("staff-grace", "Gale Grader", INSTRUCTOR)
@@ -454,16 +474,19 @@ def test_token_sign_in_keeps_working_beside_lti(platform: LtiPlatform, tool: Liv
 
 
 def test_the_lms_hears_of_a_submission_being_graded_then_its_score(
-    platform: LtiPlatform, tool: LiveProcess
+    platform: LtiPlatform, tool: LiveProcess, tmp_path: Path
 ) -> None:
     person = platform.add_person("learner-pat", "Pat Pending", LEARNER)
     item = platform.add_line_item("link-li", score_maximum=3.0)
-    slow = b"# fake-grader: sleep=1\n" + ONE_PROBLEM
+    hold = tmp_path / "release"
     with httpx.Client() as client:
         token, _ = landed(
             client, tool.url, platform.launch(client, LaunchSpec(person, "link-li", lineitem=item))
         )
-        upload(client, tool.url, token, slow)
+        upload(client, tool.url, token, held(hold) + ONE_PROBLEM)
+        # The grading is held until the LMS has heard of it; only then may it finish.
+        wait(lambda: scores_for(platform, person.sub), "the pending notice")
+        release(hold)
         wait(lambda: [s for s in scores_for(platform, person.sub) if "scoreGiven" in s], "the score")
     sent = platform.scores[item]
     assert [(s["activityProgress"], s["gradingProgress"], s.get("scoreGiven")) for s in sent] == [

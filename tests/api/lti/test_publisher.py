@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from datetime import timedelta
 
@@ -10,7 +11,16 @@ from api_testing import BOTH_DATABASES, SettingsFactory
 from sqlalchemy.orm import Session
 
 from api.database import make_engine, make_session_factory, migrate
-from api.lti.publisher import FAILED, PENDING, RETRYING, SENT, PublishPolicy, publishing_status, sync_outbox
+from api.lti.publisher import (
+    FAILED,
+    PENDING,
+    RETRYING,
+    SENT,
+    PublishPolicy,
+    ScorePublisher,
+    publishing_status,
+    sync_outbox,
+)
 from api.models import LtiLink, LtiMember, LtiPlatform, LtiScore, LtiUser, Student, Submission, utcnow
 from api.settings import GradebookPolicy
 
@@ -226,3 +236,32 @@ def test_a_regrade_of_the_only_graded_upload_never_announces_pending_over_its_sc
     session.commit()
     assert sync_outbox(session, GradebookPolicy.LATEST) == 0
     assert (_row(session, member).status, _row(session, member).score) == (SENT, 2.0)
+
+
+def test_the_publisher_counts_its_finished_rounds_and_says_when_it_stopped(
+    make_settings: SettingsFactory,
+) -> None:
+    settings = make_settings(lti_publish_seconds=0.01)
+    engine = make_engine(settings)
+    migrate(engine)
+    publisher = ScorePublisher(make_session_factory(engine), settings)
+    assert publisher.progress() == {
+        "running": False,
+        "period_seconds": 0.01,
+        "rounds": 0,
+        "last_round_at": None,
+    }
+    publisher.start()
+    try:
+        deadline = time.monotonic() + 60  # bounds a hang only: the loop ends at the second round
+        while publisher.progress()["rounds"] < 2:
+            assert time.monotonic() < deadline, publisher.progress()
+            time.sleep(0.01)
+        running = publisher.progress()
+    finally:
+        publisher.stop()
+    engine.dispose()
+    assert running["running"] and running["last_round_at"] is not None
+    stopped = publisher.progress()
+    assert not stopped["running"] and stopped["rounds"] >= running["rounds"]
+    assert stopped["last_round_at"] >= running["last_round_at"]

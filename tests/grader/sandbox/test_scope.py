@@ -20,13 +20,10 @@ from grader.sandbox.isolation.cgroup import CGROUP_RECORDS
 from grader.sandbox.isolation.scope import SCOPE_PREFIX, sandbox_scope
 
 SUBMISSION = textwrap.dedent("""
-    import time
-
     import gymnasium
 
 
     def random_blackjack(n):
-        time.sleep(3)  # cartpole() is under way by now
         env = gymnasium.make("Blackjack-v1", natural=False, sab=False)
         wins = 0
         for _ in range(n):
@@ -40,9 +37,15 @@ SUBMISSION = textwrap.dedent("""
 
 
     def cartpole():
+        with open("/proc/self/comm", "w") as comm:  # the event the test waits for: cartpole() has begun
+            comm.write("MARKER")
         while True:
             pass
 """)
+MARKER_PREFIX = "cp-"
+"""cartpole() names its process ``cp-<token>`` (a process name holds 15 characters)."""
+
+HANG_SECONDS = 120.0
 
 pytestmark = [
     pytest.mark.sandbox,
@@ -70,6 +73,19 @@ def _recorded_cgroups(tmp: Path) -> set[Path]:
     return paths
 
 
+def _named(name: str) -> list[int]:
+    """The live processes whose name (``/proc/PID/comm``) is ``name``."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                if (entry / "comm").read_text().strip() == name:
+                    found.append(int(entry.name))
+            except OSError:
+                continue
+    return found
+
+
 def _processes_mentioning(token: str) -> list[str]:
     found = []
     for entry in Path("/proc").iterdir():
@@ -88,11 +104,17 @@ def _processes_mentioning(token: str) -> list[str]:
 def test_a_grading_leaves_nothing_behind(private_tmp: Path, tmp_path: Path, abandoned: bool) -> None:
     token = secrets.token_hex(6)
     submission = tmp_path / f"student_{token}.py"
-    submission.write_text(SUBMISSION)
+    marker = MARKER_PREFIX + token
+    submission.write_text(SUBMISSION.replace("MARKER", marker))
     plan = GradingPlan.load(None, ["random_blackjack", "cartpole"] if abandoned else ["random_blackjack"])
     seen: set[Path] = set()
 
     def on_result(path: Path, result: object) -> None:
+        if abandoned:  # random_blackjack()'s result: kill the run once cartpole() is under way, not before
+            deadline = time.monotonic() + HANG_SECONDS  # bounds a hang only: the loop ends at the event
+            while not _named(marker):
+                assert time.monotonic() < deadline, f"cartpole() did not begin within {HANG_SECONDS} s"
+                time.sleep(0.05)
         seen.update(_recorded_cgroups(private_tmp))
         if abandoned:
             raise KeyboardInterrupt
@@ -117,10 +139,11 @@ def test_a_grading_leaves_nothing_behind(private_tmp: Path, tmp_path: Path, aban
 
     assert sorted(path.name for path in private_tmp.glob("gymgrade-*")) == []  # pytest's own dirs may stay
     assert [path for path in seen if path.exists()] == []
-    deadline = time.monotonic() + 5  # SIGKILLed processes take a moment to go
-    while _processes_mentioning(token) and time.monotonic() < deadline:
+    deadline = time.monotonic() + HANG_SECONDS  # SIGKILLed processes take a moment to go; bounds a hang only
+    while (_processes_mentioning(token) or _named(marker)) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert _processes_mentioning(token) == []
+    assert _named(marker) == [], "cartpole()'s process outlived the run"
 
 
 def test_closing_a_scope_removes_its_cgroups_and_files(private_tmp: Path) -> None:
