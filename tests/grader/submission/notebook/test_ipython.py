@@ -13,7 +13,9 @@ from pathlib import Path
 import nbformat
 import pytest
 from nbformat.v4 import new_code_cell, new_notebook
+from shaped_python import shaped_python
 
+from grader.sandbox.host import HOST
 from grader.submission.notebook import NotebookModule, build_module
 from grader.submission.notebook.ipython import (
     ALONE,
@@ -139,11 +141,9 @@ def _installed_ipython() -> Path:
     return Path(next(iter(spec.submodule_search_locations)))
 
 
-def test_the_installed_transformer_imports_only_what_loading_it_alone_serves() -> None:
-    """The guard of the loader's assumption: IPython's inputtransformer2, and each IPython module it takes
-    (``from IPython.utils import tokenutil`` from IPython 8.15 on), import the standard library and each
-    other only. An IPython upgrade that adds another import fails here, not in every student's notebook."""
-    package = _installed_ipython()
+def _outside_imports(package: Path) -> list[str]:
+    """The imports of IPython's inputtransformer2 (and of each IPython module of `ALONE` it takes) that are
+    neither the standard library nor a module of `ALONE`, as "module: import [names]"."""
     outside: list[str] = []
     pending, seen = [TRANSFORMER], set()
     while pending:
@@ -157,7 +157,33 @@ def test_the_installed_transformer_imports_only_what_loading_it_alone_serves() -
                 pending += [item for item in wanted if item not in seen]
                 continue
             outside.append(f"{name}: {'.' * level}{module} {list(names)}")
-    assert outside == [], f"IPython at {package} can no longer be loaded alone"
+    return outside
+
+
+def test_the_installed_transformer_imports_only_what_loading_it_alone_serves() -> None:
+    """The guard of the loader's assumption: IPython's inputtransformer2, and each IPython module it takes
+    (``from IPython.utils import tokenutil`` from IPython 8.15 on), import the standard library and each
+    other only. An IPython upgrade that adds another import fails here, not in every student's notebook."""
+    package = _installed_ipython()
+    assert _outside_imports(package) == [], f"IPython at {package} can no longer be loaded alone"
+
+
+@pytest.mark.parametrize(
+    ("first_line", "outside"),
+    [
+        ("from IPython.utils import tokenutil\n", []),
+        ("def f():\n    import numpy\n", ["IPython.core.inputtransformer2: numpy []"]),
+        ("from IPython.utils import tokenutil, py3compat\n",
+         ["IPython.core.inputtransformer2: IPython.utils ['tokenutil', 'py3compat']"]),
+        ("from .. import release\n", ["IPython.core.inputtransformer2: .. ['release']"]),
+    ],
+    ids=["tokenutil-as-8.15-on", "third-party-in-a-function", "another-ipython-module", "relative"],
+)  # fmt: skip
+def test_the_guard_fails_on_an_import_loading_alone_cannot_serve(
+    tmp_path: Path, first_line: str, outside: list[str]
+) -> None:
+    package = _fake_ipython(tmp_path, first_line + _real_transformer_source(), tokenutil=True)
+    assert _outside_imports(package) == outside
 
 
 def test_loading_it_alone_runs_nothing_of_the_ipython_package() -> None:
@@ -258,3 +284,30 @@ def test_the_reader_child_loads_ipythons_modules_alone_and_a_failure_is_the_note
         "this is a fault of the grader's installation, not of your notebook. Tell the course staff; a .py "
         "file of your code is graded meanwhile."
     )
+
+
+@pytest.mark.slow
+@pytest.mark.expected_skip("shapes this Linux CPython")
+@pytest.mark.skipif(HOST.system != "Linux", reason="shapes this Linux CPython; CI compares real runs")
+def test_a_windows_shaped_interpreter_reads_magics_where_importing_ipython_fails(tmp_path: Path) -> None:
+    """The shape has no pty (Windows has none) but says "linux", so IPython's package picks its POSIX process
+    helpers and its import fails there (the control); the transformer loaded alone reads the cell."""
+    python = shaped_python(tmp_path / "windows", "windows")
+    root = Path(__file__).resolve().parents[4]
+    environment = {"PYTHONPATH": str(root), "PATH": "/usr/bin:/bin"}
+    control = subprocess.run(
+        [str(python), "-c", "import IPython.core.inputtransformer2"],
+        capture_output=True,
+        text=True,
+        env=environment,
+    )
+    assert control.returncode != 0 and "pty" in control.stderr, control.stderr[-500:]
+    code = (
+        "from grader.submission.notebook.ipython import transform_cell\n"
+        "cell = transform_cell('!pip install gym\\n%matplotlib inline\\nx = 1', set())\n"
+        "print([line.kind for line in cell.special])"
+    )
+    read = subprocess.run(
+        [str(python), "-c", code], capture_output=True, text=True, env=environment, check=True
+    )
+    assert read.stdout.strip() == "['shell command', 'IPython magic']"
