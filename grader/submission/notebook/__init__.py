@@ -44,14 +44,16 @@ process (never running student code), and the sandbox imports it like any `.py` 
   metadata only (outputs blanked) and a failure is a note in `NotebookSummary.ignored`, not an error. Errors
   only when the cells cannot be read (not JSON, no list of cells, more than `MAX_CELLS` = 10,000 cells, a code
   cell whose source is not text, another language, more than 2,000,000 characters of code).
-- `grader/submission/notebook/ipython.py`: `transform_cell(source, defined)`, IPython's `inputtransformer2`
-  rules restated (importing IPython in the reader imports pexpect on POSIX, which a Windows-shaped
-  interpreter lacks: tests/grader/test_portable.py): leading indent,
-  `>>>`/`In [n]:` prompts, `%%cell magics`, and, per logical line from one tokenization,
-  `!`/`!!`/`%`/`?`/`??`/`,`/`;`/`/` escapes, `x = !cmd`,
-  `x = %magic`, trailing `?`; one-line cells get automagic (`pip install gym`) unless the name is bound, a
-  builtin or a keyword. Special lines become `pass` (line numbers kept) and are listed as skipped. A cell that
-  parses as it is is not tokenized (no transformation can apply to valid Python).
+- `grader/submission/notebook/ipython.py`: `transform_cell(source, defined)` with IPython's own
+  `inputtransformer2` (its cleanup transforms, cell-magic test, token grouping and each token transformer's
+  `find`), loaded alone from the installed IPython without running `IPython/__init__.py` (which imports
+  pexpect and `pty` on POSIX; a Windows-shaped interpreter has neither: tests/grader/test_portable.py):
+  leading indent, `>>>`/`In [n]:` prompts, `%%cell magics`, and, per logical line from one tokenization,
+  `!`/`!!`/`%`/`?`/`??`/`,`/`;`/`/` escapes, `x = !cmd`, `x = %magic`, trailing `?` where IPython accepts
+  the target; one-line cells get automagic (`pip install gym`) unless the name is bound, a builtin or a
+  keyword. Special lines become `pass` (line numbers kept) and are listed as skipped. A cell that parses as
+  it is is not tokenized (no transformation can apply to valid Python). A transformer that cannot be
+  loaded alone is that notebook's `FileVerdict("error", ...)`, saying it is the installation's fault.
 - `grader/submission/notebook/rules.py`: `Kind` (SAFE, PLAIN_CLASS, PROPERTY, STUDENT) and `evaluate(expr,
   scope)`, one case per `ast.expr` kind, default deny. Only SAFE values (literals, imports other than
   `submission`/`__main__`, what `CHEAP_CALLS` return for SAFE arguments, operators on SAFE values) may be

@@ -261,6 +261,7 @@ def _limit_self() -> None:
 def _main() -> None:
     _limit_self()
     from grader.submission.notebook.building import build_from_cells
+    from grader.submission.notebook.ipython import TransformerUnavailable
     from grader.submission.notebook.reading import read_cells
 
     header = json.loads(sys.argv[1])
@@ -275,6 +276,8 @@ def _main() -> None:
             read = read_cells(data, name)
         if header["mode"] == "module" and not isinstance(read, FileVerdict):
             built = build_from_cells(read, name, graded)
+    except TransformerUnavailable as error:  # the grader's installation, not the notebook: said so
+        built = FileVerdict("error", _no_transformer_message(name, str(error)))
     except RecursionError:
         built = FileVerdict("error", _unreadable_message(name, "its code nests too deeply for the reader"))
     except MemoryError:
@@ -305,6 +308,14 @@ def _reply(read: NotebookCells | FileVerdict | None, built: NotebookModule | Fil
 
 def _unreadable_message(name: str, what: str) -> str:
     return _unreadable(name, what).message
+
+
+def _no_transformer_message(name: str, what: str) -> str:
+    return (
+        f"{name} cannot be read: the grader could not load IPython's input transformer ({what}). "
+        "It reads the %magics and !commands of notebook cells; this is a fault of the grader's installation, not of your notebook. "  # noqa: E501
+        "Tell the course staff; a .py file of your code is graded meanwhile."
+    )
 
 
 if __name__ == "__main__":

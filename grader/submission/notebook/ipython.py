@@ -1,28 +1,50 @@
-"""Read a cell the way IPython does before Python sees it: its input transformations, done by hand.
+"""Read a cell the way IPython does before Python sees it: IPython's own input transformations.
 
-IPython's ``IPython.core.inputtransformer2.TransformerManager`` (and, for one-line cells, the prefilter's
-automagic) turns ``%magic``, ``%%cell magic``, ``!shell``, ``x = !cmd``, ``obj?``, ``,autocall``, prompts
-pasted from a console and a bare ``pip install gym`` into Python that calls ``get_ipython()``. The grader
-runs none of those commands, so each such line becomes ``pass`` (same indentation, same line numbers) and
-is listed as skipped. IPython is not a dependency of the trusted parent, hence this copy of its rules;
-IPython re-tokenizes the cell after every transformation, this finds every special line in a few passes
-of one tokenization each, so a cell costs time linear in its size.
+IPython's ``IPython.core.inputtransformer2`` turns ``%magic``, ``%%cell magic``, ``!shell``, ``x = !cmd``,
+``obj?``, ``,autocall`` and prompts pasted from a console into Python that calls ``get_ipython()``; its
+prefilter's automagic does the same to a one-line cell such as ``pip install gym``. The grader runs none of
+those commands, so each such line becomes ``pass`` (same indentation, same line numbers) and is listed as
+skipped. What counts as special is IPython's: its cleanup transforms (leading indent, ``>>>`` and ``In [n]:``
+prompts), its cell-magic test, its grouping of tokens by logical line (``make_tokens_by_line``) and each of
+its token transformers' ``find`` (MagicAssign, SystemAssign, EscapedCommand, HelpEnd, in its priority
+order; a help request is one only when HelpEnd's own ``transform`` accepts it). Two things are ours:
+
+- the driver: ``TransformerManager.transform_cell`` re-tokenizes the whole cell after each special line
+  (quadratic, and it gives up after 500), so every logical line of one tokenization is asked, and another
+  pass runs only when a special line stopped the tokenizer (an unclosed quote in a shell command);
+- automagic (`_automagic`, `LINE_MAGICS`): a rule of IPython's prefilter, which needs a running shell.
+
+IPython's module is loaded alone (`load_transformer`), not imported: ``import IPython.core.inputtransformer2``
+runs ``IPython/__init__.py``, which imports the terminal, pexpect and, on a POSIX ``sys.platform``, ``pty``
+(the Windows-shaped interpreter of tests/grader/test_portable.py has none, and every notebook failed there):
+542 modules and 0.24 s of CPU, against one module and 2 ms loaded alone (bench/ipython_transformer.py;
+bench/RESULTS.md, "IPython's transformer loaded alone"). Its imports are the standard library and, from
+IPython 8.15 on, ``IPython.utils.tokenutil`` (standard library only), loaded alone the same way; any other
+import is refused, and tests/grader/submission/notebook/test_ipython.py fails when an installed IPython
+grows one. This runs in the notebook reader's bounded child only (`grader.submission.notebook.bounded`),
+where a failure to load becomes the notebook's verdict (`TransformerUnavailable`), never the batch's.
 """
 
 from __future__ import annotations
 
 import ast
 import builtins
-import io
+import importlib.util
 import keyword
 import re
+import sys
 import tokenize
-from collections.abc import Container
+import types
+from collections.abc import Container, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cache
+from pathlib import Path
+from typing import Any
 
 ESCAPES = {"!": "shell command", "%": "IPython magic", "?": "help request", ",": "IPython autocall",
            ";": "IPython autocall", "/": "IPython autocall"}  # fmt: skip
-"""IPython's ESC_* characters (``!!``, ``%%`` and ``??`` start with one of them)."""
+"""What the line an escape starts is called in the report (IPython's ESCAPE_SINGLES; ``!!`` and ``??``
+start with one of them)."""
 LINE_MAGICS = frozenset(
     [
         "alias",
@@ -128,14 +150,20 @@ LINE_MAGICS = frozenset(
 PASSES = 20
 """Rounds of tokenization: one finds every special line the tokenizer reaches; another is needed only
 when a special line stopped the tokenizer (an unclosed quote in a shell command)."""
-_CLASSIC_FIRST = re.compile(r"^>>>( |$)")
-_CLASSIC_ANY = re.compile(r"^(>>>|\.\.\.)( |$)")
-_IPYTHON_PROMPT = re.compile(r"^(((\[nav\]|\[ins\])?\ )?In\ \[\d+\]:\ |\s*\.{3,}:\ ?)")
+TRANSFORMER = "IPython.core.inputtransformer2"
+"""IPython's input transformer module."""
+ALONE = frozenset({TRANSFORMER, "IPython.utils.tokenutil"})
+"""The IPython modules loaded alone (without ``IPython/__init__.py``); their imports must be the standard
+library or each other."""
 _AUTOMAGIC = re.compile(r"^\s*([\w*.]+)(.*)$")
-_INDENT = re.compile(r"^[ \t]+")
 _BUILTIN_NAMES = frozenset(dir(builtins))
+_INDENT = re.compile(r"^[ \t]+")
 _TRIGGER = re.compile(r"[!%?]|^[ \t]*[,;/]", re.M)
 """A character without which no token transformation applies (a cell of none is not tokenized)."""
+
+
+class TransformerUnavailable(Exception):
+    """IPython's input transformer could not be loaded (not installed, or an import it grew)."""
 
 
 @dataclass(frozen=True)
@@ -174,24 +202,28 @@ def transform_cell(source: str, defined: Container[str]) -> TransformedCell:
 
     Returns:
         The transformed cell.
+
+    Raises:
+        TransformerUnavailable: IPython's transformer cannot be loaded.
     """
+    transforms = transformer()
     lines = source.splitlines()
     first = next((index for index, line in enumerate(lines) if line.strip()), 0)
-    lines = _dedented(lines, first)
-    lines = _without_prompts(lines, first)
+    # IPython drops the leading blank lines; they are kept here, emptied, for the line numbers.
+    lines = [""] * first + _cleaned(transforms, lines[first:])
     result = TransformedCell("")
-    if lines and lines[first].startswith("%%"):
+    if lines and transforms.cell_magic([lines[first] + "\n"]) != [lines[first] + "\n"]:
         result.cell_magic = lines[first].split()[0]
         lines[first] = ""
         # IPython runs the body of %%time/%%capture as Python; it has no escapes of its own.
     parsed = _parsed(lines)
     special_syntax = parsed is None and _TRIGGER.search("\n".join(lines)) is not None
     for _ in range(PASSES if special_syntax else 0):
-        found, complete = _special_lines(lines)
+        found, complete = _special_lines(transforms, lines)
         for special, end in found:
             indent = _INDENT.match(lines[special.line - 1])
             lines[special.line - 1] = (indent.group(0) if indent else "") + "pass"
-            for index in range(special.line, end):
+            for index in range(special.line, min(end, len(lines))):
                 lines[index] = ""
             result.special.append(special)
         if complete or not found:  # a new pass only when the tokenizer stopped early (an unclosed quote)
@@ -206,21 +238,99 @@ def transform_cell(source: str, defined: Container[str]) -> TransformedCell:
     return result
 
 
-def _dedented(lines: list[str], first: int) -> list[str]:
-    indent = _INDENT.match(lines[first]) if lines else None
-    if indent is None:
-        return lines
-    space = indent.group(0)
-    return [line[len(space) :] if line.startswith(space) else line for line in lines]
+@cache
+def transformer() -> types.ModuleType:
+    """IPython's ``inputtransformer2``, loaded alone from the installed IPython (once per process).
+
+    Raises:
+        TransformerUnavailable: IPython is not installed where a file can be loaded, or the module (or
+            one it imports) failed to load.
+    """
+    spec = importlib.util.find_spec("IPython")  # finds the package without running its __init__
+    locations = list(spec.submodule_search_locations or []) if spec is not None else []
+    if not locations:
+        raise TransformerUnavailable(
+            "IPython is not installed as a package of files (importlib found no IPython directory); "
+            "reinstall the grader (pip install ipython)"
+        )
+    return load_transformer(Path(locations[0]))
 
 
-def _without_prompts(lines: list[str], first: int) -> list[str]:
-    rest = lines[first:]
-    if rest and _CLASSIC_FIRST.match(rest[0]):
-        return [_CLASSIC_ANY.sub("", line, count=1) for line in lines]
-    if rest and (_IPYTHON_PROMPT.match(rest[0]) or (len(rest) > 1 and _IPYTHON_PROMPT.match(rest[1]))):
-        return [_IPYTHON_PROMPT.sub("", line, count=1) for line in lines]
-    return lines
+def load_transformer(package: Path) -> types.ModuleType:
+    """IPython's ``inputtransformer2`` loaded from the IPython package directory ``package`` without
+    running ``IPython/__init__.py``: its imports are served from the standard library and from the other
+    modules of `ALONE` (loaded alone too); any other import is refused.
+
+    Args:
+        package: The ``IPython`` directory.
+
+    Returns:
+        The module, under a private name (``IPython.core.inputtransformer2`` stays unimported).
+
+    Raises:
+        TransformerUnavailable: The module, or one it imports, failed to load.
+    """
+    loaded: dict[str, types.ModuleType] = {}
+    try:
+        return _load_alone(package, TRANSFORMER, loaded)
+    except TransformerUnavailable:
+        raise
+    except Exception as error:  # whatever IPython's code raised while loading: the grader's fault, said so
+        raise TransformerUnavailable(
+            f"loading {TRANSFORMER} from {package} failed: {type(error).__name__}: {error}"
+        ) from error
+
+
+def _load_alone(package: Path, name: str, loaded: dict[str, types.ModuleType]) -> types.ModuleType:
+    if name in loaded:
+        return loaded[name]
+    path = package.joinpath(*name.split(".")[1:]).with_suffix(".py")
+    spec = importlib.util.spec_from_file_location(f"_gymgrade_alone.{name}", path)
+    if spec is None or spec.loader is None or not path.is_file():
+        raise TransformerUnavailable(f"{name} is not at {path}; reinstall the grader (pip install ipython)")
+    module = importlib.util.module_from_spec(spec)
+    module.__dict__["__builtins__"] = {
+        **builtins.__dict__,
+        "__import__": lambda *args: _import(package, loaded, *args),
+    }
+    loaded[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def _import(
+    package: Path,
+    loaded: dict[str, types.ModuleType],
+    name: str,
+    globals: Mapping[str, object] | None = None,
+    locals: Mapping[str, object] | None = None,
+    fromlist: Sequence[str] | None = (),
+    level: int = 0,
+) -> types.ModuleType:
+    """``__import__`` for a module loaded alone: the standard library as usual, an IPython module of
+    `ALONE` (``from IPython.utils import tokenutil``) loaded alone, anything else refused."""
+    if level == 0 and name.partition(".")[0] in sys.stdlib_module_names:
+        return importlib.__import__(name, globals, locals, fromlist or (), level)
+    wanted = [f"{name}.{item}" for item in fromlist or ()] if level == 0 else []
+    if wanted and all(module in ALONE for module in wanted):
+        parent = types.ModuleType(name)
+        for module in wanted:
+            setattr(parent, module.rpartition(".")[2], _load_alone(package, module, loaded))
+        return parent
+    taken = f"{'.' * level}{name} {list(fromlist or ())}"
+    raise TransformerUnavailable(
+        f"IPython's input transformer imports {taken}: neither the standard library nor one of {sorted(ALONE)}. "  # noqa: E501
+        "This IPython cannot be loaded alone; install one whose inputtransformer2 can (pip install 'ipython>=8,<10') or extend grader.submission.notebook.ipython.ALONE"  # noqa: E501
+    )
+
+
+def _cleaned(transforms: types.ModuleType, lines: list[str]) -> list[str]:
+    """IPython's cleanup transforms after its leading blank lines (indentation, then ``>>>`` / ``...`` or
+    ``In [n]:`` prompts), given the lines with their endings as IPython gives them."""
+    ended = [line + "\n" for line in lines]
+    for transform in (transforms.leading_indent, transforms.classic_prompt, transforms.ipython_prompt):
+        ended = transform(ended)
+    return [line.removesuffix("\n") for line in ended]
 
 
 def _parsed(lines: list[str]) -> ast.Module | None:
@@ -233,78 +343,68 @@ def _parsed(lines: list[str]) -> ast.Module | None:
         return None
 
 
-def _logical_lines(lines: list[str]) -> tuple[list[list[tokenize.TokenInfo]], bool]:
-    """Tokens grouped by logical line, as IPython's ``make_tokens_by_line`` groups them, and whether the
-    tokenizer reached the end."""
-    by_line: list[list[tokenize.TokenInfo]] = [[]]
-    depth = 0
-    text = "".join(line + "\n" for line in lines)
-    try:
-        for token in tokenize.generate_tokens(io.StringIO(text).readline):
-            by_line[-1].append(token)
-            if token.type == tokenize.NEWLINE or (token.type == tokenize.NL and depth <= 0):
-                by_line.append([])
-            elif token.string in "([{" and token.type == tokenize.OP:
-                depth += 1
-            elif token.string in ")]}" and token.type == tokenize.OP and depth > 0:
-                depth -= 1
-    except (tokenize.TokenError, SyntaxError):  # an unclosed string or bracket: IPython stops there too
-        return [tokens for tokens in by_line if tokens], False
-    return [tokens for tokens in by_line if tokens], True
-
-
-def _special_lines(lines: list[str]) -> tuple[list[tuple[SpecialLine, int]], bool]:
+def _special_lines(
+    transforms: types.ModuleType, lines: list[str]
+) -> tuple[list[tuple[SpecialLine, int]], bool]:
     """Each special line of the cell with the index after its last (backslash-continued) line, and whether
-    the whole cell was tokenized."""
+    the whole cell was tokenized.
+
+    IPython's ``make_tokens_by_line`` groups the tokens by logical line; on each, every token transformer's
+    ``find`` is asked, and the match IPython would apply first (``TokenTransformBase.sortby``) whose
+    transformation IPython accepts says what the line is.
+    """
+    ended = [line + "\n" for line in lines]
     found: list[tuple[SpecialLine, int]] = []
-    logical, complete = _logical_lines(lines)
-    for tokens in logical:
-        body = [token for token in tokens if token.type not in (tokenize.INDENT, tokenize.DEDENT)]
-        meaningful = [
-            token
-            for token in body
-            if token.type not in (tokenize.NEWLINE, tokenize.NL, tokenize.COMMENT)
-            and not token.string.isspace()
-        ]
-        if not meaningful:
-            continue
-        start = meaningful[0]
-        row = start.start[0]
-        binds: tuple[str, ...] = ()
-        kind = ESCAPES.get(start.string[:1]) if start.string not in ("%=", "/=") else None
-        if kind is None:
-            assigned = _assigned_command(meaningful)
-            if assigned is not None:
-                kind, binds, row = assigned
-            elif meaningful[-1].string == "?":
-                kind = "help request"
-        if kind is None:
-            continue
-        end = row
-        while end < len(lines) and lines[end - 1].endswith("\\"):
-            end += 1
-        code = lines[start.start[0] - 1].strip()
-        found.append((SpecialLine(start.start[0], kind, code, binds), end))
+    tokens_by_line = transforms.make_tokens_by_line(ended)
+    complete = bool(tokens_by_line) and tokens_by_line[-1][-1].type == tokenize.ENDMARKER
+    finders = (transforms.MagicAssign, transforms.SystemAssign, transforms.EscapedCommand, transforms.HelpEnd)
+    for tokens in tokens_by_line:
+        matches = [match for finder in finders if (match := _find(finder, tokens)) is not None]
+        for match in sorted(matches, key=transforms.TokenTransformBase.sortby):
+            special = _special(transforms, match, tokens, ended)
+            if special is not None:
+                found.append(special)
+                break
     return found, complete
 
 
-def _assigned_command(tokens: list[tokenize.TokenInfo]) -> tuple[str, tuple[str, ...], int] | None:
-    """``x = %magic`` / ``files = !ls`` (IPython's MagicAssign and SystemAssign)."""
-    depth = 0
-    for index, token in enumerate(tokens):
-        if token.type == tokenize.OP and token.string in "([{":
-            depth += 1
-        elif token.type == tokenize.OP and token.string in ")]}":
-            depth -= 1
-        elif depth == 0 and token.type == tokenize.OP and token.string == "=":
-            following = [t for t in tokens[index + 1 : index + 4] if not t.string.isspace()][:2]
-            names = tuple(t.string for t in tokens[:index] if t.type == tokenize.NAME)
-            if following and following[0].string == "!":
-                return "shell command", names, token.start[0]
-            if len(following) == 2 and following[0].string == "%" and following[1].type == tokenize.NAME:
-                return "IPython magic", names, token.start[0]
+def _find(finder: Any, tokens: list[tokenize.TokenInfo]) -> Any:
+    """``finder.find`` on one logical line; a line it trips over (MagicAssign indexes past the end of a
+    line the tokenizer cut short: ``x = %\"\"\"``) is no match, as IPython would fail on it."""
+    try:
+        return finder.find([tokens])
+    except IndexError:
+        return None
+
+
+def _special(
+    transforms: types.ModuleType, match: Any, tokens: list[tokenize.TokenInfo], ended: list[str]
+) -> tuple[SpecialLine, int] | None:
+    """The special line one of IPython's token transformers found, with the index after its last line
+    (None: IPython refuses to transform it, as HelpEnd refuses ``print(x)?``)."""
+    row = match.start_line
+    binds: tuple[str, ...] = ()
+    if isinstance(match, transforms.HelpEnd):
+        window = ended[row : match.q_line + 1]  # HelpEnd.transform on the lines it reads, renumbered
+        rebased = transforms.HelpEnd((1, match.start_col), (match.q_line - row + 1, match.q_col))
+        try:
+            rebased.transform(window)
+        except SyntaxError:
             return None
-    return None
+        kind, end = "help request", match.q_line + 1
+    else:
+        end = transforms.find_end_of_continued_line(ended, row) + 1
+        if isinstance(match, transforms.EscapedCommand):
+            kind = ESCAPES.get(ended[row][match.start_col], "IPython command")  # an escape IPython added
+        else:  # x = %magic, x = !cmd: the names before the escape are bound
+            position = (row + 1, match.start_col)
+            binds = tuple(
+                token.string for token in tokens if token.type == tokenize.NAME and token.start < position
+            )
+            kind = "IPython magic" if isinstance(match, transforms.MagicAssign) else "shell command"
+    first = next(token for token in tokens if token.type not in (tokenize.INDENT, tokenize.DEDENT))
+    line = first.start[0]
+    return SpecialLine(line, kind, ended[line - 1].strip(), binds), end
 
 
 def _automagic(lines: list[str], defined: Container[str]) -> SpecialLine | None:
