@@ -11,6 +11,8 @@ import pytest
 
 from grader.lab.rl2.checks.evaluation import points
 from grader.lab.rl2.checks.mdp_calls import cases
+from reference.errors import UnboundedValueError
+from reference.oracles.mdp import mdp_from_table, policy_value
 from reference.rl2 import solutions
 from tests.grader.lab.rl2.support import SEED, judged, read_outcomes
 
@@ -109,4 +111,23 @@ def test_each_typical_mistake_is_named(changes: dict[str, Any], cause: str) -> N
 def test_a_wrong_value_fails_without_a_cause(function: Any, found: str) -> None:
     verdict = judged("v2024", "iter_policy_eval", function)
     assert verdict.status == "failed" and found in verdict.feedback, verdict.feedback
+    assert "Likely cause" not in verdict.feedback
+
+
+def test_a_mistake_that_gives_no_value_for_any_wrong_call_is_not_named() -> None:
+    """Wrong only where the policy has no value at discount 1: "beta ignored" gives no value there, so it
+    explains none of the wrong calls, and no cause is named."""
+
+    def wrong_where_discount_1_has_no_value(
+        P: Any, nS: int, nA: int, policy: Any, beta: float = 1.0, tol: float = 1e-8
+    ) -> Any:
+        values = solutions.iter_policy_eval(P, nS, nA, policy, beta, tol)
+        try:
+            policy_value(mdp_from_table("P", P, nS, nA), policy, 1.0)
+        except UnboundedValueError:
+            return values + 0.01
+        return values
+
+    verdict = judged("v2024", "iter_policy_eval", wrong_where_discount_1_has_no_value)
+    assert verdict.status == "failed" and "its exact value on" in verdict.feedback, verdict.feedback
     assert "Likely cause" not in verdict.feedback
