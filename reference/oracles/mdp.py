@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Literal
 
 import numpy as np
@@ -36,6 +37,8 @@ FIXED_POINT_TOLERANCE = 1e-9
 """Largest Bellman residual (relative to 1 + |v|) accepted for the optimal values."""
 VALUE_ITERATION_SWEEPS = 1_000_000
 """Bound on the sweeps the optimal-value search makes before polishing (8x8 at discount 1 needs ~2 000)."""
+SOLUTIONS_CACHED = 256
+"""Optimal solutions memoised (per MDP and discount): a grading judges many calls on the same few MDPs."""
 
 
 @dataclass(frozen=True)
@@ -308,11 +311,18 @@ def optimal_solution(mdp: Mdp, beta: float) -> OptimalSolution:
     may loop on a tie forever); it is evaluated exactly, improved while an action is strictly better, and
     its values are checked to be a fixed point of the Bellman optimality operator.
 
+    A pure function of the MDP and the discount, memoised: each call returns its own copy of the arrays.
+
     Raises:
         UnboundedValueError: no optimal policy with finite values is found (the oracle's domain: discount
             below 1, or at discount 1 MDPs whose optimal policies end their episodes).
     """
-    beta = checked_discount(beta)
+    solved = _optimal_solution(mdp, checked_discount(beta))
+    return OptimalSolution(solved.values.copy(), solved.policy.copy(), solved.beta)
+
+
+@lru_cache(maxsize=SOLUTIONS_CACHED)
+def _optimal_solution(mdp: Mdp, beta: float) -> OptimalSolution:
     rewards, moves = mdp.expected_rewards(), mdp.transitions()
     values = np.zeros(mdp.n_states)
     for _ in range(VALUE_ITERATION_SWEEPS):

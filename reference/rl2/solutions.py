@@ -26,12 +26,15 @@ FROZEN_LAKE_ID = "FrozenLake-v1"
 
 
 def _look_ahead(P: Table, nS: int, nA: int, V: FloatArray, beta: float) -> FloatArray:
-    """`Q[s, a]`: every outcome of every move, weighted by its probability, added up."""
+    """`Q[s, a]`: every outcome of every move, weighted by its probability, added up (on Python floats)."""
+    values = V.tolist()
     Q = np.zeros((nS, nA))
     for s in range(nS):
         for a in range(nA):
+            total = 0.0
             for probability, next_state, reward, _ in P[s][a]:
-                Q[s, a] += probability * (reward + beta * V[next_state])
+                total += probability * (reward + beta * values[next_state])
+            Q[s, a] = total
     return Q
 
 
@@ -64,13 +67,16 @@ def iter_policy_eval(
     P: Table, nS: int, nA: int, policy: npt.ArrayLike, beta: float = 1.0, tol: float = 1e-8
 ) -> FloatArray:
     """Problem 3: the policy's value by sweeps of its own Bellman equation from V = 0 (one array)."""
-    actions = np.asarray(policy).astype(np.int64)
+    actions = np.asarray(policy).astype(np.int64).tolist()
     V = np.zeros(nS)
     while True:
+        values = V.tolist()  # Python floats: the same sums, faster than numpy's scalars
         updated = np.zeros(nS)
         for s in range(nS):
-            for probability, next_state, reward, _ in P[s][int(actions[s])]:
-                updated[s] += probability * (reward + beta * V[next_state])
+            total = 0.0
+            for probability, next_state, reward, _ in P[s][actions[s]]:
+                total += probability * (reward + beta * values[next_state])
+            updated[s] = total
         change = np.max(np.abs(updated - V))
         V = updated
         if change < tol:

@@ -126,11 +126,19 @@ def _tolerance(case: GradingCase, policy: tuple[int, ...], exact: tuple[float, .
     return value_tolerance(case, tol, worst, target)
 
 
-def _evaluated(
-    mdp: Mdp, beta: float, policy: IntArray, tol: float, start: FloatArray | None = None
-) -> FloatArray:
-    sweep = bellman_sweep(mdp, beta, policy)
-    return iterate(sweep, mdp.n_states, tol, MAX_SWEEPS, Reading(False, "max"), start)[0]
+def _evaluated(mdp: Mdp, beta: float, policy: IntArray, tol: float, start: float = 0.0) -> FloatArray:
+    return _evaluation(mdp, beta, tuple(int(action) for action in policy), tol, start)
+
+
+@lru_cache(maxsize=CACHED)
+def _evaluation(mdp: Mdp, beta: float, policy: tuple[int, ...], tol: float, start: float) -> FloatArray:
+    """The lab's iterative evaluation (from the previous V, max-norm stop) from V = `start`: what a mistake
+    gives, memoised per case and policy (shared: read only)."""
+    sweep = bellman_sweep(mdp, beta, np.array(policy, dtype=np.int64))
+    start_values = np.full(mdp.n_states, start)
+    values = iterate(sweep, mdp.n_states, tol, MAX_SWEEPS, Reading(False, "max"), start_values)[0]
+    values.setflags(write=False)
+    return values
 
 
 def _undiscounted(point: Point, tol: float) -> FloatArray | None:
@@ -159,9 +167,7 @@ MISTAKES: tuple[tuple[str, Mistake], ...] = (
     ),
     (
         "values initialised to ones: your evaluation starts from V = 1, which a terminal state looping to itself never clears at discount 1; start from zeros",  # noqa: E501
-        lambda point, tol: _evaluated(
-            point.case.mdp, point.case.beta, point.policy, tol, np.ones(point.case.mdp.n_states)
-        ),
+        lambda point, tol: _evaluated(point.case.mdp, point.case.beta, point.policy, tol, 1.0),
     ),
 )
 

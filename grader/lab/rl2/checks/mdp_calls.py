@@ -212,31 +212,55 @@ def iterate(
     start: FloatArray | None = None,
 ) -> tuple[FloatArray, int]:
     """Sweeps of `sweep(V, in_place)` from `start` (zeros) until the change is below `tol`: (V, sweeps made)."""  # noqa: E501
+    return iterate_norms(sweep, size, tol, maxiter, reading.in_place, (reading.norm,), start)[reading.norm]
+
+
+def iterate_norms(
+    sweep: Callable[[FloatArray, bool], FloatArray],
+    size: int,
+    tol: float,
+    maxiter: int,
+    in_place: bool,
+    norms: Sequence[str],
+    start: FloatArray | None = None,
+) -> dict[str, tuple[FloatArray, int]]:
+    """`iterate` stopped on each of `norms`, from one run: the sweeps do not depend on the norm, only where
+    they stop, so each norm gets the (V, sweeps made) its own `iterate` would give."""
     values = np.zeros(size) if start is None else start.copy()
+    stopped: dict[str, tuple[FloatArray, int]] = {}
     for count in range(1, maxiter + 1):
-        updated = sweep(values, reading.in_place)
-        change = stop_change(updated - values, reading.norm)
+        updated = sweep(values, in_place)
+        difference = updated - values
         values = updated
-        if change < tol:
-            return values, count
-    return values, maxiter
+        for norm in norms:
+            if norm not in stopped and stop_change(difference, norm) < tol:
+                stopped[norm] = (values, count)
+        if len(stopped) == len(set(norms)):
+            return stopped
+    return {norm: stopped.get(norm, (values, maxiter)) for norm in norms}
 
 
 def bellman_sweep(
     mdp: Mdp, beta: float, policy: IntArray | None = None
 ) -> Callable[[FloatArray, bool], FloatArray]:
-    """One sweep of the Bellman optimality update (or, with `policy`, of the policy's own equation)."""
-    rewards, moves = mdp.expected_rewards(), mdp.transitions()
+    """One sweep of the Bellman optimality update (or, with `policy`, of the policy's own equation).
+
+    Each sweep returns a new array (`values` is left as it was). `beta * T @ V` is `(beta * T) @ V`, so the
+    product `beta * T` is made once, not once a sweep (the same numbers).
+    """
+    rewards, scaled = mdp.expected_rewards(), beta * mdp.transitions()
     states = np.arange(mdp.n_states)
+    rows = list(zip(rewards, scaled, strict=True))
+    actions = None if policy is None else [int(action) for action in policy]
 
     def sweep(values: FloatArray, in_place: bool) -> FloatArray:
         if not in_place:
-            look = rewards + beta * moves @ values
+            look = rewards + scaled @ values
             return look.max(axis=1) if policy is None else look[states, policy]
         updated = values.copy()
-        for state in range(mdp.n_states):
-            look = rewards[state] + beta * moves[state] @ updated
-            updated[state] = look.max() if policy is None else look[policy[state]]
+        for state, (reward, move) in enumerate(rows):
+            look = reward + move @ updated
+            updated[state] = look.max() if actions is None else look[actions[state]]
         return updated
 
     return sweep

@@ -38,6 +38,7 @@ from grader.lab.rl2.checks.mdp_calls import (
     describe_values,
     first_outcomes,
     iterate,
+    iterate_norms,
     last_outcomes,
     mdp_call,
     optimum,
@@ -46,6 +47,7 @@ from grader.lab.rl2.checks.mdp_calls import (
 )
 from grader.lab.settings import ProblemConfig, Share
 from grader.sandbox.outcome import Call, FunctionInfo, PlainValue
+from reference.oracles.mdp import Mdp
 from reference.oracles.mdps import GradingCase
 
 FUNCTION = "value_iteration"
@@ -88,7 +90,11 @@ def expected(case: GradingCase, tol: float, maxiter: int) -> Expected:
     """The exact optimal values, the tolerance the lab's algorithm earns at `tol`, the accepted sweep counts."""  # noqa: E501
     best = optimum(case)
     sweep = bellman_sweep(case.mdp, case.beta)
-    runs = [(reading, *iterate(sweep, case.mdp.n_states, tol, maxiter, reading)) for reading in READINGS]
+    runs = []
+    for in_place in sorted({reading.in_place for reading in READINGS}):  # one run stops on every norm
+        norms = [reading.norm for reading in READINGS if reading.in_place == in_place]
+        stops = iterate_norms(sweep, case.mdp.n_states, tol, maxiter, in_place, norms)
+        runs += [(Reading(in_place, norm), *stops[norm]) for norm in norms]
     # The max norm is the smallest, so its stop is the loosest: the other norms' values are closer.
     worst = max(float(np.max(np.abs(values - best))) for reading, values, _ in runs if reading.norm == "max")
     return Expected(best, value_tolerance(case, tol, worst, best), tuple(sorted({n for _, _, n in runs})))
@@ -97,30 +103,32 @@ def expected(case: GradingCase, tol: float, maxiter: int) -> Expected:
 Mistake = Callable[[GradingCase, float, int], FloatArray]
 
 
-def _lab_values(case: GradingCase, tol: float, maxiter: int, **changes: object) -> FloatArray:
-    mdp = changes.get("mdp", case.mdp)
-    beta = float(changes.get("beta", case.beta))  # type: ignore[arg-type]
-    start = changes.get("start")
-    sweep = bellman_sweep(mdp, beta)  # type: ignore[arg-type]
-    return iterate(sweep, case.mdp.n_states, tol, maxiter, JACOBI_MAX, start)[0]  # type: ignore[arg-type]
+@lru_cache(maxsize=CACHED)
+def _lab_values(mdp: Mdp, beta: float, tol: float, maxiter: int, start: float = 0.0) -> FloatArray:
+    """V of the lab's value iteration (from the previous V, max-norm stop) on `mdp` at `beta` from
+    V = `start`: what a mistake gives, memoised per case (shared: read only)."""
+    sweep = bellman_sweep(mdp, beta)
+    values = iterate(sweep, mdp.n_states, tol, maxiter, JACOBI_MAX, np.full(mdp.n_states, start))[0]
+    values.setflags(write=False)
+    return values
 
 
 MISTAKES: tuple[tuple[str, Mistake], ...] = (
     (
         "beta ignored: your values are those of discount 1 (the discount never applied); multiply the next state's value by beta: p * (r + beta * V[s'])",  # noqa: E501
-        lambda case, tol, maxiter: _lab_values(case, tol, maxiter, beta=1.0),
+        lambda case, tol, maxiter: _lab_values(case.mdp, 1.0, tol, maxiter),
     ),
     (
         "first outcome only: your values are those of reading P[s][a][0] alone; on a slippery move every outcome (p, s', r, done) in P[s][a] counts, weighted by p: sum over all of them",  # noqa: E501
-        lambda case, tol, maxiter: _lab_values(case, tol, maxiter, mdp=first_outcomes(case.mdp)),
+        lambda case, tol, maxiter: _lab_values(first_outcomes(case.mdp), case.beta, tol, maxiter),
     ),
     (
         "`=` where `+=` is meant: your values are those of the last outcome of each move alone (each outcome overwrites the one before); add them up with +=",  # noqa: E501
-        lambda case, tol, maxiter: _lab_values(case, tol, maxiter, mdp=last_outcomes(case.mdp)),
+        lambda case, tol, maxiter: _lab_values(last_outcomes(case.mdp), case.beta, tol, maxiter),
     ),
     (
         "values initialised to ones: your values are those of value iteration started from V = 1, which a terminal state that loops to itself (FrozenLake's holes and goal) never clears at discount 1; start from V = np.zeros(nS)",  # noqa: E501
-        lambda case, tol, maxiter: _lab_values(case, tol, maxiter, start=np.ones(case.mdp.n_states)),
+        lambda case, tol, maxiter: _lab_values(case.mdp, case.beta, tol, maxiter, 1.0),
     ),
 )
 """Typical mistakes: (what the feedback says, the values they give). Named when one explains every wrong V."""

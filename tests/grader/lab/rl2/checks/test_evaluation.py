@@ -11,8 +11,10 @@ import pytest
 
 from grader.lab.rl2.checks.evaluation import points
 from grader.lab.rl2.checks.mdp_calls import cases
+from reference.errors import UnboundedValueError
+from reference.oracles.mdp import mdp_from_table, policy_value
 from reference.rl2 import solutions
-from tests.grader.lab.rl2.support import SEED, judged
+from tests.grader.lab.rl2.support import SEED, judged, read_outcomes
 
 
 def evaluation(
@@ -28,23 +30,31 @@ def evaluation(
     start: float = 0.0,
     in_place: bool = False,
     with_count: bool = False,
+    maxiter: int = 5000,
 ) -> Any:
+    """The lab's iterative evaluation (2-norm stop), and each typical mistake as a switch.
+
+    Each state's value adds `p * (r + beta * V[s'])` over its move's outcomes in their order, as the lab's
+    loop over `P[s][policy[s]]` does (on Python floats: the same sums as on numpy's). At discount 1 a policy
+    may have no value, and its evaluation would never stop (the sandbox's time limit would end it): it stops
+    after `maxiter` sweeps instead (at SEED those that stop take at most 1 191).
+    """
     factor = beta if discount else 1.0
+    moves = [read_outcomes(P[s][int(policy[s])], read) for s in range(nS)]
     V = np.full(nS, start)
-    for n in range(1, 200_000):  # at discount 1 a policy may have no value: stop as a maxiter would
-        new = V.copy() if in_place else np.zeros(nS)
+    for n in range(1, maxiter + 1):
+        old = V.tolist()
+        new = old.copy() if in_place else [0.0] * nS
         for s in range(nS):
             total = 0.0
-            outcomes = P[s][int(policy[s])]
-            for p, s1, r, _ in outcomes[:1] if read == "first" else outcomes:
-                term = p * (r + factor * (new if in_place else V)[s1])
-                total = term if read == "last" else total + term
+            for p, s1, r, _ in moves[s]:
+                total = total + p * (r + factor * (new if in_place else old)[s1])
             new[s] = total
-        change = np.linalg.norm(new - V)
-        V = new
+        change = np.linalg.norm(np.array(new) - V)
+        V = np.array(new)
         if change < tol:
             return (V, n) if with_count else V
-    return (V, n) if with_count else V
+    return (V, maxiter) if with_count else V
 
 
 def test_the_policies_asked_have_finite_values_and_include_the_labs_start() -> None:
@@ -101,4 +111,23 @@ def test_each_typical_mistake_is_named(changes: dict[str, Any], cause: str) -> N
 def test_a_wrong_value_fails_without_a_cause(function: Any, found: str) -> None:
     verdict = judged("v2024", "iter_policy_eval", function)
     assert verdict.status == "failed" and found in verdict.feedback, verdict.feedback
+    assert "Likely cause" not in verdict.feedback
+
+
+def test_a_mistake_that_gives_no_value_for_any_wrong_call_is_not_named() -> None:
+    """Wrong only where the policy has no value at discount 1: "beta ignored" gives no value there, so it
+    explains none of the wrong calls, and no cause is named."""
+
+    def wrong_where_discount_1_has_no_value(
+        P: Any, nS: int, nA: int, policy: Any, beta: float = 1.0, tol: float = 1e-8
+    ) -> Any:
+        values = solutions.iter_policy_eval(P, nS, nA, policy, beta, tol)
+        try:
+            policy_value(mdp_from_table("P", P, nS, nA), policy, 1.0)
+        except UnboundedValueError:
+            return values + 0.01
+        return values
+
+    verdict = judged("v2024", "iter_policy_eval", wrong_where_discount_1_has_no_value)
+    assert verdict.status == "failed" and "its exact value on" in verdict.feedback, verdict.feedback
     assert "Likely cause" not in verdict.feedback

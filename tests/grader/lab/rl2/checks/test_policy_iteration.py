@@ -30,7 +30,9 @@ def test_the_reference_passes_and_the_feedback_names_the_graders_helpers() -> No
 
 def test_with_the_students_helpers_no_name_is_bound_and_the_feedback_says_so() -> None:
     assert {call.provided for call in _plan("v2024", helpers="student")} == {()}
-    verdict = judged("v2024", "policy_iteration", solutions.policy_iteration, helpers="student")
+    # judged here, no name is bound either way: any passing function shows the feedback's reading
+    verdict = judged("v2024", "policy_iteration", _optimal, helpers="student")
+    assert verdict.status == "passed", verdict.feedback
     assert "called with your own iter_policy_eval and policy_improvement" in verdict.feedback
 
 
