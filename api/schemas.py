@@ -106,8 +106,7 @@ class Health(BaseModel):
     queued: int
     running: int
     workers: int = Field(
-        description="Gradings this server process runs at once (GYMGRADE_WORKERS; 0: `gymgrade worker` "
-        "or the cluster grades)."
+        description="Gradings this server process runs at once (GYMGRADE_WORKERS; 0: the cluster grades)."
     )
 
 
