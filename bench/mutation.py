@@ -1,10 +1,11 @@
 """A mutation run of the verdict logic: does a green suite prove what it seems to? (issue 34)
 
-Each mutant is one small change to the code that decides a verdict (grader/lab/checks/) or to the rules of
-a compatibility game (grader/compat/envs/): a statistical decision forced to accept, a comparison flipped,
-a diagnosis branch removed, a game rule changed. The checks of random_blackjack, blackjack and taxi have
-hand-written mutants; for every other check module (`BRANCH_MODULES`) every `if`/`elif` is found with `ast`
-and made never to fire (its condition replaced by `False`): each branch that returns a verdict, a
+Each mutant is one small change to the code that decides a verdict (grader/lab/checks/, and the second
+lab's pure checks in grader/lab/rl2/checks/) or to the rules of a compatibility game
+(grader/compat/envs/): a statistical decision forced to accept, a comparison flipped, a diagnosis branch
+removed, a game rule changed. The checks of random_blackjack, blackjack and taxi have hand-written
+mutants; for every other check module (`BRANCH_MODULES`, `RL2_BRANCH_MODULES`) every `if`/`elif` is found
+with `ast` and made never to fire (its condition replaced by `False`): each branch that returns a verdict, a
 diagnosis or a number the verdict is made of. Every mutant is applied alone to a temporary copy of the
 worktree, the tests that cover that code run there (`python -m pytest -x`, slow-marked ones included), and
 the mutant is `killed` when they fail, `survived` when they pass. A surviving mutant is a change the tests
@@ -311,13 +312,31 @@ BRANCH_MODULES: dict[str, tuple[str, ...]] = {
 }
 
 
-def branch_mutants(module: str, tests: tuple[str, ...]) -> list[Mutant]:
+RL2_CHECKS = "grader/lab/rl2/checks"
+RL2_CHECK_TESTS = "tests/grader/lab/rl2/checks"
+RL2_BRANCH_MODULES: dict[str, tuple[str, ...]] = {
+    module: tuple(f"{RL2_CHECK_TESTS}/test_{name}.py" for name in names)
+    for module, names in {
+        "mdp_calls": ("mdp_calls", "value_iteration", "evaluation", "improvement", "policy_iteration"),
+        "value_iteration": ("value_iteration", "mdp_calls"),
+        "evaluation": ("evaluation", "mdp_calls"),
+        "improvement": ("improvement", "mdp_calls"),
+        "policy_iteration": ("policy_iteration", "mdp_calls"),
+    }.items()
+}
+"""The second lab's pure checks (their played ones grade through the sandbox: not in this run), with the
+tests that cover each; their mutants are named `rl2 <module>: ...`."""
+
+
+def branch_mutants(
+    module: str, tests: tuple[str, ...], checks: str = CHECKS, prefix: str = ""
+) -> list[Mutant]:
     """A mutant for every `if`/`elif` of the check module: its condition replaced by `False`.
 
     Named by module and condition (a repeated condition by its order too). `old` is the branch's header
     (from `if` to the condition's end), widened line by line until it occurs once in the file.
     """
-    path = f"{CHECKS}/{module}.py"
+    path = f"{checks}/{module}.py"
     source = (ROOT / path).read_bytes()
     starts = [0]
     for line in source.splitlines(keepends=True):
@@ -343,12 +362,18 @@ def branch_mutants(module: str, tests: tuple[str, ...]) -> list[Mutant]:
         shown = text if len(text) <= 70 else text[:67] + "..."
         seen[shown] = seen.get(shown, 0) + 1
         suffix = f" (#{seen[shown]})" if seen[shown] > 1 else ""
-        mutants.append(Mutant(f"{module}: never `{shown}`{suffix}", path, old.decode(), new.decode(), tests))
+        name = f"{prefix}{module}: never `{shown}`{suffix}"
+        mutants.append(Mutant(name, path, old.decode(), new.decode(), tests))
     return mutants
 
 
 MUTANTS += tuple(
     mutant for module, tests in BRANCH_MODULES.items() for mutant in branch_mutants(module, tests)
+)
+MUTANTS += tuple(
+    mutant
+    for module, tests in RL2_BRANCH_MODULES.items()
+    for mutant in branch_mutants(module, tests, RL2_CHECKS, "rl2 ")
 )
 
 EQUIVALENT: dict[str, str] = {
@@ -371,6 +396,9 @@ EQUIVALENT: dict[str, str] = {
     "loop below ends with round(recomputed, 15), within 5e-16 of the recomputed number, compared by "
     "math.isclose with its default rel_tol (1e-9) and the same abs_tol: the same tolerance, so only a "
     "value within 5e-16 of the tolerance's edge could be judged differently",
+    "rl2 mdp_calls: never `len(stopped) == len(set(norms))`": "the early return once every norm has "
+    "stopped saves sweeps only: the sweeps after it change no entry of `stopped` (each holds the array of "
+    "its own sweep, and every sweep makes a new one), so the same dictionary is returned after maxiter",
 }
 """Surviving mutants that no test can kill, with the reason: the mutated code behaves as the original."""
 
@@ -502,13 +530,15 @@ def table(results: dict[str, tuple[str, float]]) -> str:
         f"`{RESULTS_LOG.relative_to(ROOT)}`; `--write` rewrites this section from it): each mutant applied "
         "alone to a temporary copy of the tree, the tests that cover it run with `pytest -x` (slow-marked "
         "ones too); the unmutated tests pass in the copy. The checks of random_blackjack, blackjack and taxi "
-        "and the toy-text games have hand-written mutants; every other check module has one mutant per `if`/"
-        "`elif` made never to fire. `equivalent`: the mutant survives and `EQUIVALENT` in the script says "
-        "why no test can see it. History: of the 43 hand-written mutants of the first run, 16 survived "
-        "until their samples were added (this file's history has that table); of the branch mutants, the "
-        "survivors of the first run were given tests (tests/grader/lab/checks/) and run again with "
-        "`--survivors`. Seconds are wall times on the shared two-core machine (load 6 to 13 during the "
-        "2026-11-28 runs), not a benchmark.",
+        "and the toy-text games have hand-written mutants; every other check module, and the second lab's "
+        "pure checks (`rl2 ...`: mdp_calls, value_iteration, evaluation, improvement, policy_iteration; its "
+        "played checks grade through the sandbox and are not in this run), has one mutant per `if`/`elif` "
+        "made never to fire. `equivalent`: the mutant survives and `EQUIVALENT` in the script says why no "
+        "test can see it. History: of the 43 hand-written mutants of the first run, 16 survived until their "
+        "samples were added (this file's history has that table); of the branch mutants, the survivors of "
+        "the first run were given tests (tests/grader/lab/checks/; for the second lab, 8 of 57, "
+        "tests/grader/lab/rl2/checks/) and run again with `--survivors`. Seconds are wall times on the "
+        "shared two-core machine (load 1 to 13 during the 2026-11-28 runs), not a benchmark.",
         "",
         f"{len(rows)} mutants: {total['killed']} killed, {total['equivalent']} equivalent, "
         f"{total['survived']} survived" + (f", {total['not run']} not run" if total["not run"] else "") + ".",

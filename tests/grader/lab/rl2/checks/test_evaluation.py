@@ -131,3 +131,9 @@ def test_a_mistake_that_gives_no_value_for_any_wrong_call_is_not_named() -> None
     verdict = judged("v2024", "iter_policy_eval", wrong_where_discount_1_has_no_value)
     assert verdict.status == "failed" and "its exact value on" in verdict.feedback, verdict.feedback
     assert "Likely cause" not in verdict.feedback
+
+
+def test_a_wrong_answer_names_the_kind_of_policy_it_was_asked_about() -> None:
+    """The first call of each MDP asks about an optimal policy, read again from the call by the judge."""
+    verdict = judged("v2024", "iter_policy_eval", lambda *args: evaluation(*args) + 0.01)
+    assert verdict.status == "failed" and "(an optimal policy) returned" in verdict.feedback, verdict.feedback

@@ -13,9 +13,10 @@ import pytest
 
 from grader.lab.checks.base import CallRecord
 from grader.lab.editions import edition_of
-from grader.lab.rl2.checks.mdp_calls import called_case
-from grader.sandbox.outcome import Call, MdpArgument
-from tests.grader.lab.rl2.support import judged, outcome, settings, wire
+from grader.lab.rl2.checks.mdp_calls import as_count, as_vector, call_text, called_case
+from grader.sandbox.outcome import Call, CallOutcome, MdpArgument, OutcomeStatus
+from reference.rl2 import solutions
+from tests.grader.lab.rl2.support import judged, judged_outcomes, outcome, settings, wire
 
 ROOT = Path(__file__).resolve().parents[5]
 MEMORISER = ROOT / "submissions" / "rl2" / "hostile" / "memorised_public_cases.py"
@@ -98,3 +99,64 @@ def test_the_memoriser_is_right_on_every_public_case(problem: str) -> None:
         records.append(CallRecord(outcome(call, wire(function(*args))), []))
     verdict = entry.check.judge(chosen, records)
     assert verdict.status == "passed", verdict.feedback
+
+
+def test_values_as_a_list_and_a_whole_float_count_are_read_as_the_lab_returns_them() -> None:
+    """`V.tolist()` and `float(n)` are the same answer: a list of numbers is the values, 3.0 is 3 sweeps."""
+
+    def listed(P: Any, nS: int, nA: int, beta: float = 1.0, tol: float = 1e-8, maxiter: int = 3000) -> Any:
+        values, sweeps = solutions.value_iteration(P, nS, nA, beta, tol, maxiter)
+        return [float(v) for v in values], float(sweeps)
+
+    verdict = judged("v2024", "value_iteration", listed)
+    assert verdict.status == "passed", verdict.feedback
+
+
+@pytest.mark.parametrize(
+    ("value", "read"),
+    [
+        ([1, 2.5], [1.0, 2.5]),
+        (np.array([[1], [2]]), [1.0, 2.0]),
+        ([1, "2"], None),
+        ([True, False], None),
+        ([1.0, float("nan")], None),
+        ([1.0], None),
+        ((1.0, 2.0), None),
+    ],
+    ids=["list", "column", "text-item", "bools", "nan", "too-short", "tuple"],
+)
+def test_a_returned_vector_is_numbers_only(value: Any, read: list[float] | None) -> None:
+    vector = as_vector(value, 2)
+    assert (None if vector is None else vector.tolist()) == read
+
+
+@pytest.mark.parametrize(
+    ("value", "count"),
+    [(3, 3), (3.0, 3), (3.5, None), (float("inf"), None), (True, None), ("3", None)],
+    ids=["int", "whole-float", "fraction", "inf", "bool", "text"],
+)
+def test_a_returned_count_is_an_int_or_a_whole_float(value: Any, count: int | None) -> None:
+    assert as_count(value) == count
+
+
+def test_feedback_shows_an_array_argument_by_its_size_and_the_table_by_its_name() -> None:
+    call = next(c for c in _plan("iter_policy_eval", 0) if isinstance(c.args[3], np.ndarray))
+    assert call_text(call) == (
+        f"iter_policy_eval(<P of {call.args[0].name}>, {call.args[1]}, {call.args[2]}, "
+        f"<array of {call.args[3].size}>, {call.args[4]!r}, {call.args[5]!r})"
+    )
+
+
+def test_a_planned_call_without_an_mdp_first_is_the_graders_error() -> None:
+    call = Call("value_iteration", ([[0]], 1, 1, 0.9, 1e-8, 3000))
+    with pytest.raises(TypeError, match="the first argument planned is not an MDP table"):
+        called_case(call, 3)
+
+
+@pytest.mark.parametrize("problem", PURE_2024)
+def test_a_call_that_raised_is_the_verdict_before_any_value_is_read(problem: str) -> None:
+    def raised(call: Any) -> CallOutcome:
+        return outcome(call, None, OutcomeStatus.EXCEPTION, "ZeroDivisionError: division by zero")
+
+    verdict = judged_outcomes("v2024", problem, raised)
+    assert verdict.status == "error" and "ZeroDivisionError" in verdict.feedback, verdict.feedback
