@@ -37,11 +37,14 @@ class ImportedGrader:
         on_progress: ProgressCallback,
         only: Sequence[str] | None = None,
         config: Path | None = None,
+        name: str | None = None,
     ) -> JsonObject:
         """Grade the file at ``path`` with ``seed``; call ``on_progress`` with each finished problem (JSON).
 
         ``only`` and ``config`` (a distributed batch's --only and --config) default to every enabled
-        problem of the bundled configuration. Returns the report as JSON data.
+        problem of the bundled configuration. ``name`` is the file's own name as its messages and report
+        show it when its copy here has a safe grading name instead (an upload named ``my lab.py``, a
+        class's ``smith-1.py``); ``path.name`` when None. Returns the report as JSON data.
         """
         grade_submission = load_function(self.target)
         from grader.sandbox import IsolationPolicy  # the grader is heavy: import it only where grading runs
@@ -52,6 +55,8 @@ class ImportedGrader:
             selection["only"] = only
         if config is not None:  # passed only when set, so graders without the parameter still work
             selection["config"] = config
+        if name is not None:  # likewise: a grader without the parameter shows its file's own name
+            selection["name"] = name
         report = grade_submission(
             path,
             seed=seed,

@@ -66,6 +66,7 @@ def grade_submission(
     on_progress: Callable[[ProblemResult], None] | None = None,
     config: Path | None = None,
     plan: GradingPlan | None = None,
+    name: str | None = None,
 ) -> Report:
     """Grade one submission file.
 
@@ -82,6 +83,9 @@ def grade_submission(
         on_progress: Called with each problem's result as soon as its check finishes.
         config: Assignment configuration TOML; the bundled one when None.
         plan: A plan made already (`GradingPlan.load`); ``config`` and ``only`` are then not read.
+        name: The file's own name as shown to a person, already neutralised, when its copy on disk is
+            called otherwise (a worker grades a class's file under a safe name): see `grade_files`'
+            ``names``. ``path.name`` when None.
 
     Returns:
         The report. ``report.grader_errors`` lists failures of the grader itself (the affected problems
@@ -97,7 +101,10 @@ def grade_submission(
         progress = on_progress
         listener = OnResult(lambda _path, result: progress(result))
     chosen = plan or GradingPlan.load(config, only)
-    return grade_files([path], chosen, seed=seed, workers=workers, policy=policy, listener=listener)[0]
+    names = {path: name} if name else None
+    return grade_files(
+        [path], chosen, seed=seed, workers=workers, policy=policy, listener=listener, names=names
+    )[0]
 
 
 def grade_files(
