@@ -41,7 +41,7 @@ from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.host import usable_cpus
 from grader.sandbox.isolation.scope import sandbox_scope
-from grader.sandbox.runner import require_isolation
+from grader.sandbox.runner import require_isolation, sandbox_file_name
 from grader.submission.notebook import MAX_NOTEBOOK_BYTES, build_module, is_notebook
 from grader.submission.notebook.cells import write_cells
 from grader.submission.untrusted_file import UnsafeFile, read_untrusted
@@ -212,11 +212,14 @@ def _prepare(
 
 def _sandbox_name(submission: Submission) -> str:
     """The name the sandbox's messages give a file (``--name``), or "" to let them name its copy as before:
-    given only when the file is shown by another name than its own (a class's zip is read into numbered
-    copies), as its copy would be called (a notebook's module is ``<notebook>.py``)."""
-    if not submission.name or submission.name == submission.path.name:
+    given only when the file is shown by another name than the sandbox would call its copy (a class's zip
+    is read into numbered copies, a worker writes a file under a safe name, a file's own name holds a space
+    or a bracket that the sandbox's copy replaces), as its copy would be called (a notebook's module is
+    ``<notebook>.py``); so the sandbox's messages say what the grader's own do, whoever wrote the copy."""
+    if not submission.name:
         return ""
-    return f"{submission.name}.py" if submission.notebook is not None else submission.name
+    shown = f"{submission.name}.py" if submission.notebook is not None else submission.name
+    return "" if shown == sandbox_file_name(submission.module.name) else shown
 
 
 def _edition_note(source: bytes, name: str, plan: GradingPlan) -> str | None:

@@ -348,6 +348,8 @@ ROOT = Path(__file__).resolve().parents[2]
 RAISES_ENTRY = "raiserosa_3005_7005_opengym-2.py"
 MISTAKEN_ENTRY = "bobby_3002_7002_opengym (1).py"
 CALL_RAISES_ENTRY = "calla_3006_7006_opengym-3.py"
+FOLDER_ENTRY = "opengym (2).py"
+"""A folder download's file, graded under its own name, which the sandbox's copy would spell otherwise."""
 
 
 @pytest.mark.slow
@@ -376,9 +378,11 @@ def test_a_real_worker_grades_through_the_real_sandbox(tmp_path: Path, redis_ser
     (inputs / "2.py").write_bytes(b"raise RuntimeError('boom at import')\n")
     (inputs / "3.py").write_bytes(BROKEN)
     (inputs / "4.py").write_bytes(b"def random_blackjack(n):\n    raise ValueError('no games today')\n")
+    (inputs / FOLDER_ENTRY).write_bytes(b"raise RuntimeError('boom at import')\n")
     paths = sorted(inputs.glob("*.py"))
     shown = [HONEST_ENTRY, MISTAKEN_ENTRY, RAISES_ENTRY, file_name(HOSTILE_FILE), CALL_RAISES_ENTRY]
-    file_names = dict(zip(paths, shown, strict=True))
+    file_names = dict(zip(paths, shown, strict=False))  # a folder's file keeps its own name: none given
+    shown.append(FOLDER_ENTRY)
     try:
         deadline = time.monotonic() + READY_SECONDS  # bounds a hang only: the loop ends at the log's "ready"
         while not re.search(r"gymgrade-\d+@\S+ ready", worker.log()):
@@ -396,7 +400,7 @@ def test_a_real_worker_grades_through_the_real_sandbox(tmp_path: Path, redis_ser
     finally:
         worker.stop()
 
-    ada, bob, rosa, broken, calling = outcome.reports
+    ada, bob, rosa, broken, calling, folder = outcome.reports
     assert (ada.grader_errors, bob.grader_errors, rosa.grader_errors) == ([], [], []), worker.log()
     assert ada.isolation is not None and ada.isolation.full, worker.log()
     assert [(result.id, result.status) for result in ada.problems] == [("random_blackjack", "passed")]
@@ -410,6 +414,7 @@ def test_a_real_worker_grades_through_the_real_sandbox(tmp_path: Path, redis_ser
         f'File "/submission/{CALL_RAISES_ENTRY}", line 2, in random_blackjack' in calling.problems[0].feedback
     )
     assert "served the classic gym API" in json.dumps(ada.graded_view())
+    assert f'File "/submission/{FOLDER_ENTRY}", line 1, in <module>' in folder.problems[0].feedback
     for report in outcome.reports:  # never the numbered copies (0.py...) nor the worker's submission.py
         assert not re.search(r"(?<![\w-])(\d+|submission)\.py", json.dumps(report.graded_view())), report
     local = grade_many(paths, tmp_path / "local", seed=11, only=["random_blackjack"], file_names=file_names)
