@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import inspect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -55,7 +56,7 @@ class ImportedGrader:
             selection["only"] = only
         if config is not None:  # passed only when set, so graders without the parameter still work
             selection["config"] = config
-        if name is not None:  # likewise: a grader without the parameter shows its file's own name
+        if name is not None and accepts(grade_submission, "name"):  # a grader without it shows its file's
             selection["name"] = name
         report = grade_submission(
             path,
@@ -70,6 +71,17 @@ class ImportedGrader:
             raise GraderFailed(f"the grader failed on this submission (not the student's fault): {failures}")
         dumped: JsonObject = report.model_dump(mode="json")
         return dumped
+
+
+def accepts(function: Callable[..., Any], parameter: str) -> bool:
+    """Whether ``function`` takes the keyword ``parameter`` (or any keyword); False when it cannot be told."""
+    try:
+        parameters = inspect.signature(function).parameters
+    except (TypeError, ValueError):
+        return False
+    return parameter in parameters or any(
+        item.kind is inspect.Parameter.VAR_KEYWORD for item in parameters.values()
+    )
 
 
 def check_grader_target(target: str) -> None:
