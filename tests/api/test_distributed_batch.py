@@ -2,7 +2,8 @@
 the real grader, through the real sandbox under full isolation).
 
 The batch core is the local one (tests/grader/grading/test_batch.py); these tests pin that the cluster's
-executor hands every report back, that a re-run resumes, and that an interrupted batch keeps what it finished.
+executor hands every report back, that a re-run resumes, that an interrupted batch keeps what it finished,
+and that a class zip's files are named as a local grading names them (the request's names untrusted).
 """
 
 from __future__ import annotations
