@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import inspect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,11 +38,14 @@ class ImportedGrader:
         on_progress: ProgressCallback,
         only: Sequence[str] | None = None,
         config: Path | None = None,
+        name: str | None = None,
     ) -> JsonObject:
         """Grade the file at ``path`` with ``seed``; call ``on_progress`` with each finished problem (JSON).
 
         ``only`` and ``config`` (a distributed batch's --only and --config) default to every enabled
-        problem of the bundled configuration. Returns the report as JSON data.
+        problem of the bundled configuration. ``name`` is the file's own name as its messages and report
+        show it when its copy here has a safe grading name instead (an upload named ``my lab.py``, a
+        class's ``smith-1.py``); ``path.name`` when None. Returns the report as JSON data.
         """
         grade_submission = load_function(self.target)
         from grader.sandbox import IsolationPolicy  # the grader is heavy: import it only where grading runs
@@ -52,6 +56,8 @@ class ImportedGrader:
             selection["only"] = only
         if config is not None:  # passed only when set, so graders without the parameter still work
             selection["config"] = config
+        if name is not None and accepts(grade_submission, "name"):  # a grader without it shows its file's
+            selection["name"] = name
         report = grade_submission(
             path,
             seed=seed,
@@ -65,6 +71,17 @@ class ImportedGrader:
             raise GraderFailed(f"the grader failed on this submission (not the student's fault): {failures}")
         dumped: JsonObject = report.model_dump(mode="json")
         return dumped
+
+
+def accepts(function: Callable[..., Any], parameter: str) -> bool:
+    """Whether ``function`` takes the keyword ``parameter`` (or any keyword); False when it cannot be told."""
+    try:
+        parameters = inspect.signature(function).parameters
+    except (TypeError, ValueError):
+        return False
+    return parameter in parameters or any(
+        item.kind is inspect.Parameter.VAR_KEYWORD for item in parameters.values()
+    )
 
 
 def check_grader_target(target: str) -> None:

@@ -103,9 +103,14 @@ def _suffix(name: str) -> str:
 
 
 def grading_file_name(name: str) -> str:
-    """The file name a submission is graded under: its display name when it is a valid module name."""
+    """The file name a submission is graded under: its display name when it is a valid module name of at
+    most ``MAX_DISPLAY_NAME_CHARS`` characters, else ``submission`` with its suffix (``.py`` or ``.ipynb``).
+
+    Safe as one path component whatever ``name`` is (a cluster's request is untrusted input). The name
+    messages show is the display name either way: the runner gives the grader it (``ClaimedJob``)."""
     suffix = next((suffix for suffix in SUBMISSION_SUFFIXES if name.endswith(suffix)), None)
-    if suffix is not None and _MODULE_STEM.fullmatch(name.removesuffix(suffix)):
+    stem = name.removesuffix(suffix) if suffix is not None else ""
+    if suffix is not None and len(name) <= MAX_DISPLAY_NAME_CHARS and _MODULE_STEM.fullmatch(stem):
         return name
     return GRADING_FALLBACK_NAME.removesuffix(".py") + (suffix or ".py")
 

@@ -25,7 +25,13 @@ backend.
   the same command (`os.execve`, same pid; at most 5 times in 300 s, backing off 1-16 s, counted in
   `GYMGRADE_WORKER_RESTARTS`), so a broker restart never leaves the cluster without its worker.
 - Distributed batch: `batch.CeleryExecutor` (entry point `gymgrade.executors: cluster`) sends task
-  `gymgrade.grade_file({key, reply_to, filename, content (base64), seed, only, config_toml, ...})`; the
+  `gymgrade.grade_file({key, reply_to, filename, name, content (base64), seed, only, config_toml, ...})`;
+  `filename` is the file's name on the batch's disk (a zip's numbered copy, `6.py`: its kind, `.py` or
+  `.ipynb`), `name` its own name as shown (the batch's `file_names`, `grader.render.neutral.file_name` of
+  the download's; absent from a batch of before the field, then `filename` is shown). The worker trusts
+  neither: it shows `file_name(name)` (bounded) and writes the file as `uploads.grading_file_name(filename)`,
+  then grades it as an upload is graded: the runner gives the child the name to show (`"name"`, when the
+  file's grading name differs) and the child the grader (`grade_submission(..., name=)`). The
   worker grades it in the same child and RPUSHes `{key, report}` or `{key, error}` to the batch's Redis
   list `gymgrade:batch:<uuid>`, which the client BLPOPs (Celery's Redis result backend is not used: it
   gives up for good after a broker outage). After a broker outage the client sends the outstanding files

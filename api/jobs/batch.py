@@ -120,8 +120,9 @@ class CeleryExecutor:
     ) -> None:
         """Send every file to the cluster and hand each report over as it arrives.
 
-        ``file_names`` (each file's own name as shown) is not yet carried to the cluster: its workers name
-        a file by ``path.name``, so a class read from a zip shows the numbered names there.
+        ``file_names`` (each file's own name as shown, ``path.name`` without one) goes with each file as
+        the request's ``name``: the worker's messages and the report's ``submission`` say what a local
+        grading says, while the worker writes the file under a safe grading name of its own.
 
         A broker restart during the batch loses its queued tasks: once the broker answers again, every
         file still outstanding is sent again (a report that arrives twice is taken once).
@@ -138,6 +139,7 @@ class CeleryExecutor:
         reply_to = REPLY_PREFIX + uuid.uuid4().hex
         config_toml = configuration_text(plan)
         requests: dict[str, dict[str, Any]] = {}
+        shown = {path: (file_names or {}).get(path) or path.name for path in paths}
         contents: dict[str, bytes] = {}
         pending: dict[str, Path] = {}
         for index, path in enumerate(paths):
@@ -160,6 +162,7 @@ class CeleryExecutor:
                 "key": key,
                 "reply_to": reply_to,
                 "filename": path.name,
+                "name": shown[path],
                 "content": base64.b64encode(data).decode("ascii"),
                 "seed": seed,
                 "only": list(plan.problems),
@@ -189,7 +192,7 @@ class CeleryExecutor:
                 if key not in pending:
                     continue  # a duplicate delivery's report, already taken
                 path = pending.pop(key)
-                report = _report(path, contents[key], message, plan, seed)
+                report = _report(path, contents[key], message, plan, seed, shown[path])
                 for result in report.problems:
                     listener.result(path, result)
                 listener.report(path, report)
@@ -209,13 +212,16 @@ class CeleryExecutor:
         return task_id
 
 
-def _report(path: Path, data: bytes, message: dict[str, Any], plan: GradingPlan, seed: int) -> Report:
-    """The report a worker sent, named after the file; a grading that failed becomes a grader error."""
+def _report(
+    path: Path, data: bytes, message: dict[str, Any], plan: GradingPlan, seed: int, name: str = ""
+) -> Report:
+    """The report a worker sent, its ``submission`` the file's name as shown (``name``, ``path.name`` when
+    empty: what this side read, whatever the worker says); a grading that failed becomes a grader error."""
     if "report" in message:
         report = Report.model_validate(message["report"])
-        return report.model_copy(update={"submission": path.name})
+        return report.model_copy(update={"submission": name or path.name})
     reason = str(message.get("error", "the worker sent no report"))
     collector = Outcomes(plan, seed=seed, workers=0, listener=Silent())
-    collector.expect(Submission(path, data, path))
+    collector.expect(Submission(path, data, path, name=name))
     collector.close(f"the cluster could not grade it: {reason}")
     return collector.reports[path]

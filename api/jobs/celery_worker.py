@@ -39,6 +39,7 @@ from api.jobs.local import DatabaseQueue
 from api.jobs.runner import run_job
 from api.models import JobStatus
 from api.settings import Settings
+from grader.render.neutral import MAX_FILE_NAME_CHARS, file_name
 
 logger = logging.getLogger(__name__)
 
@@ -119,6 +120,19 @@ def startup_problem(settings: Settings) -> str | None:
             "Install the missing layers (see scripts/setup.sh), or set GYMGRADE_ALLOW_WEAK_ISOLATION=1 for a trial only"  # noqa: E501
         )
     return None
+
+
+MAX_REQUEST_NAME_CHARS = 4 * MAX_FILE_NAME_CHARS
+"""Characters of a request's ``filename`` or ``name`` read: more than any name shown keeps."""
+
+
+def shown_name(name: object, filename: str) -> str:
+    """The name a batch file's messages and report show: the request's ``name`` (the batch computed it from
+    the download, ``grader.render.neutral.file_name``), else its ``filename`` (a request from a batch of
+    before the field), neutralised again here: a request is untrusted input, and the name is only ever
+    shown (the file is written under ``api.uploads.grading_file_name``)."""
+    given = name if isinstance(name, str) and name else filename
+    return file_name(given[:MAX_REQUEST_NAME_CHARS])
 
 
 @dataclass
@@ -218,9 +232,11 @@ class WorkerRuntime:
         Raises:
             celery.exceptions.Reject: The worker is shutting down; the task goes back to the queue.
         """
+        filename = str(request["filename"])[:MAX_REQUEST_NAME_CHARS]
         job = ClaimedJob(
             submission_id=0,
-            filename=str(request["filename"]),
+            filename=filename,
+            shown_name=shown_name(request.get("name"), filename),
             content=base64.b64decode(request["content"]),
             seed=int(request["seed"]),
             attempt=1,

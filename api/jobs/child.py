@@ -1,10 +1,12 @@
 """The niced child process that grades one submission: request on stdin, JSON lines on its protocol pipe.
 
-Run as ``python -m api.jobs.child``. The parent writes one JSON request to stdin. Messages go out on
-the original standard output, one JSON object per line: ``{"kind": "progress", "problem": {...}}`` as
-problems finish, then ``{"kind": "report", "report": {...}}`` or ``{"kind": "error", "message": ...}``.
-File descriptor 1 itself is pointed at standard error first, so nothing the grader or its children
-print can corrupt the protocol.
+Run as ``python -m api.jobs.child``. The parent writes one JSON request to stdin: among its fields the
+file's ``path`` (under a safe grading name, ``api.uploads.grading_file_name``) and ``name``, the name its
+messages and report show when that differs (the upload's or the download's; the grader's ``name``).
+Messages go out on the original standard output, one JSON object per line:
+``{"kind": "progress", "problem": {...}}`` as problems finish, then ``{"kind": "report", "report": {...}}``
+or ``{"kind": "error", "message": ...}``. File descriptor 1 itself is pointed at standard error first, so
+nothing the grader or its children print can corrupt the protocol.
 """
 
 from __future__ import annotations
@@ -75,6 +77,7 @@ def main() -> int:
             on_progress=lambda problem: _send(channel, {"kind": "progress", "problem": problem}),
             only=request.get("only"),
             config=config,
+            name=request.get("name"),
         )
     except ServiceError as error:
         _send(channel, {"kind": "error", "message": str(error)})

@@ -19,6 +19,9 @@ class ClaimedJob:
     """Problems to grade (a batch's --only); all enabled ones when None."""
     config_toml: str | None = None
     """The assignment configuration's TOML text (a batch's --config); the bundled one when None."""
+    shown_name: str | None = None
+    """The file's own name as its messages and report show it (a class's download name, sent by the batch
+    that read it, neutralised again on receipt); ``filename`` when None. Only ever shown, never a path."""
 
 
 class JobQueue(Protocol):

@@ -83,9 +83,13 @@ def run_job(
 def _send_request(
     child: subprocess.Popen[str], submission: Path, config: Path | None, job: ClaimedJob, settings: Settings
 ) -> None:
+    shown = job.shown_name or job.filename
     request = {
         "grader": settings.grader,
         "path": str(submission),
+        # The name messages and the report show, when the file here has another (safe) name: "my lab.py"
+        # graded as submission.py, a class's download name. Only ever shown, never a path.
+        "name": shown if shown != submission.name else None,
         "seed": job.seed,
         "only": list(job.only) if job.only is not None else None,
         "config": str(config) if config is not None else None,

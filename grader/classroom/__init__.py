@@ -38,7 +38,8 @@ In detail:
   `command.file_names_of(submissions)` maps each graded file to `grader.render.neutral.file_name` of its
   `graded_file.relative` (its last part, neutralised, at most 120 characters), carried as data through
   `grade_many(..., file_names=...)` to the feedback, the report's `submission`, the gradebook note and the
-  sandbox's import messages (`--name`), and through `ClassSources.names` to the similarity check.
+  sandbox's messages (`--name`: import errors, tracebacks, compat events), on this machine or the cluster
+  (the request's `name`), and through `ClassSources.names` to the similarity check.
 - `layouts/`: one module per layout behind `layouts/protocol.py`'s `Layout` (`name`, `title`,
   `score(tree) -> 0..1`, `group(tree) -> Grouping(groups, unattributed)`), registered in
   `layouts.LAYOUTS` (the `--layout` names: plain, canvas, gradescope, github-classroom, moodle, nbgrader,

@@ -34,6 +34,18 @@ _SKIPPED_DIRECTORIES = (
 _served: dict[tuple[CodeType, int], Api] = {}
 _announced: set[tuple[str, str]] = set()
 _served_generation = -1
+# A file's path -> its own name as the grader shows it (`show_file_as`); its file name when not listed.
+_shown_names: dict[str, str] = {}
+
+
+def show_file_as(filename: str, name: str) -> None:
+    """Name the file at ``filename`` ``name`` in what the layer says (events, errors): the sandbox imports a
+    copy whose name may be numbered or made safe, while a person reads the file's own name (`--name`)."""
+    _shown_names[filename] = name
+
+
+def _shown(filename: str) -> str:
+    return _shown_names.get(filename) or Path(filename).name
 
 
 def caller_api(env_id: str, depth: int = 2) -> Api:
@@ -83,7 +95,7 @@ def _resolve(frame: FrameType | None, site: tuple[CodeType, int], env_id: str) -
                 raise _ambiguous(filename, scope, decision)
         frame = frame.f_back
     _served[site] = DEFAULT_API
-    where = Path(first[0]).name if first is not None else "the calling code"
+    where = _shown(first[0]) if first is not None else "the calling code"
     if (where, "") in _announced:
         return DEFAULT_API
     _announced.add((where, ""))
@@ -107,7 +119,7 @@ def _announce(env_id: str, filename: str, scope: str, api: Api, decision: Decisi
     if (filename, scope) in _announced:
         return
     _announced.add((filename, scope))
-    where = Path(filename).name if scope == "<module>" else f"{scope}() in {Path(filename).name}"
+    where = _shown(filename) if scope == "<module>" else f"{scope}() in {_shown(filename)}"
     # One event per scope: the key of an event is its (kind, env_id), and one env can serve several scopes.
     label = env_id if scope == "<module>" else f"{env_id} in {scope}()"
     events.record(events.API_DETECTED, label, f"{where} was served {api.label}: {decision.explain()}")
@@ -117,7 +129,7 @@ def _ambiguous(filename: str, scope: str, decision: Decision) -> AmbiguousApiErr
     where = "this file" if scope == "<module>" else f"{scope}()"
     lines = "; ".join(f"{item.describe()} ({item.api.short})" for item in decision.evidence[:6])
     return AmbiguousApiError(
-        f"gymgrade cannot tell which gym API {where} in {Path(filename).name} expects: {lines}. "
+        f"gymgrade cannot tell which gym API {where} in {_shown(filename)} expects: {lines}. "
         "Classic gym's reset() returns the observation and step() 4 values (obs, reward, done, info); "
         "gym 0.26's reset() returns (obs, info) and step() 5 values (obs, reward, terminated, truncated, info). "  # noqa: E501
         "Make these lines follow one of them."

@@ -41,7 +41,7 @@ from grader.report import ProblemResult, Report
 from grader.sandbox import IsolationPolicy
 from grader.sandbox.host import usable_cpus
 from grader.sandbox.isolation.scope import sandbox_scope
-from grader.sandbox.runner import require_isolation
+from grader.sandbox.runner import require_isolation, sandbox_file_name
 from grader.submission.notebook import MAX_NOTEBOOK_BYTES, build_module, is_notebook
 from grader.submission.notebook.cells import write_cells
 from grader.submission.untrusted_file import UnsafeFile, read_untrusted
@@ -66,6 +66,7 @@ def grade_submission(
     on_progress: Callable[[ProblemResult], None] | None = None,
     config: Path | None = None,
     plan: GradingPlan | None = None,
+    name: str | None = None,
 ) -> Report:
     """Grade one submission file.
 
@@ -82,6 +83,9 @@ def grade_submission(
         on_progress: Called with each problem's result as soon as its check finishes.
         config: Assignment configuration TOML; the bundled one when None.
         plan: A plan made already (`GradingPlan.load`); ``config`` and ``only`` are then not read.
+        name: The file's own name as shown to a person, already neutralised, when its copy on disk is
+            called otherwise (a worker grades a class's file under a safe name): see `grade_files`'
+            ``names``. ``path.name`` when None.
 
     Returns:
         The report. ``report.grader_errors`` lists failures of the grader itself (the affected problems
@@ -97,7 +101,10 @@ def grade_submission(
         progress = on_progress
         listener = OnResult(lambda _path, result: progress(result))
     chosen = plan or GradingPlan.load(config, only)
-    return grade_files([path], chosen, seed=seed, workers=workers, policy=policy, listener=listener)[0]
+    names = {path: name} if name else None
+    return grade_files(
+        [path], chosen, seed=seed, workers=workers, policy=policy, listener=listener, names=names
+    )[0]
 
 
 def grade_files(
@@ -205,11 +212,14 @@ def _prepare(
 
 def _sandbox_name(submission: Submission) -> str:
     """The name the sandbox's messages give a file (``--name``), or "" to let them name its copy as before:
-    given only when the file is shown by another name than its own (a class's zip is read into numbered
-    copies), as its copy would be called (a notebook's module is ``<notebook>.py``)."""
-    if not submission.name or submission.name == submission.path.name:
+    given only when the file is shown by another name than the sandbox would call its copy (a class's zip
+    is read into numbered copies, a worker writes a file under a safe name, a file's own name holds a space
+    or a bracket that the sandbox's copy replaces), as its copy would be called (a notebook's module is
+    ``<notebook>.py``); so the sandbox's messages say what the grader's own do, whoever wrote the copy."""
+    if not submission.name:
         return ""
-    return f"{submission.name}.py" if submission.notebook is not None else submission.name
+    shown = f"{submission.name}.py" if submission.notebook is not None else submission.name
+    return "" if shown == sandbox_file_name(submission.module.name) else shown
 
 
 def _edition_note(source: bytes, name: str, plan: GradingPlan) -> str | None:

@@ -54,9 +54,11 @@ def require_isolation(policy: IsolationPolicy, isolation: IsolationReport | None
     return report
 
 
-def _file_name(submission: Path) -> str:
-    name = re.sub(r"[^A-Za-z0-9_.-]", "_", submission.name) or "submission.py"
-    return name if name.endswith(".py") else f"{name}.py"
+def sandbox_file_name(name: str) -> str:
+    """What the sandbox calls its copy of a file named ``name`` (and so its messages, without a shown name):
+    every character outside ``[A-Za-z0-9_.-]`` made ``_``, ending in ``.py``."""
+    safe = re.sub(r"[^A-Za-z0-9_.-]", "_", name) or "submission.py"
+    return safe if safe.endswith(".py") else f"{safe}.py"
 
 
 class Sandbox:
@@ -100,7 +102,7 @@ class Sandbox:
         self.seed = seed
         self.limits = limits or Limits()
         self._source = submission.read_bytes()
-        self._name = _file_name(submission)
+        self._name = sandbox_file_name(submission.name)
         self._shown_name = shown_name
         self._next_index = 0
         self._child: ChildProcess | None = None

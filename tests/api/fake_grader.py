@@ -83,11 +83,14 @@ def grade_submission(
     policy: Any = None,
     on_progress: Callable[[ProblemResult], None] | None = None,
     config: Path | None = None,
+    name: str | None = None,
 ) -> Report:
     """Grade ``path`` the fake way (see the module docstring); ``only`` picks among its problems.
 
-    Reports carry the real configuration digest of ``config``, so a resumed batch can reuse them.
+    Reports carry the real configuration digest of ``config``, so a resumed batch can reuse them, and name
+    the file ``name`` (its own name as shown, the real grader's parameter), ``path.name`` when None.
     """
+    shown = name or path.name
     data = path.read_bytes()
     source = data.decode("utf-8")
     sha256 = hashlib.sha256(data).hexdigest()
@@ -100,9 +103,9 @@ def grade_submission(
     try:
         compile(source, path.name, "exec")
     except SyntaxError as error:
-        message = f"{path.name} is not valid Python: line {error.lineno}: {error.msg}"
+        message = f"{shown} is not valid Python: line {error.lineno}: {error.msg}"
         return Report(
-            submission=path.name,
+            submission=shown,
             sha256=sha256,
             seed=seed,
             config_sha256=config_sha256,
@@ -146,7 +149,7 @@ def grade_submission(
         if on_progress is not None:
             on_progress(result)
     return Report(
-        submission=path.name,
+        submission=shown,
         sha256=sha256,
         seed=seed,
         config_sha256=config_sha256,

@@ -7,6 +7,7 @@ from api_testing import SettingsFactory
 
 from api.jobs import celery_worker
 from api.jobs.celery_worker import split_cores, startup_problem
+from grader.render.neutral import MAX_FILE_NAME_CHARS, file_name
 from grader.sandbox import IsolationReport, LayerReport
 
 
@@ -88,3 +89,35 @@ def test_the_restart_history_keeps_the_window_and_ignores_garbage() -> None:
     variable = f"{now - window - 1},{now - 10},x,,{now + 5},{now}"
     assert celery_worker.restart_history(variable, now) == (now - 10, now)
     assert celery_worker.restart_history(None, now) == ()
+
+
+@pytest.mark.parametrize(
+    ("name", "filename", "shown"),
+    [
+        ("smithjohn_3001_7001_policy_iteration-1.py", "6.py", "smithjohn_3001_7001_policy_iteration-1.py"),
+        ("'=cmd.py", "6.py", "'=cmd.py"),
+        ("=cmd.py", "6.py", "'=cmd.py"),
+        ("../../etc/passwd.py", "6.py", "passwd.py"),
+        ("a\x1b]0;owned\x07\u202eb.py", "6.py", "a\ufffd]0;owned\ufffd\ufffdb.py"),
+        ("x" * 100_000, "6.py", "x" * (MAX_FILE_NAME_CHARS - 1) + "…"),
+        (None, "6.py", "6.py"),
+        ("", "../evil.py", "evil.py"),
+        (["a.py"], "6.py", "6.py"),
+    ],
+    ids=[
+        "lms-name",
+        "already-neutralised",
+        "formula",
+        "climbing",
+        "controls-and-bidi",
+        "huge",
+        "no-field",
+        "empty",
+        "not-text",
+    ],
+)
+def test_a_requests_name_is_shown_as_file_name_shows_it(name: object, filename: str, shown: str) -> None:
+    """The batch sends ``file_name`` of the download's name; the worker, trusting no request, applies it
+    again (a no-op on what the batch sent) and falls back on the request's ``filename``."""
+    assert celery_worker.shown_name(name, filename) == shown
+    assert file_name(shown) == shown

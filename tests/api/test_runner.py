@@ -103,12 +103,19 @@ def test_the_grader_gets_the_isolation_policy_and_workers_of_the_settings(
     assert row.report["problems"][0]["measurements"] == {"policy": policy, "workers": workers}
 
 
-def test_a_syntax_error_is_a_stored_verdict(sessions: sessionmaker[Session], settings: Settings) -> None:
-    row = _grade(sessions, settings, b"def broken(:\n")
+@pytest.mark.parametrize(
+    "filename",
+    ["opengym.py", "my lab (2).py", "policy_iteration-1.py"],
+    ids=["module-name", "space", "hyphen"],
+)
+def test_a_syntax_error_is_a_stored_verdict_naming_the_upload(
+    sessions: sessionmaker[Session], settings: Settings, filename: str
+) -> None:
+    """An upload whose name is no module name is graded as submission.py, and still named as uploaded."""
+    row = _grade(sessions, settings, b"def broken(:\n", filename=filename)
     assert row.status == "done"
-    assert row.report is not None and row.report["submission_error"].startswith(
-        "opengym.py is not valid Python"
-    )
+    assert row.report is not None and row.report["submission"] == filename
+    assert row.report["submission_error"].startswith(f"{filename} is not valid Python")
 
 
 @pytest.mark.parametrize(

@@ -7,7 +7,7 @@ import re
 import pytest
 
 from api.errors import InvalidUpload, UploadTooLarge
-from api.uploads import check_upload, upload_rules
+from api.uploads import MAX_DISPLAY_NAME_CHARS, check_upload, grading_file_name, upload_rules
 
 MAX_BYTES = 64
 
@@ -57,3 +57,40 @@ def test_the_file_name_rule_matches_check_upload(name: str) -> None:
     header = f'form-data; name="file"; filename="{name}"'
     assert (re.search(disposition["schema"]["pattern"], header) is not None) == _service_accepts(name, b"x=1")
     assert re.search(disposition["schema"]["pattern"], disposition["example"]) is not None
+
+
+@pytest.mark.parametrize(
+    ("name", "graded_as"),
+    [
+        ("opengym.py", "opengym.py"),
+        ("opengym.ipynb", "opengym.ipynb"),
+        ("my lab.py", "submission.py"),
+        ("my lab.ipynb", "submission.ipynb"),
+        ("policy_iteration-1.py", "submission.py"),
+        ("6.py", "submission.py"),
+        ("../../evil.py", "submission.py"),
+        ("evil", "submission.py"),
+        ("a" * (MAX_DISPLAY_NAME_CHARS - 3) + ".py", "a" * (MAX_DISPLAY_NAME_CHARS - 3) + ".py"),
+        ("a" * MAX_DISPLAY_NAME_CHARS + ".py", "submission.py"),
+        ("a" * 5_000 + ".ipynb", "submission.ipynb"),
+    ],
+    ids=[
+        "module-name",
+        "notebook",
+        "space",
+        "notebook-with-space",
+        "hyphen",
+        "digit-start",
+        "climbing",
+        "no-suffix",
+        "at-the-bound",
+        "over-the-bound",
+        "far-over-the-bound",
+    ],
+)
+def test_a_file_is_graded_under_its_name_only_when_that_is_a_short_module_name(
+    name: str, graded_as: str
+) -> None:
+    """A worker's request is untrusted: whatever name it carries, the grading file's name is one safe path
+    component (the name messages show is given to the grader apart, ``ClaimedJob.shown_name``)."""
+    assert grading_file_name(name) == graded_as

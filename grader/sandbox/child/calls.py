@@ -101,9 +101,15 @@ def parse_call(frame: dict[str, Any]) -> CallRequest:
 
 
 def run_call(
-    module: ModuleType, request: CallRequest, recorder: Recorder, submission: Path, max_frame: int
+    module: ModuleType,
+    request: CallRequest,
+    recorder: Recorder,
+    submission: Path,
+    max_frame: int,
+    name: str | None = None,
 ) -> bytes:
-    """Call the student's function as `request` says and return the encoded result frame payload.
+    """Call the student's function as `request` says and return the encoded result frame payload; a
+    traceback names the file `name` (the harness's `--name`), `submission.name` when None.
 
     `SystemExit` propagates (the process ends and the runner reports the exit); every other
     failure, `KeyboardInterrupt` included, becomes a status with a message. The frame stays within the
@@ -113,7 +119,7 @@ def run_call(
     max_frame = limits.max_bytes
     compat_events.drain()
     recorder.begin_call(request.seed, record=request.record, budget=request.budget)
-    result = _outcome(module, request, submission, max_frame, recorder)
+    result = _outcome(module, request, submission, max_frame, recorder, name)
     episodes = recorder.finish_call()
     if recorder.exceeded is not None and result["status"] not in ("missing_function", "bad_signature"):
         result = _status(
@@ -173,7 +179,12 @@ def _budget_message(function: str, recorder: Recorder) -> str:
 
 
 def _outcome(
-    module: ModuleType, request: CallRequest, submission: Path, max_frame: int, recorder: Recorder
+    module: ModuleType,
+    request: CallRequest,
+    submission: Path,
+    max_frame: int,
+    recorder: Recorder,
+    shown: str | None = None,
 ) -> dict[str, Any]:
     name = request.function
     function = functools.partial(run_cells, module) if name == RUN_CELLS else vars(module).get(name)
@@ -238,7 +249,7 @@ def _outcome(
         return _status(
             "exception",
             f"{name}() raised {describe_exception(attempt.error)}",
-            traceback=student_traceback(attempt.error, submission),
+            traceback=student_traceback(attempt.error, submission, shown),
             wall_time=attempt.wall_time,
         )
     value, wall_time = attempt.value, attempt.wall_time

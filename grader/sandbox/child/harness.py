@@ -18,6 +18,7 @@ from types import ModuleType
 from typing import Any
 
 import grader.compat
+from grader.compat.dialect import show_file_as
 from grader.sandbox.child import frames
 from grader.sandbox.child.calls import parse_call, run_call
 from grader.sandbox.child.errors import ProtocolError
@@ -59,6 +60,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     requests = os.fdopen(arguments.requests, "rb")
     submission: Path = arguments.submission
     prepare_process(submission)
+    if arguments.name:
+        show_file_as(str(submission), arguments.name)
     recorder = Recorder(arguments.seed, arguments.max_recorded_steps)
     install(recorder)
     recorder.begin_import(arguments.seed)
@@ -101,7 +104,9 @@ def _serve(module: ModuleType, requests: Any, recorder: Recorder, arguments: arg
         except ProtocolError as error:
             os.write(2, f"gymgrade harness: bad request: {error}\n".encode())
             return EXIT_PROTOCOL_ERROR
-        payload = run_call(module, request, recorder, arguments.submission, arguments.max_frame)
+        payload = run_call(
+            module, request, recorder, arguments.submission, arguments.max_frame, arguments.name
+        )
         _flush_student_output()
         _write_all(arguments.results, frames.HEADER.pack(len(payload)) + payload)
 

@@ -55,7 +55,7 @@ def import_submission(path: Path, name: str | None = None) -> ModuleType | Impor
             )
         return ImportFailure(
             shortened(f"importing {shown} raised {describe_exception(error)}"),
-            shortened(_renamed(student_traceback(error, path), path, name)),
+            shortened(student_traceback(error, path, name)),
         )
     return module
 
@@ -81,15 +81,17 @@ def describe_exception(error: BaseException) -> str:
     return line
 
 
-def student_traceback(error: BaseException, path: Path) -> str:
-    """Format `error`'s traceback starting at the first frame in the student's file.
+def student_traceback(error: BaseException, path: Path, name: str | None = None) -> str:
+    """Format `error`'s traceback starting at the first frame in the student's file, its frames there
+    naming the file `name` (its own name as the grader shows it), `path.name` when None.
 
     Frames above it (the harness, importlib) are dropped; frames below it (libraries the student
     called) are kept. Without a frame in the student's file only the outermost (harness) frame
     is dropped.
     """
     tb = _first_student_frame(error.__traceback__, str(path))
-    return "".join(traceback.format_exception(type(error), error.with_traceback(tb), tb))
+    formatted = "".join(traceback.format_exception(type(error), error.with_traceback(tb), tb))
+    return _renamed(formatted, path, name)
 
 
 def function_table(module: ModuleType) -> dict[str, dict[str, Any]]:

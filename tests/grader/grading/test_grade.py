@@ -302,3 +302,31 @@ def test_the_workers_a_report_records_are_those_its_valid_files_needed(
     )
     assert refused.submission_error is not None and refused.timings is None
     assert graded.timings is not None and graded.timings.workers == 1  # one case: one worker, not two
+
+
+@pytest.mark.parametrize(
+    ("copy", "shown", "sandbox_name"),
+    [
+        ("opengym.py", "opengym.py", ""),
+        ("opengym.py", "", ""),
+        ("6.py", "smithjohn_3001_7001_policy_iteration-1.py", "smithjohn_3001_7001_policy_iteration-1.py"),
+        (
+            "submission.py",
+            "smithjohn_3001_7001_policy_iteration-1.py",
+            "smithjohn_3001_7001_policy_iteration-1.py",
+        ),
+        ("opengym (1).py", "opengym (1).py", "opengym (1).py"),
+        ("submission.py", "my lab.py", "my lab.py"),
+    ],
+    ids=["own-name", "no-name", "zip-copy", "worker-copy", "folder-name-with-a-space", "upload-name"],
+)
+def test_the_sandbox_is_given_the_shown_name_whenever_its_copy_would_be_called_otherwise(
+    tmp_path: Path, copy: str, shown: str, sandbox_name: str
+) -> None:
+    """Whoever wrote the copy (a zip read into numbered files, a worker's safe name) and whatever the sandbox
+    makes of its name (a space becomes ``_``), its messages name the file as the grader's own do."""
+    from grader.grading.grade import _sandbox_name
+    from grader.grading.outcomes import Submission
+
+    submission = Submission(tmp_path / copy, b"", tmp_path / "0" / copy, name=shown)
+    assert _sandbox_name(submission) == sandbox_name

@@ -345,6 +345,37 @@ def test_import_errors_name_the_file_by_the_name_it_is_shown_by(
         assert frame["message"] == message
 
 
+NAMED = textwrap.dedent("""
+    import gym
+
+
+    def fails():
+        raise ValueError("no games today")
+
+
+    def steps():
+        env = gym.make("CartPole-v1")
+        env.reset()
+        obs, reward, done, info = env.step(0)
+        return int(done)
+""")
+
+
+def test_calls_name_the_file_by_the_name_it_is_shown_by(tmp_path: Path) -> None:
+    """A call's traceback and the compat layer's events name the file as ``--name`` does, never its copy."""
+    shown = "smithjohn_1_2_opengym-1.py"
+    with ChildClient(write_submission(tmp_path, NAMED, name="0.py"), extra_args=("--name", shown)) as client:
+        assert client.first_frame is not None and client.first_frame["type"] == "ready"
+        failed = client.call("fails")
+        stepped = client.call("steps")
+
+    assert failed is not None and stepped is not None
+    assert f'File "{tmp_path}/{shown}", line 6, in fails' in failed["traceback"]
+    details = " ".join(str(event["detail"]) for event in stepped["compat_events"])
+    assert f"steps() in {shown} was served the classic gym API" in details
+    assert "0.py" not in failed["traceback"] + details
+
+
 def test_lab_only_ids_and_clear_output_work_at_import(tmp_path: Path) -> None:
     source = "import gym\nfrom IPython.display import clear_output\nenv = gym.make('NChain-v0')\n"
 
