@@ -12,22 +12,14 @@ import pytest
 from grader.grading.grade import grade_files
 from grader.grading.plan import GradingPlan
 from grader.lab.editions import edition_of
+from grader.lab.rl2.editions import PURE_2018, PURE_2023, PURE_2024
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
 from reference.rl2.editions import EDITIONS
 from tests.grader.lab.rl2.support import judged
 
 SUBMISSIONS = Path(__file__).resolve().parents[4] / "submissions" / "rl2"
-PURE = frozenset(
-    {
-        "value_iteration",
-        "extract_policy",
-        "policy_improvement",
-        "compute_policy_v",
-        "iter_policy_eval",
-        "policy_iteration",
-    }
-)
+PURE = frozenset(problem.id for problem in (*PURE_2018, *PURE_2023, *PURE_2024))
 """The problems judged in this process: the played ones (run_simulation, frozen_lake, model_comparison) play
 episodes that only the sandbox records and replays (and 2019's render in a window), so they are graded
 through the sandbox below."""

@@ -14,13 +14,15 @@ import pytest
 from grader.lab.checks.base import CallRecord
 from grader.lab.editions import edition_of
 from grader.lab.rl2.checks.mdp_calls import as_count, as_vector, call_text, called_case
+from grader.lab.rl2.editions import PURE_2024
 from grader.sandbox.outcome import Call, CallOutcome, MdpArgument, OutcomeStatus
 from reference.rl2 import solutions
 from tests.grader.lab.rl2.support import judged, judged_outcomes, outcome, settings, wire
 
 ROOT = Path(__file__).resolve().parents[5]
 MEMORISER = ROOT / "submissions" / "rl2" / "hostile" / "memorised_public_cases.py"
-PURE_2024 = ("value_iteration", "policy_improvement", "iter_policy_eval", "policy_iteration")
+PURE = tuple(problem.id for problem in PURE_2024)
+"""The 2024 edition's pure problems, in lab order."""
 
 
 def _plan(problem: str, seed: int) -> list[Call]:
@@ -40,7 +42,7 @@ def _plain(call: Call) -> Any:
     return (call.function, args, call.provided)
 
 
-@pytest.mark.parametrize("problem", PURE_2024)
+@pytest.mark.parametrize("problem", PURE)
 def test_the_same_seed_plans_the_same_calls_and_another_seed_other_mdps(problem: str) -> None:
     assert [_plain(c) for c in _plan(problem, 11)] == [_plain(c) for c in _plan(problem, 11)]
     first, second = (
@@ -79,7 +81,7 @@ def _memoriser() -> ModuleType:
 
 
 @pytest.mark.parametrize("seed", [0, 1, 20261128])
-@pytest.mark.parametrize("problem", PURE_2024)
+@pytest.mark.parametrize("problem", PURE)
 def test_a_file_that_memorised_the_public_cases_fails_under_a_grading_seed(problem: str, seed: int) -> None:
     verdict = judged("v2024", problem, getattr(_memoriser(), problem), seed=seed)
     assert verdict.status == "failed", verdict.feedback
@@ -153,7 +155,7 @@ def test_a_planned_call_without_an_mdp_first_is_the_graders_error() -> None:
         called_case(call, 3)
 
 
-@pytest.mark.parametrize("problem", PURE_2024)
+@pytest.mark.parametrize("problem", PURE)
 def test_a_call_that_raised_is_the_verdict_before_any_value_is_read(problem: str) -> None:
     def raised(call: Any) -> CallOutcome:
         return outcome(call, None, OutcomeStatus.EXCEPTION, "ZeroDivisionError: division by zero")
