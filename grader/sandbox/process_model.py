@@ -24,13 +24,13 @@ from __future__ import annotations
 import contextlib
 import os
 import selectors
-import signal
 import subprocess
 import time
 from collections.abc import Mapping, Sequence
 from types import TracebackType
 from typing import Any
 
+from grader.sandbox import signalling
 from grader.sandbox.host import HOST, Feature
 
 if HOST.has(Feature.POSIX_PROCESSES):
@@ -110,12 +110,12 @@ def start(
 
 
 def end(process: subprocess.Popen[bytes]) -> None:
-    """Kills the child at once: its process group where there is one, else the process itself."""
+    """Kills the child at once: its process group where there is one (never the grader's own:
+    `signalling.refusal`), else the process itself."""
     if process.returncode is not None:  # reaped: its pid and group id may belong to someone else now
         return
     if MODEL == "posix":
-        with contextlib.suppress(ProcessLookupError, PermissionError):
-            os.killpg(process.pid, signal.SIGKILL)
+        signalling.kill_group(process.pid)
     with contextlib.suppress(ProcessLookupError, PermissionError):
         process.kill()
 

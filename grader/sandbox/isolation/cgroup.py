@@ -2,16 +2,15 @@
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import os
 import secrets
-import signal
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from grader.sandbox import signalling
 from grader.sandbox.host import Feature
 from grader.sandbox.isolation import scope
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
@@ -76,6 +75,24 @@ def _v2_available(group: Path) -> set[str]:
         return set()
 
 
+@dataclass(frozen=True)
+class Members:
+    """The processes in a job as one PID namespace shows them.
+
+    Attributes:
+        visible: Their pids in this namespace.
+        hidden: How many are outside this namespace (listed as 0: they have no pid here).
+    """
+
+    visible: frozenset[int]
+    hidden: int = 0
+
+    @property
+    def empty(self) -> bool:
+        """True when no process is left in the job."""
+        return not self.visible and not self.hidden
+
+
 @dataclass
 class JobCgroup:
     """The cgroups (one per hierarchy) a single child runs in; `remove` after the child is gone."""
@@ -92,12 +109,19 @@ class JobCgroup:
         """The controllers that limit the child."""
         return {name for group in self.groups for name in group.controllers}
 
-    def pids(self) -> set[int]:
-        """Every process still in the job."""
-        found: set[int] = set()
+    def members(self) -> Members:
+        """Every process still in the job, as this process's PID namespace shows it."""
+        visible: set[int] = set()
+        hidden = 0
         for group in self.groups:
-            found.update(int(pid) for pid in group.read("cgroup.procs").split())
-        return found
+            listed = [int(pid) for pid in group.read("cgroup.procs").split()]
+            visible.update(pid for pid in listed if pid > 0)
+            hidden = max(hidden, sum(1 for pid in listed if pid <= 0))
+        return Members(frozenset(visible), hidden)
+
+    def pids(self) -> set[int]:
+        """The processes still in the job that this process can see (and so signal)."""
+        return set(self.members().visible)
 
     def oom_kills(self) -> int:
         """How many processes the kernel killed for exceeding the memory limit."""
@@ -111,22 +135,38 @@ class JobCgroup:
         return 0
 
     def kill(self, timeout: float = 2.0) -> bool:
-        """SIGKILLs every process in the job until it is empty; False when some survived `timeout`."""
+        """SIGKILLs every process in the job until it is empty; False when some survived `timeout`.
+
+        The kernel kills the whole job where a v2 group has `cgroup.kill` (Linux 5.14), whatever PID
+        namespace each process is in. Besides, each process this namespace shows is signalled through
+        `grader.sandbox.signalling` (pinned by a pidfd, only while still listed here, never a pid of 0 or
+        below nor the grader's own); a process the namespace hides is never signalled by number, so a
+        job holding only such processes (or the grader's own), without `cgroup.kill`, is left as it is
+        (False at once).
+        """
         deadline = time.monotonic() + timeout
+        while True:
+            by_kernel = self._kill_by_kernel()
+            members = self.members()
+            if members.empty:
+                return True
+            reachable = [pid for pid in members.visible if signalling.refusal(pid) is None]
+            if time.monotonic() > deadline or (not by_kernel and not reachable):
+                return False
+            signalling.kill_members(reachable, self.pids)
+            time.sleep(0.005)
+
+    def _kill_by_kernel(self) -> bool:
+        """Writes `cgroup.kill` in every v2 group that has it; whether any write was taken."""
+        taken = False
         for group in self.groups:
             if group.version == 2 and (group.path / "cgroup.kill").exists():
-                with contextlib.suppress(OSError):
+                try:
                     group.write("cgroup.kill", "1")
-        while True:
-            remaining = self.pids()
-            if not remaining:
-                return True
-            if time.monotonic() > deadline:
-                return False
-            for pid in remaining:
-                with contextlib.suppress(ProcessLookupError, PermissionError):
-                    os.kill(pid, signal.SIGKILL)
-            time.sleep(0.005)
+                except OSError:
+                    continue
+                taken = True
+        return taken
 
     def remove(self) -> bool:
         """Kills what is left and removes the job's directories; False when something stayed behind."""
