@@ -14,9 +14,10 @@ In detail:
 - `grader/sandbox/host.py` is the one place that reads the platform: `HOST.system` ("Linux", "macOS",
   "Windows") and `HOST.features`, each found by asking for the capability (`POSIX_PROCESSES`: fork,
   killpg, setsid, SIGKILL; `RESOURCE_LIMITS`; `USER_IDS`: geteuid and pwd; `LINUX_KERNEL`: Linux with
-  POSIX processes; `CPU_AFFINITY`; `WINDOWS_HANDLES`: msvcrt and _winapi), plus `usable_cpus()` and
-  `signal_number(name)` (None where a signal does not exist). Nothing else under `grader/` tests
-  `sys.platform` or imports `resource`/`pwd` at module level.
+  POSIX processes; `CPU_AFFINITY`; `WINDOWS_HANDLES`: msvcrt and _winapi; `FILE_LOCKS`: fcntl's flock,
+  which proves who owns a job's cgroup or harness tree, `grader.sandbox.isolation.ownership`), plus
+  `usable_cpus()` and `signal_number(name)` (None where a signal does not exist). Nothing else under
+  `grader/` tests `sys.platform` or imports `resource`/`pwd` at module level.
 - Each layer declares `needs: tuple[Feature, ...]` (cgroup, bubblewrap, seccomp, Landlock: `LINUX_KERNEL`;
   privileges: `USER_IDS`; rlimits: `RESOURCE_LIMITS`) and `guards` (what it enforces); `probe_isolation`
   reports a layer whose needs are missing as "not available on this system (<system> without
@@ -60,6 +61,7 @@ class Feature(StrEnum):
     LINUX_KERNEL = "Linux kernel features (/proc, cgroups, namespaces, seccomp, Landlock)"
     CPU_AFFINITY = "CPU affinity (os.sched_getaffinity)"
     WINDOWS_HANDLES = "Windows handles (msvcrt, _winapi)"
+    FILE_LOCKS = "file locks (fcntl.flock)"
 
 
 def _importable(name: str) -> bool:
@@ -84,6 +86,8 @@ def _detect() -> frozenset[Feature]:
         found.add(Feature.CPU_AFFINITY)
     if _importable("msvcrt") and _importable("_winapi"):
         found.add(Feature.WINDOWS_HANDLES)
+    if _importable("fcntl"):
+        found.add(Feature.FILE_LOCKS)
     return frozenset(found)
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
 import secrets
@@ -12,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from grader.sandbox import signalling
 from grader.sandbox.host import Feature
-from grader.sandbox.isolation import scope
+from grader.sandbox.isolation import ownership, scope
 from grader.sandbox.isolation.layer import IsolationReport, LayerReport
 
 if TYPE_CHECKING:
@@ -20,8 +21,11 @@ if TYPE_CHECKING:
 
 CGROUP_ROOT = Path("/sys/fs/cgroup")
 CONTROLLERS = ("memory", "pids", "cpu")
-JOB_PREFIX = "gymgrade-"
-"""Job cgroups are named gymgrade-<grader pid>-<random>."""
+JOB_PREFIX = "gymgrade-job-"
+"""Job cgroups are named gymgrade-job-<grader pid>-<random>; the pid is for people to read, ownership is
+the lock its grader holds on the directory (`grader.sandbox.isolation.ownership`). Directories of earlier
+versions (gymgrade-<pid>-<random>, no lock) are never touched: nothing proves them abandoned."""
+_CLAIM_ATTEMPTS = 50
 _REMEDY = (
     "run as root, or in a delegated cgroup (e.g. `systemd-run --user --scope -p Delegate=yes gymgrade ...`)"
 )
@@ -40,6 +44,8 @@ class _Group:
     path: Path
     version: int
     controllers: tuple[str, ...]
+    claim: ownership.Claim | None = field(default=None, compare=False)
+    """The lock proving the job this grader's while it lives (None for a job being swept or released)."""
 
     def write(self, name: str, value: str) -> None:
         (self.path / name).write_text(value)
@@ -183,6 +189,9 @@ class JobCgroup:
                     time.sleep(0.01)
             else:
                 removed = False
+        for group in self.groups:
+            if group.claim is not None:
+                group.claim.release()
         if removed and self.groups:
             scope.forget(CGROUP_RECORDS, self.groups[0].path.name)
         return emptied and removed
@@ -209,24 +218,34 @@ scope.register_cleanup(CGROUP_RECORDS, _remove_recorded)
 
 def _remove_stale(parent: Path, version: int) -> None:
     """Removes job cgroups left by grader processes that died without cleaning up (e.g. SIGKILL), killing
-    any process still inside (its grader is gone)."""
-    for path in parent.glob(f"{JOB_PREFIX}*-*"):
-        try:
-            os.kill(int(path.name.split("-")[1]), 0)
-        except ProcessLookupError:
-            remove_job_directories([(version, path)])
-        except (ValueError, IndexError, PermissionError):
-            continue
+    any process still inside (its grader is gone).
+
+    A job is taken for abandoned only when this process can take its directory's lock, which its grader
+    holds while it lives, in whatever PID namespace either runs; the lock is kept while the job is removed.
+    """
+    for path in parent.glob(f"{JOB_PREFIX}*"):
+        claim = ownership.claim_abandoned(path)
+        if claim is not None:
+            with claim:
+                remove_job_directories([(version, path)])
 
 
 def _make_group(parent: Path, name: str, version: int, controllers: tuple[str, ...]) -> _Group:
+    """Makes and locks one job directory (again, when another grader's sweep took the empty directory
+    between its `mkdir` and the lock)."""
     _remove_stale(parent, version)
     path = parent / name
     scope.record(
         CGROUP_RECORDS, name, f"{version} {path}"
     )  # before it exists: a kill right after mkdir leaves nothing
-    path.mkdir()
-    return _Group(path, version, controllers)
+    for _ in range(_CLAIM_ATTEMPTS):
+        with contextlib.suppress(FileExistsError):
+            path.mkdir()
+        try:
+            return _Group(path, version, controllers, ownership.claim_new(path))
+        except (BlockingIOError, FileNotFoundError):
+            time.sleep(0.01)
+    raise OSError(f"the job cgroup {path} was taken by another grader's sweep {_CLAIM_ATTEMPTS} times")
 
 
 def _v2_parent(v2_root: Path, own_path: str) -> tuple[Path, tuple[str, ...]]:

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from grader.sandbox import process_model
 from grader.sandbox.host import HOST, Feature
+from grader.sandbox.isolation import ownership
 from grader.sandbox.isolation.scope import temp_root
 
 SYSTEM_DIRS = ("/usr", "/bin", "/sbin", "/lib", "/lib64", "/lib32")
@@ -34,9 +35,13 @@ _CHILD_SIDE_FILES = ("bootstrap.py", "landlock_syscalls.py")
 """Stdlib-only files of this package the child runs before the harness (at the top of the tree)."""
 _SCRATCH_PREFIX = "gymgrade-scratch-"
 _SUBMISSION_SUBDIR = ".submission"
-TREE_PREFIX = "gymgrade-harness-"
-"""Harness trees are temporary directories named gymgrade-harness-<grader pid>-<random>, inside the
-grading's scope when there is one (`grader.sandbox.isolation.scope`), which removes them with it."""
+TREE_PREFIX = "gymgrade-tree-"
+"""Harness trees are temporary directories named gymgrade-tree-<grader pid>-<random>, inside the grading's
+scope when there is one (`grader.sandbox.isolation.scope`), which removes them with it. Their grader holds
+a lock on the tree while it lives (`grader.sandbox.isolation.ownership`); where locks exist, only that
+lock, never the pid in the name, tells a sweep the tree is abandoned."""
+_TREE_CLAIMS: list[ownership.Claim] = []
+"""The locks on this process's harness trees, held until it ends."""
 
 
 @dataclass(frozen=True)
@@ -166,14 +171,38 @@ def python_paths() -> PythonPaths:
 
 
 def remove_stale_trees() -> None:
-    """Removes trees of grader processes that ended without running their exit handlers (e.g. SIGKILL)."""
+    """Removes trees of grader processes that ended without running their exit handlers (e.g. SIGKILL).
+
+    Where locks exist, a tree is removed only under its lock, which its grader held while it lived (a pid
+    means nothing to a grader in another PID namespace); elsewhere (Windows) when the pid in its name no
+    longer runs.
+    """
     for path in Path(tempfile.gettempdir()).glob(f"{TREE_PREFIX}*-*"):
+        if ownership.LOCKS:
+            claim = ownership.claim_abandoned(path)
+            if claim is not None:
+                with claim:
+                    shutil.rmtree(path, ignore_errors=True)
+            continue
         try:
             pid = int(path.name.removeprefix(TREE_PREFIX).split("-")[0])
         except ValueError:
             continue
         if process_model.exists(pid) is False:
             shutil.rmtree(path, ignore_errors=True)
+
+
+def _owned_tree_directory() -> Path:
+    """A new directory for this process's harness tree, locked by it where locks exist."""
+    while True:
+        root = Path(tempfile.mkdtemp(prefix=f"{TREE_PREFIX}{os.getpid()}-", dir=temp_root()))
+        if not ownership.LOCKS:
+            return root
+        try:
+            _TREE_CLAIMS.append(ownership.claim_new(root))
+        except (BlockingIOError, FileNotFoundError):  # another grader's sweep took the empty directory
+            continue
+        return root
 
 
 @functools.cache
@@ -185,7 +214,7 @@ def harness_tree() -> Path:
     ``grader/compat``. Nothing else of the project (not `reference`, not the assignment config).
     """
     remove_stale_trees()
-    root = Path(tempfile.mkdtemp(prefix=f"{TREE_PREFIX}{os.getpid()}-", dir=temp_root()))
+    root = _owned_tree_directory()
     atexit.register(shutil.rmtree, root, ignore_errors=True)
     lib = root / "lib"
     (lib / "grader" / "sandbox").mkdir(parents=True)

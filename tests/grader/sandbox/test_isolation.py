@@ -25,8 +25,8 @@ from grader.sandbox import (
     Sandbox,
     probe_isolation,
 )
-from grader.sandbox.isolation import landlock_syscalls
-from grader.sandbox.isolation.cgroup import create_job_cgroup
+from grader.sandbox.isolation import landlock_syscalls, ownership
+from grader.sandbox.isolation.cgroup import JOB_PREFIX, create_job_cgroup
 from grader.sandbox.isolation.filesystem import TREE_PREFIX, harness_tree, python_paths, remove_stale_trees
 from grader.sandbox.isolation.privileges import SANDBOX_UID, running_as_root
 from grader.sandbox.isolation.rlimits import rlimit_table
@@ -286,17 +286,29 @@ def test_process_count_rlimit_is_set_only_where_it_counts_the_childs_processes(
 
 
 @pytest.mark.skipif(not FULL.is_active("cgroup"), reason="the cgroup tree is not writable here")
-def test_empty_job_cgroups_of_dead_graders_are_removed_when_a_job_starts() -> None:
+def test_unlocked_job_cgroups_are_removed_when_a_job_starts_and_locked_or_old_ones_kept() -> None:
     dead_pid = subprocess.Popen(["true"])
     dead_pid.wait()
     job = create_job_cgroup(memory_bytes=1536 << 20, max_pids=8)
     parents = [group.path.parent for group in job.groups]
     job.remove()
-    stale = [parent / f"gymgrade-{dead_pid.pid}-5ca1e" for parent in parents]
-    for path in stale:
+    stale = [parent / f"{JOB_PREFIX}{dead_pid.pid}-5ca1e" for parent in parents]
+    # A live grader's job whose pid this namespace does not show: only its lock says it lives.
+    held = [parent / f"{JOB_PREFIX}{dead_pid.pid}-11fe" for parent in parents]
+    # An earlier version's job (no lock): nothing proves it abandoned.
+    old = [parent / f"gymgrade-{dead_pid.pid}-01d" for parent in parents]
+    for path in (*stale, *held, *old):
         path.mkdir()
-    create_job_cgroup(memory_bytes=1536 << 20, max_pids=8).remove()
-    assert [path for path in stale if path.exists()] == []
+    claims = [ownership.claim_new(path) for path in held]
+    try:
+        create_job_cgroup(memory_bytes=1536 << 20, max_pids=8).remove()
+        assert [path for path in stale if path.exists()] == []
+        assert [path for path in (*held, *old) if not path.exists()] == []
+    finally:
+        for claim in claims:
+            claim.release()
+        for path in (*held, *old):
+            path.rmdir()
 
 
 def test_the_harness_tree_holds_only_the_harness_and_the_compat_layer() -> None:
@@ -348,6 +360,17 @@ def test_harness_trees_of_dead_graders_are_removed_and_live_ones_kept() -> None:
     dead.wait()
     stale = Path(tempfile.gettempdir()) / f"{TREE_PREFIX}{dead.pid}-stale"
     (stale / "lib").mkdir(parents=True)
-    remove_stale_trees()
-    assert not stale.exists()
-    assert harness_tree().exists()
+    held = Path(tempfile.gettempdir()) / f"{TREE_PREFIX}{dead.pid}-held"
+    held.mkdir()
+    claim = ownership.claim_new(held) if ownership.LOCKS else None
+    try:
+        remove_stale_trees()
+        assert not stale.exists()
+        assert harness_tree().exists()
+        # Where locks exist, a live grader's tree is kept whatever its name says (another PID namespace).
+        assert held.exists() is ownership.LOCKS
+    finally:
+        if claim is not None:
+            claim.release()
+        if held.exists():
+            held.rmdir()
