@@ -196,6 +196,17 @@ def bwrap_argv(
 
 _SEES_DIRECTORIES = "import os, sys; sys.exit(' '.join(p for p in sys.argv[1:] if not os.path.isdir(p)) or 0)"
 """Run by the probe's interpreter inside bwrap: exits naming each directory of its sys.path it cannot see."""
+_CONTAINER_REMEDY = (
+    "root may not make namespaces here: a container's default (Docker's seccomp profile, no CAP_SYS_ADMIN); "
+    "allow them (`docker run --security-opt seccomp=unconfined --cap-add SYS_ADMIN`) or grade on the host"
+)
+
+
+def _refused_namespaces_as_root(failure: str) -> bool:
+    """Whether bwrap, run as root, was refused its namespaces (a container, not a missing sysctl)."""
+    return os.geteuid() == 0 and "namespace" in failure and "Operation not permitted" in failure
+
+
 _LAYOUT_REMEDY = "run `gymgrade doctor` and report its output; meanwhile install gymgrade in a virtualenv of a Python under its own prefix (pyenv, /opt/...)"  # noqa: E501
 
 
@@ -247,7 +258,9 @@ def _probe_machine() -> LayerReport:
     if isinstance(result, str):
         return LayerReport(name, False, result, _REMEDY)
     if result.returncode != 0:
-        return LayerReport(name, False, f"bwrap failed: {without_new_root(result.stderr)}", _REMEDY)
+        failure = without_new_root(result.stderr)
+        remedy = _CONTAINER_REMEDY if _refused_namespaces_as_root(failure) else _REMEDY
+        return LayerReport(name, False, f"bwrap failed: {failure}", remedy)
     problem = _probe_interpreter(binary)
     if problem is not None:
         return LayerReport(name, False, problem, _LAYOUT_REMEDY)

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import functools
 import os
 import secrets
+import signal
+import subprocess
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +31,13 @@ versions (gymgrade-<pid>-<random>, no lock) are never touched: nothing proves th
 _CLAIM_ATTEMPTS = 50
 _REMEDY = (
     "run as root, or in a delegated cgroup (e.g. `systemd-run --user --scope -p Delegate=yes gymgrade ...`)"
+)
+_INITIAL_PID_NAMESPACE = 0xEFFFFFFC
+"""The inode of the initial PID namespace (the kernel's PROC_PID_INIT_INO)."""
+_REMEDY_RO = (
+    "a container's default: give it a writable, delegated cgroup (cgroup v2 with `--cgroupns=private`, or "
+    "run the grader on the host); without one, memory and CPU are bounded per process (rlimits) and a "
+    "child's tree is killed by its process group"
 )
 _JOIN_CGROUPS = 'for f do [ "$f" = -- ] && break; echo $$ > "$f" || exit 125; shift; done; shift; exec "$@"'
 JOIN_FAILED_EXIT = 125
@@ -324,15 +334,30 @@ def _write_limits(job: JobCgroup, memory_bytes: int, max_pids: int, cpus: float)
 
 @functools.cache
 def _probe_machine() -> LayerReport:
-    """Creates and removes a throw-away job cgroup to see which controllers can be used (once)."""
+    """Creates a throw-away job cgroup, kills a process placed in it, and removes it (once): which
+    controllers can be used, and whether the job's tree can be killed from here."""
     try:
         job = create_job_cgroup(memory_bytes=1 << 30, max_pids=16)
     except OSError as error:
+        if error.errno == errno.EROFS:
+            return LayerReport(
+                CgroupLayer.name, False, f"the cgroup tree is read-only here ({error})", _REMEDY_RO
+            )
         detail = f"the cgroup tree is not writable here ({error})"
         return LayerReport(CgroupLayer.name, False, detail, _REMEDY)
-    limited = job.limited
-    versions = sorted({f"v{group.version}" for group in job.groups})
-    job.remove()
+    try:
+        limited = job.limited
+        versions = sorted({f"v{group.version}" for group in job.groups})
+        killing = _kill_probe(job)
+    finally:
+        job.remove()
+    if killing is None:
+        return LayerReport(
+            CgroupLayer.name,
+            False,
+            "a process placed in a job cgroup could not be killed from here",
+            _REMEDY,
+        )
     missing = [c for c in CONTROLLERS if c not in limited]
     if missing:
         return LayerReport(
@@ -342,7 +367,50 @@ def _probe_machine() -> LayerReport:
             "mount the cgroup controllers or delegate them to this user (" + _REMEDY + ")",
         )
     return LayerReport(
-        CgroupLayer.name, True, f"cgroup {'+'.join(versions)}: memory, pids and cpu limited per child"
+        CgroupLayer.name,
+        True,
+        f"cgroup {'+'.join(versions)}: memory, pids and cpu limited per child; the tree killed by {killing}"
+        f"{_namespace_note()}",
+    )
+
+
+def _kill_probe(job: JobCgroup) -> str | None:
+    """Places a process in `job` and kills the job: how it was killed, or None when it could not be."""
+    argv = [*join_argv(job), "/bin/sh", "-c", "echo joined; exec sleep 60"]
+    try:
+        process = subprocess.Popen(
+            argv,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
+    except OSError:
+        return None
+    try:
+        joined = process.stdout is not None and process.stdout.readline().strip() == b"joined"
+        by_kernel = any(group.version == 2 and (group.path / "cgroup.kill").exists() for group in job.groups)
+        if not joined or not job.kill() or process.wait(timeout=5) != -signal.SIGKILL:
+            return None
+    except subprocess.TimeoutExpired:
+        return None
+    finally:
+        if process.poll() is None:
+            signalling.kill_group(process.pid)
+            process.wait()
+        if process.stdout is not None:
+            process.stdout.close()
+    return "cgroup.kill" if by_kernel else "a signal to each of its processes (pinned by pidfd)"
+
+
+def _namespace_note() -> str:
+    """Says so when this process runs in a PID namespace other than the kernel's first (its inode)."""
+    try:
+        nested = os.stat("/proc/self/ns/pid").st_ino != _INITIAL_PID_NAMESPACE
+    except OSError:
+        return ""
+    return (
+        "; in a nested PID namespace: jobs owned by locks, hidden processes never signalled" if nested else ""
     )
 
 

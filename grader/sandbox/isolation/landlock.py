@@ -1,7 +1,9 @@
 """Landlock: the file-system fallback when bubblewrap is unavailable, applied by the child to itself.
 
 Reads are limited to the interpreter, the libraries and the harness tree, writes to the scratch
-directory, and (Landlock ABI >= 4) TCP bind and connect are denied. The system calls themselves are in
+directory, (Landlock ABI >= 4) TCP bind and connect are denied, and (ABI >= 6) the child signals no
+process outside its own tree: without bubblewrap's PID namespace and a dropped uid (a container's root),
+`kill(-1)` would otherwise reach the grader and the other children. The system calls themselves are in
 `landlock_syscalls.py` (stdlib only: the child's bootstrap loads it from the harness tree).
 """
 
@@ -45,11 +47,17 @@ class LandlockLayer:
                 required=False,
             )
         network = "and TCP" if abi >= 4 else "(network NOT restricted: Landlock ABI < 4)"
+        signals = (
+            "; no signal leaves the child's own tree"
+            if abi >= landlock_syscalls.SCOPED_ABI
+            else "; signals NOT scoped (Landlock ABI < 6)"
+        )
         return LayerReport(
             self.name,
             True,
             f"fallback (ABI {abi}): "
-            f"reads limited to the interpreter and libraries, writes to the scratch directory, {network}",
+            f"reads limited to the interpreter and libraries, writes to the scratch directory, {network}"
+            f"{signals}",
             required=False,
         )
 

@@ -19,10 +19,19 @@ EXECUTE, WRITE_FILE, READ_FILE, READ_DIR = 1 << 0, 1 << 1, 1 << 2, 1 << 3
 _WRITE_EXTRA = sum(1 << bit for bit in range(4, 13))  # remove/make dir, file, fifo, socket, symlink, devices
 _REFER, _TRUNCATE = 1 << 13, 1 << 14
 _NET_BIND_TCP, _NET_CONNECT_TCP = 1 << 0, 1 << 1
+_SCOPE_ABSTRACT_UNIX_SOCKET, _SCOPE_SIGNAL = 1 << 0, 1 << 1
+SCOPED_ABI = 6
+"""From this ABI on, a restricted process can neither signal nor reach by abstract socket any process
+outside its own domain: the grader and the other children (kill -1 as root, where no uid could be
+dropped, reached them)."""
 
 
 class _RulesetAttr(ctypes.Structure):
-    _fields_ = [("handled_access_fs", ctypes.c_uint64), ("handled_access_net", ctypes.c_uint64)]
+    _fields_ = [
+        ("handled_access_fs", ctypes.c_uint64),
+        ("handled_access_net", ctypes.c_uint64),
+        ("scoped", ctypes.c_uint64),
+    ]
 
 
 class _PathBeneathAttr(ctypes.Structure):
@@ -56,7 +65,9 @@ def _handled(abi: int) -> int:
 def restrict_self(read_paths: list[str], write_paths: list[str]) -> int:
     """Restricts this process and its future children to reading `read_paths` and writing `write_paths`.
 
-    With ABI 4 or later, TCP bind and connect are denied as well. Paths that do not exist are skipped.
+    With ABI 4 or later, TCP bind and connect are denied as well; with ABI 6 or later, signals and
+    abstract Unix sockets reach no process outside this one's domain (`SCOPED_ABI`). Paths that do not
+    exist are skipped.
 
     Returns:
         The ABI version applied.
@@ -69,8 +80,10 @@ def restrict_self(read_paths: list[str], write_paths: list[str]) -> int:
         raise OSError("Landlock is not available in this kernel")
     libc = _libc()
     handled = _handled(abi)
-    attr = _RulesetAttr(handled, _NET_BIND_TCP | _NET_CONNECT_TCP if abi >= 4 else 0)
-    size = ctypes.sizeof(_RulesetAttr) if abi >= 4 else ctypes.sizeof(ctypes.c_uint64)
+    scoped = _SCOPE_ABSTRACT_UNIX_SOCKET | _SCOPE_SIGNAL if abi >= SCOPED_ABI else 0
+    attr = _RulesetAttr(handled, _NET_BIND_TCP | _NET_CONNECT_TCP if abi >= 4 else 0, scoped)
+    fields = 3 if abi >= SCOPED_ABI else 2 if abi >= 4 else 1
+    size = fields * ctypes.sizeof(ctypes.c_uint64)
     ruleset = libc.syscall(
         _SYSCALLS["create_ruleset"], ctypes.byref(attr), ctypes.c_size_t(size), ctypes.c_uint32(0)
     )

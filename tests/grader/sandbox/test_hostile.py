@@ -17,6 +17,7 @@ from typing import Any
 import pytest
 
 from grader.sandbox import Call, CallBudget, IsolationPolicy, Limits, OutcomeStatus, Sandbox, probe_isolation
+from grader.sandbox.isolation.cgroup import JOB_PREFIX
 from grader.sandbox.replay import replay_episode
 from grader.sandbox.text import EVENT_CHARS, MESSAGE_CHARS
 
@@ -95,7 +96,7 @@ def _processes_mentioning(token: str) -> list[str]:
 
 
 def _job_cgroups() -> list[Path]:
-    pattern = f"gymgrade-{os.getpid()}-*"
+    pattern = f"{JOB_PREFIX}{os.getpid()}-*"
     return [path for path in Path("/sys/fs/cgroup").glob(f"**/{pattern}") if path.is_dir()]
 
 

@@ -153,7 +153,7 @@ def test_closing_a_scope_removes_its_cgroups_and_files(private_tmp: Path) -> Non
         os.environ.update(variables)
         try:
             job = create_job_cgroup(memory_bytes=1 << 30, max_pids=16)
-            (Path(variables["GYMGRADE_SANDBOX_SCOPE"]) / "gymgrade-harness-1-x").mkdir()
+            (Path(variables["GYMGRADE_SANDBOX_SCOPE"]) / "gymgrade-tree-1-x").mkdir()
         finally:
             for name in variables:
                 del os.environ[name]
