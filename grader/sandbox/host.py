@@ -31,8 +31,9 @@ In detail:
   line, `Popen.kill()`, pipes polled with PeekNamedPipe) and `inherited` (no `pass_fds` and no handles:
   inheritable descriptors with `close_fds=False`, `Popen.kill()`; the Windows-shaped test runs use it).
   `ChildProcess` (`process.py`) calls `start`, `end`, `read_available` and `pipe_selector` only;
-  `exists(pid)` asks whether a grader that left a harness tree still runs (Windows' `os.kill(pid, 0)`
-  would end it). On Windows the request pipe is written blocking (frames are sent to an idle child). The
+  `exists(pid)` asks, where there are no file locks, whether a grader that left a harness tree still
+  runs (Windows' `os.kill(pid, 0)` would end it). On Windows the request pipe is written blocking
+  (frames are sent to an idle child). The
   child's environment adds `PYTHONUTF8=1` (and, on Windows, `SYSTEMROOT` and the like), so a student's
   text is UTF-8 whatever the locale. The wall-clock limit per call is the parent's and holds on every
   system; memory and CPU limits hold where the rlimits or cgroup layer is active, and the report's

@@ -79,9 +79,18 @@ def test_every_layer_the_system_cannot_run_is_reported_unprobed(
 EXPECTED_MODELS = {
     "Linux": (
         "posix",
-        {Feature.POSIX_PROCESSES, Feature.RESOURCE_LIMITS, Feature.USER_IDS, Feature.LINUX_KERNEL},
+        {
+            Feature.POSIX_PROCESSES,
+            Feature.RESOURCE_LIMITS,
+            Feature.USER_IDS,
+            Feature.LINUX_KERNEL,
+            Feature.FILE_LOCKS,
+        },
     ),
-    "macOS": ("posix", {Feature.POSIX_PROCESSES, Feature.RESOURCE_LIMITS, Feature.USER_IDS}),
+    "macOS": (
+        "posix",
+        {Feature.POSIX_PROCESSES, Feature.RESOURCE_LIMITS, Feature.USER_IDS, Feature.FILE_LOCKS},
+    ),
     "Windows": ("windows", {Feature.WINDOWS_HANDLES}),
 }
 
