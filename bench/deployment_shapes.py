@@ -20,6 +20,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import textwrap
 import threading
 import time
 from datetime import date
@@ -127,10 +128,16 @@ def main() -> None:
     lines = [
         HEADING,
         "",
-        f"`python bench/deployment_shapes.py --runs {args.runs}` on {date.today().isoformat()} "
-        f"(2 shared cores, load {load_before:.1f} at the start): the honest solution's `random_blackjack`, "
-        "seed 1, in each shape, while the host grades two problems of it in a loop. Lost: no report, a "
-        "non-zero exit, or a status other than the plain run's `passed`.",
+        textwrap.fill(
+            f"`python bench/deployment_shapes.py --runs {args.runs}` on {date.today().isoformat()} "
+            f"(2 shared cores, load {load_before:.1f} at the start): the honest solution's "
+            "`random_blackjack`, seed 1, in each shape, while the host grades two problems of it in a loop. "
+            "Lost: no report, a non-zero exit, or a status other than the plain run's `passed`. "
+            "Before issue 46 (commit d2db536) a check in a PID namespace beside a live host job exited 137 "
+            "with no report, and its sweep "
+            "SIGKILLed the host job's processes.",
+            110,
+        ),
         "",
         "| shape | runs | lost reports | s per run |",
         "|---|---|---|---|",
