@@ -110,11 +110,12 @@ NOT_APPLIED = {"pid namespace": set(), "docker default": {"cgroup", "bubblewrap"
 """Layers each shape cannot apply (the Docker shape's `privileges` too where the interpreter is not
 readable by an unprivileged uid, as on this machine's /root/.pyenv; Gradescope's /usr/bin Python is)."""
 DEGRADED = {
-    ("docker default", "fork_bomb.py"): "timeout",
+    ("docker default", "fork_bomb.py"): {"timeout", "ok"},
 }
-"""Where a shape's status differs from the plain Linux run's, and why: without a pids cgroup, nothing
-bounds the fork bomb's 500 forks (root ignores RLIMIT_NPROC; a dropped uid shares it with every child)
-but the call's wall clock (docs/operations.md, "Deployment shapes")."""
+"""Where a shape's status may differ from the plain Linux run's, and why: without a pids cgroup, nothing
+bounds the fork bomb's 500 forks (root ignores RLIMIT_NPROC; a dropped uid shares it with every child) but
+the call's wall clock: a loaded machine stops it (`timeout`), an idle one may finish all 500 (`ok`, with
+500 where the plain run's pids limit stopped it below 32) (docs/operations.md, "Deployment shapes")."""
 
 
 @pytest.mark.parametrize("file", SHAPE_HOSTILE)
@@ -126,7 +127,7 @@ def test_hostile_samples_get_the_plain_runs_outcome_in_each_shape(shape: str, fi
     assert run.returncode == 0, f"the grader did not report (exit {run.returncode}): {run.stderr[-2000:]}"
     outcome: dict[str, Any] = json.loads(run.stdout)
     sample = hostile_sample(file)
-    assert outcome["status"] == DEGRADED.get((shape, file), sample["status"]), outcome["message"]
+    assert outcome["status"] in DEGRADED.get((shape, file), {sample["status"]}), outcome["message"]
     if "value" in sample:  # kill_parent: the parent and init refused it, as in the plain run
         assert outcome["value"] == sample["value"]
     assert outcome["following"] == ["ok", 42]
