@@ -35,9 +35,8 @@ _REMEDY = (
 _INITIAL_PID_NAMESPACE = 0xEFFFFFFC
 """The inode of the initial PID namespace (the kernel's PROC_PID_INIT_INO)."""
 _REMEDY_RO = (
-    "a container's default: give it a writable, delegated cgroup (cgroup v2 with `--cgroupns=private`, or "
-    "run the grader on the host); without one, memory and CPU are bounded per process (rlimits) and a "
-    "child's tree is killed by its process group"
+    "a container's default: give it a writable, delegated cgroup (cgroup v2 with `--cgroupns=private`, or run the grader on the host); "  # noqa: E501
+    "without one, memory and CPU are bounded per process (rlimits) and a child's tree is killed by its process group"  # noqa: E501
 )
 _JOIN_CGROUPS = 'for f do [ "$f" = -- ] && break; echo $$ > "$f" || exit 125; shift; done; shift; exec "$@"'
 JOIN_FAILED_EXIT = 125

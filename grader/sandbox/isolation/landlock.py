@@ -56,8 +56,7 @@ class LandlockLayer:
             self.name,
             True,
             f"fallback (ABI {abi}): "
-            f"reads limited to the interpreter and libraries, writes to the scratch directory, {network}"
-            f"{signals}",
+            f"reads limited to the interpreter and libraries, writes to the scratch directory, {network}{signals}",  # noqa: E501
             required=False,
         )
 
