@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import contextlib
 import json
 import logging
-import os
 import queue
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -21,6 +18,7 @@ from typing import IO, Any
 from api.jobs.job_queue import ClaimedJob, JobQueue
 from api.settings import Settings
 from api.uploads import grading_file_name
+from grader.sandbox import signalling
 
 logger = logging.getLogger(__name__)
 
@@ -131,6 +129,7 @@ def _follow(
         except queue.Empty:
             message = None
         if isinstance(message, _ChildExited):
+            _kill_group(child)  # its leftovers, before its pid (the group's id) is free for reuse
             code = child.wait()
             logger.warning("grading child of submission %s exited with %s: %s", sid, code, _tail(stderr_path))
             jobs.retry(sid, worker_id, f"the grading process ended unexpectedly (exit status {code})")
@@ -171,8 +170,12 @@ def _read_messages(stream: IO[str], messages: queue.Queue[dict[str, Any] | _Chil
 
 
 def _kill_group(child: subprocess.Popen[str]) -> None:
-    with contextlib.suppress(ProcessLookupError, PermissionError):
-        os.killpg(child.pid, signal.SIGKILL)
+    """SIGKILLs the grading child's process group (it leads its own session), then reaps it.
+
+    Once the child is reaped its pid, the group's id, may name another process's group: then nothing is
+    signalled (`grader.sandbox.signalling` also refuses the worker's own group)."""
+    if child.returncode is None:
+        signalling.kill_group(child.pid)
     child.wait()
 
 

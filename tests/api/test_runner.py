@@ -280,3 +280,24 @@ def test_the_real_grader_grades_the_services_lab_never_the_uploads(
     assert statuses[missing] == "missing"
     note = row.report["edition_note"]
     assert note is not None and f"This file looks written for {told}" in note, note
+
+
+def test_the_grading_childs_group_is_killed_only_while_its_pid_is_its_own(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Once reaped, the child's pid (its group's id) may be another process's group: never signalled."""
+    import subprocess
+
+    from api.jobs import runner
+    from grader.sandbox import signalling
+
+    sent: list[int] = []
+    monkeypatch.setattr(signalling.os, "killpg", lambda pgid, _sig: sent.append(pgid))
+    reaped = subprocess.Popen(["true"], start_new_session=True, text=True)
+    reaped.wait()
+    runner._kill_group(reaped)
+    live = subprocess.Popen(["sleep", "60"], start_new_session=True, text=True)
+    monkeypatch.undo()
+    runner._kill_group(live)
+    assert sent == []
+    assert live.returncode == -9
