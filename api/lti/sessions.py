@@ -37,11 +37,13 @@ def session_caller(session: Session, token: str) -> Principal | None:
     )
 
 
-_IN_A_URL = re.compile(rf"({SESSION_PARAMETER}=)[^&\s\"']+")
+SECRET_PARAMETERS = (SESSION_PARAMETER, "ticket", "registration_token")
+"""Query parameters whose values are credentials: a session, a registration ticket, a platform's token."""
+_IN_A_URL = re.compile(rf"((?:^|[?&\s])(?:{'|'.join(SECRET_PARAMETERS)})=)[^&\s\"']+")
 
 
 def redacted(text: str) -> str:
-    """``text`` with every ``lti_session=...`` value replaced (a session token is a password)."""
+    """``text`` with the value of each of :data:`SECRET_PARAMETERS` replaced (they are passwords)."""
     return _IN_A_URL.sub(r"\1[redacted]", text)
 
 

@@ -134,20 +134,53 @@ def deep_link(
 
 
 @router.get("/lti/register")
-def dynamic_registration(
+def dynamic_registration_form(
     request: Request,
     session: SessionDep,
     settings: SettingsDep,
     openid_configuration: str = "",
-    registration_token: str | None = None,
+    registration_token: str = "",
     ticket: str = "",
 ) -> Response:
-    """LTI Dynamic Registration, opened by the platform with the instructor's registration URL."""
-    check_ticket(session, ticket, settings.lti_key_grace_seconds)
+    """LTI Dynamic Registration, opened by the platform with the instructor's registration URL: a form whose
+    POST registers (a GET registers nothing and leaves the ticket unused)."""
+    check_ticket(session, ticket, settings.lti_key_grace_seconds, use=False)
     if not openid_configuration:
         raise LtiRequestInvalid("the platform opens this URL with openid_configuration; found none")
+    return templates.TemplateResponse(
+        request,
+        "lti_register.html",
+        {
+            "ticket": ticket,
+            "openid_configuration": openid_configuration,
+            "registration_token": registration_token,
+            "session_query": "",
+        },
+        headers=page_headers("*"),
+    )
+
+
+@router.post("/lti/register")
+def dynamic_registration(
+    request: Request,
+    session: SessionDep,
+    context: ContextDep,
+    openid_configuration: Annotated[str, Form()] = "",
+    registration_token: Annotated[str, Form()] = "",
+    ticket: Annotated[str, Form()] = "",
+) -> Response:
+    """Register: spend the ticket, read the platform's configuration, register the tool there."""
+    settings = context.settings
+    check_ticket(session, ticket, settings.lti_key_grace_seconds, use=True)
+    if not openid_configuration:
+        raise LtiRequestInvalid("the registration form carries no openid_configuration; open the URL again")
     platform = register_dynamically(
-        session, tool_urls(request, settings), openid_configuration, registration_token
+        session,
+        context.outbound,
+        tool_urls(request, settings),
+        openid_configuration,
+        registration_token or None,
+        allowed_hosts=settings.lti_hosts,
     )
     return templates.TemplateResponse(
         request,
@@ -158,7 +191,8 @@ def dynamic_registration(
 
 
 class RegistrationUrl(BaseModel):
-    """A URL the LMS administrator gives the LMS for dynamic registration (valid 7 days)."""
+    """A URL the LMS administrator gives the LMS for dynamic registration (used once, valid
+    GYMGRADE_LTI_REGISTRATION_TICKET_SECONDS)."""
 
     url: str
 
@@ -169,7 +203,10 @@ def new_registration(
 ) -> RegistrationUrl:
     """A dynamic registration URL carrying a ticket the tool signed."""
     base = tool_urls(request, settings).base
-    return RegistrationUrl(url=f"{base}/lti/register?" + urlencode({"ticket": registration_ticket(session)}))
+    return RegistrationUrl(
+        url=f"{base}/lti/register?"
+        + urlencode({"ticket": registration_ticket(session, settings.lti_registration_ticket_seconds)})
+    )
 
 
 class PlatformIn(BaseModel):
@@ -196,7 +233,9 @@ def _platform_view(row: LtiPlatform) -> dict[str, Any]:
 
 
 @router.post("/lti/platforms", status_code=201)
-def post_platform(body: PlatformIn, session: SessionDep, _instructor: InstructorDep) -> dict[str, Any]:
+def post_platform(
+    body: PlatformIn, session: SessionDep, settings: SettingsDep, _instructor: InstructorDep
+) -> dict[str, Any]:
     """Register a platform by hand."""
     row = register_platform(
         session,
@@ -208,6 +247,7 @@ def post_platform(body: PlatformIn, session: SessionDep, _instructor: Instructor
             body.auth_url,
             body.token_url,
         ),
+        allow_http=settings.lti_allow_http,
     )
     return _platform_view(row)
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import html
 import os
 import re
 import time
@@ -12,16 +13,21 @@ from typing import Any
 import httpx
 from api_testing import FAKE_GRADER, TESTS_DIR
 from live_server import service_environment
-from lti_platform import query_of
+from lti_platform import REGISTRATION_TOKEN, query_of
 
 ONE_PROBLEM = b"def random_blackjack(n):\n    return 0.4\n"
 TWO_PROBLEMS = ONE_PROBLEM + b"def blackjack(n):\n    return 0.4\n"
 WAIT_SECONDS = 60.0
 
 
+LOOPBACK_PLATFORMS = {"lti_allow_http": "true", "lti_allowed_networks": "127.0.0.0/8,::1/128"}
+"""The settings letting the tool reach the test platforms: plain http on loopback (never in production)."""
+
+
 def tool_environment(data_dir: Path, **settings: Any) -> dict[str, str]:
-    """`gymgrade serve`'s environment with the fake grader importable by its grading children."""
-    env = service_environment(data_dir, FAKE_GRADER, **settings)
+    """`gymgrade serve`'s environment with the fake grader importable by its grading children, allowed to
+    reach the platforms on loopback over http (unless ``settings`` say otherwise)."""
+    env = service_environment(data_dir, FAKE_GRADER, **{**LOOPBACK_PLATFORMS, **settings})
     paths = [str(TESTS_DIR), *filter(None, env.get("PYTHONPATH", "").split(os.pathsep))]
     env["PYTHONPATH"] = os.pathsep.join(paths)
     return env
@@ -55,3 +61,18 @@ def wait(condition: Callable[[], Any], what: str, timeout: float = WAIT_SECONDS)
             return value
         time.sleep(0.1)
     raise AssertionError(f"timed out waiting for {what}")
+
+
+def register(
+    client: httpx.Client, registration_url: str, configuration: str, token: str = REGISTRATION_TOKEN
+) -> httpx.Response:
+    """Play the LMS administrator's browser: open the registration URL as the platform does (a GET with
+    openid_configuration and registration_token), then press the form's button (its POST); the POST's answer."""
+    base = registration_url.split("?", 1)[0]
+    opened = client.get(
+        base,
+        params={**query_of(registration_url), "openid_configuration": configuration, "registration_token": token},
+    )
+    assert opened.status_code == 200, opened.text
+    fields = dict(re.findall(r'<input type="hidden" name="(\w+)" value="([^"]*)">', opened.text))
+    return client.post(base, data={name: html.unescape(value) for name, value in fields.items()})

@@ -26,7 +26,7 @@ from lti_platform import (
     new_private_key,
     query_of,
 )
-from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, landed, tool_environment, upload, wait
+from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, landed, register, tool_environment, upload, wait
 
 pytestmark = [pytest.mark.e2e, pytest.mark.slow]
 
@@ -437,14 +437,7 @@ def test_dynamic_registration_needs_the_instructors_ticket_then_registers_the_to
         assert made.status_code == 201
         url = made.json()["url"]
         assert url.startswith(tool.url + "/lti/register?ticket=")
-        done = client.get(
-            tool.url + "/lti/register",
-            params={
-                **query_of(url),
-                "openid_configuration": configuration,
-                "registration_token": REGISTRATION_TOKEN,
-            },
-        )
+        done = register(client, url, configuration)
         assert done.status_code == 200, done.text
         assert "gymgrade is registered" in done.text
         (sent,) = lms.registrations
