@@ -68,10 +68,10 @@ def refusal(address: Address, policy: OutboundPolicy) -> str | None:
     kinds = [
         ("loopback", address.is_loopback),
         ("link-local", address.is_link_local),
-        ("private", address.is_private),
-        ("multicast", address.is_multicast),
-        ("reserved", address.is_reserved),
         ("unspecified", address.is_unspecified),
+        ("multicast", address.is_multicast),
+        ("private", address.is_private),
+        ("reserved", address.is_reserved),
         ("not globally routable", not address.is_global),
     ]
     for kind, applies in kinds:

@@ -103,6 +103,8 @@ class LaunchSpec:
     """The line item the platform made for the link (as Canvas and Moodle do for an assignment)."""
     browser: bool = False
     """The authorisation endpoint answers as an LMS does for a browser: a form posted by a script."""
+    kid: str | None = None
+    """Another key id in the id_token's header (a key the platform's JWKS does not hold)."""
 
 
 class _Config(LTI1P3PlatformConfAbstract):
@@ -154,6 +156,14 @@ class LtiPlatform:
         self.registrations: list[dict[str, Any]] = []
         self.deep_link_items: list[dict[str, Any]] = []
         self.course_pages: dict[str, str] = {}
+        self.configuration: dict[str, Any] = {}
+        """Fields overriding the OpenID configuration served (a hostile platform's issuer, endpoints)."""
+        self.jwks_padding = 0
+        """Bytes of padding added to the JWKS document (a huge one)."""
+        self.memberships_next: str | None = None
+        """A ``Link: <...>; rel="next"`` the roster's pages carry."""
+        self.requests: list[tuple[str, str]] = []
+        """Every request the platform received: (Host header, path)."""
         self.lock = threading.Lock()
         self.app = self._make_app()
         self._server: uvicorn.Server | None = None
@@ -166,9 +176,9 @@ class LtiPlatform:
         self.tool_launch_url = base_url + "/lti/launch"
         self.tool_jwks_url = base_url + "/lti/jwks"
 
-    def registration(self, signing_key: str | None = None) -> KeyedRegistration:
+    def registration(self, signing_key: str | None = None, kid: str | None = None) -> KeyedRegistration:
         """The package's registration object of the tool."""
-        registration = KeyedRegistration(self.kid)
+        registration = KeyedRegistration(kid or self.kid)
         (
             registration.set_iss(self.issuer)
             .set_client_id(self.client_id)
@@ -182,8 +192,8 @@ class LtiPlatform:
         )
         return registration
 
-    def config(self, signing_key: str | None = None) -> _Config:
-        return _Config(registration=self.registration(signing_key))
+    def config(self, signing_key: str | None = None, kid: str | None = None) -> _Config:
+        return _Config(registration=self.registration(signing_key, kid))
 
     @property
     def manual_registration(self) -> dict[str, Any]:
@@ -234,7 +244,7 @@ class LtiPlatform:
         spec = self.launches[query["lti_message_hint"]]
         if query.get("login_hint") != spec.person.sub:
             raise LtiException("login_hint does not name the user of this launch")
-        launch = _Launch(_Preflight(query), self.config(spec.signing_key))
+        launch = _Launch(_Preflight(query), self.config(spec.signing_key, spec.kid))
         launch.set_user_data(spec.person.sub, spec.person.roles, full_name=spec.person.name)
         launch.set_launch_context_claim(CONTEXT_ID, context_title="Reinforcement learning")
         launch.set_launch_presentation_claim("iframe", return_url=self.issuer + "/course")
@@ -270,6 +280,13 @@ class LtiPlatform:
         app = FastAPI()
         ags = "https://purl.imsglobal.org/spec/lti-ags/scope/"
 
+        @app.middleware("http")
+        async def _count(request: Request, call_next: Any) -> Response:
+            with self.lock:
+                self.requests.append((request.headers.get("host", ""), request.url.path))
+            response: Response = await call_next(request)
+            return response
+
         @app.exception_handler(PermissionError)
         async def _forbidden(_request: Request, error: Exception) -> Response:
             return JSONResponse({"error": str(error)}, status_code=401)
@@ -294,6 +311,7 @@ class LtiPlatform:
                     "product_family_code": "lti1p3platform-tests",
                     "version": "0.1.8",
                 },
+                **self.configuration,
             }
 
         @app.post("/register")
@@ -321,7 +339,10 @@ class LtiPlatform:
         def jwks() -> dict[str, Any]:
             config = self.config()
             config.get_registration()
-            return dict(config.get_jwks())
+            document = dict(config.get_jwks())
+            if self.jwks_padding:
+                document["padding"] = "x" * self.jwks_padding
+            return document
 
         @app.get("/auth", response_model=None)
         def auth(request: Request) -> dict[str, Any] | Response:
@@ -392,18 +413,27 @@ class LtiPlatform:
             return Response(status_code=204)
 
         @app.get("/memberships")
-        def memberships(request: Request) -> dict[str, Any]:
+        def memberships(request: Request) -> Response:
             self._check_token(
                 request, "https://purl.imsglobal.org/spec/lti-nrps/scope/contextmembership.readonly"
             )
-            return {
-                "id": self.issuer + "/memberships",
-                "context": {"id": CONTEXT_ID},
-                "members": [
-                    {"status": "Active", "user_id": person.sub, "name": person.name, "roles": person.roles}
-                    for person in self.people.values()
-                ],
-            }
+            headers = {"Link": f'<{self.memberships_next}>; rel="next"'} if self.memberships_next else {}
+            return JSONResponse(
+                headers=headers,
+                content={
+                    "id": self.issuer + "/memberships",
+                    "context": {"id": CONTEXT_ID},
+                    "members": [
+                        {
+                            "status": "Active",
+                            "user_id": person.sub,
+                            "name": person.name,
+                            "roles": person.roles,
+                        }
+                        for person in self.people.values()
+                    ],
+                },
+            )
 
         @app.post("/deep_link_return")
         async def deep_link_return(request: Request) -> dict[str, Any]:

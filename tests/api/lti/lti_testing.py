@@ -67,11 +67,15 @@ def register(
     client: httpx.Client, registration_url: str, configuration: str, token: str = REGISTRATION_TOKEN
 ) -> httpx.Response:
     """Play the LMS administrator's browser: open the registration URL as the platform does (a GET with
-    openid_configuration and registration_token), then press the form's button (its POST); the POST's answer."""
+    openid_configuration and registration_token), then press the form's button; the answer to its POST."""
     base = registration_url.split("?", 1)[0]
     opened = client.get(
         base,
-        params={**query_of(registration_url), "openid_configuration": configuration, "registration_token": token},
+        params={
+            **query_of(registration_url),
+            "openid_configuration": configuration,
+            "registration_token": token,
+        },
     )
     assert opened.status_code == 200, opened.text
     fields = dict(re.findall(r'<input type="hidden" name="(\w+)" value="([^"]*)">', opened.text))

@@ -24,7 +24,6 @@ from lti_platform import (
     LaunchSpec,
     LtiPlatform,
     new_private_key,
-    query_of,
 )
 from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, landed, register, tool_environment, upload, wait
 
