@@ -12,6 +12,7 @@ from api.jobs.job_queue import Dispatcher, JobQueue
 from api.jobs.local import DatabaseQueue, PollingDispatcher
 from api.jobs.pool import WorkerPool
 from api.jobs.reconciler import Reconciler
+from api.lti.keys import protect_keys
 from api.lti.outbound import Outbound, OutboundPolicy
 from api.lti.platforms import PlatformKeys
 from api.lti.publisher import ScorePublisher
@@ -48,6 +49,7 @@ class ServiceContext:
         engine = make_engine(settings)
         migrate(engine)
         sessions = make_session_factory(engine)
+        protect_keys(sessions, settings)
         publisher = ScorePublisher(sessions, settings) if publish else None
         if publisher is not None:
             publisher.start()

@@ -130,3 +130,8 @@ class PlatformUnreachable(ServiceError):
 class OutboundRefused(PlatformUnreachable):
     """Raised when the tool refuses a request it would make for a platform: plain http, a loopback,
     link-local or private address, a host that is not the platform's, or an answer too large or too slow."""
+
+
+class LtiKeysUnprotected(InternalError):
+    """Raised when the LTI signing keys would be stored or read unencrypted outside development
+    (GYMGRADE_KEY_ENCRYPTION_KEY unset), or cannot be decrypted with the key given."""

@@ -215,7 +215,7 @@ class Settings(BrokerSettings):
     )
     key_encryption_key: SecretStr | None = Field(
         default=None,
-        description="The key (Fernet: 32 random bytes, URL-safe base64) encrypting the LTI signing keys in the database; required to use LTI outside development.",  # noqa: E501
+        description="The key (Fernet: 32 random bytes, URL-safe base64) encrypting the LTI signing keys in the database; required to use LTI outside development. NEW,OLD: encrypt with NEW, read OLD too (keys are encrypted again with NEW at start-up).",  # noqa: E501
     )
 
     @field_validator("lti_allowed_networks")
@@ -239,7 +239,8 @@ class Settings(BrokerSettings):
         from cryptography.fernet import Fernet
 
         try:
-            Fernet(value.get_secret_value())
+            for key in value.get_secret_value().split(","):
+                Fernet(key.strip())
         except (ValueError, TypeError):
             raise ValueError(
                 "GYMGRADE_KEY_ENCRYPTION_KEY is not a Fernet key; expected 32 random bytes in URL-safe base64 "  # noqa: E501

@@ -289,9 +289,9 @@ def tool_configuration(request: Request, settings: SettingsDep, _instructor: Ins
 
 
 @router.post("/lti/keys/rotate")
-def rotate_keys(session: SessionDep, _instructor: InstructorDep) -> dict[str, str]:
+def rotate_keys(session: SessionDep, settings: SettingsDep, _instructor: InstructorDep) -> dict[str, str]:
     """Make a new signing key; the old ones stay published for GYMGRADE_LTI_KEY_GRACE_SECONDS."""
-    return {"kid": rotate(session)}
+    return {"kid": rotate(session, settings.lti_key_grace_seconds)}
 
 
 @router.get("/lti/links")

@@ -12,6 +12,7 @@ from typing import Any
 
 import httpx
 from api_testing import FAKE_GRADER, TESTS_DIR
+from cryptography.fernet import Fernet
 from live_server import service_environment
 from lti_platform import REGISTRATION_TOKEN, query_of
 
@@ -20,8 +21,14 @@ TWO_PROBLEMS = ONE_PROBLEM + b"def blackjack(n):\n    return 0.4\n"
 WAIT_SECONDS = 60.0
 
 
-LOOPBACK_PLATFORMS = {"lti_allow_http": "true", "lti_allowed_networks": "127.0.0.0/8,::1/128"}
-"""The settings letting the tool reach the test platforms: plain http on loopback (never in production)."""
+KEY_ENCRYPTION_KEY = Fernet.generate_key().decode("ascii")
+LOOPBACK_PLATFORMS = {
+    "lti_allow_http": "true",
+    "lti_allowed_networks": "127.0.0.0/8,::1/128",
+    "key_encryption_key": KEY_ENCRYPTION_KEY,
+}
+"""The settings letting the tool reach the test platforms (plain http on loopback: never in production),
+with its signing keys encrypted."""
 
 
 def tool_environment(data_dir: Path, **settings: Any) -> dict[str, str]:

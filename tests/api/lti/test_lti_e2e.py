@@ -413,6 +413,11 @@ def test_a_launch_started_before_a_key_rotation_completes_after_it(
         assert {key["kid"] for key in old} < {key["kid"] for key in published}
         assert rotated.json()["kid"] in {key["kid"] for key in published}
         assert all("d" not in key for key in published), "a private part was published"
+        with sqlite3.connect(database(tool)) as connection:
+            kept = [row[0] for row in connection.execute("SELECT private_pem FROM lti_keys")]
+        assert kept and all(pem.startswith("fernet:") and "PRIVATE" not in pem for pem in kept), (
+            "a key at rest in plaintext"
+        )
         response = client.post(
             form["launch_url"], data={"id_token": form["id_token"], "state": form["state"]}
         )
