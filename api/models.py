@@ -191,6 +191,9 @@ class LtiSession(Base):
     user_id: Mapped[int] = mapped_column(ForeignKey("lti_users.id"))
     link_id: Mapped[int | None] = mapped_column(ForeignKey("lti_links.id"), nullable=True)
     frame_origin: Mapped[str] = mapped_column(String(500))
+    browser_sha256: Mapped[str | None] = mapped_column(String(64), nullable=True)
+    """The SHA-256 of the browser cookie's secret the session works with (api/lti/binding.py); None: a
+    session opened through the platform's storage, by a browser keeping no cookie."""
     expires_at: Mapped[datetime] = mapped_column(DateTime)
 
 

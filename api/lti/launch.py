@@ -1,9 +1,10 @@
 """OIDC third-party login initiation and the launch, with every check LTI 1.3 (Core, Security) asks for.
 
-No cookie carries the state: it is a short-lived JWT the tool signs (``purpose`` "lti-state", the nonce,
-the platform), posted back by the platform with the id_token, so a launch works inside an LMS's iframe
-whose browser blocks third-party cookies. The nonce is stored when a launch is accepted: a second launch
-with it is refused. Every check runs before anything is written; a refused launch stores nothing.
+The state is a short-lived JWT the tool signs (``purpose`` "lti-state", the nonce, the platform, and the
+digest of the browser's secret, ``bind``: api/lti/binding.py), posted back by the platform with the
+id_token; the launch is accepted only from the browser holding the secret (a cookie, or the platform's
+storage). The nonce is stored when a launch is accepted: a second launch with it is refused. Every check
+runs before anything is written; a refused launch stores nothing.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from sqlalchemy.orm import Session
 
 from api.errors import LaunchRefused, LtiRequestInvalid
 from api.lti import claims as names
+from api.lti.binding import matches
 from api.lti.claims import Role, role_of
 from api.lti.keys import ALGORITHM, published_keys, sign
 from api.lti.people import display_name, ensure_link, ensure_member, ensure_user
@@ -39,7 +41,18 @@ LEEWAY_SECONDS = 60
 STATE_PURPOSE = "lti-state"
 
 
-def login_redirect(session: Session, params: dict[str, str], launch_url: str, tool_origin: str) -> str:
+@dataclass(frozen=True)
+class Login:
+    """Where a login initiation sends the browser, the state it made, and the platform's auth URL."""
+
+    url: str
+    state: str
+    auth_url: str
+
+
+def login_redirect(
+    session: Session, params: dict[str, str], launch_url: str, tool_origin: str, *, bind: str
+) -> Login:
     """Answer an OIDC third-party login initiation: the platform's authorisation URL to redirect to.
 
     Args:
@@ -48,6 +61,7 @@ def login_redirect(session: Session, params: dict[str, str], launch_url: str, to
             lti_message_hint, client_id, lti_deployment_id when the platform sends them.
         launch_url: The tool's launch URL (the redirect_uri it registered).
         tool_origin: scheme://host[:port] of the tool: target_link_uri must point at it.
+        bind: The digest of the browser's secret, carried by the state.
 
     Raises:
         LtiRequestInvalid: A required parameter is missing, or target_link_uri points elsewhere.
@@ -76,6 +90,8 @@ def login_redirect(session: Session, params: dict[str, str], launch_url: str, to
             "purpose": STATE_PURPOSE,
             "platform": platform.id,
             "nonce": nonce,
+            "bind": bind,
+            "store": params.get("lti_storage_target") or None,
             "iat": now,
             "exp": now + STATE_SECONDS,
         },
@@ -94,7 +110,7 @@ def login_redirect(session: Session, params: dict[str, str], launch_url: str, to
     if params.get("lti_message_hint"):
         query["lti_message_hint"] = params["lti_message_hint"]
     separator = "&" if urlsplit(platform.auth_url).query else "?"
-    return platform.auth_url + separator + urlencode(query)
+    return Login(platform.auth_url + separator + urlencode(query), state, platform.auth_url)
 
 
 @dataclass(frozen=True)
@@ -109,9 +125,16 @@ class Launch:
 
 
 def verify_launch(
-    session: Session, keys: PlatformKeys, id_token: str, state: str, *, grace_seconds: float
+    session: Session,
+    keys: PlatformKeys,
+    id_token: str,
+    state: str,
+    *,
+    grace_seconds: float,
+    browser_secret: str | None,
 ) -> Launch:
-    """Check a launch (the form post of id_token and state) without writing anything.
+    """Check a launch (the form post of id_token and state, from the browser holding ``browser_secret``)
+    without writing anything.
 
     Raises:
         LaunchRefused: Any check failed; the message names it, what was expected and what was found.
@@ -120,7 +143,13 @@ def verify_launch(
         raise LaunchRefused(
             "an LTI launch posts id_token and state; found " + ("no state" if id_token else "no id_token")
         )
-    state_claims = _tool_state(session, state, grace_seconds)
+    state_claims = tool_state(session, state, grace_seconds)
+    if not matches(browser_secret, state_claims.get("bind")):
+        raise LaunchRefused(
+            "this launch did not come from the browser its login started in (the state is bound to that "
+            "browser by a cookie or the LMS's storage, and this one has neither): a launch replayed from "
+            "another browser is refused; open the assignment in the LMS again"
+        )
     platform = session.get(LtiPlatform, state_claims.get("platform"))
     if platform is None:
         raise LaunchRefused("the launch's state names a platform that is no longer registered")
@@ -154,7 +183,8 @@ def verify_launch(
     return Launch(platform, claims, role, message_type, str(claims[names.DEPLOYMENT_ID]))
 
 
-def _tool_state(session: Session, state: str, grace_seconds: float) -> dict[str, Any]:
+def tool_state(session: Session, state: str, grace_seconds: float) -> dict[str, Any]:
+    """The claims of a state this tool issued, unexpired (raises LaunchRefused)."""
     try:
         token = jwt.decode(state, published_keys(session, grace_seconds), algorithms=[ALGORITHM])
         jwt.JWTClaimsRegistry(exp={"essential": True}, nonce={"essential": True}).validate(token.claims)
@@ -258,8 +288,11 @@ class Landing:
     link: LtiLink | None
 
 
-def accept_launch(session: Session, launch: Launch, *, session_seconds: float) -> Landing:
-    """Store what an accepted launch brings (the nonce, the user and student, the link, a session), at once.
+def accept_launch(
+    session: Session, launch: Launch, *, session_seconds: float, browser_digest: str | None
+) -> Landing:
+    """Store what an accepted launch brings (the nonce, the user and student, the link, a session bound to
+    the browser's cookie of digest ``browser_digest``, or to nothing but its link when None), at once.
 
     Raises:
         LaunchRefused: The nonce was used before (a replay); nothing is stored.
@@ -297,6 +330,7 @@ def accept_launch(session: Session, launch: Launch, *, session_seconds: float) -
             user_id=user.id,
             link_id=link.id if link is not None else None,
             frame_origin=frame_origins(launch),
+            browser_sha256=browser_digest,
             expires_at=now + timedelta(seconds=session_seconds),
         )
     )

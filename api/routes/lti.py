@@ -13,11 +13,22 @@ from fastapi import APIRouter, Form, Request
 from fastapi.responses import JSONResponse, RedirectResponse, Response
 from pydantic import BaseModel, Field
 from sqlalchemy import select
+from sqlalchemy.orm import Session
 from starlette.concurrency import run_in_threadpool
 
 from api.deps import ContextDep, InstructorDep, SessionDep, SettingsDep
 from api.errors import LtiRequestInvalid
 from api.lti import claims as names
+from api.lti.binding import (
+    LAUNCH_PATH,
+    LOGIN_COOKIE_PREFIX,
+    SESSION_COOKIE,
+    STORAGE_KEY_PREFIX,
+    digest,
+    new_secret,
+    set_cookie,
+    state_name,
+)
 from api.lti.deep_linking import (
     check_link_edition,
     choices,
@@ -26,7 +37,15 @@ from api.lti.deep_linking import (
     picker_token,
 )
 from api.lti.keys import public_jwks, rotate
-from api.lti.launch import accept_launch, frame_origins, login_redirect, verify_launch
+from api.lti.launch import (
+    STATE_SECONDS,
+    Login,
+    accept_launch,
+    frame_origins,
+    login_redirect,
+    tool_state,
+    verify_launch,
+)
 from api.lti.platforms import PlatformRegistration, add_deployment, register_platform
 from api.lti.publisher import publishing_status
 from api.lti.registration import ToolUrls, check_ticket, register_dynamically, registration_ticket
@@ -54,18 +73,47 @@ def jwks(session: SessionDep, settings: SettingsDep) -> JSONResponse:
 
 @router.api_route("/lti/login", methods=["GET", "POST"])
 async def login(request: Request, context: ContextDep) -> Response:
-    """OIDC third-party login initiation: redirect to the platform's authorisation endpoint."""
+    """OIDC third-party login initiation: bind the login to the browser (a cookie, and the platform's
+    storage when it offers one), then on to the platform's authorisation endpoint."""
     params = dict(request.query_params)
     if request.method == "POST":
         params.update({key: str(value) for key, value in (await request.form()).items()})
     urls = tool_urls(request, context.settings)
+    secret, bind = new_secret()
 
-    def redirect() -> str:  # the database (and the first key's generation) off the event loop
+    def redirect() -> Login:  # the database (and the first key's generation) off the event loop
         with context.sessions() as session:
-            return login_redirect(session, params, urls.launch, urls.origin)
+            return login_redirect(session, params, urls.launch, urls.origin, bind=bind)
 
-    target = await run_in_threadpool(redirect)
-    return RedirectResponse(target, status_code=302 if request.method == "GET" else 303)
+    started = await run_in_threadpool(redirect)
+    name = state_name(started.state)
+    storage = params.get("lti_storage_target")
+    response: Response
+    if storage:
+        # A page without anything to click, framed by the LMS whichever page of it frames the tool.
+        response = templates.TemplateResponse(
+            request,
+            "lti_storage.html",
+            {
+                "action": "put",
+                "target": storage,
+                "origin": _origin(started.auth_url),
+                "key": STORAGE_KEY_PREFIX + name,
+                "value": secret,
+                "next": started.url,
+                "session_query": "",
+            },
+            headers=page_headers("*"),
+        )
+    else:
+        response = RedirectResponse(started.url, status_code=302 if request.method == "GET" else 303)
+    set_cookie(response, LOGIN_COOKIE_PREFIX + name, secret, max_age=STATE_SECONDS, path=LAUNCH_PATH)
+    return response
+
+
+def _origin(url: str) -> str:
+    parts = urlsplit(url)
+    return f"{parts.scheme}://{parts.netloc}"
 
 
 @router.post("/lti/launch")
@@ -75,16 +123,39 @@ def launch(
     context: ContextDep,
     id_token: Annotated[str, Form()] = "",
     state: Annotated[str, Form()] = "",
+    storage_answer: Annotated[str | None, Form()] = None,
 ) -> Response:
-    """The launch: verify everything, then land signed in (the upload page, or the lab picker)."""
+    """The launch: verify everything (in the browser the login began in), then land signed in (the upload
+    page, or the lab picker)."""
     settings = context.settings
+    name = state_name(state)
+    from_cookie = request.cookies.get(LOGIN_COOKIE_PREFIX + name)
+    if from_cookie is None and storage_answer is None and state:
+        stored = _from_platform_storage(request, session, settings, id_token, state)
+        if stored is not None:
+            return stored
     checked = verify_launch(
-        session, context.platform_keys, id_token, state, grace_seconds=settings.lti_key_grace_seconds
+        session,
+        context.platform_keys,
+        id_token,
+        state,
+        grace_seconds=settings.lti_key_grace_seconds,
+        browser_secret=from_cookie or storage_answer,
     )
+    # A browser that sent the login's cookie keeps cookies: its session is bound to its browser cookie (the
+    # one it has, which its other sessions are bound to, else a new one).
+    browser_secret: str | None = None
+    browser_digest: str | None = None
+    if from_cookie is not None:
+        browser_secret = request.cookies.get(SESSION_COOKIE) or new_secret()[0]
+        browser_digest = digest(browser_secret)
+    response: Response
     if checked.message_type == names.DEEP_LINKING_REQUEST:
         token = picker_token(session, checked)
-        accept_launch(session, checked, session_seconds=settings.lti_session_seconds)
-        return templates.TemplateResponse(
+        accept_launch(
+            session, checked, session_seconds=settings.lti_session_seconds, browser_digest=browser_digest
+        )
+        response = templates.TemplateResponse(
             request,
             "lti_picker.html",
             {
@@ -95,11 +166,45 @@ def launch(
             },
             headers=page_headers(frame_origins(checked)),
         )
-    custom = checked.claims.get(names.CUSTOM)
-    graded = graded_edition(settings.edition, settings.lab)
-    check_link_edition(custom if isinstance(custom, dict) else {}, graded)
-    landing = accept_launch(session, checked, session_seconds=settings.lti_session_seconds)
-    return RedirectResponse("/?" + urlencode({SESSION_PARAMETER: landing.token}), status_code=303)
+    else:
+        custom = checked.claims.get(names.CUSTOM)
+        graded = graded_edition(settings.edition, settings.lab)
+        check_link_edition(custom if isinstance(custom, dict) else {}, graded)
+        landing = accept_launch(
+            session, checked, session_seconds=settings.lti_session_seconds, browser_digest=browser_digest
+        )
+        response = RedirectResponse("/?" + urlencode({SESSION_PARAMETER: landing.token}), status_code=303)
+    if browser_secret is not None:
+        set_cookie(response, SESSION_COOKIE, browser_secret, max_age=settings.lti_session_seconds, path="/")
+    return response
+
+
+def _from_platform_storage(
+    request: Request, session: Session, settings: Settings, id_token: str, state: str
+) -> Response | None:
+    """The page reading the login's secret back from the platform's storage (then posting the launch
+    again), when the login stored it there; None when it did not."""
+    claims = tool_state(session, state, settings.lti_key_grace_seconds)
+    platform = session.get(LtiPlatform, claims.get("platform"))
+    target = claims.get("store")
+    if not target or platform is None:
+        return None
+    return templates.TemplateResponse(
+        request,
+        "lti_storage.html",
+        {
+            "action": "get",
+            "target": target,
+            "origin": _origin(platform.auth_url),
+            "key": STORAGE_KEY_PREFIX + state_name(state),
+            "value": "",
+            "next": "",
+            "id_token": id_token,
+            "state": state,
+            "session_query": "",
+        },
+        headers=page_headers("*"),
+    )
 
 
 @router.post("/lti/deep-link")

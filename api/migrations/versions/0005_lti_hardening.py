@@ -1,5 +1,5 @@
-"""LTI hardened: tokens spent once (registration tickets, lab picker forms) and the origins that may frame
-the tool, per platform."""
+"""LTI hardened: tokens spent once (registration tickets, lab picker forms), the origins that may frame
+the tool, per platform, and sessions bound to a browser's cookie."""
 
 from __future__ import annotations
 
@@ -21,9 +21,13 @@ def upgrade() -> None:
     )
     with op.batch_alter_table("lti_platforms") as batch:
         batch.add_column(sa.Column("frame_ancestors", sa.JSON(), nullable=False, server_default="[]"))
+    with op.batch_alter_table("lti_sessions") as batch:
+        batch.add_column(sa.Column("browser_sha256", sa.String(64), nullable=True))
 
 
 def downgrade() -> None:
+    with op.batch_alter_table("lti_sessions") as batch:
+        batch.drop_column("browser_sha256")
     with op.batch_alter_table("lti_platforms") as batch:
         batch.drop_column("frame_ancestors")
     op.drop_table("lti_spent_tokens")

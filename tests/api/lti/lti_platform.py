@@ -21,7 +21,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
-from urllib.parse import parse_qsl, urlsplit
+from urllib.parse import parse_qsl, urlencode, urlsplit
 
 import httpx
 import uvicorn
@@ -42,6 +42,26 @@ INSTRUCTOR = "http://purl.imsglobal.org/vocab/lis/v2/membership#Instructor"
 TEACHING_ASSISTANT = "http://purl.imsglobal.org/vocab/lis/v2/membership/Instructor#TeachingAssistant"
 CONTEXT_ID = "course-rl-2026"
 REGISTRATION_TOKEN = "platform-registration-" + "k3y9"
+PLATFORM_STORAGE = """
+var stored = {};
+window.addEventListener("message", function (event) {
+  var message = event.data;
+  if (!message || typeof message.subject !== "string") { return; }
+  var key = event.origin + " " + message.key;
+  var answer = { message_id: message.message_id, key: message.key };
+  if (message.subject === "lti.put_data") {
+    stored[key] = message.value;
+    answer.subject = "lti.put_data.response";
+    answer.value = message.value;
+  } else if (message.subject === "lti.get_data") {
+    answer.subject = "lti.get_data.response";
+    answer.value = stored[key];
+  } else { return; }
+  event.source.postMessage(answer, event.origin);
+});
+"""
+"""The platform's storage for LTI client-side OIDC (lti.put_data, lti.get_data), kept per tool origin, on
+the course page that frames the tool (its ``lti_storage_target`` is ``_parent``)."""
 
 
 def new_private_key() -> str:
@@ -105,6 +125,8 @@ class LaunchSpec:
     """The authorisation endpoint answers as an LMS does for a browser: a form posted by a script."""
     kid: str | None = None
     """Another key id in the id_token's header (a key the platform's JWKS does not hold)."""
+    storage_target: str | None = None
+    """The login offers the platform's storage (LTI client-side OIDC): ``lti_storage_target``."""
 
 
 class _Config(LTI1P3PlatformConfAbstract):
@@ -216,7 +238,10 @@ class LtiPlatform:
         login.set_lti_message_hint(hint=hint)
         if spec.deep_linking:
             login.set_deeplinking_launch_url()
-        return login.initiate_login(spec.person.sub)
+        url: str = login.initiate_login(spec.person.sub)
+        if spec.storage_target:
+            url += "&" + urlencode({"lti_storage_target": spec.storage_target})
+        return url
 
     def course_page(self, spec: LaunchSpec) -> str:
         """The URL of the course's page framing the tool, which a browser opens (the launch starts there)."""
@@ -365,6 +390,7 @@ class LtiPlatform:
             return HTMLResponse(
                 "<h1>Reinforcement learning</h1>"
                 f'<iframe id="tool" src="{html.escape(login)}" width="1000" height="800"></iframe>'
+                f"<script>{PLATFORM_STORAGE}</script>"
             )
 
         @app.post("/token")

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import html
+import http.cookiejar
 import os
 import re
 import time
+import urllib.parse
+import urllib.request
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -87,3 +90,30 @@ def register(
     assert opened.status_code == 200, opened.text
     fields = dict(re.findall(r'<input type="hidden" name="(\w+)" value="([^"]*)">', opened.text))
     return client.post(base, data={name: html.unescape(value) for name, value in fields.items()})
+
+
+class _LoopbackIsSecure(http.cookiejar.DefaultCookiePolicy):
+    """A browser's cookie policy: Secure cookies are sent to http://127.0.0.1 and localhost too (browsers
+    treat loopback as a secure context; Python's cookie jar does not)."""
+
+    def return_ok_secure(self, cookie: http.cookiejar.Cookie, request: urllib.request.Request) -> bool:
+        host = urllib.parse.urlsplit(request.get_full_url()).hostname
+        return host in ("127.0.0.1", "localhost") or super().return_ok_secure(cookie, request)
+
+
+def browser() -> httpx.Client:
+    """An HTTP client keeping cookies as a browser does on loopback (one browser: its own cookie jar).
+
+    The jar is the hooks' own: httpx copies a client's cookies into a jar of the default policy for each
+    request, which would drop the policy."""
+    jar = httpx.Cookies(http.cookiejar.CookieJar(policy=_LoopbackIsSecure()))
+
+    def send_cookies(request: httpx.Request) -> None:
+        if "cookie" in request.headers:
+            del request.headers["cookie"]
+        jar.set_cookie_header(request)
+
+    def keep_cookies(response: httpx.Response) -> None:
+        jar.extract_cookies(response)
+
+    return httpx.Client(event_hooks={"request": [send_cookies], "response": [keep_cookies]})

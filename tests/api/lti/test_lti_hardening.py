@@ -16,7 +16,7 @@ import pytest
 from api_testing import instructor_headers
 from live_server import LiveProcess
 from lti_platform import INSTRUCTOR, LEARNER, LaunchSpec, LtiPlatform, query_of
-from lti_testing import ONE_PROBLEM, landed, register, tool_environment, upload, wait
+from lti_testing import ONE_PROBLEM, browser, landed, register, tool_environment, upload, wait
 
 from api.errors import LtiRequestInvalid
 from api.lti.platforms import PlatformRegistration
@@ -72,7 +72,7 @@ def test_a_ticket_registers_once_on_a_post_and_stays_out_of_the_log(
 ) -> None:
     url = registration_url(tool)
     ticket = query_of(url)["ticket"]
-    with httpx.Client() as client:
+    with browser() as client:
         # The platform's GET shows a form and does nothing: no configuration read, no registration, the
         # ticket left unused (a link previewer or prefetch opening the URL spends nothing).
         opened = client.get(
@@ -138,7 +138,7 @@ def test_a_configuration_claiming_another_issuer_or_foreign_endpoints_registers_
 ) -> None:
     lms.configuration = configuration(lms)
     before = httpx.get(tool.url + "/lti/platforms", headers=instructor_headers()).json()
-    with httpx.Client() as client:
+    with browser() as client:
         refused = register(client, registration_url(tool), configuration_url(lms))
     assert refused.status_code in (400, 502), refused.text
     assert message.format(**lms.configuration) in html.unescape(refused.text)
@@ -149,7 +149,7 @@ def test_a_configuration_claiming_another_issuer_or_foreign_endpoints_registers_
 def test_a_refused_registration_shows_none_of_the_platforms_answer(
     tool: LiveProcess, lms: LtiPlatform
 ) -> None:
-    with httpx.Client() as client:
+    with browser() as client:
         refused = register(client, registration_url(tool), configuration_url(lms), token="wrong-token")
     assert refused.status_code == 502
     assert "its registration endpoint answered 401" in refused.text
@@ -162,7 +162,7 @@ def test_a_loopback_platform_is_refused_unless_the_operator_allows_it(
     env = tool_environment(tmp_path / "data", lti_allowed_networks="")
     strict = LiveProcess("serve", env, tmp_path / "serve.log").start()
     try:
-        with httpx.Client() as client:
+        with browser() as client:
             refused = register(client, registration_url(strict), configuration_url(lms))
         assert refused.status_code == 502
         assert "the tool does not connect to '127.0.0.1': 127.0.0.1 is a loopback address" in refused.text
@@ -192,7 +192,7 @@ def test_the_access_token_never_goes_to_a_line_item_on_another_host(
     item = lms.add_line_item("link-elsewhere", score_maximum=3.0)
     elsewhere = item.replace("127.0.0.1", "localhost")  # loopback (allowed), but not the platform's host
     person = lms.add_person("learner-far", "Farah Far", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         token, _ = landed(
             client, tool.url, lms.launch(client, LaunchSpec(person, "link-elsewhere", lineitem=elsewhere))
         )
@@ -212,7 +212,7 @@ def test_a_roster_page_linking_to_another_host_is_not_followed(tool: LiveProcess
     register_by_hand(tool, lms)
     lms.memberships_next = lms.issuer.replace("127.0.0.1", "localhost") + "/memberships?page=2"
     teacher = lms.add_person("staff-rose", "Rose Roster", INSTRUCTOR)
-    with httpx.Client() as client:
+    with browser() as client:
         token, _ = landed(client, tool.url, lms.launch(client, LaunchSpec(teacher, "link-roster")))
         imported = client.post(tool.url + "/ui/lti/roster", params={"lti_session": token})
     assert imported.status_code == 502
@@ -228,7 +228,7 @@ def test_a_huge_jwks_is_refused_unread(tool: LiveProcess, lms: LtiPlatform) -> N
     register_by_hand(tool, lms)
     lms.jwks_padding = 5_000_000
     person = lms.add_person("learner-huge", "Hugo", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         refused = lms.launch(client, LaunchSpec(person, "link-huge"))
     assert refused.status_code == 502
     assert re.search(r"announced \d+ bytes; the tool reads at most 1000000", refused.text), refused.text
@@ -237,7 +237,7 @@ def test_a_huge_jwks_is_refused_unread(tool: LiveProcess, lms: LtiPlatform) -> N
 def test_made_up_key_ids_fetch_the_jwks_at_most_once_a_minute(tool: LiveProcess, lms: LtiPlatform) -> None:
     register_by_hand(tool, lms)
     person = lms.add_person("learner-kid", "Kit", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         for attempt in range(5):
             refused = lms.launch(client, LaunchSpec(person, "link-kid", kid=f"made-up-{attempt}"))
             assert refused.status_code == 403
