@@ -39,6 +39,8 @@ STATE_SECONDS = 600
 LEEWAY_SECONDS = 60
 """Clock difference tolerated between the platform and the tool (exp, iat, nbf)."""
 STATE_PURPOSE = "lti-state"
+FRAME_ORIGINS_CHARS = 500
+"""The longest frame-ancestors list a session keeps (its column's size)."""
 
 
 @dataclass(frozen=True)
@@ -50,21 +52,19 @@ class Login:
     auth_url: str
 
 
-def login_redirect(
-    session: Session, params: dict[str, str], launch_url: str, tool_origin: str, *, bind: str
-) -> Login:
+def login_redirect(session: Session, params: dict[str, str], launch_url: str, *, bind: str) -> Login:
     """Answer an OIDC third-party login initiation: the platform's authorisation URL to redirect to.
 
     Args:
         session: A database session (the signing key is made on first use).
         params: The initiation's parameters (query or form): iss, login_hint, target_link_uri, and
             lti_message_hint, client_id, lti_deployment_id when the platform sends them.
-        launch_url: The tool's launch URL (the redirect_uri it registered).
-        tool_origin: scheme://host[:port] of the tool: target_link_uri must point at it.
+        launch_url: The tool's launch URL (the redirect_uri it registered): target_link_uri must be it
+            (a query aside).
         bind: The digest of the browser's secret, carried by the state.
 
     Raises:
-        LtiRequestInvalid: A required parameter is missing, or target_link_uri points elsewhere.
+        LtiRequestInvalid: A required parameter is missing, or target_link_uri is not the launch URL.
         LaunchRefused: The issuer (and client id) is not registered.
     """
     missing = [name for name in ("iss", "login_hint", "target_link_uri") if not params.get(name)]
@@ -73,9 +73,9 @@ def login_redirect(
             f"an LTI login initiation needs {', '.join(missing)}; found only {', '.join(sorted(params)) or 'nothing'}"  # noqa: E501
         )
     target = params["target_link_uri"]
-    if _origin(target) != tool_origin:
+    if _without_query(target) != launch_url:
         raise LtiRequestInvalid(
-            f"target_link_uri {target!r} is not this tool's (expected a URL under {tool_origin}); "
+            f"target_link_uri {target!r} is not this tool's launch URL (expected {launch_url}); "
             "check the tool's launch URL in the LMS"
         )
     platform = find_platform(session, params["iss"], params.get("client_id"))
@@ -92,6 +92,7 @@ def login_redirect(
             "nonce": nonce,
             "bind": bind,
             "store": params.get("lti_storage_target") or None,
+            "target": target,
             "iat": now,
             "exp": now + STATE_SECONDS,
         },
@@ -172,6 +173,11 @@ def verify_launch(
     claims = dict(token.claims)
     _check_times(claims)
     _check_claims(claims, platform, state_claims["nonce"])
+    if claims.get(names.TARGET_LINK_URI) != state_claims.get("target"):
+        raise LaunchRefused(
+            f"the id_token's target_link_uri is {claims.get(names.TARGET_LINK_URI)!r}; expected "
+            f"{state_claims.get('target')!r}, the one its login was started for"
+        )
     role = role_of(claims.get(names.ROLES) or [])
     if role is None:
         raise LaunchRefused(
@@ -227,9 +233,9 @@ def _check_claims(claims: dict[str, Any], platform: LtiPlatform, nonce: str) -> 
             f"the id_token is addressed to {audiences!r}; "
             f"expected this tool's client id {platform.client_id!r}"
         )
-    if len(audiences) > 1 and claims.get("azp") != platform.client_id:
+    if (len(audiences) > 1 or "azp" in claims) and claims.get("azp") != platform.client_id:
         raise LaunchRefused(
-            f"the id_token has several audiences and azp {claims.get('azp')!r}; expected azp {platform.client_id!r}"  # noqa: E501
+            f"the id_token's azp (authorised party) is {claims.get('azp')!r}; expected this tool's client id {platform.client_id!r}"  # noqa: E501
         )
     if claims.get("nonce") != nonce:
         raise LaunchRefused("the id_token's nonce is not the one this login started with")
@@ -252,9 +258,10 @@ def _check_claims(claims: dict[str, Any], platform: LtiPlatform, nonce: str) -> 
 
 
 def _unknown_deployment(deployment: str, platform: LtiPlatform) -> str:
+    # The registered ids are not listed: whoever sees this page is not signed in.
     return (
-        f"deployment {deployment!r} of {platform.issuer} is not registered with this tool "
-        f"(registered: {', '.join(platform.deployment_ids) or 'none'}); the instructor adds it"
+        f"deployment {deployment!r} of {platform.issuer} is not registered with this tool; "
+        "the instructor adds it (POST /lti/platforms/{id}/deployments)"
     )
 
 
@@ -267,16 +274,32 @@ def _when(seconds: object) -> str:
 
 def frame_origins(launch: Launch) -> str:
     """The origins allowed to frame the tool's pages after this launch (CSP frame-ancestors): the LMS's
-    return URL's (the page embedding the tool: Canvas's issuer is not the school's host) and the issuer's."""
+    return URL's (the page embedding the tool: Canvas's issuer is not the school's host), the issuer's and
+    those registered with the platform (browsers check every ancestor: Open edX's learning MFE frames
+    the LMS page that frames the tool)."""
     presentation = launch.claims.get(names.LAUNCH_PRESENTATION) or {}
-    urls = [str(presentation.get("return_url") or ""), launch.platform.issuer]
+    urls = [
+        str(presentation.get("return_url") or ""),
+        launch.platform.issuer,
+        *launch.platform.frame_ancestors,
+    ]
     origins = dict.fromkeys(_origin(url) for url in urls if urlsplit(url).scheme in ("http", "https"))
-    return " ".join(origins)[:500]
+    kept: list[str] = []
+    for origin in origins:  # whole origins only: a cut one would be another source
+        if len(" ".join([*kept, origin])) > FRAME_ORIGINS_CHARS:
+            break
+        kept.append(origin)
+    return " ".join(kept)
 
 
 def _origin(url: str) -> str:
     parts = urlsplit(url)
     return f"{parts.scheme}://{parts.netloc}"
+
+
+def _without_query(url: str) -> str:
+    parts = urlsplit(url)
+    return f"{parts.scheme}://{parts.netloc}{parts.path}"
 
 
 @dataclass(frozen=True)

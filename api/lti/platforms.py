@@ -36,6 +36,8 @@ class PlatformRegistration:
     jwks_url: str
     auth_url: str
     token_url: str
+    frame_ancestors: tuple[str, ...] = ()
+    """Origins besides the launch's and the issuer's that frame the tool (every ancestor frame's)."""
 
     def checked(self, *, allow_http: bool) -> PlatformRegistration:
         """The registration itself, once every field is present and every URL is https (or http when
@@ -51,7 +53,31 @@ class PlatformRegistration:
                     f"a platform's {field} must be an {' or '.join(schemes)} URL, found {value!r}; "
                     "copy it from the LMS's tool registration page (LMSs serve LTI over https)"
                 )
+        checked_origins(self.frame_ancestors, allow_http=allow_http)
         return self
+
+
+def checked_origins(origins: tuple[str, ...] | list[str], *, allow_http: bool) -> list[str]:
+    """``origins`` when each is an origin (scheme://host[:port], https or, when ``allow_http``, http).
+
+    Raises:
+        LtiRequestInvalid: One is not.
+    """
+    schemes = ("https", "http") if allow_http else ("https",)
+    for origin in origins:
+        parts = urlsplit(origin)
+        if (
+            parts.scheme not in schemes
+            or not parts.hostname
+            or parts.path not in ("", "/")
+            or parts.query
+            or parts.fragment
+            or any(character in origin for character in " ;,'\"")
+        ):
+            raise LtiRequestInvalid(
+                f"a frame ancestor must be an origin such as https://apps.lms.example.edu ({' or '.join(schemes)}, no path); found {origin!r}"  # noqa: E501
+            )
+    return [origin.rstrip("/") for origin in origins]
 
 
 def register_platform(
@@ -66,6 +92,7 @@ def register_platform(
         jwks_url=registration.jwks_url,
         auth_url=registration.auth_url,
         token_url=registration.token_url,
+        frame_ancestors=checked_origins(registration.frame_ancestors, allow_http=allow_http),
     )
     session.add(row)
     try:

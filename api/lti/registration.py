@@ -57,12 +57,6 @@ class ToolUrls:
         """The tool's public keys."""
         return self.base + "/lti/jwks"
 
-    @property
-    def origin(self) -> str:
-        """scheme://host[:port]."""
-        parts = urlsplit(self.base)
-        return f"{parts.scheme}://{parts.netloc}"
-
 
 def registration_ticket(session: Session, seconds: float) -> str:
     """A ticket allowing one dynamic registration within ``seconds``."""

@@ -46,7 +46,7 @@ from api.lti.launch import (
     tool_state,
     verify_launch,
 )
-from api.lti.platforms import PlatformRegistration, add_deployment, register_platform
+from api.lti.platforms import PlatformRegistration, add_deployment, checked_origins, register_platform
 from api.lti.publisher import publishing_status
 from api.lti.registration import ToolUrls, check_ticket, register_dynamically, registration_ticket
 from api.lti.roster import import_roster
@@ -83,7 +83,7 @@ async def login(request: Request, context: ContextDep) -> Response:
 
     def redirect() -> Login:  # the database (and the first key's generation) off the event loop
         with context.sessions() as session:
-            return login_redirect(session, params, urls.launch, urls.origin, bind=bind)
+            return login_redirect(session, params, urls.launch, bind=bind)
 
     started = await run_in_threadpool(redirect)
     name = state_name(started.state)
@@ -323,6 +323,8 @@ class PlatformIn(BaseModel):
     jwks_url: str = Field(min_length=1, max_length=1000)
     auth_url: str = Field(min_length=1, max_length=1000)
     token_url: str = Field(min_length=1, max_length=1000)
+    frame_ancestors: list[str] = Field(default_factory=list, max_length=10)
+    """Origins of pages framing the LMS page that frames the tool (Open edX's learning MFE)."""
 
 
 def _platform_view(row: LtiPlatform) -> dict[str, Any]:
@@ -334,6 +336,7 @@ def _platform_view(row: LtiPlatform) -> dict[str, Any]:
         "jwks_url": row.jwks_url,
         "auth_url": row.auth_url,
         "token_url": row.token_url,
+        "frame_ancestors": row.frame_ancestors,
     }
 
 
@@ -351,6 +354,7 @@ def post_platform(
             body.jwks_url,
             body.auth_url,
             body.token_url,
+            tuple(body.frame_ancestors),
         ),
         allow_http=settings.lti_allow_http,
     )
@@ -372,6 +376,29 @@ def post_deployment(
     if platform is None:
         raise LtiRequestInvalid(f"no platform has id {platform_id}; list them with GET /lti/platforms")
     add_deployment(session, platform, body.deployment_id)
+    return _platform_view(platform)
+
+
+class FrameAncestorsIn(BaseModel):
+    """The origins, besides the launch's and the issuer's, whose pages frame the tool (every ancestor)."""
+
+    frame_ancestors: list[str] = Field(max_length=10)
+
+
+@router.put("/lti/platforms/{platform_id}/frame-ancestors")
+def put_frame_ancestors(
+    platform_id: int,
+    body: FrameAncestorsIn,
+    session: SessionDep,
+    settings: SettingsDep,
+    _instructor: InstructorDep,
+) -> dict[str, Any]:
+    """Set the origins that may frame the tool's pages after a launch from this platform."""
+    platform = session.get(LtiPlatform, platform_id)
+    if platform is None:
+        raise LtiRequestInvalid(f"no platform has id {platform_id}; list them with GET /lti/platforms")
+    platform.frame_ancestors = checked_origins(body.frame_ancestors, allow_http=settings.lti_allow_http)
+    session.commit()
     return _platform_view(platform)
 
 

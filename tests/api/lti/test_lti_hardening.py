@@ -1,7 +1,8 @@
 """Attacks on the tool's LTI side, played by a real platform (`lti1p3platform`, lti_platform.py) against
 `gymgrade serve`: registration tickets replayed or opened by a GET, a configuration claiming another
 issuer, endpoints and service URLs on other hosts, a loopback platform the operator did not allow, a huge
-JWKS, launches with made-up key ids."""
+JWKS, launches with made-up key ids, another azp or target, a lab picker's form sent twice; and the
+origins framing the tool set per platform."""
 
 from __future__ import annotations
 
@@ -243,3 +244,92 @@ def test_made_up_key_ids_fetch_the_jwks_at_most_once_a_minute(tool: LiveProcess,
             assert refused.status_code == 403
             assert f"(key id 'made-up-{attempt}'" in html.unescape(refused.text)
     assert [path for _, path in lms.requests].count("/jwks") == 1
+
+
+@pytest.mark.parametrize(
+    ("claims", "message"),
+    [
+        (
+            {"azp": "another-tool"},
+            "the id_token's azp (authorised party) is 'another-tool'; expected this tool's client id",
+        ),
+        (
+            {"https://purl.imsglobal.org/spec/lti/claim/target_link_uri": "https://evil.example/lti/launch"},
+            "the id_token's target_link_uri is 'https://evil.example/lti/launch'; expected",
+        ),
+        (
+            {"https://purl.imsglobal.org/spec/lti/claim/deployment_id": "deployment-x"},
+            "deployment 'deployment-x' of",
+        ),
+    ],
+    ids=["azp-with-one-audience", "target-link-uri", "unknown-deployment"],
+)
+def test_a_launch_with_a_foreign_azp_or_target_is_refused_naming_no_registered_id(
+    tool: LiveProcess, lms: LtiPlatform, claims: dict[str, Any], message: str
+) -> None:
+    register_by_hand(tool, lms)
+    person = lms.add_person("learner-azp", "Ann Azp", LEARNER)
+    with browser() as client:
+        refused = lms.launch(client, LaunchSpec(person, "link-azp", claims=claims))
+    assert refused.status_code == 403
+    assert message in html.unescape(refused.text)
+    assert lms.deployment_id not in refused.text, "an unauthenticated page listed the registered deployments"
+
+
+def test_a_login_for_another_target_than_the_launch_url_is_refused(
+    tool: LiveProcess, lms: LtiPlatform
+) -> None:
+    register_by_hand(tool, lms)
+    params = {"iss": lms.issuer, "login_hint": "x", "target_link_uri": tool.url + "/ui/gradebook.csv"}
+    refused = httpx.get(tool.url + "/lti/login", params=params)
+    assert refused.status_code == 400
+    assert "is not this tool's launch URL (expected " + tool.url + "/lti/launch)" in html.unescape(
+        refused.text
+    )
+
+
+def test_the_lab_pickers_form_adds_one_link(tool: LiveProcess, lms: LtiPlatform) -> None:
+    register_by_hand(tool, lms)
+    teacher = lms.add_person("staff-pick", "Pia Picker", INSTRUCTOR)
+    with browser() as client:
+        picker = lms.launch(client, LaunchSpec(teacher, "", deep_linking=True))
+        token = re.search(r'name="picker" value="([^"]+)"', picker.text)
+        assert token, picker.text
+        form = {"picker": token.group(1), "edition": "classic"}
+        assert client.post(tool.url + "/lti/deep-link", data=form).status_code == 200
+        again = client.post(tool.url + "/lti/deep-link", data=form)
+    assert again.status_code == 403
+    assert "this lab picker's form was sent already (it adds one link)" in html.unescape(again.text)
+
+
+def test_the_origins_framing_the_lms_are_set_per_platform(tool: LiveProcess, lms: LtiPlatform) -> None:
+    """Open edX: the learning MFE (its own origin) frames the LMS page that frames the tool; a browser
+    checks every ancestor against frame-ancestors."""
+    mfe = "https://apps.lms.example.edu"
+    lms.register_tool(tool.url)
+    made = httpx.post(
+        tool.url + "/lti/platforms",
+        json={**lms.manual_registration, "frame_ancestors": [mfe]},
+        headers=instructor_headers(),
+    )
+    assert made.status_code == 201 and made.json()["frame_ancestors"] == [mfe], made.text
+    person = lms.add_person("learner-mfe", "Mo Mfe", LEARNER)
+    with browser() as client:
+        _, page = landed(client, tool.url, lms.launch(client, LaunchSpec(person, "link-mfe")))
+    assert f"frame-ancestors {lms.issuer} {mfe};" in page.headers["content-security-policy"]
+    platform_id = made.json()["id"]
+    refused = httpx.put(
+        f"{tool.url}/lti/platforms/{platform_id}/frame-ancestors",
+        json={"frame_ancestors": ["https://apps.example.edu/learning; script-src *"]},
+        headers=instructor_headers(),
+    )
+    assert refused.status_code == 400
+    assert (
+        "a frame ancestor must be an origin such as https://apps.lms.example.edu" in refused.json()["detail"]
+    )
+    cleared = httpx.put(
+        f"{tool.url}/lti/platforms/{platform_id}/frame-ancestors",
+        json={"frame_ancestors": []},
+        headers=instructor_headers(),
+    )
+    assert cleared.status_code == 200 and cleared.json()["frame_ancestors"] == []
