@@ -243,8 +243,8 @@ class Settings(BrokerSettings):
                 Fernet(key.strip())
         except (ValueError, TypeError):
             raise ValueError(
-                "GYMGRADE_KEY_ENCRYPTION_KEY is not a Fernet key; expected 32 random bytes in URL-safe base64 "  # noqa: E501
-                "(`python -c 'from cryptography.fernet import Fernet; print(Fernet.generate_key().decode())'`)"  # noqa: E501
+                "GYMGRADE_KEY_ENCRYPTION_KEY is not a Fernet key; "
+                "expected 32 random bytes in URL-safe base64 (`python -c 'from cryptography.fernet import Fernet; print(Fernet.generate_key().decode())'`)"  # noqa: E501
             ) from None
         return value
 

@@ -59,9 +59,8 @@ class KeyProtection:
         if self.development:
             return pem
         raise LtiKeysUnprotected(
-            "the LTI signing key would be stored unencrypted: set GYMGRADE_KEY_ENCRYPTION_KEY "
-            "(`python -c 'from cryptography.fernet import Fernet; print(Fernet.generate_key().decode())'`) "
-            "and restart; only GYMGRADE_DEVELOPMENT=1 keeps keys in plaintext"
+            "the LTI signing key would be stored unencrypted: set GYMGRADE_KEY_ENCRYPTION_KEY (`python -c 'from cryptography.fernet import Fernet; print(Fernet.generate_key().decode())'`) and restart; "  # noqa: E501
+            "only GYMGRADE_DEVELOPMENT=1 keeps keys in plaintext"
         )
 
     def open(self, stored: str) -> str:

@@ -147,9 +147,8 @@ def verify_launch(
     state_claims = tool_state(session, state, grace_seconds)
     if not matches(browser_secret, state_claims.get("bind")):
         raise LaunchRefused(
-            "this launch did not come from the browser its login started in (the state is bound to that "
-            "browser by a cookie or the LMS's storage, and this one has neither): a launch replayed from "
-            "another browser is refused; open the assignment in the LMS again"
+            "this launch did not come from the browser its login started in (the state is bound to that browser by a cookie or the LMS's storage, and this one has neither): "  # noqa: E501
+            "a launch replayed from another browser is refused; open the assignment in the LMS again"
         )
     platform = session.get(LtiPlatform, state_claims.get("platform"))
     if platform is None:
@@ -175,8 +174,8 @@ def verify_launch(
     _check_claims(claims, platform, state_claims["nonce"])
     if claims.get(names.TARGET_LINK_URI) != state_claims.get("target"):
         raise LaunchRefused(
-            f"the id_token's target_link_uri is {claims.get(names.TARGET_LINK_URI)!r}; expected "
-            f"{state_claims.get('target')!r}, the one its login was started for"
+            f"the id_token's target_link_uri is {claims.get(names.TARGET_LINK_URI)!r}; "
+            f"expected {state_claims.get('target')!r}, the one its login was started for"
         )
     role = role_of(claims.get(names.ROLES) or [])
     if role is None:

@@ -77,8 +77,8 @@ def refusal(address: Address, policy: OutboundPolicy) -> str | None:
     for kind, applies in kinds:
         if applies:
             return (
-                f"{address} is a {kind} address; the tool reaches only public addresses "
-                "unless the operator allows the network (GYMGRADE_LTI_ALLOWED_NETWORKS)"
+                f"{address} is a {kind} address; "
+                "the tool reaches only public addresses unless the operator allows the network (GYMGRADE_LTI_ALLOWED_NETWORKS)"  # noqa: E501
             )
     return None
 
@@ -94,7 +94,7 @@ def checked_address(host: str, port: int, policy: OutboundPolicy) -> str:
         found = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
     except OSError as error:
         raise PlatformUnreachable(f"the host {host!r} does not resolve ({error.strerror or error})") from None
-    addresses = list(dict.fromkeys(ipaddress.ip_address(entry[4][0].split("%")[0]) for entry in found))
+    addresses = list(dict.fromkeys(ipaddress.ip_address(str(entry[4][0]).split("%")[0]) for entry in found))
     if not addresses:
         raise PlatformUnreachable(f"the host {host!r} resolves to no address")
     for address in addresses:
@@ -213,8 +213,8 @@ class Outbound:
         schemes = ("https", "http") if self.policy.allow_http else ("https",)
         if parts.scheme not in schemes or not parts.hostname:
             raise OutboundRefused(
-                f"{what}: {url!r} is not an {' or '.join(schemes)} URL; the tool talks to platforms over "
-                "https only (GYMGRADE_LTI_ALLOW_HTTP is for tests on loopback)"
+                f"{what}: {url!r} is not an {' or '.join(schemes)} URL; "
+                "the tool talks to platforms over https only (GYMGRADE_LTI_ALLOW_HTTP is for tests on loopback)"  # noqa: E501
             )
         return url
 
@@ -268,23 +268,22 @@ class Outbound:
         declared = response.headers.get("content-length", "")
         if declared.isdigit() and int(declared) > limit:
             raise OutboundRefused(
-                f"{what}: {url} announced {int(declared)} bytes; the tool reads at most {limit} "
-                "(GYMGRADE_LTI_MAX_RESPONSE_BYTES)"
+                f"{what}: {url} announced {int(declared)} bytes; "
+                f"the tool reads at most {limit} (GYMGRADE_LTI_MAX_RESPONSE_BYTES)"
             )
         body = bytearray()
         for chunk in response.iter_raw():
             body += chunk
             if len(body) > limit:
                 raise OutboundRefused(
-                    f"{what}: {url} sent more than {limit} bytes; the tool reads at most {limit} "
-                    "(GYMGRADE_LTI_MAX_RESPONSE_BYTES)"
+                    f"{what}: {url} sent more than {limit} bytes; "
+                    f"the tool reads at most {limit} (GYMGRADE_LTI_MAX_RESPONSE_BYTES)"
                 )
         return bytes(body)
 
     def _too_slow(self, url: str, what: str) -> OutboundRefused:
         return OutboundRefused(
-            f"{what}: {url} did not answer whole within {self.policy.total_seconds:g} s "
-            "(GYMGRADE_LTI_REQUEST_SECONDS, the whole request's time)"
+            f"{what}: {url} did not answer whole within {self.policy.total_seconds:g} s (GYMGRADE_LTI_REQUEST_SECONDS, the whole request's time)"  # noqa: E501
         )
 
     def get_json(self, url: str, *, what: str, headers: dict[str, str] | None = None) -> Any:
