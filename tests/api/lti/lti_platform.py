@@ -243,10 +243,13 @@ class LtiPlatform:
             url += "&" + urlencode({"lti_storage_target": spec.storage_target})
         return url
 
-    def course_page(self, spec: LaunchSpec) -> str:
-        """The URL of the course's page framing the tool, which a browser opens (the launch starts there)."""
+    def course_page(self, spec: LaunchSpec, *, mfe_origin: str | None = None) -> str:
+        """The URL of the course's page framing the tool, which a browser opens (the launch starts there);
+        with ``mfe_origin`` (another name of this server), a page there framing the course's page."""
         hint = secrets.token_urlsafe(8)
         self.course_pages[hint] = self.login_url(spec)
+        if mfe_origin is not None:
+            return f"{mfe_origin}/mfe/{hint}"
         return f"{self.issuer}/course/{hint}"
 
     def id_token_post(self, client: httpx.Client, spec: LaunchSpec) -> dict[str, str]:
@@ -391,6 +394,14 @@ class LtiPlatform:
                 "<h1>Reinforcement learning</h1>"
                 f'<iframe id="tool" src="{html.escape(login)}" width="1000" height="800"></iframe>'
                 f"<script>{PLATFORM_STORAGE}</script>"
+            )
+
+        @app.get("/mfe/{hint}")
+        def learning_mfe(hint: str) -> Response:
+            # Open edX's learning MFE: a page of another origin framing the LMS's page that frames the tool.
+            return HTMLResponse(
+                "<h1>Learning</h1>"
+                f'<iframe id="lms" src="{html.escape(self.issuer)}/course/{html.escape(hint)}" width="1100" height="900"></iframe>'  # noqa: E501
             )
 
         @app.post("/token")

@@ -119,3 +119,43 @@ def test_a_launch_upload_and_score_inside_the_lms_iframe(
             time.sleep(0.1)
         sent = [score for scores in platform.scores.values() for score in scores]
         assert [(score["userId"], score["scoreGiven"]) for score in sent] == [("learner-iframe", 1.0)]
+
+
+def test_every_ancestor_frame_must_be_allowed_and_a_registered_one_is(tool: LiveProcess) -> None:
+    """Open edX: the learning MFE (its own site) frames the LMS page that frames the tool. Chromium checks
+    every ancestor against the tool's frame-ancestors: refused until the MFE's origin is registered."""
+    sync_api: Any = _chromium()
+    with LtiPlatform().running() as platform:
+        mfe = f"http://mfe.test:{platform.port}"  # the platform's server under another site's name
+        platform.register_tool(f"http://localhost:{tool.port}")
+        registered = httpx.post(
+            tool.url + "/lti/platforms", json=platform.manual_registration, headers=instructor_headers()
+        )
+        assert registered.status_code == 201, registered.text
+        person = platform.add_person("learner-mfe", "Mia Mfe", LEARNER)
+        resolver = ["--host-resolver-rules=MAP mfe.test 127.0.0.1"]
+        with sync_api.sync_playwright() as playwright:
+            browser = playwright.chromium.launch(
+                executable_path=CHROMIUM, args=[*CHROMIUM_ARGS, *resolver], headless=True
+            )
+            try:
+                page = browser.new_context().new_page()
+                refused = lambda message: "frame-ancestors" in message.text  # noqa: E731
+                with page.expect_console_message(refused, timeout=WAIT_MS) as violation:
+                    page.goto(
+                        platform.course_page(LaunchSpec(person, "link-mfe", browser=True), mfe_origin=mfe)
+                    )
+                assert f"frame-ancestors {platform.issuer}" in violation.value.text
+                tool_frame = page.frame_locator("#lms").frame_locator("#tool")
+                assert tool_frame.locator("#upload").count() == 0
+                allowed = httpx.put(
+                    f"{tool.url}/lti/platforms/{registered.json()['id']}/frame-ancestors",
+                    json={"frame_ancestors": [mfe]},
+                    headers=instructor_headers(),
+                )
+                assert allowed.status_code == 200, allowed.text
+                page.goto(platform.course_page(LaunchSpec(person, "link-mfe", browser=True), mfe_origin=mfe))
+                tool_frame.locator("#upload").wait_for(timeout=WAIT_MS)
+                assert "signed in as Mia Mfe" in tool_frame.locator("header").inner_text()
+            finally:
+                browser.close()
