@@ -63,8 +63,10 @@ def refusal(address: Address, policy: OutboundPolicy) -> str | None:
     operator's allowed networks."""
     if any(address in network for network in policy.allowed_networks):
         return None
-    if isinstance(address, ipaddress.IPv6Address) and address.ipv4_mapped is not None:
-        return refusal(address.ipv4_mapped, policy)
+    if isinstance(address, ipaddress.IPv6Address):
+        embedded = _embedded_ipv4(address)
+        if embedded is not None:
+            return refusal(embedded, policy)
     kinds = [
         ("loopback", address.is_loopback),
         ("link-local", address.is_link_local),
@@ -80,6 +82,21 @@ def refusal(address: Address, policy: OutboundPolicy) -> str | None:
                 f"{address} is a {kind} address; "
                 "the tool reaches only public addresses unless the operator allows the network (GYMGRADE_LTI_ALLOWED_NETWORKS)"  # noqa: E501
             )
+    return None
+
+
+NAT64 = (ipaddress.ip_network("64:ff9b::/96"), ipaddress.ip_network("64:ff9b:1::/48"))
+"""IPv6 prefixes a NAT64 gateway translates to the IPv4 address in their last 32 bits."""
+
+
+def _embedded_ipv4(address: ipaddress.IPv6Address) -> ipaddress.IPv4Address | None:
+    """The IPv4 address an IPv6 one reaches in the end: mapped (::ffff:a.b.c.d), 6to4 or NAT64."""
+    if address.ipv4_mapped is not None:
+        return address.ipv4_mapped
+    if address.sixtofour is not None:
+        return address.sixtofour
+    if any(address in network for network in NAT64):
+        return ipaddress.IPv4Address(int(address) & 0xFFFFFFFF)
     return None
 
 

@@ -133,6 +133,8 @@ def test_loopback_is_refused_unless_the_operator_allows_it(server: str, host: st
         ("::1", "loopback"),
         ("fe80::1", "link-local"),
         ("::ffff:127.0.0.1", "loopback"),
+        ("64:ff9b::a9fe:a9fe", "link-local"),
+        ("2002:a00:1::1", "private"),
         ("0.0.0.0", "unspecified"),
         ("100.64.0.1", "not globally routable"),
         ("224.0.0.1", "multicast"),
@@ -142,6 +144,7 @@ def test_every_non_public_address_is_refused(address: str, kind: str) -> None:
     why = refusal(ipaddress.ip_address(address), OutboundPolicy())
     assert why is not None and f"is a {kind} address" in why
     assert refusal(ipaddress.ip_address("93.184.215.14"), OutboundPolicy()) is None
+    assert refusal(ipaddress.ip_address("2606:4700:4700::1111"), OutboundPolicy()) is None
     assert (
         refusal(
             ipaddress.ip_address("10.1.2.3"),
