@@ -277,11 +277,8 @@ def frame_origins(launch: Launch) -> str:
     those registered with the platform (browsers check every ancestor: Open edX's learning MFE frames
     the LMS page that frames the tool)."""
     presentation = launch.claims.get(names.LAUNCH_PRESENTATION) or {}
-    urls = [
-        str(presentation.get("return_url") or ""),
-        launch.platform.issuer,
-        *launch.platform.frame_ancestors,
-    ]
+    registered = launch.platform.frame_ancestors or []  # None on a platform row not flushed yet
+    urls = [str(presentation.get("return_url") or ""), launch.platform.issuer, *registered]
     origins = dict.fromkeys(_origin(url) for url in urls if urlsplit(url).scheme in ("http", "https"))
     kept: list[str] = []
     for origin in origins:  # whole origins only: a cut one would be another source
