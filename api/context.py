@@ -12,6 +12,8 @@ from api.jobs.job_queue import Dispatcher, JobQueue
 from api.jobs.local import DatabaseQueue, PollingDispatcher
 from api.jobs.pool import WorkerPool
 from api.jobs.reconciler import Reconciler
+from api.lti.keys import protect_keys
+from api.lti.outbound import Outbound, OutboundPolicy
 from api.lti.platforms import PlatformKeys
 from api.lti.publisher import ScorePublisher
 from api.lti.services import AccessTokens
@@ -30,8 +32,14 @@ class ServiceContext:
     pool: WorkerPool | None = None
     reconciler: Reconciler | None = None
     publisher: ScorePublisher | None = None
-    platform_keys: PlatformKeys = field(default_factory=PlatformKeys)
-    access_tokens: AccessTokens = field(default_factory=AccessTokens)
+    outbound: Outbound = field(init=False)
+    platform_keys: PlatformKeys = field(init=False)
+    access_tokens: AccessTokens = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.outbound = Outbound(OutboundPolicy.of(self.settings))
+        self.platform_keys = PlatformKeys(self.outbound)
+        self.access_tokens = AccessTokens(self.outbound, self.settings.lti_hosts)
 
     @classmethod
     def open(cls, settings: Settings, *, pool_size: int, publish: bool = True) -> ServiceContext:
@@ -41,6 +49,7 @@ class ServiceContext:
         engine = make_engine(settings)
         migrate(engine)
         sessions = make_session_factory(engine)
+        protect_keys(sessions, settings)
         publisher = ScorePublisher(sessions, settings) if publish else None
         if publisher is not None:
             publisher.start()
@@ -70,4 +79,5 @@ class ServiceContext:
         if self.publisher is not None:
             self.publisher.stop()
         self.dispatcher.close()
+        self.outbound.close()
         self.engine.dispose()

@@ -20,6 +20,7 @@ from api.context import ServiceContext
 from api.disclosure import Disclosure, disclosure_for
 from api.errors import NotAuthenticated
 from api.jobs.job_queue import Dispatcher
+from api.lti.binding import SESSION_COOKIE as BROWSER_COOKIE
 from api.lti.sessions import SESSION_PARAMETER, SESSION_PREFIX, session_caller
 from api.models import Student
 from api.settings import Settings
@@ -108,7 +109,7 @@ def get_page_caller(request: Request, session: SessionDep, settings: SettingsDep
     page's links), or None when signed out."""
     launched = request.query_params.get(SESSION_PARAMETER, "")
     if launched.startswith(SESSION_PREFIX):
-        caller = session_caller(session, launched)
+        caller = session_caller(session, launched, request.cookies.get(BROWSER_COOKIE))
         request.state.lti_caller = caller
         return caller
     token = request.cookies.get(SESSION_COOKIE)

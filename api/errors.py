@@ -125,3 +125,13 @@ class PlatformExists(ServiceError):
 
 class PlatformUnreachable(ServiceError):
     """Raised when a platform's endpoint (OpenID configuration, JWKS, token, registration) cannot be used."""
+
+
+class OutboundRefused(PlatformUnreachable):
+    """Raised when the tool refuses a request it would make for a platform: plain http, a loopback,
+    link-local or private address, a host that is not the platform's, or an answer too large or too slow."""
+
+
+class LtiKeysUnprotected(InternalError):
+    """Raised when the LTI signing keys would be stored or read unencrypted outside development
+    (GYMGRADE_KEY_ENCRYPTION_KEY unset), or cannot be decrypted with the key given."""

@@ -112,6 +112,20 @@ class LtiPlatform(Base):
     auth_url: Mapped[str] = mapped_column(String(1000))
     token_url: Mapped[str] = mapped_column(String(1000))
     created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
+    frame_ancestors: Mapped[list[str]] = mapped_column(JSON, default=list, server_default="[]")
+    """Origins besides the launch's own that may frame the tool (every ancestor: an LMS's page framing
+    the page that frames the tool), set at registration."""
+
+
+class LtiSpentToken(Base):
+    """A single-use token of the tool's own (registration ticket, lab picker form) once used, by ``jti``,
+    kept until it expires."""
+
+    __tablename__ = "lti_spent_tokens"
+
+    jti: Mapped[str] = mapped_column(String(100), primary_key=True)
+    purpose: Mapped[str] = mapped_column(String(32))
+    expires_at: Mapped[datetime] = mapped_column(DateTime, index=True)
 
 
 class LtiNonce(Base):
@@ -177,6 +191,9 @@ class LtiSession(Base):
     user_id: Mapped[int] = mapped_column(ForeignKey("lti_users.id"))
     link_id: Mapped[int | None] = mapped_column(ForeignKey("lti_links.id"), nullable=True)
     frame_origin: Mapped[str] = mapped_column(String(500))
+    browser_sha256: Mapped[str | None] = mapped_column(String(64), nullable=True)
+    """The SHA-256 of the browser cookie's secret the session works with (api/lti/binding.py); None: a
+    session opened through the platform's storage, by a browser keeping no cookie."""
     expires_at: Mapped[datetime] = mapped_column(DateTime)
 
 

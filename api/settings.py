@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ipaddress
 from datetime import UTC, datetime
 from enum import StrEnum
 from pathlib import Path
@@ -184,6 +185,78 @@ class Settings(BrokerSettings):
         gt=0,
         description="The first wait before sending a refused score again; each retry doubles it (at most 10 minutes).",  # noqa: E501
     )
+    lti_allow_http: bool = Field(
+        default=False,
+        description="Let the tool talk to platforms over plain http and accept http endpoints in registrations: for tests on loopback only (LMSs need https).",  # noqa: E501
+    )
+    lti_allowed_networks: str = Field(
+        default="",
+        description="Comma-separated networks (CIDR, e.g. 10.20.0.0/16) the tool may reach for a platform although they are loopback, link-local or private (an LMS on the campus network); unset: public addresses only.",  # noqa: E501
+    )
+    lti_service_hosts: str = Field(
+        default="",
+        description="Comma-separated host names (or *.example.edu for subdomains) where a platform's endpoints and service URLs may be besides the platform's own hosts (Canvas cloud: sso.canvaslms.com,*.instructure.com).",  # noqa: E501
+    )
+    lti_max_response_bytes: int = Field(
+        default=1_000_000,
+        gt=0,
+        description="The largest answer the tool reads from a platform (JWKS, configuration, token, roster page).",  # noqa: E501
+    )
+    lti_request_seconds: float = Field(
+        default=15.0,
+        gt=0,
+        description="The longest a request to a platform may take in total (connection, sending, the whole answer).",  # noqa: E501
+    )
+    lti_registration_ticket_seconds: float = Field(
+        default=1800.0,
+        gt=0,
+        le=7 * 24 * 3600.0,
+        description="How long a dynamic registration URL stays usable (it is used once).",
+    )
+    key_encryption_key: SecretStr | None = Field(
+        default=None,
+        description="The key (Fernet: 32 random bytes, URL-safe base64) encrypting the LTI signing keys in the database; required to use LTI outside development. NEW,OLD: encrypt with NEW, read OLD too (keys are encrypted again with NEW at start-up).",  # noqa: E501
+    )
+
+    @field_validator("lti_allowed_networks")
+    @classmethod
+    def _networks(cls, value: str) -> str:
+        for item in _listed(value):
+            try:
+                ipaddress.ip_network(item, strict=False)
+            except ValueError:
+                raise ValueError(
+                    f"GYMGRADE_LTI_ALLOWED_NETWORKS holds {item!r}, which is not a network; "
+                    "expected comma-separated CIDR networks such as 10.20.0.0/16,127.0.0.1/32"
+                ) from None
+        return value
+
+    @field_validator("key_encryption_key")
+    @classmethod
+    def _fernet_key(cls, value: SecretStr | None) -> SecretStr | None:
+        if value is None or not value.get_secret_value():
+            return None
+        from cryptography.fernet import Fernet
+
+        try:
+            for key in value.get_secret_value().split(","):
+                Fernet(key.strip())
+        except (ValueError, TypeError):
+            raise ValueError(
+                "GYMGRADE_KEY_ENCRYPTION_KEY is not a Fernet key; "
+                "expected 32 random bytes in URL-safe base64 (`python -c 'from cryptography.fernet import Fernet; print(Fernet.generate_key().decode())'`)"  # noqa: E501
+            ) from None
+        return value
+
+    @property
+    def lti_networks(self) -> tuple[ipaddress.IPv4Network | ipaddress.IPv6Network, ...]:
+        """GYMGRADE_LTI_ALLOWED_NETWORKS, parsed."""
+        return tuple(ipaddress.ip_network(item, strict=False) for item in _listed(self.lti_allowed_networks))
+
+    @property
+    def lti_hosts(self) -> tuple[str, ...]:
+        """GYMGRADE_LTI_SERVICE_HOSTS, parsed (lower case)."""
+        return tuple(item.lower() for item in _listed(self.lti_service_hosts))
 
     @field_validator("edition")
     @classmethod
@@ -282,6 +355,10 @@ class Settings(BrokerSettings):
         if self.database_url:
             return self.database_url
         return f"sqlite:///{(self.data_dir / 'gymgrade.sqlite3').resolve()}"
+
+
+def _listed(value: str) -> list[str]:
+    return [item.strip() for item in value.split(",") if item.strip()]
 
 
 def token_weakness(token: str) -> str | None:

@@ -16,12 +16,14 @@ from api.errors import LaunchRefused, LtiRequestInvalid
 from api.lti import claims as names
 from api.lti.keys import ALGORITHM, published_keys, sign
 from api.lti.launch import Launch
+from api.lti.spent import TokenSpent, spend
 from api.models import LtiPlatform
 from grader.lab.editions import EDITIONS
 from grader.lab.editions.choice import service_edition
 
 PICKER_PURPOSE = "lti-deep-link"
 PICKER_SECONDS = 3600
+"""How long the picker's form may stay open; it is sent once."""
 RESPONSE_SECONDS = 600
 
 
@@ -69,6 +71,7 @@ def picker_token(session: Session, launch: Launch) -> str:
             "deployment": launch.deployment_id,
             "return_url": str(return_url),
             "data": settings.get("data"),
+            "jti": secrets.token_urlsafe(16),
             "iat": now,
             "exp": now + PICKER_SECONDS,
         },
@@ -86,7 +89,7 @@ def deep_linking_response(
     """
     try:
         picked = jwt.decode(token, published_keys(session, grace_seconds), algorithms=[ALGORITHM])
-        jwt.JWTClaimsRegistry(exp={"essential": True}).validate(picked.claims)
+        jwt.JWTClaimsRegistry(exp={"essential": True}, jti={"essential": True}).validate(picked.claims)
     except (JoseError, ValueError, UnicodeError):
         raise LaunchRefused(
             "the lab picker's form was not issued by this tool, or expired; start again from the LMS"
@@ -104,6 +107,12 @@ def deep_linking_response(
     platform = session.get(LtiPlatform, context["platform"])
     if platform is None:
         raise LaunchRefused("the platform of this deep linking request is no longer registered")
+    try:
+        spend(session, PICKER_PURPOSE, str(context.get("jti")), int(context["exp"]))
+    except TokenSpent:
+        raise LaunchRefused(
+            "this lab picker's form was sent already (it adds one link); start again from the LMS"
+        ) from None
     title = EDITIONS[edition].title
     now = int(time.time())
     claims: dict[str, Any] = {

@@ -1,9 +1,10 @@
 """OIDC third-party login initiation and the launch, with every check LTI 1.3 (Core, Security) asks for.
 
-No cookie carries the state: it is a short-lived JWT the tool signs (``purpose`` "lti-state", the nonce,
-the platform), posted back by the platform with the id_token, so a launch works inside an LMS's iframe
-whose browser blocks third-party cookies. The nonce is stored when a launch is accepted: a second launch
-with it is refused. Every check runs before anything is written; a refused launch stores nothing.
+The state is a short-lived JWT the tool signs (``purpose`` "lti-state", the nonce, the platform, and the
+digest of the browser's secret, ``bind``: api/lti/binding.py), posted back by the platform with the
+id_token; the launch is accepted only from the browser holding the secret (a cookie, or the platform's
+storage). The nonce is stored when a launch is accepted: a second launch with it is refused. Every check
+runs before anything is written; a refused launch stores nothing.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from sqlalchemy.orm import Session
 
 from api.errors import LaunchRefused, LtiRequestInvalid
 from api.lti import claims as names
+from api.lti.binding import matches
 from api.lti.claims import Role, role_of
 from api.lti.keys import ALGORITHM, published_keys, sign
 from api.lti.people import display_name, ensure_link, ensure_member, ensure_user
@@ -37,20 +39,32 @@ STATE_SECONDS = 600
 LEEWAY_SECONDS = 60
 """Clock difference tolerated between the platform and the tool (exp, iat, nbf)."""
 STATE_PURPOSE = "lti-state"
+FRAME_ORIGINS_CHARS = 500
+"""The longest frame-ancestors list a session keeps (its column's size)."""
 
 
-def login_redirect(session: Session, params: dict[str, str], launch_url: str, tool_origin: str) -> str:
+@dataclass(frozen=True)
+class Login:
+    """Where a login initiation sends the browser, the state it made, and the platform's auth URL."""
+
+    url: str
+    state: str
+    auth_url: str
+
+
+def login_redirect(session: Session, params: dict[str, str], launch_url: str, *, bind: str) -> Login:
     """Answer an OIDC third-party login initiation: the platform's authorisation URL to redirect to.
 
     Args:
         session: A database session (the signing key is made on first use).
         params: The initiation's parameters (query or form): iss, login_hint, target_link_uri, and
             lti_message_hint, client_id, lti_deployment_id when the platform sends them.
-        launch_url: The tool's launch URL (the redirect_uri it registered).
-        tool_origin: scheme://host[:port] of the tool: target_link_uri must point at it.
+        launch_url: The tool's launch URL (the redirect_uri it registered): target_link_uri must be it
+            (a query aside).
+        bind: The digest of the browser's secret, carried by the state.
 
     Raises:
-        LtiRequestInvalid: A required parameter is missing, or target_link_uri points elsewhere.
+        LtiRequestInvalid: A required parameter is missing, or target_link_uri is not the launch URL.
         LaunchRefused: The issuer (and client id) is not registered.
     """
     missing = [name for name in ("iss", "login_hint", "target_link_uri") if not params.get(name)]
@@ -59,9 +73,9 @@ def login_redirect(session: Session, params: dict[str, str], launch_url: str, to
             f"an LTI login initiation needs {', '.join(missing)}; found only {', '.join(sorted(params)) or 'nothing'}"  # noqa: E501
         )
     target = params["target_link_uri"]
-    if _origin(target) != tool_origin:
+    if _without_query(target) != launch_url:
         raise LtiRequestInvalid(
-            f"target_link_uri {target!r} is not this tool's (expected a URL under {tool_origin}); "
+            f"target_link_uri {target!r} is not this tool's launch URL (expected {launch_url}); "
             "check the tool's launch URL in the LMS"
         )
     platform = find_platform(session, params["iss"], params.get("client_id"))
@@ -76,6 +90,9 @@ def login_redirect(session: Session, params: dict[str, str], launch_url: str, to
             "purpose": STATE_PURPOSE,
             "platform": platform.id,
             "nonce": nonce,
+            "bind": bind,
+            "store": params.get("lti_storage_target") or None,
+            "target": target,
             "iat": now,
             "exp": now + STATE_SECONDS,
         },
@@ -94,7 +111,7 @@ def login_redirect(session: Session, params: dict[str, str], launch_url: str, to
     if params.get("lti_message_hint"):
         query["lti_message_hint"] = params["lti_message_hint"]
     separator = "&" if urlsplit(platform.auth_url).query else "?"
-    return platform.auth_url + separator + urlencode(query)
+    return Login(platform.auth_url + separator + urlencode(query), state, platform.auth_url)
 
 
 @dataclass(frozen=True)
@@ -109,9 +126,16 @@ class Launch:
 
 
 def verify_launch(
-    session: Session, keys: PlatformKeys, id_token: str, state: str, *, grace_seconds: float
+    session: Session,
+    keys: PlatformKeys,
+    id_token: str,
+    state: str,
+    *,
+    grace_seconds: float,
+    browser_secret: str | None,
 ) -> Launch:
-    """Check a launch (the form post of id_token and state) without writing anything.
+    """Check a launch (the form post of id_token and state, from the browser holding ``browser_secret``)
+    without writing anything.
 
     Raises:
         LaunchRefused: Any check failed; the message names it, what was expected and what was found.
@@ -120,7 +144,12 @@ def verify_launch(
         raise LaunchRefused(
             "an LTI launch posts id_token and state; found " + ("no state" if id_token else "no id_token")
         )
-    state_claims = _tool_state(session, state, grace_seconds)
+    state_claims = tool_state(session, state, grace_seconds)
+    if not matches(browser_secret, state_claims.get("bind")):
+        raise LaunchRefused(
+            "this launch did not come from the browser its login started in (the state is bound to that browser by a cookie or the LMS's storage, and this one has neither): "  # noqa: E501
+            "a launch replayed from another browser is refused; open the assignment in the LMS again"
+        )
     platform = session.get(LtiPlatform, state_claims.get("platform"))
     if platform is None:
         raise LaunchRefused("the launch's state names a platform that is no longer registered")
@@ -143,6 +172,11 @@ def verify_launch(
     claims = dict(token.claims)
     _check_times(claims)
     _check_claims(claims, platform, state_claims["nonce"])
+    if claims.get(names.TARGET_LINK_URI) != state_claims.get("target"):
+        raise LaunchRefused(
+            f"the id_token's target_link_uri is {claims.get(names.TARGET_LINK_URI)!r}; "
+            f"expected {state_claims.get('target')!r}, the one its login was started for"
+        )
     role = role_of(claims.get(names.ROLES) or [])
     if role is None:
         raise LaunchRefused(
@@ -154,7 +188,8 @@ def verify_launch(
     return Launch(platform, claims, role, message_type, str(claims[names.DEPLOYMENT_ID]))
 
 
-def _tool_state(session: Session, state: str, grace_seconds: float) -> dict[str, Any]:
+def tool_state(session: Session, state: str, grace_seconds: float) -> dict[str, Any]:
+    """The claims of a state this tool issued, unexpired (raises LaunchRefused)."""
     try:
         token = jwt.decode(state, published_keys(session, grace_seconds), algorithms=[ALGORITHM])
         jwt.JWTClaimsRegistry(exp={"essential": True}, nonce={"essential": True}).validate(token.claims)
@@ -197,9 +232,9 @@ def _check_claims(claims: dict[str, Any], platform: LtiPlatform, nonce: str) -> 
             f"the id_token is addressed to {audiences!r}; "
             f"expected this tool's client id {platform.client_id!r}"
         )
-    if len(audiences) > 1 and claims.get("azp") != platform.client_id:
+    if (len(audiences) > 1 or "azp" in claims) and claims.get("azp") != platform.client_id:
         raise LaunchRefused(
-            f"the id_token has several audiences and azp {claims.get('azp')!r}; expected azp {platform.client_id!r}"  # noqa: E501
+            f"the id_token's azp (authorised party) is {claims.get('azp')!r}; expected this tool's client id {platform.client_id!r}"  # noqa: E501
         )
     if claims.get("nonce") != nonce:
         raise LaunchRefused("the id_token's nonce is not the one this login started with")
@@ -222,9 +257,10 @@ def _check_claims(claims: dict[str, Any], platform: LtiPlatform, nonce: str) -> 
 
 
 def _unknown_deployment(deployment: str, platform: LtiPlatform) -> str:
+    # The registered ids are not listed: whoever sees this page is not signed in.
     return (
-        f"deployment {deployment!r} of {platform.issuer} is not registered with this tool "
-        f"(registered: {', '.join(platform.deployment_ids) or 'none'}); the instructor adds it"
+        f"deployment {deployment!r} of {platform.issuer} is not registered with this tool; "
+        "the instructor adds it (POST /lti/platforms/{id}/deployments)"
     )
 
 
@@ -237,16 +273,29 @@ def _when(seconds: object) -> str:
 
 def frame_origins(launch: Launch) -> str:
     """The origins allowed to frame the tool's pages after this launch (CSP frame-ancestors): the LMS's
-    return URL's (the page embedding the tool: Canvas's issuer is not the school's host) and the issuer's."""
+    return URL's (the page embedding the tool: Canvas's issuer is not the school's host), the issuer's and
+    those registered with the platform (browsers check every ancestor: Open edX's learning MFE frames
+    the LMS page that frames the tool)."""
     presentation = launch.claims.get(names.LAUNCH_PRESENTATION) or {}
-    urls = [str(presentation.get("return_url") or ""), launch.platform.issuer]
+    registered = launch.platform.frame_ancestors or []  # None on a platform row not flushed yet
+    urls = [str(presentation.get("return_url") or ""), launch.platform.issuer, *registered]
     origins = dict.fromkeys(_origin(url) for url in urls if urlsplit(url).scheme in ("http", "https"))
-    return " ".join(origins)[:500]
+    kept: list[str] = []
+    for origin in origins:  # whole origins only: a cut one would be another source
+        if len(" ".join([*kept, origin])) > FRAME_ORIGINS_CHARS:
+            break
+        kept.append(origin)
+    return " ".join(kept)
 
 
 def _origin(url: str) -> str:
     parts = urlsplit(url)
     return f"{parts.scheme}://{parts.netloc}"
+
+
+def _without_query(url: str) -> str:
+    parts = urlsplit(url)
+    return f"{parts.scheme}://{parts.netloc}{parts.path}"
 
 
 @dataclass(frozen=True)
@@ -258,8 +307,11 @@ class Landing:
     link: LtiLink | None
 
 
-def accept_launch(session: Session, launch: Launch, *, session_seconds: float) -> Landing:
-    """Store what an accepted launch brings (the nonce, the user and student, the link, a session), at once.
+def accept_launch(
+    session: Session, launch: Launch, *, session_seconds: float, browser_digest: str | None
+) -> Landing:
+    """Store what an accepted launch brings (the nonce, the user and student, the link, a session bound to
+    the browser's cookie of digest ``browser_digest``, or to nothing but its link when None), at once.
 
     Raises:
         LaunchRefused: The nonce was used before (a replay); nothing is stored.
@@ -297,6 +349,7 @@ def accept_launch(session: Session, launch: Launch, *, session_seconds: float) -
             user_id=user.id,
             link_id=link.id if link is not None else None,
             frame_origin=frame_origins(launch),
+            browser_sha256=browser_digest,
             expires_at=now + timedelta(seconds=session_seconds),
         )
     )

@@ -24,6 +24,7 @@ from sqlalchemy.orm import Session, sessionmaker
 
 from api.gradebook import kept_submissions
 from api.lti.claims import SCOPE_LINEITEM, SCOPE_LINEITEM_READONLY, SCOPE_SCORE
+from api.lti.outbound import Outbound, OutboundPolicy
 from api.lti.services import AccessTokens, ServiceFailed, line_item, publish_score
 from api.models import (
     JobStatus,
@@ -249,7 +250,7 @@ class ScorePublisher:
         self._sessions = sessions
         self._policy = PublishPolicy.of(settings)
         self._period = settings.lti_publish_seconds
-        self._tokens = AccessTokens()
+        self._tokens = AccessTokens(Outbound(OutboundPolicy.of(settings)), settings.lti_hosts)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="gymgrade-lti-publisher", daemon=True)
         self._lock = threading.Lock()

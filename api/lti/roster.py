@@ -37,11 +37,11 @@ def import_roster(session: Session, link: LtiLink, tokens: AccessTokens) -> Rost
     platform = session.get(LtiPlatform, link.platform_id)
     assert platform is not None  # a foreign key
     try:
-        token = tokens.token(session, platform, (SCOPE_MEMBERSHIPS,))
+        grant = tokens.token(session, platform, (SCOPE_MEMBERSHIPS,))
     except ServiceFailed as error:
         raise PlatformUnreachable(str(error)) from None
     learners = staff = skipped = 0
-    for member in roster(link.memberships_url, token):
+    for member in roster(link.memberships_url, grant):
         sub = str(member.get("user_id") or "")
         role = role_of(member.get("roles") or [])
         if not sub or member.get("status", "Active") != "Active" or role is None:

@@ -6,18 +6,18 @@ from __future__ import annotations
 import secrets
 import threading
 import time
+from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 from urllib.parse import urlencode, urlsplit, urlunsplit
 
-import httpx
 from sqlalchemy.orm import Session
 
 from api.errors import PlatformUnreachable
 from api.lti.keys import sign
+from api.lti.outbound import Answer, Outbound, on_hosts
 from api.models import LtiLink, LtiPlatform
 
-HTTP_TIMEOUT_SECONDS = 15.0
 ASSERTION_SECONDS = 300
 RESOURCE_ID = "gymgrade"
 """The resourceId of the tool's line items: a link's line item is found by it, never made twice."""
@@ -29,34 +29,76 @@ MAX_ROSTER_PAGES = 100
 
 
 class ServiceFailed(Exception):
-    """A platform's service refused or failed a request (the message says which, and its answer)."""
+    """A platform's service refused or failed a request (the message says which, never its answer's body)."""
 
 
-def _refused(what: str, response: httpx.Response) -> ServiceFailed:
-    return ServiceFailed(f"{what}: the LMS answered {response.status_code} {response.text[:200]!r}")
+def _refused(what: str, answer: Answer) -> ServiceFailed:
+    return ServiceFailed(f"{what}: the LMS answered {answer.status}")
 
 
-def _json(response: httpx.Response, what: str) -> Any:
+def _json(answer: Answer, what: str) -> Any:
     try:
-        return response.json()
-    except ValueError:
-        raise ServiceFailed(f"{what}: the LMS answered {response.text[:200]!r}, which is not JSON") from None
+        return answer.json(what)
+    except PlatformUnreachable as error:
+        raise ServiceFailed(str(error)) from None
+
+
+def platform_origins(platform: LtiPlatform) -> tuple[str, ...]:
+    """The URLs whose origins are the platform's own: its issuer and registered endpoints."""
+    return (platform.issuer, platform.token_url, platform.jwks_url, platform.auth_url)
+
+
+@dataclass(frozen=True)
+class Grant:
+    """A platform's access token, and where it may be sent: only URLs on the platform's own origins or
+    hosts the operator allows (GYMGRADE_LTI_SERVICE_HOSTS), whatever URL a launch or a roster page names."""
+
+    bearer: str
+    origins: tuple[str, ...]
+    allowed_hosts: tuple[str, ...]
+    outbound: Outbound
+
+    def call(
+        self,
+        method: str,
+        url: str,
+        *,
+        what: str,
+        accept: str,
+        json_body: Any = None,
+        content_type: str | None = None,
+    ) -> Answer:
+        """One request with the token (raises ServiceFailed: a foreign host, no answer, a refused one)."""
+        if not on_hosts(url, self.origins, self.allowed_hosts):
+            raise ServiceFailed(
+                f"{what}: {url!r} is not on the platform's own hosts ({', '.join(sorted({urlsplit(o).netloc for o in self.origins}))}); "  # noqa: E501
+                "the access token is never sent elsewhere; the operator allows other hosts with GYMGRADE_LTI_SERVICE_HOSTS"  # noqa: E501
+            )
+        headers = {"Authorization": f"Bearer {self.bearer}", "Accept": accept}
+        if content_type is not None:
+            headers["Content-Type"] = content_type
+        try:
+            return self.outbound.request(method, url, what=what, headers=headers, json_body=json_body)
+        except PlatformUnreachable as error:
+            raise ServiceFailed(str(error)) from None
 
 
 class AccessTokens:
     """Access tokens per (platform, scopes), requested with client_credentials and kept until near expiry."""
 
-    def __init__(self) -> None:
+    def __init__(self, outbound: Outbound, allowed_hosts: tuple[str, ...] = ()) -> None:
+        self._outbound = outbound
+        self._allowed_hosts = allowed_hosts
         self._lock = threading.Lock()
         self._tokens: dict[tuple[int, str], tuple[float, str]] = {}
 
-    def token(self, session: Session, platform: LtiPlatform, scopes: tuple[str, ...]) -> str:
+    def token(self, session: Session, platform: LtiPlatform, scopes: tuple[str, ...]) -> Grant:
         """A bearer token for ``scopes`` at the platform (raises ServiceFailed)."""
         key = (platform.id, " ".join(sorted(scopes)))
         with self._lock:
             cached = self._tokens.get(key)
         if cached is not None and cached[0] > time.monotonic():
-            return cached[1]
+            return self._grant(platform, cached[1])
         now = int(time.time())
         assertion = sign(
             session,
@@ -69,26 +111,27 @@ class AccessTokens:
                 "jti": secrets.token_urlsafe(16),
             },
         )
+        what = f"asking the LMS's token endpoint {platform.token_url} for an access token"
         try:
-            response = httpx.post(
+            answer = self._outbound.request(
+                "POST",
                 platform.token_url,
-                data={
+                what=what,
+                headers={"Accept": "application/json"},
+                form={
                     "grant_type": "client_credentials",
                     "client_assertion_type": "urn:ietf:params:oauth:client-assertion-type:jwt-bearer",
                     "client_assertion": assertion,
                     "scope": key[1],
                 },
-                timeout=HTTP_TIMEOUT_SECONDS,
             )
-        except httpx.HTTPError as error:
-            raise ServiceFailed(
-                f"the LMS's token endpoint {platform.token_url} did not answer: {error}"
-            ) from None
-        if response.status_code != 200:
-            raise _refused(f"the LMS refused an access token at {platform.token_url}", response)
-        body = _json(response, "asking for an access token")
+        except PlatformUnreachable as error:
+            raise ServiceFailed(str(error)) from None
+        if answer.status != 200:
+            raise _refused(what, answer)
+        body = _json(answer, what)
         if not isinstance(body, dict) or not isinstance(body.get("access_token"), str):
-            raise ServiceFailed(f"the LMS's token endpoint answered {body!r:.200} without an access_token")
+            raise ServiceFailed(f"{what}: the answer holds no access_token")
         token = str(body["access_token"])
         try:
             lifetime = float(body.get("expires_in", 3600))
@@ -96,7 +139,10 @@ class AccessTokens:
             lifetime = 60.0
         with self._lock:
             self._tokens[key] = (time.monotonic() + max(lifetime - 60.0, 1.0), token)
-        return token
+        return self._grant(platform, token)
+
+    def _grant(self, platform: LtiPlatform, bearer: str) -> Grant:
+        return Grant(bearer, platform_origins(platform), self._allowed_hosts, self._outbound)
 
     def forget(self, platform: LtiPlatform) -> None:
         """Drop a platform's tokens (after the platform refused one)."""
@@ -110,7 +156,7 @@ def _with_path(url: str, suffix: str) -> str:
     return urlunsplit(parts._replace(path=parts.path.rstrip("/") + suffix))
 
 
-def line_item(link: LtiLink, token: str, *, score_maximum: float) -> str:
+def line_item(link: LtiLink, grant: Grant, *, score_maximum: float) -> str:
     """The URL of the link's line item: the launch's, else the one found by resourceId, else a new one."""
     if link.lineitem_url:
         return link.lineitem_url
@@ -118,50 +164,47 @@ def line_item(link: LtiLink, token: str, *, score_maximum: float) -> str:
         raise ServiceFailed(
             "the LMS gave this link no line items service (Assignment and Grade Services off)"
         )
-    headers = {"Authorization": f"Bearer {token}"}
     query = urlencode({"resource_link_id": link.resource_link_id, "resource_id": RESOURCE_ID})
     separator = "&" if urlsplit(link.lineitems_url).query else "?"
-    try:
-        response = httpx.get(
-            link.lineitems_url + separator + query,
-            headers={**headers, "Accept": LINEITEMS},
-            timeout=HTTP_TIMEOUT_SECONDS,
-        )
-        if response.status_code != 200:
-            raise _refused("listing the link's line items", response)
-        for item in _json(response, "listing the link's line items"):
-            if (
-                isinstance(item, dict)
-                and item.get("resourceId") == RESOURCE_ID
-                and item.get("resourceLinkId") == link.resource_link_id
-                and item.get("id")
-            ):
-                return str(item["id"])
-        response = httpx.post(
-            link.lineitems_url,
-            json={
-                "scoreMaximum": score_maximum,
-                "label": link.title or "gymgrade",
-                "resourceId": RESOURCE_ID,
-                "resourceLinkId": link.resource_link_id,
-                "tag": "gymgrade",
-            },
-            headers={**headers, "Content-Type": LINEITEM, "Accept": LINEITEM},
-            timeout=HTTP_TIMEOUT_SECONDS,
-        )
-    except httpx.HTTPError as error:
-        raise ServiceFailed(f"the LMS's line items service did not answer: {error}") from None
-    if response.status_code not in (200, 201):
-        raise _refused("creating the link's line item", response)
-    created = _json(response, "creating the link's line item")
+    what = "listing the link's line items"
+    answer = grant.call("GET", link.lineitems_url + separator + query, what=what, accept=LINEITEMS)
+    if answer.status != 200:
+        raise _refused(what, answer)
+    listed = _json(answer, what)
+    for item in listed if isinstance(listed, list) else []:
+        if (
+            isinstance(item, dict)
+            and item.get("resourceId") == RESOURCE_ID
+            and item.get("resourceLinkId") == link.resource_link_id
+            and item.get("id")
+        ):
+            return str(item["id"])
+    what = "creating the link's line item"
+    answer = grant.call(
+        "POST",
+        link.lineitems_url,
+        what=what,
+        accept=LINEITEM,
+        content_type=LINEITEM,
+        json_body={
+            "scoreMaximum": score_maximum,
+            "label": link.title or "gymgrade",
+            "resourceId": RESOURCE_ID,
+            "resourceLinkId": link.resource_link_id,
+            "tag": "gymgrade",
+        },
+    )
+    if answer.status not in (200, 201):
+        raise _refused(what, answer)
+    created = _json(answer, what)
     if not isinstance(created, dict) or not created.get("id"):
-        raise ServiceFailed(f"the LMS made a line item without an id: {created!r:.200}")
+        raise ServiceFailed(f"{what}: the LMS made a line item without an id")
     return str(created["id"])
 
 
 def publish_score(
     lineitem_url: str,
-    token: str,
+    grant: Grant,
     *,
     user_id: str,
     score: float | None,
@@ -183,43 +226,38 @@ def publish_score(
             activityProgress="Completed",
             gradingProgress="FullyGraded",
         )
-    try:
-        response = httpx.post(
-            _with_path(lineitem_url, "/scores"),
-            json=body,
-            headers={"Authorization": f"Bearer {token}", "Content-Type": SCORE},
-            timeout=HTTP_TIMEOUT_SECONDS,
-        )
-    except httpx.HTTPError as error:
-        raise ServiceFailed(f"the LMS's scores service did not answer: {error}") from None
-    if response.status_code not in (200, 201, 202, 204):
-        raise _refused("publishing the score", response)
+    what = "publishing the score"
+    answer = grant.call(
+        "POST",
+        _with_path(lineitem_url, "/scores"),
+        what=what,
+        accept="application/json",
+        content_type=SCORE,
+        json_body=body,
+    )
+    if answer.status not in (200, 201, 202, 204):
+        raise _refused(what, answer)
 
 
-def roster(memberships_url: str, token: str) -> list[dict[str, Any]]:
-    """Every member of the context (Names and Role Provisioning, following ``rel="next"`` pages)."""
+def roster(memberships_url: str, grant: Grant) -> list[dict[str, Any]]:
+    """Every member of the context (Names and Role Provisioning, following ``rel="next"`` pages, each on
+    the platform's own hosts)."""
     members: list[dict[str, Any]] = []
     url: str | None = memberships_url
+    what = "reading the course roster"
     for _ in range(MAX_ROSTER_PAGES):
         if url is None:
             return members
         try:
-            response = httpx.get(
-                url,
-                headers={"Authorization": f"Bearer {token}", "Accept": MEMBERSHIPS},
-                timeout=HTTP_TIMEOUT_SECONDS,
-            )
-        except httpx.HTTPError as error:
-            raise PlatformUnreachable(f"the LMS's roster service did not answer: {error}") from None
-        if response.status_code != 200:
-            raise PlatformUnreachable(str(_refused("reading the course roster", response)))
-        try:
-            page = _json(response, "reading the course roster")
+            answer = grant.call("GET", url, what=what, accept=MEMBERSHIPS)
+            if answer.status != 200:
+                raise _refused(what, answer)
+            page = _json(answer, what)
         except ServiceFailed as error:
             raise PlatformUnreachable(str(error)) from None
         found = page.get("members") if isinstance(page, dict) else None
         if not isinstance(found, list):
             raise PlatformUnreachable("the LMS's roster has no members list")
         members.extend(member for member in found if isinstance(member, dict))
-        url = response.links.get("next", {}).get("url")
+        url = answer.next_url
     raise PlatformUnreachable(f"the roster has more than {MAX_ROSTER_PAGES} pages; expected a course's")

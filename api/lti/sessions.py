@@ -1,4 +1,5 @@
-"""The browser sessions LTI launches open: a token (only its SHA-256 stored) resolved to its caller."""
+"""The browser sessions LTI launches open: a token (only its SHA-256 stored) resolved to its caller, in the
+browser it is bound to (api/lti/binding.py)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from sqlalchemy import select
 from sqlalchemy.orm import Session
 
 from api.auth import Principal
+from api.lti.binding import matches
 from api.models import LtiSession, LtiUser, Student, utcnow
 from api.security import token_digest
 
@@ -18,10 +20,13 @@ SESSION_PARAMETER = "lti_session"
 """The query parameter carrying the session in links and forms: an LMS iframe may get no cookie at all."""
 
 
-def session_caller(session: Session, token: str) -> Principal | None:
-    """The caller of an unexpired launch session (a student, or the context's staff as instructor)."""
+def session_caller(session: Session, token: str, browser_secret: str | None) -> Principal | None:
+    """The caller of an unexpired launch session (a student, or the context's staff as instructor), when
+    the browser sends the cookie the session is bound to (``browser_secret``; api/lti/binding.py)."""
     row = session.scalars(select(LtiSession).where(LtiSession.token_sha256 == token_digest(token))).first()
     if row is None or row.expires_at < utcnow():
+        return None
+    if row.browser_sha256 is not None and not matches(browser_secret, row.browser_sha256):
         return None
     user = session.get(LtiUser, row.user_id)
     if user is None:
@@ -37,11 +42,13 @@ def session_caller(session: Session, token: str) -> Principal | None:
     )
 
 
-_IN_A_URL = re.compile(rf"({SESSION_PARAMETER}=)[^&\s\"']+")
+SECRET_PARAMETERS = (SESSION_PARAMETER, "ticket", "registration_token")
+"""Query parameters whose values are credentials: a session, a registration ticket, a platform's token."""
+_IN_A_URL = re.compile(rf"((?:^|[?&\s])(?:{'|'.join(SECRET_PARAMETERS)})=)[^&\s\"']+")
 
 
 def redacted(text: str) -> str:
-    """``text`` with every ``lti_session=...`` value replaced (a session token is a password)."""
+    """``text`` with the value of each of :data:`SECRET_PARAMETERS` replaced (they are passwords)."""
     return _IN_A_URL.sub(r"\1[redacted]", text)
 
 

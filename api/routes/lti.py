@@ -13,11 +13,22 @@ from fastapi import APIRouter, Form, Request
 from fastapi.responses import JSONResponse, RedirectResponse, Response
 from pydantic import BaseModel, Field
 from sqlalchemy import select
+from sqlalchemy.orm import Session
 from starlette.concurrency import run_in_threadpool
 
 from api.deps import ContextDep, InstructorDep, SessionDep, SettingsDep
 from api.errors import LtiRequestInvalid
 from api.lti import claims as names
+from api.lti.binding import (
+    LAUNCH_PATH,
+    LOGIN_COOKIE_PREFIX,
+    SESSION_COOKIE,
+    STORAGE_KEY_PREFIX,
+    digest,
+    new_secret,
+    set_cookie,
+    state_name,
+)
 from api.lti.deep_linking import (
     check_link_edition,
     choices,
@@ -26,8 +37,16 @@ from api.lti.deep_linking import (
     picker_token,
 )
 from api.lti.keys import public_jwks, rotate
-from api.lti.launch import accept_launch, frame_origins, login_redirect, verify_launch
-from api.lti.platforms import PlatformRegistration, add_deployment, register_platform
+from api.lti.launch import (
+    STATE_SECONDS,
+    Login,
+    accept_launch,
+    frame_origins,
+    login_redirect,
+    tool_state,
+    verify_launch,
+)
+from api.lti.platforms import PlatformRegistration, add_deployment, checked_origins, register_platform
 from api.lti.publisher import publishing_status
 from api.lti.registration import ToolUrls, check_ticket, register_dynamically, registration_ticket
 from api.lti.roster import import_roster
@@ -54,18 +73,47 @@ def jwks(session: SessionDep, settings: SettingsDep) -> JSONResponse:
 
 @router.api_route("/lti/login", methods=["GET", "POST"])
 async def login(request: Request, context: ContextDep) -> Response:
-    """OIDC third-party login initiation: redirect to the platform's authorisation endpoint."""
+    """OIDC third-party login initiation: bind the login to the browser (a cookie, and the platform's
+    storage when it offers one), then on to the platform's authorisation endpoint."""
     params = dict(request.query_params)
     if request.method == "POST":
         params.update({key: str(value) for key, value in (await request.form()).items()})
     urls = tool_urls(request, context.settings)
+    secret, bind = new_secret()
 
-    def redirect() -> str:  # the database (and the first key's generation) off the event loop
+    def redirect() -> Login:  # the database (and the first key's generation) off the event loop
         with context.sessions() as session:
-            return login_redirect(session, params, urls.launch, urls.origin)
+            return login_redirect(session, params, urls.launch, bind=bind)
 
-    target = await run_in_threadpool(redirect)
-    return RedirectResponse(target, status_code=302 if request.method == "GET" else 303)
+    started = await run_in_threadpool(redirect)
+    name = state_name(started.state)
+    storage = params.get("lti_storage_target")
+    response: Response
+    if storage:
+        # A page without anything to click, framed by the LMS whichever page of it frames the tool.
+        response = templates.TemplateResponse(
+            request,
+            "lti_storage.html",
+            {
+                "action": "put",
+                "target": storage,
+                "origin": _origin(started.auth_url),
+                "key": STORAGE_KEY_PREFIX + name,
+                "value": secret,
+                "next": started.url,
+                "session_query": "",
+            },
+            headers=page_headers("*"),
+        )
+    else:
+        response = RedirectResponse(started.url, status_code=302 if request.method == "GET" else 303)
+    set_cookie(response, LOGIN_COOKIE_PREFIX + name, secret, max_age=STATE_SECONDS, path=LAUNCH_PATH)
+    return response
+
+
+def _origin(url: str) -> str:
+    parts = urlsplit(url)
+    return f"{parts.scheme}://{parts.netloc}"
 
 
 @router.post("/lti/launch")
@@ -75,16 +123,39 @@ def launch(
     context: ContextDep,
     id_token: Annotated[str, Form()] = "",
     state: Annotated[str, Form()] = "",
+    storage_answer: Annotated[str | None, Form()] = None,
 ) -> Response:
-    """The launch: verify everything, then land signed in (the upload page, or the lab picker)."""
+    """The launch: verify everything (in the browser the login began in), then land signed in (the upload
+    page, or the lab picker)."""
     settings = context.settings
+    name = state_name(state)
+    from_cookie = request.cookies.get(LOGIN_COOKIE_PREFIX + name)
+    if from_cookie is None and storage_answer is None and state:
+        stored = _from_platform_storage(request, session, settings, id_token, state)
+        if stored is not None:
+            return stored
     checked = verify_launch(
-        session, context.platform_keys, id_token, state, grace_seconds=settings.lti_key_grace_seconds
+        session,
+        context.platform_keys,
+        id_token,
+        state,
+        grace_seconds=settings.lti_key_grace_seconds,
+        browser_secret=from_cookie or storage_answer,
     )
+    # A browser that sent the login's cookie keeps cookies: its session is bound to its browser cookie (the
+    # one it has, which its other sessions are bound to, else a new one).
+    browser_secret: str | None = None
+    browser_digest: str | None = None
+    if from_cookie is not None:
+        browser_secret = request.cookies.get(SESSION_COOKIE) or new_secret()[0]
+        browser_digest = digest(browser_secret)
+    response: Response
     if checked.message_type == names.DEEP_LINKING_REQUEST:
         token = picker_token(session, checked)
-        accept_launch(session, checked, session_seconds=settings.lti_session_seconds)
-        return templates.TemplateResponse(
+        accept_launch(
+            session, checked, session_seconds=settings.lti_session_seconds, browser_digest=browser_digest
+        )
+        response = templates.TemplateResponse(
             request,
             "lti_picker.html",
             {
@@ -95,11 +166,45 @@ def launch(
             },
             headers=page_headers(frame_origins(checked)),
         )
-    custom = checked.claims.get(names.CUSTOM)
-    graded = graded_edition(settings.edition, settings.lab)
-    check_link_edition(custom if isinstance(custom, dict) else {}, graded)
-    landing = accept_launch(session, checked, session_seconds=settings.lti_session_seconds)
-    return RedirectResponse("/?" + urlencode({SESSION_PARAMETER: landing.token}), status_code=303)
+    else:
+        custom = checked.claims.get(names.CUSTOM)
+        graded = graded_edition(settings.edition, settings.lab)
+        check_link_edition(custom if isinstance(custom, dict) else {}, graded)
+        landing = accept_launch(
+            session, checked, session_seconds=settings.lti_session_seconds, browser_digest=browser_digest
+        )
+        response = RedirectResponse("/?" + urlencode({SESSION_PARAMETER: landing.token}), status_code=303)
+    if browser_secret is not None:
+        set_cookie(response, SESSION_COOKIE, browser_secret, max_age=settings.lti_session_seconds, path="/")
+    return response
+
+
+def _from_platform_storage(
+    request: Request, session: Session, settings: Settings, id_token: str, state: str
+) -> Response | None:
+    """The page reading the login's secret back from the platform's storage (then posting the launch
+    again), when the login stored it there; None when it did not."""
+    claims = tool_state(session, state, settings.lti_key_grace_seconds)
+    platform = session.get(LtiPlatform, claims.get("platform"))
+    target = claims.get("store")
+    if not target or platform is None:
+        return None
+    return templates.TemplateResponse(
+        request,
+        "lti_storage.html",
+        {
+            "action": "get",
+            "target": target,
+            "origin": _origin(platform.auth_url),
+            "key": STORAGE_KEY_PREFIX + state_name(state),
+            "value": "",
+            "next": "",
+            "id_token": id_token,
+            "state": state,
+            "session_query": "",
+        },
+        headers=page_headers("*"),
+    )
 
 
 @router.post("/lti/deep-link")
@@ -134,20 +239,53 @@ def deep_link(
 
 
 @router.get("/lti/register")
-def dynamic_registration(
+def dynamic_registration_form(
     request: Request,
     session: SessionDep,
     settings: SettingsDep,
     openid_configuration: str = "",
-    registration_token: str | None = None,
+    registration_token: str = "",
     ticket: str = "",
 ) -> Response:
-    """LTI Dynamic Registration, opened by the platform with the instructor's registration URL."""
-    check_ticket(session, ticket, settings.lti_key_grace_seconds)
+    """LTI Dynamic Registration, opened by the platform with the instructor's registration URL: a form whose
+    POST registers (a GET registers nothing and leaves the ticket unused)."""
+    check_ticket(session, ticket, settings.lti_key_grace_seconds, use=False)
     if not openid_configuration:
         raise LtiRequestInvalid("the platform opens this URL with openid_configuration; found none")
+    return templates.TemplateResponse(
+        request,
+        "lti_register.html",
+        {
+            "ticket": ticket,
+            "openid_configuration": openid_configuration,
+            "registration_token": registration_token,
+            "session_query": "",
+        },
+        headers=page_headers("*"),
+    )
+
+
+@router.post("/lti/register")
+def dynamic_registration(
+    request: Request,
+    session: SessionDep,
+    context: ContextDep,
+    openid_configuration: Annotated[str, Form()] = "",
+    registration_token: Annotated[str, Form()] = "",
+    ticket: Annotated[str, Form()] = "",
+) -> Response:
+    """Register: spend the ticket, read the platform's configuration, register the tool there."""
+    settings = context.settings
+    check_ticket(session, ticket, settings.lti_key_grace_seconds, use=True)
+    if not openid_configuration:
+        raise LtiRequestInvalid("the registration form carries no openid_configuration; open the URL again")
     platform = register_dynamically(
-        session, tool_urls(request, settings), openid_configuration, registration_token
+        session,
+        context.outbound,
+        tool_urls(request, settings),
+        openid_configuration,
+        registration_token or None,
+        allowed_hosts=settings.lti_hosts,
     )
     return templates.TemplateResponse(
         request,
@@ -158,7 +296,8 @@ def dynamic_registration(
 
 
 class RegistrationUrl(BaseModel):
-    """A URL the LMS administrator gives the LMS for dynamic registration (valid 7 days)."""
+    """A URL the LMS administrator gives the LMS for dynamic registration (used once, valid
+    GYMGRADE_LTI_REGISTRATION_TICKET_SECONDS)."""
 
     url: str
 
@@ -169,7 +308,10 @@ def new_registration(
 ) -> RegistrationUrl:
     """A dynamic registration URL carrying a ticket the tool signed."""
     base = tool_urls(request, settings).base
-    return RegistrationUrl(url=f"{base}/lti/register?" + urlencode({"ticket": registration_ticket(session)}))
+    return RegistrationUrl(
+        url=f"{base}/lti/register?"
+        + urlencode({"ticket": registration_ticket(session, settings.lti_registration_ticket_seconds)})
+    )
 
 
 class PlatformIn(BaseModel):
@@ -181,6 +323,8 @@ class PlatformIn(BaseModel):
     jwks_url: str = Field(min_length=1, max_length=1000)
     auth_url: str = Field(min_length=1, max_length=1000)
     token_url: str = Field(min_length=1, max_length=1000)
+    frame_ancestors: list[str] = Field(default_factory=list, max_length=10)
+    """Origins of pages framing the LMS page that frames the tool (Open edX's learning MFE)."""
 
 
 def _platform_view(row: LtiPlatform) -> dict[str, Any]:
@@ -192,11 +336,14 @@ def _platform_view(row: LtiPlatform) -> dict[str, Any]:
         "jwks_url": row.jwks_url,
         "auth_url": row.auth_url,
         "token_url": row.token_url,
+        "frame_ancestors": row.frame_ancestors,
     }
 
 
 @router.post("/lti/platforms", status_code=201)
-def post_platform(body: PlatformIn, session: SessionDep, _instructor: InstructorDep) -> dict[str, Any]:
+def post_platform(
+    body: PlatformIn, session: SessionDep, settings: SettingsDep, _instructor: InstructorDep
+) -> dict[str, Any]:
     """Register a platform by hand."""
     row = register_platform(
         session,
@@ -207,7 +354,9 @@ def post_platform(body: PlatformIn, session: SessionDep, _instructor: Instructor
             body.jwks_url,
             body.auth_url,
             body.token_url,
+            tuple(body.frame_ancestors),
         ),
+        allow_http=settings.lti_allow_http,
     )
     return _platform_view(row)
 
@@ -230,6 +379,29 @@ def post_deployment(
     return _platform_view(platform)
 
 
+class FrameAncestorsIn(BaseModel):
+    """The origins, besides the launch's and the issuer's, whose pages frame the tool (every ancestor)."""
+
+    frame_ancestors: list[str] = Field(max_length=10)
+
+
+@router.put("/lti/platforms/{platform_id}/frame-ancestors")
+def put_frame_ancestors(
+    platform_id: int,
+    body: FrameAncestorsIn,
+    session: SessionDep,
+    settings: SettingsDep,
+    _instructor: InstructorDep,
+) -> dict[str, Any]:
+    """Set the origins that may frame the tool's pages after a launch from this platform."""
+    platform = session.get(LtiPlatform, platform_id)
+    if platform is None:
+        raise LtiRequestInvalid(f"no platform has id {platform_id}; list them with GET /lti/platforms")
+    platform.frame_ancestors = checked_origins(body.frame_ancestors, allow_http=settings.lti_allow_http)
+    session.commit()
+    return _platform_view(platform)
+
+
 @router.get("/lti/platforms")
 def get_platforms(session: SessionDep, _instructor: InstructorDep) -> list[dict[str, Any]]:
     """The registered platforms."""
@@ -249,9 +421,9 @@ def tool_configuration(request: Request, settings: SettingsDep, _instructor: Ins
 
 
 @router.post("/lti/keys/rotate")
-def rotate_keys(session: SessionDep, _instructor: InstructorDep) -> dict[str, str]:
+def rotate_keys(session: SessionDep, settings: SettingsDep, _instructor: InstructorDep) -> dict[str, str]:
     """Make a new signing key; the old ones stay published for GYMGRADE_LTI_KEY_GRACE_SECONDS."""
-    return {"kid": rotate(session)}
+    return {"kid": rotate(session, settings.lti_key_grace_seconds)}
 
 
 @router.get("/lti/links")

@@ -21,7 +21,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
-from urllib.parse import parse_qsl, urlsplit
+from urllib.parse import parse_qsl, urlencode, urlsplit
 
 import httpx
 import uvicorn
@@ -42,6 +42,26 @@ INSTRUCTOR = "http://purl.imsglobal.org/vocab/lis/v2/membership#Instructor"
 TEACHING_ASSISTANT = "http://purl.imsglobal.org/vocab/lis/v2/membership/Instructor#TeachingAssistant"
 CONTEXT_ID = "course-rl-2026"
 REGISTRATION_TOKEN = "platform-registration-" + "k3y9"
+PLATFORM_STORAGE = """
+var stored = {};
+window.addEventListener("message", function (event) {
+  var message = event.data;
+  if (!message || typeof message.subject !== "string") { return; }
+  var key = event.origin + " " + message.key;
+  var answer = { message_id: message.message_id, key: message.key };
+  if (message.subject === "lti.put_data") {
+    stored[key] = message.value;
+    answer.subject = "lti.put_data.response";
+    answer.value = message.value;
+  } else if (message.subject === "lti.get_data") {
+    answer.subject = "lti.get_data.response";
+    answer.value = stored[key];
+  } else { return; }
+  event.source.postMessage(answer, event.origin);
+});
+"""
+"""The platform's storage for LTI client-side OIDC (lti.put_data, lti.get_data), kept per tool origin, on
+the course page that frames the tool (its ``lti_storage_target`` is ``_parent``)."""
 
 
 def new_private_key() -> str:
@@ -103,6 +123,10 @@ class LaunchSpec:
     """The line item the platform made for the link (as Canvas and Moodle do for an assignment)."""
     browser: bool = False
     """The authorisation endpoint answers as an LMS does for a browser: a form posted by a script."""
+    kid: str | None = None
+    """Another key id in the id_token's header (a key the platform's JWKS does not hold)."""
+    storage_target: str | None = None
+    """The login offers the platform's storage (LTI client-side OIDC): ``lti_storage_target``."""
 
 
 class _Config(LTI1P3PlatformConfAbstract):
@@ -154,6 +178,14 @@ class LtiPlatform:
         self.registrations: list[dict[str, Any]] = []
         self.deep_link_items: list[dict[str, Any]] = []
         self.course_pages: dict[str, str] = {}
+        self.configuration: dict[str, Any] = {}
+        """Fields overriding the OpenID configuration served (a hostile platform's issuer, endpoints)."""
+        self.jwks_padding = 0
+        """Bytes of padding added to the JWKS document (a huge one)."""
+        self.memberships_next: str | None = None
+        """A ``Link: <...>; rel="next"`` the roster's pages carry."""
+        self.requests: list[tuple[str, str]] = []
+        """Every request the platform received: (Host header, path)."""
         self.lock = threading.Lock()
         self.app = self._make_app()
         self._server: uvicorn.Server | None = None
@@ -166,9 +198,9 @@ class LtiPlatform:
         self.tool_launch_url = base_url + "/lti/launch"
         self.tool_jwks_url = base_url + "/lti/jwks"
 
-    def registration(self, signing_key: str | None = None) -> KeyedRegistration:
+    def registration(self, signing_key: str | None = None, kid: str | None = None) -> KeyedRegistration:
         """The package's registration object of the tool."""
-        registration = KeyedRegistration(self.kid)
+        registration = KeyedRegistration(kid or self.kid)
         (
             registration.set_iss(self.issuer)
             .set_client_id(self.client_id)
@@ -182,8 +214,8 @@ class LtiPlatform:
         )
         return registration
 
-    def config(self, signing_key: str | None = None) -> _Config:
-        return _Config(registration=self.registration(signing_key))
+    def config(self, signing_key: str | None = None, kid: str | None = None) -> _Config:
+        return _Config(registration=self.registration(signing_key, kid))
 
     @property
     def manual_registration(self) -> dict[str, Any]:
@@ -206,12 +238,18 @@ class LtiPlatform:
         login.set_lti_message_hint(hint=hint)
         if spec.deep_linking:
             login.set_deeplinking_launch_url()
-        return login.initiate_login(spec.person.sub)
+        url: str = login.initiate_login(spec.person.sub)
+        if spec.storage_target:
+            url += "&" + urlencode({"lti_storage_target": spec.storage_target})
+        return url
 
-    def course_page(self, spec: LaunchSpec) -> str:
-        """The URL of the course's page framing the tool, which a browser opens (the launch starts there)."""
+    def course_page(self, spec: LaunchSpec, *, mfe_origin: str | None = None) -> str:
+        """The URL of the course's page framing the tool, which a browser opens (the launch starts there);
+        with ``mfe_origin`` (another name of this server), a page there framing the course's page."""
         hint = secrets.token_urlsafe(8)
         self.course_pages[hint] = self.login_url(spec)
+        if mfe_origin is not None:
+            return f"{mfe_origin}/mfe/{hint}"
         return f"{self.issuer}/course/{hint}"
 
     def id_token_post(self, client: httpx.Client, spec: LaunchSpec) -> dict[str, str]:
@@ -234,7 +272,7 @@ class LtiPlatform:
         spec = self.launches[query["lti_message_hint"]]
         if query.get("login_hint") != spec.person.sub:
             raise LtiException("login_hint does not name the user of this launch")
-        launch = _Launch(_Preflight(query), self.config(spec.signing_key))
+        launch = _Launch(_Preflight(query), self.config(spec.signing_key, spec.kid))
         launch.set_user_data(spec.person.sub, spec.person.roles, full_name=spec.person.name)
         launch.set_launch_context_claim(CONTEXT_ID, context_title="Reinforcement learning")
         launch.set_launch_presentation_claim("iframe", return_url=self.issuer + "/course")
@@ -270,6 +308,13 @@ class LtiPlatform:
         app = FastAPI()
         ags = "https://purl.imsglobal.org/spec/lti-ags/scope/"
 
+        @app.middleware("http")
+        async def _count(request: Request, call_next: Any) -> Response:
+            with self.lock:
+                self.requests.append((request.headers.get("host", ""), request.url.path))
+            response: Response = await call_next(request)
+            return response
+
         @app.exception_handler(PermissionError)
         async def _forbidden(_request: Request, error: Exception) -> Response:
             return JSONResponse({"error": str(error)}, status_code=401)
@@ -294,6 +339,7 @@ class LtiPlatform:
                     "product_family_code": "lti1p3platform-tests",
                     "version": "0.1.8",
                 },
+                **self.configuration,
             }
 
         @app.post("/register")
@@ -321,7 +367,10 @@ class LtiPlatform:
         def jwks() -> dict[str, Any]:
             config = self.config()
             config.get_registration()
-            return dict(config.get_jwks())
+            document = dict(config.get_jwks())
+            if self.jwks_padding:
+                document["padding"] = "x" * self.jwks_padding
+            return document
 
         @app.get("/auth", response_model=None)
         def auth(request: Request) -> dict[str, Any] | Response:
@@ -344,6 +393,15 @@ class LtiPlatform:
             return HTMLResponse(
                 "<h1>Reinforcement learning</h1>"
                 f'<iframe id="tool" src="{html.escape(login)}" width="1000" height="800"></iframe>'
+                f"<script>{PLATFORM_STORAGE}</script>"
+            )
+
+        @app.get("/mfe/{hint}")
+        def learning_mfe(hint: str) -> Response:
+            # Open edX's learning MFE: a page of another origin framing the LMS's page that frames the tool.
+            return HTMLResponse(
+                "<h1>Learning</h1>"
+                f'<iframe id="lms" src="{html.escape(self.issuer)}/course/{html.escape(hint)}" width="1100" height="900"></iframe>'  # noqa: E501
             )
 
         @app.post("/token")
@@ -392,18 +450,27 @@ class LtiPlatform:
             return Response(status_code=204)
 
         @app.get("/memberships")
-        def memberships(request: Request) -> dict[str, Any]:
+        def memberships(request: Request) -> Response:
             self._check_token(
                 request, "https://purl.imsglobal.org/spec/lti-nrps/scope/contextmembership.readonly"
             )
-            return {
-                "id": self.issuer + "/memberships",
-                "context": {"id": CONTEXT_ID},
-                "members": [
-                    {"status": "Active", "user_id": person.sub, "name": person.name, "roles": person.roles}
-                    for person in self.people.values()
-                ],
-            }
+            headers = {"Link": f'<{self.memberships_next}>; rel="next"'} if self.memberships_next else {}
+            return JSONResponse(
+                headers=headers,
+                content={
+                    "id": self.issuer + "/memberships",
+                    "context": {"id": CONTEXT_ID},
+                    "members": [
+                        {
+                            "status": "Active",
+                            "user_id": person.sub,
+                            "name": person.name,
+                            "roles": person.roles,
+                        }
+                        for person in self.people.values()
+                    ],
+                },
+            )
 
         @app.post("/deep_link_return")
         async def deep_link_return(request: Request) -> dict[str, Any]:

@@ -78,3 +78,13 @@ def test_the_lms_pages_that_may_frame_the_tool(presentation: dict[str, str], exp
 )
 def test_session_tokens_are_kept_out_of_the_logs(line: str, expected: str) -> None:
     assert redacted(line) == expected
+
+
+def test_registered_ancestors_frame_the_tool_whole_origins_only() -> None:
+    launch = _launch({})
+    launch.platform.frame_ancestors = ["https://apps.lms.example.edu", "https://canvas.instructure.com"]
+    assert frame_origins(launch) == "https://canvas.instructure.com https://apps.lms.example.edu"
+    launch.platform.frame_ancestors = [f"https://{n}.{'x' * 60}.example.edu" for n in range(10)]
+    kept = frame_origins(launch).split(" ")
+    assert len(" ".join(kept)) <= 500 and all(origin.endswith(".example.edu") for origin in kept[1:])
+    assert len(kept) < 11, "every origin was kept past the column's 500 characters"

@@ -24,9 +24,8 @@ from lti_platform import (
     LaunchSpec,
     LtiPlatform,
     new_private_key,
-    query_of,
 )
-from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, landed, tool_environment, upload, wait
+from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, browser, landed, register, tool_environment, upload, wait
 
 pytestmark = [pytest.mark.e2e, pytest.mark.slow]
 
@@ -106,12 +105,17 @@ def test_a_learner_lands_signed_in_and_each_grading_reaches_the_gradebook_once(
     platform: LtiPlatform, tool: LiveProcess
 ) -> None:
     person = platform.add_person("learner-ada", "Ada Lovelace", LEARNER)
-    with httpx.Client() as client:
-        token, page = landed(client, tool.url, platform.launch(client, LaunchSpec(person, "link-1")))
+    with browser() as client:
+        launched = platform.launch(client, LaunchSpec(person, "link-1"))
+        (bound,) = [
+            cookie for cookie in launched.headers.get_list("set-cookie") if cookie.startswith("lti_browser=")
+        ]
+        for attribute in ("HttpOnly", "Partitioned", "SameSite=None", "Secure", "Path=/"):
+            assert attribute in bound, f"the session's cookie lacks {attribute} (an LMS frame would drop it)"
+        token, page = landed(client, tool.url, launched)
         assert page.status_code == 200
         assert "Upload your solution" in page.text
         assert "signed in as Ada Lovelace" in page.text
-        assert not client.cookies, "the launch needs no cookie (third-party cookies may be blocked)"
         assert f"frame-ancestors {platform.issuer}" in page.headers["content-security-policy"]
         assert f'action="/ui/submissions?lti_session={token}"' in page.text
 
@@ -183,7 +187,7 @@ def test_a_hostile_launch_is_refused_and_stores_nothing(
     if change.get("signing_key") == "forged":
         change = {**change, "signing_key": new_private_key()}
     before = counts(tool)
-    with httpx.Client() as client:
+    with browser() as client:
         response = platform.launch(client, LaunchSpec(person, "link-1", **change))
     assert response.status_code == 403
     assert message in html.unescape(response.text)
@@ -192,7 +196,7 @@ def test_a_hostile_launch_is_refused_and_stores_nothing(
 
 def test_a_replayed_launch_is_refused_and_stores_nothing(platform: LtiPlatform, tool: LiveProcess) -> None:
     person = platform.add_person("learner-eve", "Eve", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         form = platform.id_token_post(client, LaunchSpec(person, "link-1"))
         post = {"id_token": form["id_token"], "state": form["state"]}
         assert client.post(form["launch_url"], data=post).status_code == 303
@@ -207,7 +211,7 @@ def test_an_id_token_posted_with_another_logins_state_is_refused(
     platform: LtiPlatform, tool: LiveProcess
 ) -> None:
     person = platform.add_person("learner-oscar", "Oscar", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         first = platform.id_token_post(client, LaunchSpec(person, "link-1"))
         second = platform.id_token_post(client, LaunchSpec(person, "link-1"))
         before = counts(tool)
@@ -221,7 +225,7 @@ def test_an_id_token_posted_with_another_logins_state_is_refused(
 
 def test_a_state_not_issued_by_the_tool_is_refused(platform: LtiPlatform, tool: LiveProcess) -> None:
     person = platform.add_person("learner-trudy", "Trudy", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         form = platform.id_token_post(client, LaunchSpec(person, "link-1"))
         before = counts(tool)
         response = client.post(
@@ -237,7 +241,7 @@ def test_a_student_cannot_publish_scores_or_read_another_students_work(
 ) -> None:
     alice = platform.add_person("learner-alice", "Alice", LEARNER)
     bob = platform.add_person("learner-bob", "Bob", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         alice_token, _ = landed(client, tool.url, platform.launch(client, LaunchSpec(alice, "link-1")))
         bob_token, _ = landed(client, tool.url, platform.launch(client, LaunchSpec(bob, "link-1")))
         bobs = upload(client, tool.url, bob_token, ONE_PROBLEM)
@@ -265,7 +269,7 @@ def test_scores_refused_by_the_platform_are_sent_again_and_shown_to_the_instruct
     person = platform.add_person("learner-grace", "Grace", LEARNER)
     platform.score_failures[person.sub] = 10**9  # the gradebook is down until the test brings it back
     refused_before = platform.refused_scores
-    with httpx.Client() as client:
+    with browser() as client:
         token, _ = landed(client, tool.url, platform.launch(client, LaunchSpec(person, "link-2")))
         submission = upload(client, tool.url, token, ONE_PROBLEM)
 
@@ -287,7 +291,7 @@ def test_scores_refused_by_the_platform_are_sent_again_and_shown_to_the_instruct
     rows = httpx.get(tool.url + "/lti/scores", headers=instructor_headers()).json()
     assert [(row["status"], row["error"]) for row in rows if row["student"] == "Grace"] == [("sent", None)]
     teacher = platform.add_person("staff-grace", "Gale Grader", INSTRUCTOR)
-    with httpx.Client() as client:
+    with browser() as client:
         _, page = landed(client, tool.url, platform.launch(client, LaunchSpec(teacher, "link-2")))
     assert "Scores in the LMS" in page.text
     assert re.search(
@@ -298,7 +302,7 @@ def test_scores_refused_by_the_platform_are_sent_again_and_shown_to_the_instruct
 def test_staff_land_as_the_instructor_and_import_the_roster(platform: LtiPlatform, tool: LiveProcess) -> None:
     teacher = platform.add_person("staff-ta", "Terry TA", TEACHING_ASSISTANT)
     platform.add_person("learner-never", "Nora Neverlaunched", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         token, page = landed(client, tool.url, platform.launch(client, LaunchSpec(teacher, "link-1")))
         assert "All submissions" in page.text and "Upload your solution" not in page.text
         assert f'action="/ui/lti/roster?lti_session={token}"' in page.text
@@ -321,7 +325,7 @@ def test_staff_land_as_the_instructor_and_import_the_roster(platform: LtiPlatfor
 def test_a_deployment_added_by_the_instructor_is_accepted(platform: LtiPlatform, tool: LiveProcess) -> None:
     person = platform.add_person("learner-dep", "Dana Deployment", LEARNER)
     other = {"claims": {"https://purl.imsglobal.org/spec/lti/claim/deployment_id": "deployment-7"}}
-    with httpx.Client() as client:
+    with browser() as client:
         assert platform.launch(client, LaunchSpec(person, "link-7", **other)).status_code == 403
         (row,) = [
             p
@@ -340,7 +344,7 @@ def test_a_deployment_added_by_the_instructor_is_accepted(platform: LtiPlatform,
 
 def test_deep_linking_carries_the_lab_and_edition_picked(platform: LtiPlatform, tool: LiveProcess) -> None:
     teacher = platform.add_person("staff-ines", "Ines Instructor", INSTRUCTOR)
-    with httpx.Client() as client:
+    with browser() as client:
         picker = platform.launch(client, LaunchSpec(teacher, "", deep_linking=True))
         assert picker.status_code == 200, picker.text
         token = re.search(r'name="picker" value="([^"]+)"', picker.text)
@@ -367,7 +371,7 @@ def test_deep_linking_carries_the_lab_and_edition_picked(platform: LtiPlatform, 
     assert item["custom"] == {"lab": "OpenGym AI (classic gym)", "edition": "classic"}
     assert item["url"] == tool.url + "/lti/launch"
     learner = platform.add_person("learner-linked", "Lin Linked", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         _, page = landed(
             client, tool.url, platform.launch(client, LaunchSpec(learner, "link-dl", custom=item["custom"]))
         )
@@ -379,7 +383,7 @@ def test_a_link_made_for_another_edition_is_refused_and_stores_nothing(
 ) -> None:
     learner = platform.add_person("learner-rl1", "Rhea", LEARNER)
     before = counts(tool)
-    with httpx.Client() as client:
+    with browser() as client:
         response = platform.launch(
             client,
             LaunchSpec(learner, "link-rl1", custom={"lab": "Reinforcement Learning 1", "edition": "rl1"}),
@@ -394,7 +398,7 @@ def test_a_link_made_for_another_edition_is_refused_and_stores_nothing(
 def test_a_learner_cannot_add_the_tool_by_deep_linking(platform: LtiPlatform, tool: LiveProcess) -> None:
     person = platform.add_person("learner-dl", "Dee", LEARNER)
     before = counts(tool)
-    with httpx.Client() as client:
+    with browser() as client:
         response = platform.launch(client, LaunchSpec(person, "", deep_linking=True))
     assert response.status_code == 403
     assert "only the course's instructors add the tool" in html.unescape(response.text)
@@ -406,7 +410,7 @@ def test_a_launch_started_before_a_key_rotation_completes_after_it(
 ) -> None:
     person = platform.add_person("learner-rot", "Rosa Rotation", LEARNER)
     old = httpx.get(tool.url + "/lti/jwks").json()["keys"]
-    with httpx.Client() as client:
+    with browser() as client:
         form = platform.id_token_post(client, LaunchSpec(person, "link-1"))
         rotated = httpx.post(tool.url + "/lti/keys/rotate", headers=instructor_headers())
         assert rotated.status_code == 200
@@ -414,6 +418,11 @@ def test_a_launch_started_before_a_key_rotation_completes_after_it(
         assert {key["kid"] for key in old} < {key["kid"] for key in published}
         assert rotated.json()["kid"] in {key["kid"] for key in published}
         assert all("d" not in key for key in published), "a private part was published"
+        with sqlite3.connect(database(tool)) as connection:
+            kept = [row[0] for row in connection.execute("SELECT private_pem FROM lti_keys")]
+        assert kept and all(pem.startswith("fernet:") and "PRIVATE" not in pem for pem in kept), (
+            "a key at rest in plaintext"
+        )
         response = client.post(
             form["launch_url"], data={"id_token": form["id_token"], "state": form["state"]}
         )
@@ -425,7 +434,7 @@ def test_a_launch_started_before_a_key_rotation_completes_after_it(
 
 
 def test_dynamic_registration_needs_the_instructors_ticket_then_registers_the_tool(tool: LiveProcess) -> None:
-    with LtiPlatform().running() as lms, httpx.Client() as client:
+    with LtiPlatform().running() as lms, browser() as client:
         configuration = lms.issuer + "/.well-known/openid-configuration"
         refused = client.get(
             tool.url + "/lti/register",
@@ -437,14 +446,7 @@ def test_dynamic_registration_needs_the_instructors_ticket_then_registers_the_to
         assert made.status_code == 201
         url = made.json()["url"]
         assert url.startswith(tool.url + "/lti/register?ticket=")
-        done = client.get(
-            tool.url + "/lti/register",
-            params={
-                **query_of(url),
-                "openid_configuration": configuration,
-                "registration_token": REGISTRATION_TOKEN,
-            },
-        )
+        done = register(client, url, configuration)
         assert done.status_code == 200, done.text
         assert "gymgrade is registered" in done.text
         (sent,) = lms.registrations
@@ -465,7 +467,7 @@ def test_token_sign_in_keeps_working_beside_lti(platform: LtiPlatform, tool: Liv
     token = create_student(tool.url, "Tom Token")
     submission = upload_with_token(tool.url, token, ONE_PROBLEM)
     wait(lambda: graded(tool, submission), "the token student's grading")
-    with httpx.Client() as client:
+    with browser() as client:
         signed_in = client.post(tool.url + "/ui/sign-in", data={"token": token})
         assert signed_in.status_code == 303
         assert "signed in as Tom Token" in client.get(tool.url + "/").text
@@ -479,7 +481,7 @@ def test_the_lms_hears_of_a_submission_being_graded_then_its_score(
     person = platform.add_person("learner-pat", "Pat Pending", LEARNER)
     item = platform.add_line_item("link-li", score_maximum=3.0)
     hold = tmp_path / "release"
-    with httpx.Client() as client:
+    with browser() as client:
         token, _ = landed(
             client, tool.url, platform.launch(client, LaunchSpec(person, "link-li", lineitem=item))
         )

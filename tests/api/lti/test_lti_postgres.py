@@ -12,7 +12,7 @@ import pytest
 from api_testing import PostgresServer, instructor_headers
 from live_server import LiveProcess
 from lti_platform import LEARNER, LaunchSpec, LtiPlatform
-from lti_testing import ONE_PROBLEM, landed, tool_environment, upload, wait
+from lti_testing import ONE_PROBLEM, browser, landed, tool_environment, upload, wait
 
 pytestmark = [pytest.mark.e2e, pytest.mark.slow]
 
@@ -28,7 +28,7 @@ def tool(tmp_path: Path, postgres_server: PostgresServer) -> Iterator[LiveProces
 
 
 def test_launch_replay_and_score_on_postgresql(tool: LiveProcess) -> None:
-    with LtiPlatform().running() as platform, httpx.Client() as client:
+    with LtiPlatform().running() as platform, browser() as client:
         platform.register_tool(tool.url)
         registered = httpx.post(
             tool.url + "/lti/platforms", json=platform.manual_registration, headers=instructor_headers()
