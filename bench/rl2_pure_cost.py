@@ -41,7 +41,7 @@ DESCRIPTION = (
 FILES = (
     ("v2024", "submissions/rl2/honest_v2024.py"),
     ("v2018", "submissions/rl2/honest_v2018.py"),
-    ("v2026", "submissions/rl2/mistakes/policy_iteration_zero_start.py"),
+    ("v2024", "submissions/rl2/mistakes/policy_iteration_alternating_start.py"),
 )
 
 
