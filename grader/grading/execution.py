@@ -143,7 +143,7 @@ def run_problem(
         planned = check.plan(settings, FunctionsOnDemand(sandbox), seed)
         records, verdict = _reading(sandbox, submission, check, settings, planned)
         if isinstance(check, SecondReading):
-            again = check.second_plan(settings, verdict, seed)
+            again = check.second_plan(settings, verdict, FunctionsOnDemand(sandbox), seed)
             if again:
                 more, second = _reading(sandbox, submission, check, settings, again)
                 records, verdict = records + more, check.keep(settings, verdict, second)

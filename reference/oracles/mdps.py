@@ -270,7 +270,7 @@ def held_out_cases(seed: int) -> tuple[GradingCase, ...]:
 def grading_cases(seed: int | None = None) -> tuple[GradingCase, ...]:
     """Every MDP and discount the second lab's pure functions are graded on, the lab's example first.
 
-    Without a seed, the ten public cases; with a problem's seed, those and `held_out_cases(seed)`.
+    Without a seed, the nine public cases; with a problem's seed, those and `held_out_cases(seed)`.
     """
     if seed is not None:
         return (*grading_cases(), *held_out_cases(seed))

@@ -102,8 +102,11 @@ class SecondReading(Protocol[ConfigT_contra]):
     them, and judges them with the same `judge`.
     """
 
-    def second_plan(self, settings: ConfigT_contra, first: Verdict, seed: int) -> list[Call]:
-        """The calls of the second reading, or [] when the first verdict stands."""
+    def second_plan(
+        self, settings: ConfigT_contra, first: Verdict, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
+        """The calls of the second reading, or [] when the first verdict stands (`functions` and `seed` as
+        `ProblemCheck.plan` gets them)."""
         ...
 
     def keep(self, settings: ConfigT_contra, first: Verdict, second: Verdict) -> Verdict:

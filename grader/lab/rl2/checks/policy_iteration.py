@@ -93,7 +93,13 @@ class PolicyIterationCheck:
         the grader's steps bound only with `helpers = "grader"`)."""
         return self._calls(settings, seed, provided=settings.helpers == "grader")
 
-    def second_plan(self, settings: PolicyIterationConfig, first: Verdict, seed: int) -> list[Call]:
+    def second_plan(
+        self,
+        settings: PolicyIterationConfig,
+        first: Verdict,
+        functions: Mapping[str, FunctionInfo],
+        seed: int,
+    ) -> list[Call]:
         """The same calls with the grader's evaluation and improvement steps bound, when the student's own
         reading did not pass (`helpers = "student_then_grader"`); else none."""
         if settings.helpers != "student_then_grader" or first.status == "passed":

@@ -48,19 +48,19 @@ def test_the_second_reading_binds_the_editions_steps_only_when_the_first_did_not
 ) -> None:
     chosen = settings(edition, "policy_iteration")
     failed, passed = Verdict("failed", 0.0, "wrong"), Verdict("passed", 1.0, "right")
-    again = _check(edition).second_plan(chosen, failed, SEED)
+    again = _check(edition).second_plan(chosen, failed, {}, SEED)
     assert {call.provided for call in again} == {names}
     assert [call.args[0].name for call in again] == [call.args[0].name for call in _plan(edition)]
-    assert _check(edition).second_plan(chosen, passed, SEED) == []
+    assert _check(edition).second_plan(chosen, passed, {}, SEED) == []
     for status in ("error", "timeout", "missing"):
-        assert _check(edition).second_plan(chosen, Verdict(status, 0.0, "x"), SEED)
+        assert _check(edition).second_plan(chosen, Verdict(status, 0.0, "x"), {}, SEED)
 
 
 @pytest.mark.parametrize(("helpers", "provided"), [("grader", True), ("student", False)])
 def test_with_one_reading_chosen_there_is_no_second(helpers: str, provided: bool) -> None:
     chosen = settings("v2024", "policy_iteration", helpers=helpers)
     assert {bool(call.provided) for call in _plan("v2024", helpers=helpers)} == {provided}
-    assert _check().second_plan(chosen, Verdict("failed", 0.0, "wrong"), SEED) == []
+    assert _check().second_plan(chosen, Verdict("failed", 0.0, "wrong"), {}, SEED) == []
 
 
 def test_the_graders_reading_is_kept_only_when_it_is_better_and_the_feedback_says_which() -> None:
@@ -84,7 +84,7 @@ def test_the_judge_reads_the_reading_from_the_calls() -> None:
     """A call that bound the grader's steps says so, whatever the settings: the judge reads the calls."""
     check, chosen = _check(), settings("v2024", "policy_iteration")
     records = []
-    for call in check.second_plan(chosen, Verdict("failed", 0.0, "wrong"), SEED):
+    for call in check.second_plan(chosen, Verdict("failed", 0.0, "wrong"), {}, SEED):
         args = [arg.as_table() if hasattr(arg, "as_table") else arg for arg in call.args]
         records.append(CallRecord(outcome(call, wire(solutions.policy_iteration(*args))), []))
     verdict = check.judge(chosen, records)
