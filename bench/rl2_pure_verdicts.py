@@ -23,6 +23,7 @@ honest file.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import importlib.util
 import json
 import signal
@@ -34,6 +35,8 @@ from pathlib import Path
 from types import FrameType, ModuleType
 from typing import Any
 
+import numpy as np
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from grader.lab.assignment import load_config
@@ -43,7 +46,9 @@ from grader.sandbox.child.frames import MdpArgument, decode_value, encode_value
 from grader.sandbox.child.provided import PROVIDED
 from grader.sandbox.outcome import CallOutcome, OutcomeStatus
 
-HEADING = "## Second lab: the pure problems' false-fail and detection rates on the lab's kind of MDP (issue 43)"
+HEADING = (
+    "## Second lab: the pure problems' false-fail and detection rates on the lab's kind of MDP (issue 43)"
+)
 SUBMISSIONS = Path(__file__).resolve().parents[1] / "submissions"
 PURE = {
     "value_iteration",
@@ -90,13 +95,34 @@ def _outcome(call: Any, function: Callable[..., Any], seconds: float) -> CallOut
         signal.setitimer(signal.ITIMER_REAL, 0)
 
 
+_MADE: dict[tuple[Any, ...], CallOutcome] = {}
+"""Outcomes of calls already made, by module, function, arguments and names bound: the public cases are
+asked alike under every seed, and every sample's functions are deterministic (none draws its start)."""
+
+
+def _key(module: ModuleType, call: Any) -> tuple[Any, ...]:
+    args = tuple(
+        ("mdp", arg.table)
+        if isinstance(arg, MdpArgument)
+        else ("array", arg.tobytes(), str(arg.dtype))
+        if isinstance(arg, np.ndarray)
+        else arg
+        for arg in call.args
+    )
+    return (module.__name__, call.function, args, call.provided)
+
+
 def _reading(check: Any, chosen: Any, calls: list[Any], module: ModuleType, seconds: float) -> Verdict:
     """One reading's calls made in order (stopping at the first that does not return), then judged."""
     records = []
     for call in calls:
         function = getattr(module, call.function, None)
+        key = _key(module, call)
         if function is None:
-            outcome = CallOutcome(call, OutcomeStatus.MISSING_FUNCTION, None, [], [], "", "", f"no {call.function}", 0.0, 0)
+            message = f"no {call.function}"
+            outcome = CallOutcome(call, OutcomeStatus.MISSING_FUNCTION, None, [], [], "", "", message, 0.0, 0)
+        elif key in _MADE:
+            outcome = dataclasses.replace(_MADE[key], call=call)
         else:
             kept = {name: vars(module).get(name) for name in call.provided}
             vars(module).update({name: PROVIDED[name] for name in call.provided})
@@ -104,6 +130,7 @@ def _reading(check: Any, chosen: Any, calls: list[Any], module: ModuleType, seco
                 outcome = _outcome(call, function, seconds)
             finally:
                 vars(module).update(kept)
+            _MADE[key] = outcome
         records.append(CallRecord(outcome, []))
         if outcome.status is not OutcomeStatus.OK:
             break
@@ -125,10 +152,12 @@ def verdict(edition: str, problem: str, module: ModuleType, seed: int, seconds: 
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--first-seed", type=int, default=43_000)
-    parser.add_argument("--call-seconds", type=float, default=5.0)
+    parser.add_argument("--call-seconds", type=float, default=60.0)
     parser.add_argument("--write", action="store_true")
     args = parser.parse_args()
     signal.signal(signal.SIGALRM, _alarm)

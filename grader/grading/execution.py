@@ -2,6 +2,12 @@
 
 How a problem is run (`run_problem`):
 
+- **One reading, or two.** The check's planned calls are made in order (until the verdict can no longer
+  change) and judged. A check that is also a `SecondReading` may then ask, only when that verdict is not
+  a pass, for a second reading's calls (the second lab's policy_iteration and frozen_lake, made again
+  with the grader's own steps bound in place of the student's); they are made in the same sandbox, judged
+  by the same `judge`, and the check keeps the better verdict. Both readings' output and time count.
+
 - **No student CPU where no verdict needs it.** `run_problem` hands a plan the submission's functions on
   demand (`grader.grading.execution.FunctionsOnDemand`): the sandbox child starts (and imports the submission)
   only when the plan reads them or the first call is made, so a plan without calls costs no child.
