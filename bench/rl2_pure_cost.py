@@ -1,7 +1,8 @@
 """What grading the second lab's pure problems costs (issue 35): wall and student seconds per problem.
 
 Grades, through the real sandbox with each edition's default configuration, the honest files and the sample
-whose policy iteration never converges (its timeout is the problem's largest cost), and prints each
+whose policy iteration never converges on the lab's example (its two timeouts, one per reading, are the
+problem's largest cost), and prints each
 problem's calls, wall seconds (child start, import, every call, judging) and the seconds spent in the
 student's functions. Timings are measurements of this machine at this load, never assertions.
 
@@ -30,18 +31,19 @@ ROOT = Path(__file__).resolve().parents[1]
 HEADING = "## Second lab: the cost of the pure problems (issue 35)"
 DESCRIPTION = (
     "`python bench/rl2_pure_cost.py`: each file graded through the sandbox with its edition's default "
-    "configuration, grading seed 35 (the ten public MDPs and three held-out random ones drawn from each "
-    "problem's seed), 2 workers, on {cores} cores shared with other work. "
+    "configuration, grading seed 35 (the nine public MDPs of the lab's kind and three held-out random ones "
+    "drawn from each problem's seed), 2 workers, on {cores} cores shared with other work. "
     "Wall: the problem's child start, import, every call and judging; "
     "student: seconds inside the submission's functions. "
     "A problem's calls all run in its one child; "
-    "a call that times out (policy_iteration's zero start on the ring at discount 1, `call_seconds = 20`) "
+    "a call that times out (policy_iteration's alternating start on the lab's example at discount 1, "
+    "`call_seconds = 20`, once in each of its two readings: the student's own steps, then the grader's) "
     "restarts it for the next call."
 )
 FILES = (
     ("v2024", "submissions/rl2/honest_v2024.py"),
     ("v2018", "submissions/rl2/honest_v2018.py"),
-    ("v2026", "submissions/rl2/mistakes/policy_iteration_zero_start.py"),
+    ("v2026", "submissions/rl2/mistakes/policy_iteration_alternating_start.py"),
 )
 
 

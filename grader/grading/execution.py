@@ -2,6 +2,12 @@
 
 How a problem is run (`run_problem`):
 
+- **One reading, or two.** The check's planned calls are made in order (until the verdict can no longer
+  change) and judged. A check that is also a `SecondReading` may then ask, only when that verdict is not
+  a pass, for a second reading's calls (the second lab's policy_iteration and frozen_lake, made again
+  with the grader's own steps bound in place of the student's); they are made in the same sandbox, judged
+  by the same `judge`, and the check keeps the better verdict. Both readings' output and time count.
+
 - **No student CPU where no verdict needs it.** `run_problem` hands a plan the submission's functions on
   demand (`grader.grading.execution.FunctionsOnDemand`): the sandbox child starts (and imports the submission)
   only when the plan reads them or the first call is made, so a plan without calls costs no child.
@@ -26,11 +32,13 @@ import time
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 from grader.lab.assignment import AssignmentConfig
-from grader.lab.checks.base import CallRecord, Verdict
+from grader.lab.checks.base import CallRecord, ProblemCheck, SecondReading, Verdict
 from grader.lab.checks.integrity import replay_call, settled_by
 from grader.lab.registry import ProblemId
+from grader.lab.settings import ProblemConfig
 from grader.lab.showcase import showcase_episode
 from grader.report import (
     IsolationSummary,
@@ -42,6 +50,7 @@ from grader.report import (
     plain_json,
 )
 from grader.sandbox import (
+    Call,
     CallOutcome,
     CompatEventRecord,
     FunctionInfo,
@@ -136,24 +145,16 @@ def run_problem(
     check, settings = entry.check, entry.settings(config)
     seed = problem_seed(grading_seed, problem)
     limits = config.sandbox.to_limits(settings.call_seconds)
-    games = settings.game_rules()
-    records: list[CallRecord] = []
-    stopped: str | None = None
     with Sandbox(submission, seed=seed, limits=limits, policy=policy, shown_name=shown_name) as sandbox:
-        calls = check.plan(settings, FunctionsOnDemand(sandbox), seed)
-        for call in calls:
-            if call.function == RUN_CELLS:  # the cells are the submission's, known here, not to the plan
-                call = replace(call, args=(runnable_cells(submission),))
-            records.append(replay_call(sandbox.call(call), games))
-            stopped = settled_by(records[-1], games)
-            if stopped is not None:
-                break
+        planned = check.plan(settings, FunctionsOnDemand(sandbox), seed)
+        records, verdict = _reading(sandbox, submission, check, settings, planned)
+        if isinstance(check, SecondReading):
+            again = check.second_plan(settings, verdict, FunctionsOnDemand(sandbox), seed)
+            if again:
+                more, second = _reading(sandbox, submission, check, settings, again)
+                records, verdict = records + more, check.keep(settings, verdict, second)
         isolation = isolation_summary(sandbox.isolation)
     outcomes = [record.outcome for record in records]
-    verdict = check.judge(settings, records)
-    cells_failed = bool(records) and records[-1].outcome.call.function == RUN_CELLS  # the check says so
-    if stopped is not None and len(records) < len(calls) and not cells_failed:
-        verdict = _stopped_early(verdict, stopped, len(records), len(calls))
     wall_seconds = time.perf_counter() - started
     student_seconds = sum(outcome.wall_time for outcome in outcomes)
     fraction = min(max(verdict.fraction, 0.0), 1.0)
@@ -178,6 +179,31 @@ def run_problem(
         ),
     )
     return ProblemRun(submission=str(submission), result=result, isolation=isolation)
+
+
+def _reading(
+    sandbox: Sandbox,
+    submission: Path,
+    check: ProblemCheck[Any],
+    settings: ProblemConfig,
+    calls: Sequence[Call],
+) -> tuple[list[CallRecord], Verdict]:
+    """Make one reading's calls in order (until the verdict can no longer change) and judge them."""
+    games = settings.game_rules()
+    records: list[CallRecord] = []
+    stopped: str | None = None
+    for call in calls:
+        if call.function == RUN_CELLS:  # the cells are the submission's, known here, not to the plan
+            call = replace(call, args=(runnable_cells(submission),))
+        records.append(replay_call(sandbox.call(call), games))
+        stopped = settled_by(records[-1], games)
+        if stopped is not None:
+            break
+    verdict = check.judge(settings, records)
+    cells_failed = bool(records) and records[-1].outcome.call.function == RUN_CELLS  # the check says so
+    if stopped is not None and len(records) < len(calls) and not cells_failed:
+        verdict = _stopped_early(verdict, stopped, len(records), len(calls))
+    return records, verdict
 
 
 def _stopped_early(verdict: Verdict, reason: str, made: int, planned: int) -> Verdict:

@@ -404,6 +404,27 @@ def terminal_states(mdp: Mdp) -> IntArray:
     return np.flatnonzero(_absorbing(mdp)).astype(np.int64)
 
 
+def trapping_states(mdp: Mdp) -> IntArray:
+    """The states from which some policy never reaches a terminal state (empty: every policy ends).
+
+    The largest set C of non-terminal states in which every state has an action whose every outcome of
+    positive probability stays in C, found by removing, until none is left to remove, each state with no
+    such action. Exact for deterministic policies: if C is not empty, the policy that takes such an action
+    in every state of C never leaves it; if a deterministic policy can be trapped (some state of its chain
+    cannot reach a terminal state), the states its chain reaches from there form such a set, which no
+    removal takes away. A move with no outcome of positive probability (the lab's example writes its
+    impossible moves so) stays nowhere, so it cannot trap.
+    """
+    moves = mdp.transitions() > 0
+    inside = ~_absorbing(mdp)
+    while True:
+        stays = ~np.any(moves & ~inside[np.newaxis, np.newaxis, :], axis=2) & moves.any(axis=2)
+        kept = inside & stays.any(axis=1)
+        if np.array_equal(kept, inside):
+            return np.flatnonzero(inside).astype(np.int64)
+        inside = kept
+
+
 @dataclass(frozen=True)
 class PolicyJudgement:
     """How a policy compares with the optimum, state by state."""

@@ -1,18 +1,26 @@
 """The MDPs the second lab's functions are graded on, each with the discounts it is graded at.
 
+Every one is of the lab's kind: `P[s][a]` for FrozenLake's four actions (Left, Down, Right, Up), terminal
+states written as the lab writes them (the example's, FrozenLake's `[(1.0, s, 0, True)]`), and at discount 1
+only MDPs on which the lab's own iterative evaluation converges from every start policy the texts allow:
+the lab's example (its reward cycle 0 -> 1 -> 0 is the lab's own; the all-zeros and all-ones starts
+converge there), FrozenLake (its only reward is the goal, so a policy that never ends has the value 0), and
+MDPs of the grader's make on which every policy ends its episodes (`reference.oracles.mdp.trapping_states`
+is empty). An MDP on which some policy loops forever through rewards is never asked at discount 1: a start
+policy the text allows would never converge on an input the lab never gives.
+
 The lab's worked example alone would let a file that hard-codes its answers, or that reads only the first
 outcome of each move, or that forgets the discount, pass. So the grader also owns: FrozenLake 4x4 and 8x8,
 deterministic and slippery, built here from their maps exactly as gymnasium 1.4 builds them (the side slips
 are `(1 - 1/3) / 2 = 0.33333333333333337`, the intended move `1/3`, outcomes listed left of the intended
-move, the move, right of it, duplicates kept); a windy corridor (stochastic, rewards on every step,
-graded below discount 1) and a ring (stochastic, negative rewards, where the all-zeros start policy of
-policy iteration loops forever at discount 1 while the lab's all-ones start ends).
+move, the move, right of it, duplicates kept); and a windy 2x3 grid (`windy_grid`: four outcomes per move,
+rewards on every step, a wind that ends every policy's walk), graded at discount 1 and 0.8.
 
-Those ten cases are public (they are in this file), so a file could memorise their answers. A grading seed
-therefore adds held-out cases (`held_out_cases(seed)`): random MDPs of varied size drawn from the seed
-(`random_mdp`), each with terminal states, stochastic moves of one to three outcomes and rewards on every
-move, graded below discount 1 so that every policy has a finite value, value iteration contracts and no
-policy's evaluation can loop forever. `grading_cases(seed)` is the public cases followed by those.
+Those nine cases are public (they are in this file), so a file could memorise their answers. A grading seed
+therefore adds held-out cases (`held_out_cases(seed)`): random MDPs of the lab's shape and of varied size
+drawn from the seed (`random_mdp`), each with terminal states, stochastic moves of one to three outcomes,
+rewards on every move and a first outcome that leads closer to the end (so every policy ends), graded below
+discount 1. `grading_cases(seed)` is the public cases followed by those.
 """
 
 from __future__ import annotations
@@ -107,72 +115,108 @@ def frozen_lake(map_name: str, *, slippery: bool) -> Mdp:
     return Mdp(f"FrozenLake {map_name} ({kind})", tuple(table))
 
 
-def windy_corridor() -> Mdp:
-    """Seven cells in a row and an exit (state 7): a gust may push the walker back.
+GRID_COLUMNS = 3
+"""The windy grid's width: two rows of three cells, states numbered row by row as FrozenLake's."""
+GRID_HOLE, GRID_GOAL = 4, 5
+"""The windy grid's terminal states."""
+GRID_MOVE, GRID_SLIP, GRID_WIND = 0.7, 0.1, 0.1
+"""The windy grid's chances: the move asked for, a slip to either side of it, the wind's push."""
 
-    Action 0 walks left: from cell 0 it leaves through the small door (reward 1, episode over); elsewhere it
-    moves one cell left (reward -0.1). Action 1 walks right against the wind: it moves right with probability
-    0.7 (reward -0.1, or 10 when it leaves through the big door after cell 6), stays with probability 0.2
-    (reward -0.2) and is blown one cell left with probability 0.1 (reward -0.3). Every move pays a reward, so
-    a discount counted from the wrong step changes every value; every rightward move has three outcomes with
-    three rewards, so reading one outcome, or overwriting instead of adding, changes them too.
+
+def windy_grid() -> Mdp:
+    """Six states on a 2x3 grid with four actions, a hole, a goal and a wind that ends every walk.
+
+        0 1 2
+        3 H G      H (state 4): a hole, entering it pays -1; G (state 5): the goal, entering it pays 2.
+
+    A move from a live state (0 to 3) has four outcomes, listed as FrozenLake lists its slips and then the
+    wind: a slip to the left of the move asked for (0.1), the move (0.7), a slip to its right (0.1), and the
+    wind (0.1), which carries the walker one cell east, or from the east column down into the goal. A move
+    into the edge stays put. Every step that does not end the episode pays -0.1. The terminal states hold
+    `[(1.0, s, 0, True)]` for every action, as FrozenLake's holes and goal do.
+
+    The wind leads from every live state closer to an end (0 -> 1 -> 2 -> G, 3 -> H) whatever the action,
+    so every policy ends its episodes with probability 1 (`trapping_states` is empty) and has a finite value
+    at discount 1: the lab's iterative evaluation converges from any start policy. Rewards on every step, four
+    outcomes with different rewards and probabilities (the first is not the last) and a discount that trades
+    the hole's risk against the walk's cost make a discount from the wrong step, the first or last outcome
+    alone, and a discount ignored all change the values.
     """
-    cells, exit_state = 7, 7
+    rows = 2
+    terminal = {GRID_HOLE, GRID_GOAL}
+
+    def moved(state: int, action: int) -> int:
+        row, column = divmod(state, GRID_COLUMNS)
+        if action == LEFT:
+            column = max(column - 1, 0)
+        elif action == DOWN:
+            row = min(row + 1, rows - 1)
+        elif action == RIGHT:
+            column = min(column + 1, GRID_COLUMNS - 1)
+        else:
+            row = max(row - 1, 0)
+        return row * GRID_COLUMNS + column
+
+    def blown(state: int) -> int:
+        row, column = divmod(state, GRID_COLUMNS)
+        return state + 1 if column < GRID_COLUMNS - 1 else (row + 1) * GRID_COLUMNS + column
+
+    def outcome(probability: float, target: int) -> Outcome:
+        reward = {GRID_HOLE: -1.0, GRID_GOAL: 2.0}.get(target, -0.1)
+        return (probability, target, reward, target in terminal)
+
     table: list[Actions] = []
-    for cell in range(cells):
-        left = ((1.0, exit_state, 1.0, True),) if cell == 0 else ((1.0, cell - 1, -0.1, False),)
-        ahead = (0.7, exit_state, 10.0, True) if cell == cells - 1 else (0.7, cell + 1, -0.1, False)
-        right = (ahead, (0.2, cell, -0.2, False), (0.1, max(cell - 1, 0), -0.3, False))
-        table.append((left, right))
-    table.append((((1.0, exit_state, 0.0, True),), ((1.0, exit_state, 0.0, True),)))
-    return Mdp("a windy corridor", tuple(table))
+    for state in range(rows * GRID_COLUMNS):
+        if state in terminal:
+            table.append(tuple(((1.0, state, 0.0, True),) for _ in range(4)))
+            continue
+        table.append(
+            tuple(
+                (
+                    outcome(GRID_SLIP, moved(state, (action - 1) % 4)),
+                    outcome(GRID_MOVE, moved(state, action)),
+                    outcome(GRID_SLIP, moved(state, (action + 1) % 4)),
+                    outcome(GRID_WIND, blown(state)),
+                )
+                for action in range(4)
+            )
+        )
+    return Mdp("a windy 2x3 grid", tuple(table))
 
 
-def ring() -> Mdp:
-    """Four states on a ring and an exit (state 4), with four actions.
-
-    Action 0 walks on to the next state of the ring at a cost (reward -1): a policy of walking never ends.
-    Action 1 leaves at once with a reward equal to the state's number. Action 2 gambles: with probability 0.5
-    it leaves with reward 3, otherwise it moves two states on (reward 0). Action 3 waits where it is (reward
-    -0.5). At discount 1 every policy that never ends has no finite value, so the optimum is unique.
-    """
-    states, exit_state = 4, 4
-    table: list[Actions] = []
-    for state in range(states):
-        walk = ((1.0, (state + 1) % states, -1.0, False),)
-        leave = ((1.0, exit_state, float(state), True),)
-        gamble = ((0.5, exit_state, 3.0, True), (0.5, (state + 2) % states, 0.0, False))
-        wait = ((1.0, state, -0.5, False),)
-        table.append((walk, leave, gamble, wait))
-    table.append(tuple(((1.0, exit_state, 0.0, True),) for _ in range(4)))
-    return Mdp("a ring with an exit", tuple(table))
+RANDOM_ACTIONS = 4
+"""A random MDP's actions: FrozenLake's four, as every MDP of the lab has."""
 
 
 def random_mdp(draw: np.random.Generator, name: str) -> Mdp:
-    """A random MDP: 6 to 14 states, 2 to 4 actions, the last 1 or 2 states terminal (a zero-reward self-loop
-    per action, as FrozenLake's holes and goal), every other move with 1 to 3 outcomes to distinct states (2
-    or 3 for action 0, so every state has a stochastic move).
+    """A random MDP of the lab's shape: 6 to 14 states, FrozenLake's four actions, the last 1 or 2 states
+    terminal (`[(1.0, s, 0, True)]` for every action, as FrozenLake's holes and goal), every other move with 1
+    to 3 outcomes to distinct states (2 or 3 for action 0, so every state has a stochastic move).
 
+    The first outcome of every move leads to a state of a higher number (a terminal one from the last live
+    state), so from every state every action may bring the walker closer to a terminal state: every policy
+    ends its episodes with probability 1 (`trapping_states` is empty) and has a finite value at any discount.
     Probabilities are Dirichlet(1) draws and rewards uniform on [-1, 1] (a terminal outcome's on [-1, 2]),
     continuous, so two actions tie only with probability 0: a correct greedy step has one answer. `done` is
     True exactly on moves into a terminal state. Every row's probabilities sum to 1 up to rounding.
     """
     n_states = int(draw.integers(6, 15))
-    n_actions = int(draw.integers(2, 5))
     n_terminal = int(draw.integers(1, 3))
     terminal = set(range(n_states - n_terminal, n_states))
     table: list[Actions] = []
     for state in range(n_states):
         if state in terminal:
-            table.append(tuple(((1.0, state, 0.0, True),) for _ in range(n_actions)))
+            table.append(tuple(((1.0, state, 0.0, True),) for _ in range(RANDOM_ACTIONS)))
             continue
         actions: list[tuple[Outcome, ...]] = []
-        for action in range(n_actions):
+        for action in range(RANDOM_ACTIONS):
             count = int(draw.integers(2 if action == 0 else 1, 4))  # some move of every state is stochastic
-            targets = draw.choice(n_states, size=count, replace=False)
+            ahead = int(draw.integers(state + 1, n_states))  # a step closer to the end, whatever the policy
+            others = [s for s in range(n_states) if s != ahead]
+            targets = [ahead, *draw.choice(others, size=count - 1, replace=False).tolist()]
             weights = draw.dirichlet(np.ones(count)) if count > 1 else np.ones(1)
             outcomes = []
-            for target, weight in zip(targets.tolist(), weights.tolist(), strict=True):
+            for target, weight in zip(targets, weights.tolist(), strict=True):
                 ends = target in terminal
                 reward = float(draw.uniform(-1.0, 2.0 if ends else 1.0))
                 outcomes.append((float(weight), int(target), reward, ends))
@@ -226,11 +270,11 @@ def held_out_cases(seed: int) -> tuple[GradingCase, ...]:
 def grading_cases(seed: int | None = None) -> tuple[GradingCase, ...]:
     """Every MDP and discount the second lab's pure functions are graded on, the lab's example first.
 
-    Without a seed, the ten public cases; with a problem's seed, those and `held_out_cases(seed)`.
+    Without a seed, the nine public cases; with a problem's seed, those and `held_out_cases(seed)`.
     """
     if seed is not None:
         return (*grading_cases(), *held_out_cases(seed))
-    example, corridor, circle = lab_example(), windy_corridor(), ring()
+    example, grid = lab_example(), windy_grid()
     lake4, lake8 = frozen_lake("4x4", slippery=True), frozen_lake("8x8", slippery=True)
     still4, still8 = frozen_lake("4x4", slippery=False), frozen_lake("8x8", slippery=False)
     return (
@@ -251,9 +295,11 @@ def grading_cases(seed: int | None = None) -> tuple[GradingCase, ...]:
             "deterministic, larger; below discount 1, since at 1 almost every move ties and the lab's own "
             "first-argmax policy walks into a wall forever",
         ),
-        GradingCase("corridor_0.95", corridor, 0.95, "rewards on every step and three outcomes per move"),
         GradingCase(
-            "ring", circle, 1.0, "negative rewards; all-zeros starts of policy iteration loop forever"
+            "grid",
+            grid,
+            1.0,
+            "rewards on every step, four outcomes per move; every policy ends, so any start converges",
         ),
-        GradingCase("ring_0.8", circle, 0.8, "the same ring discounted: the best action changes"),
+        GradingCase("grid_0.8", grid, 0.8, "the same grid discounted: the walk's cost weighs less"),
     )

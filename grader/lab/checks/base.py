@@ -6,7 +6,7 @@ import functools
 import gc
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, ParamSpec, Protocol, TypeVar
+from typing import TYPE_CHECKING, ParamSpec, Protocol, TypeVar, runtime_checkable
 
 from grader.lab.ids import ProblemId
 from grader.lab.settings import ProblemConfig
@@ -20,6 +20,7 @@ __all__ = [
     "CallRecord",
     "ProblemCheck",
     "ProblemId",
+    "SecondReading",
     "Status",
     "Verdict",
     "judged_when_all_returned",
@@ -86,6 +87,52 @@ class ProblemCheck(Protocol[ConfigT_contra]):
         """The verdict for the planned calls' records (same order as planned; each record's `outcome.call` is
         the parent's planned call, so what a call was asked can be read from it)."""
         ...
+
+
+@runtime_checkable
+class SecondReading(Protocol[ConfigT_contra]):
+    """A check that may judge its problem a second way when the first verdict is not full marks.
+
+    The second lab's `policy_iteration` and `frozen_lake` call the student's other functions; a mistake in
+    those counts in their own problems, so when the student's own functions give a verdict short of full
+    marks, the problem is judged again with the grader's own definitions bound in their place
+    (`Call.provided`) and the better verdict is kept. "A mistake counts once" only ever helps: the first
+    reading is always the student's own. The runner (`grader.grading.execution.run_problem`) makes the
+    second reading's calls in the same sandbox after the first verdict, only when `second_plan` asks for
+    them, and judges them with the same `judge`.
+    """
+
+    def second_plan(
+        self, settings: ConfigT_contra, first: Verdict, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
+        """The calls of the second reading, or [] when the first verdict stands (`functions` and `seed` as
+        `ProblemCheck.plan` gets them)."""
+        ...
+
+    def keep(self, settings: ConfigT_contra, first: Verdict, second: Verdict) -> Verdict:
+        """The verdict kept of the two readings (the better), its feedback saying which reading gave it."""
+        ...
+
+
+def better_reading(first: Verdict, second: Verdict) -> Verdict:
+    """The better of a `SecondReading` check's two verdicts, the feedback saying which reading gave it.
+
+    The second (the grader's functions in place of the student's) is kept only when it earns more of the
+    points; ties keep the student's own. Each verdict's feedback already says how its calls were made.
+    """
+    if second.fraction > first.fraction:
+        return Verdict(
+            second.status,
+            second.fraction,
+            f"{second.feedback} (With your own functions it was {first.status}: {first.feedback})",
+            {**second.measurements, "reading": "grader", "own_reading_status": first.status},
+        )
+    return Verdict(
+        first.status,
+        first.fraction,
+        f"{first.feedback} (Judged again with the grader's own functions in place of yours, it was {second.status}; the better reading is kept.)",  # noqa: E501
+        {**first.measurements, "reading": "own", "grader_reading_status": second.status},
+    )
 
 
 def paused_gc(judge: Callable[P, R]) -> Callable[P, R]:

@@ -18,7 +18,8 @@ How its parts fit:
   (`grader.lab.games`: the FrozenLake games) as the first lab's are.
 - The MDP reaches the student's function as `grader.sandbox.outcome.MdpArgument` (declared by the child in
   `grader/sandbox/child/frames.py`): plain lists on the wire, a fresh `{s: {a: [(p, s', r, done), ...]}}` at
-  every call. `policy_iteration` may call the grader's own evaluation and improvement steps
-  (`grader/sandbox/child/provided.py`, `helpers = "grader"`).
+  every call. `policy_iteration` and `frozen_lake` are judged with the student's own functions first and,
+  only when that does not pass, again with the grader's own steps bound in their place
+  (`grader/sandbox/child/provided.py`; `grader.lab.checks.base.SecondReading`), the better verdict kept.
 - What each check calls and how it judges: `grader/lab/rl2/ASSIGNMENT.md`.
 """

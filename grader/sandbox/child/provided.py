@@ -6,8 +6,11 @@ child bind these for the duration of the call. The second lab's `policy_iteratio
 evaluation and improvement steps by their edition's names (`compute_policy_v`/`extract_policy` to 2023,
 `iter_policy_eval`/`policy_improvement` since 2024): the grader's are the lab's algorithms, iterative
 evaluation from zeros until a sweep changes V by less than tol (so a start policy that never ends its
-episodes at discount 1 still never converges) and the first best action. Stdlib and numpy only: the child
-imports it.
+episodes at discount 1 still never converges) and the first best action. Its `frozen_lake` calls the
+solvers and `run_simulation`: the lab's value iteration, policy iteration (from the all-ones start of the
+2023 texts) and one episode of a policy, discounted from k = 0, in the env the caller made and reset here.
+They are bound only for a second reading, after the student's own functions gave a verdict short of full
+marks (`grader.lab.checks.base.SecondReading`). Stdlib and numpy only: the child imports it.
 """
 
 from __future__ import annotations
@@ -73,11 +76,73 @@ def iter_policy_eval(
             return values
 
 
+def value_iteration(
+    P: Table, nS: int, nA: int, beta: float = 1.0, tol: float = 1e-8, maxiter: int = 3000, *_: Any, **__: Any
+) -> tuple[np.ndarray, int]:
+    """The lab's value iteration: Bellman optimality sweeps from V = 0 until a sweep changes V by < tol;
+    `(V, sweeps made)`, the last sweep counted."""
+    values = np.zeros(nS)
+    for sweep in range(1, maxiter + 1):
+        look = np.zeros((nS, nA))
+        for state in range(nS):
+            for action in range(nA):
+                for probability, next_state, reward, _terminal in P[state][action]:
+                    look[state, action] += probability * (reward + beta * values[next_state])
+        updated = look.max(axis=1)
+        change = float(np.max(np.abs(updated - values)))
+        values = updated
+        if change < tol:
+            return values, sweep
+    return values, maxiter
+
+
+def policy_iteration(
+    P: Table, nS: int, nA: int, beta: float = 1.0, tol: float = 1e-8, maxiter: int = 200, *_: Any, **__: Any
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """The lab's policy iteration from the all-ones start: evaluate, improve, until the policy stays;
+    `(V, policy, iterations)`."""
+    policy = np.ones(nS, dtype=np.int64)
+    values = np.zeros(nS)
+    for iteration in range(1, maxiter + 1):
+        values = iter_policy_eval(P, nS, nA, policy, beta, tol)
+        improved = policy_improvement(P, nS, nA, values, beta)
+        if np.array_equal(improved, policy):
+            return values, policy, iteration
+        policy = improved
+    return values, policy, maxiter
+
+
+def run_simulation(env: Any, policy: Any, *args: Any, **kwargs: Any) -> float:
+    """One episode of `policy` in `env`, reset here and left open: `sum beta**k * r_k` from k = 0.
+
+    Takes 2019-2022's `(env, policy, render=True, beta=1.0)` and the other editions' `(env, policy,
+    beta=1.0)`: a bool third argument is `render` (nothing is drawn). Whichever API the env serves its
+    caller (the classic observation and four results of a step, or gym 0.26's pairs and five), the episode
+    runs until it ends (terminated, or truncated by a time limit).
+    """
+    rest = [value for value in args if type(value) is not bool]
+    beta = float(kwargs.get("beta", rest[0] if rest else 1.0))
+    actions = np.asarray(policy).reshape(-1)
+    started = env.reset()
+    state = started[0] if isinstance(started, tuple) else started
+    total, weight, ended = 0.0, 1.0, False
+    while not ended:
+        result = env.step(int(actions[int(state)]))
+        state, reward = result[0], float(result[1])
+        ended = bool(result[2]) or (len(result) == 5 and bool(result[3]))
+        total += weight * reward
+        weight *= beta
+    return total
+
+
 PROVIDED: dict[str, Callable[..., Any]] = {
     "epsilon_decay": epsilon_decay,
     "policy_improvement": policy_improvement,
     "extract_policy": extract_policy,
     "iter_policy_eval": iter_policy_eval,
     "compute_policy_v": iter_policy_eval,
+    "value_iteration": value_iteration,
+    "policy_iteration": policy_iteration,
+    "run_simulation": run_simulation,
 }
 """The names a call may provide, and the grader's definition of each."""

@@ -33,8 +33,7 @@ from reference.oracles.mdps import (
     frozen_lake,
     grading_cases,
     lab_example,
-    ring,
-    windy_corridor,
+    windy_grid,
 )
 
 Z_LIMIT = 5.0
@@ -166,12 +165,13 @@ def test_ties_are_judged_by_value_not_by_the_list() -> None:
 
 
 def test_a_policy_that_loops_through_rewards_has_no_value() -> None:
-    walking = [0, 0, 0, 0, 0]
+    # On the lab's example, right from state 0 and left from state 1 walk 0 -> 1 -> 0 at a cost of 1 a lap.
+    looping = [2, 0, 2, 0]
     with pytest.raises(UnboundedValueError, match="loops forever through nonzero rewards"):
-        policy_value(ring(), walking, 1.0)
-    judgement = judge_policy(ring(), walking, 1.0)
-    assert not judgement.optimal and np.isinf(judgement.shortfall[:4]).all()
-    assert policy_value(ring(), walking, 0.5).tolist() == pytest.approx([-2, -2, -2, -2, 0])
+        policy_value(lab_example(), looping, 1.0)
+    judgement = judge_policy(lab_example(), looping, 1.0)
+    assert not judgement.optimal and np.isinf(judgement.shortfall[:2]).all()
+    assert policy_value(lab_example(), looping, 0.5).tolist() == pytest.approx([-2 / 3, -4 / 3, 1, 0])
 
 
 def test_a_zero_reward_loop_is_worth_nothing_at_discount_1() -> None:
@@ -179,16 +179,18 @@ def test_a_zero_reward_loop_is_worth_nothing_at_discount_1() -> None:
     assert policy_value(frozen_lake("4x4", slippery=False), [0] * 16, 1.0).tolist() == [0.0] * 16
 
 
-def test_the_corridor_policy_value_against_plain_iteration() -> None:
-    corridor = windy_corridor()
-    policy = [1, 0, 1, 1, 0, 1, 1, 0]
-    values = [0.0] * corridor.n_states
+@pytest.mark.parametrize("beta", [1.0, 0.8])
+def test_the_grid_policy_value_against_plain_iteration(beta: float) -> None:
+    """Every policy of the windy grid ends, so plain iteration converges even at discount 1."""
+    grid = windy_grid()
+    policy = [3, 0, 3, 0, 0, 0]  # up and left, against the wind: only the wind ends the walk
+    values = [0.0] * grid.n_states
     for _ in range(5_000):
         values = [
-            sum(p * (r + 0.95 * values[s]) for p, s, r, _ in corridor.table[state][policy[state]])
-            for state in range(8)
+            sum(p * (r + beta * values[s]) for p, s, r, _ in grid.table[state][policy[state]])
+            for state in range(grid.n_states)
         ]
-    np.testing.assert_allclose(policy_value(corridor, policy, 0.95), values, atol=1e-12)
+    np.testing.assert_allclose(policy_value(grid, policy, beta), values, atol=1e-12)
 
 
 def _monte_carlo(

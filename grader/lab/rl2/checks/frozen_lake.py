@@ -24,20 +24,26 @@ the grader compares it with what the student's own `value_iteration` (its greedy
 `policy_iteration` return on the same lake (called in the same sandbox); when they agree, frozen_lake wired
 the lab's steps right and passes, the feedback saying which reading was used (the mistake is graded in
 value_iteration or policy_iteration).
+
+A second reading (`grader.lab.checks.base.SecondReading`): only when that verdict is not a pass, both lakes'
+frozen_lake calls are made again with the grader's own `value_iteration`, `policy_iteration`,
+`run_simulation` and improvement and evaluation steps (`grader.sandbox.child.provided`) bound in place of the
+student's, and the better verdict is kept, the feedback saying which reading gave it: a frozen_lake that
+wires the lab's steps right is not failed for a mistake (or a missing function) graded in another problem.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 from typing import Literal
 
 import numpy as np
 from pydantic import Field
 
-from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.lab.checks.base import CallRecord, Verdict, better_reading, outcome_verdict, paused_gc
 from grader.lab.checks.integrity import (
     NO_EPISODES,
     Episode,
@@ -55,6 +61,17 @@ from reference.oracles.mdp import Mdp, greedy_gaps, judge_policy, optimal_soluti
 from reference.oracles.mdps import frozen_lake as lake_mdp
 
 Shape = Literal["five", "six"]
+STEPS_PROVIDED = (
+    "value_iteration",
+    "policy_iteration",
+    "run_simulation",
+    "extract_policy",
+    "compute_policy_v",
+    "policy_improvement",
+    "iter_policy_eval",
+)
+"""What the second reading binds: the functions frozen_lake calls, under every edition's names."""
+GRADERS_READING = "frozen_lake was called with the grader's own value_iteration, policy_iteration, run_simulation and improvement and evaluation steps (the lab's algorithms) in place of yours, so a mistake in those counts only in their own problems."  # noqa: E501
 LAKE_STEPS = 200
 """Steps per episode the budget allows for (gym.make's limit on 8x8; longer episodes are played by `.env`
 users and loops on `terminated` only, and the budget's slack covers them)."""
@@ -151,9 +168,29 @@ class FrozenLakeCheck:
             calls.append(Call("policy_iteration", (table, *size), budget=NO_EPISODES))
         return calls
 
+    def second_plan(
+        self, settings: FrozenLakeConfig, first: Verdict, functions: Mapping[str, FunctionInfo], seed: int
+    ) -> list[Call]:
+        """Both lakes' frozen_lake calls again, the grader's steps bound, when the first did not pass."""
+        if first.status == "passed":
+            return []
+        played = self.plan(settings, functions, seed)[: len(LAKES)]
+        return [replace(call, provided=STEPS_PROVIDED) for call in played]
+
+    def keep(self, settings: FrozenLakeConfig, first: Verdict, second: Verdict) -> Verdict:
+        """The better of the two readings, the student's own on a tie."""
+        return better_reading(first, second)
+
     @paused_gc
     def judge(self, settings: FrozenLakeConfig, records: Sequence[CallRecord]) -> Verdict:
         """Judge both calls; the solver calls only explain a non-optimal answer (the own reading)."""
+        verdict = self._judged(settings, records)
+        if any(record.outcome.call.provided for record in records):
+            feedback = f"{verdict.feedback} {GRADERS_READING}"
+            return Verdict(verdict.status, verdict.fraction, feedback, verdict.measurements)
+        return verdict
+
+    def _judged(self, settings: FrozenLakeConfig, records: Sequence[CallRecord]) -> Verdict:
         played = [record for record in records if record.outcome.call.function == self.function]
         own = [record for record in records if record.outcome.call.function != self.function]
         early = outcome_verdict(played)

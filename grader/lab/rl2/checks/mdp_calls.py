@@ -1,9 +1,9 @@
 """What the second lab's pure problems share: the MDPs they are called on, how a returned value is read, and
 the tolerance the lab's own algorithm earns at the `tol` it is passed.
 
-The MDPs are `reference.oracles.mdps.grading_cases(seed)` (the lab's example and the grader's own: FrozenLake
-4x4/8x8 slippery and deterministic, a windy corridor, a ring; discounts 1, 0.95, 0.9 and 0.8; then random
-MDPs drawn from the problem's seed, held out), each passed
+The MDPs are `reference.oracles.mdps.grading_cases(seed)`, all of the lab's kind (the lab's example,
+FrozenLake 4x4/8x8 slippery and deterministic, a windy 2x3 grid on which every policy ends; discounts 1, 0.9
+and 0.8; then random MDPs of the lab's shape drawn from the problem's seed, held out), each passed
 as an `MdpArgument` (the child hands the function a fresh `{s: {a: [(p, s', r, done), ...]}}`), with `nS`
 and `nA` as plain ints, positionally as the templates order the parameters.
 

@@ -9,13 +9,19 @@ tolerance an iterative evaluation of the returned policy earns at that tol
 convention for it).
 
 **Which evaluation and improvement.** The student's policy_iteration calls its evaluation and improvement
-steps by name. With `helpers = "grader"` (the default) each call binds the grader's own (the lab's
-algorithms, `grader.sandbox.child.provided`) in their place, so a mistake there counts only in its own
-problem; with `helpers = "student"` the submission's own are used. The feedback says which.
+steps by name. With `helpers = "student_then_grader"` (the default) it is judged first as written, with the
+submission's own; only when that verdict is not a pass is it judged again with the grader's own (the lab's
+algorithms, `grader.sandbox.child.provided`) bound in their place for each call, and the better verdict is
+kept (`grader.lab.checks.base.SecondReading`): a mistake in those steps counts in their own problems, and a
+policy_iteration written for its own steps (one that unpacks its own `V, n = compute_policy_v(...)`, or
+passes its own policy representation) is never judged against steps it was not written for. `"grader"`
+binds the grader's in every call, `"student"` never. The feedback says which reading gave the verdict.
 
-**A start that never converges.** At discount 1 a start policy that loops forever through costly moves
-(all zeros on the ring) has no finite value, so its iterative evaluation never stops: the call reaches its
-time limit (`call_seconds`) and the problem is `timeout`, named; the other problems are graded as usual.
+**A start that never converges.** Every MDP asked at discount 1 is the lab's own or lets every policy end
+(`reference.oracles.mdps`), so every start the texts allow converges but one: on the lab's own example a
+start policy that walks 0 -> 1 -> 0 (right, then left, at a cost of 1 a lap) has no finite value, and its
+iterative evaluation never stops. The call reaches its time limit (`call_seconds`) and the problem is
+`timeout`, named; the other problems are graded as usual.
 """
 
 from __future__ import annotations
@@ -27,7 +33,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.lab.checks.base import CallRecord, Verdict, better_reading, outcome_verdict, paused_gc
 from grader.lab.rl2.checks.evaluation import evaluation_tolerance
 from grader.lab.rl2.checks.mdp_calls import (
     as_count,
@@ -44,7 +50,7 @@ from grader.lab.rl2.checks.mdp_calls import (
 from grader.lab.settings import ProblemConfig
 from grader.sandbox.outcome import Call, FunctionInfo, OutcomeStatus, PlainValue
 from reference.errors import UnboundedValueError
-from reference.oracles.mdp import judge_policy, policy_value
+from reference.oracles.mdp import judge_policy, policy_value, trapping_states
 from reference.oracles.mdps import GradingCase
 
 FUNCTION = "policy_iteration"
@@ -57,9 +63,9 @@ class PolicyIterationConfig(ProblemConfig):
     maxiter: int = Field(
         default=200, ge=10, le=10_000, description="The maxiter passed (the lab's default 200)."
     )
-    helpers: Literal["grader", "student"] = Field(
-        default="grader",
-        description="'grader': each call binds the grader's own evaluation and improvement steps in place of the submission's, so a mistake there counts only in its own problem; 'student': the submission's own.",  # noqa: E501
+    helpers: Literal["student_then_grader", "grader", "student"] = Field(
+        default="student_then_grader",
+        description="'student_then_grader': judged with the submission's own evaluation and improvement steps, then, only if that verdict is not a pass, again with the grader's own in their place, the better verdict kept; 'grader': the grader's own in every call; 'student': the submission's own only.",  # noqa: E501
     )
 
 
@@ -69,10 +75,11 @@ BETA_AT = 3
 
 @dataclass(frozen=True)
 class PolicyIterationCheck:
-    """One call per graded MDP; the policy judged by its exact value, V against the optimum.
+    """One call per graded MDP; the policy judged by its exact value, V against the optimum. A
+    `SecondReading`: judged again with the grader's steps when the student's own do not pass.
 
     Attributes:
-        evaluation: The edition's name of the evaluation step (bound to the grader's with helpers="grader").
+        evaluation: The edition's name of the evaluation step (the grader's bound in the second reading).
         improvement: The edition's name of the improvement step.
     """
 
@@ -82,25 +89,46 @@ class PolicyIterationCheck:
     def plan(
         self, settings: PolicyIterationConfig, functions: Mapping[str, FunctionInfo], seed: int
     ) -> list[Call]:
-        """`policy_iteration(P, nS, nA, beta, tol, maxiter)` on every case, positionally."""
-        provided = (self.evaluation, self.improvement) if settings.helpers == "grader" else ()
+        """`policy_iteration(P, nS, nA, beta, tol, maxiter)` on every case, positionally (the first reading:
+        the grader's steps bound only with `helpers = "grader"`)."""
+        return self._calls(settings, seed, provided=settings.helpers == "grader")
+
+    def second_plan(
+        self,
+        settings: PolicyIterationConfig,
+        first: Verdict,
+        functions: Mapping[str, FunctionInfo],
+        seed: int,
+    ) -> list[Call]:
+        """The same calls with the grader's evaluation and improvement steps bound, when the student's own
+        reading did not pass (`helpers = "student_then_grader"`); else none."""
+        if settings.helpers != "student_then_grader" or first.status == "passed":
+            return []
+        return self._calls(settings, seed, provided=True)
+
+    def keep(self, settings: PolicyIterationConfig, first: Verdict, second: Verdict) -> Verdict:
+        """The better of the two readings, the student's own on a tie."""
+        return better_reading(first, second)
+
+    def _calls(self, settings: PolicyIterationConfig, seed: int, *, provided: bool) -> list[Call]:
+        names = (self.evaluation, self.improvement) if provided else ()
         calls = []
         for case in cases(seed):
             call = mdp_call(FUNCTION, case, case.beta, settings.tol, settings.maxiter)
             calls.append(
-                Call(call.function, call.args, record_episodes=True, budget=call.budget, provided=provided)
+                Call(call.function, call.args, record_episodes=True, budget=call.budget, provided=names)
             )
         return calls
 
-    def _reading(self, settings: PolicyIterationConfig) -> str:
-        if settings.helpers == "grader":
+    def _reading(self, records: Sequence[CallRecord]) -> str:
+        if any(record.outcome.call.provided for record in records):
             return f"policy_iteration was called with the grader's own {self.evaluation} and {self.improvement} (the lab's algorithms) in place of yours, so a mistake in those counts only in their own problems."  # noqa: E501
         return f"policy_iteration was called with your own {self.evaluation} and {self.improvement}."
 
     @paused_gc
     def judge(self, settings: PolicyIterationConfig, records: Sequence[CallRecord]) -> Verdict:
         """Each policy optimal by its exact value, V the optimal values, n a whole number of iterations."""
-        reading = self._reading(settings)
+        reading = self._reading(records)
         early = outcome_verdict(records)
         if early is not None:
             if early.status == "timeout":
@@ -115,7 +143,7 @@ class PolicyIterationCheck:
         measurements: dict[str, PlainValue] = {
             "mdps_graded": len(graded),
             "calls_wrong": len(problems),
-            "helpers": settings.helpers,
+            "helpers": "grader" if any(record.outcome.call.provided for record in records) else "student",
         }
         if not problems:
             return Verdict(
@@ -157,9 +185,9 @@ class PolicyIterationCheck:
     def _timeout(self, early: Verdict, records: Sequence[CallRecord], reading: str) -> Verdict:
         index = next(i for i, r in enumerate(records) if r.outcome.status is OutcomeStatus.TIMEOUT)
         case = called_case(records[index].outcome.call, BETA_AT)
-        if case.beta < 1:
+        if case.beta < 1 or trapping_states(case.mdp).size == 0:  # every policy has a value there
             return Verdict(early.status, early.fraction, f"{early.feedback}. {reading}", early.measurements)
-        cause = f"Likely cause: on {case.mdp.name} at beta = 1 your start policy never converges at discount 1: a policy whose moves loop forever through costly states (all zeros walks the ring at a cost forever) has no finite value, so its iterative evaluation never stops. Start from a policy that ends its episodes, such as the all-ones start of the 2023 and later texts (np.ones(nS, dtype=int))."  # noqa: E501
+        cause = f"Likely cause: on {case.mdp.name} at beta = 1 your start policy never converges: a policy whose moves loop forever through costly states (on the lab's example, right from state 0 and left from state 1 walk 0 -> 1 -> 0 at a cost of 1 a lap) has no finite value, so its iterative evaluation never stops. Start from a policy that ends its episodes, such as the all-zeros start or the all-ones start of the 2023 and later texts (np.ones(nS, dtype=int))."  # noqa: E501
         return Verdict(
             early.status, early.fraction, f"{early.feedback}. {cause} {reading}", early.measurements
         )

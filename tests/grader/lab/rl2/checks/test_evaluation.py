@@ -60,7 +60,7 @@ def evaluation(
 def test_the_policies_asked_have_finite_values_and_include_the_labs_start() -> None:
     asked = points(SEED)
     kinds = [point.kind for point in asked]
-    assert kinds.count("the all-ones policy") == len(cases(SEED)) == 13
+    assert kinds.count("the all-ones policy") == len(cases(SEED)) == 12
     assert all(bool(np.all(np.isfinite(point.exact))) for point in asked)
     held_out = [point for point in asked if point.case.key.startswith("random")]
     assert len(held_out) == 9  # below discount 1 every policy has a value: all three asked
@@ -81,7 +81,7 @@ def test_the_2018_name_is_graded_the_same() -> None:
 def test_a_tuple_where_one_array_is_asked_for_is_named() -> None:
     verdict = judged("v2024", "iter_policy_eval", partial(evaluation, with_count=True))
     assert verdict.status == "failed"
-    assert "returned a tuple where one array is asked for (38 of 38 calls)" in verdict.feedback
+    assert "returned a tuple where one array is asked for (36 of 36 calls)" in verdict.feedback
 
 
 @pytest.mark.parametrize(
@@ -116,7 +116,9 @@ def test_a_wrong_value_fails_without_a_cause(function: Any, found: str) -> None:
 
 def test_a_mistake_that_gives_no_value_for_any_wrong_call_is_not_named() -> None:
     """Wrong only where the policy has no value at discount 1: "beta ignored" gives no value there, so it
-    explains none of the wrong calls, and no cause is named."""
+    explains none of the wrong calls, and no cause is named. Every MDP of the grader's make lets every policy
+    end, so only the lab's example has such a policy: seed 38 asks it at 0.9 with the random policy
+    right-then-left (0 -> 1 -> 0 at a cost), which has a value at 0.9 and none at 1."""
 
     def wrong_where_discount_1_has_no_value(
         P: Any, nS: int, nA: int, policy: Any, beta: float = 1.0, tol: float = 1e-8
@@ -128,7 +130,7 @@ def test_a_mistake_that_gives_no_value_for_any_wrong_call_is_not_named() -> None
             return values + 0.01
         return values
 
-    verdict = judged("v2024", "iter_policy_eval", wrong_where_discount_1_has_no_value)
+    verdict = judged("v2024", "iter_policy_eval", wrong_where_discount_1_has_no_value, seed=38)
     assert verdict.status == "failed" and "its exact value on" in verdict.feedback, verdict.feedback
     assert "Likely cause" not in verdict.feedback
 

@@ -43,7 +43,7 @@ def improvement(
 def test_the_reference_passes_under_each_editions_name(edition: str, problem: str) -> None:
     verdict = judged(edition, problem, solutions.policy_improvement)
     assert verdict.status == "passed", verdict.feedback
-    assert "in all 26 calls" in verdict.feedback
+    assert "in all 24 calls" in verdict.feedback
 
 
 def test_another_tie_break_is_as_right() -> None:
@@ -72,7 +72,7 @@ def test_each_typical_mistake_is_named(changes: dict[str, Any], cause: str) -> N
         (lambda *args: np.zeros(len(args[0]), dtype=int), "short of the best one-step look-ahead"),
         (
             lambda *args: [2, 1, 2, 0],
-            "of 26 calls",  # the example's answer, 4 actions where 16 are asked, or not greedy
+            "of 24 calls",  # the example's answer, 4 actions where 16 are asked, or not greedy
         ),
         (lambda *args: improvement(*args) + 0.5, "expected a policy"),
         (lambda *args: improvement(*args) + 4, "expected a policy"),

@@ -1,6 +1,7 @@
 """policy_iteration's check: the policy judged by its exact value, V against the optimum, n a whole number of
-iterations; a start that never converges at discount 1 is a named timeout; the feedback says whose
-evaluation and improvement steps the calls used."""
+iterations; a start that never converges on the lab's example at discount 1 is a named timeout; judged with
+the student's own evaluation and improvement steps first, with the grader's only when that fails, the better
+verdict kept and the feedback saying which reading gave it."""
 
 from __future__ import annotations
 
@@ -9,41 +10,89 @@ from typing import Any
 import numpy as np
 import pytest
 
+from grader.lab.checks.base import CallRecord, Verdict
+from grader.lab.editions import edition_of
 from grader.lab.rl2.checks.mdp_calls import cases
 from grader.sandbox.outcome import OutcomeStatus
 from reference.oracles.mdp import optimal_solution
 from reference.rl2 import solutions
 from tests.grader.lab.rl2.support import SEED, judged, judged_outcomes, outcome, settings, wire
 
-RING = next(index for index, case in enumerate(cases(SEED)) if case.key == "ring")
-RING_DISCOUNTED = next(index for index, case in enumerate(cases(SEED)) if case.key == "ring_0.8")
+EXAMPLE = next(index for index, case in enumerate(cases(SEED)) if case.key == "example")
+EXAMPLE_DISCOUNTED = next(index for index, case in enumerate(cases(SEED)) if case.key == "example_0.9")
+GRID = next(index for index, case in enumerate(cases(SEED)) if case.key == "grid")
+OWN = "policy_iteration was called with your own iter_policy_eval and policy_improvement."
+GRADERS = "policy_iteration was called with the grader's own iter_policy_eval and policy_improvement (the lab's algorithms) in place of yours, so a mistake in those counts only in their own problems."  # noqa: E501
 
 
-def test_the_reference_passes_and_the_feedback_names_the_graders_helpers() -> None:
+def test_the_reference_passes_with_its_own_steps_and_the_feedback_says_so() -> None:
     verdict = judged("v2024", "policy_iteration", solutions.policy_iteration)
     assert verdict.status == "passed", verdict.feedback
-    reading = "policy_iteration was called with the grader's own iter_policy_eval and policy_improvement (the lab's algorithms) in place of yours, so a mistake in those counts only in their own problems."  # noqa: E501
-    assert reading in verdict.feedback
-    plan = [call.provided for call in _plan("v2018")]
-    assert set(plan) == {("compute_policy_v", "extract_policy")}
+    assert OWN in verdict.feedback
+    assert {call.provided for call in _plan("v2024")} == {()}
 
 
-def test_with_the_students_helpers_no_name_is_bound_and_the_feedback_says_so() -> None:
-    assert {call.provided for call in _plan("v2024", helpers="student")} == {()}
-    # judged here, no name is bound either way: any passing function shows the feedback's reading
-    verdict = judged("v2024", "policy_iteration", _optimal, helpers="student")
-    assert verdict.status == "passed", verdict.feedback
-    assert "called with your own iter_policy_eval and policy_improvement" in verdict.feedback
+def _check(edition: str = "v2024") -> Any:
+    return edition_of(edition).registry.problem("policy_iteration").check
+
+
+@pytest.mark.parametrize(
+    ("edition", "names"),
+    [
+        ("v2018", ("compute_policy_v", "extract_policy")),
+        ("v2024", ("iter_policy_eval", "policy_improvement")),
+    ],
+)
+def test_the_second_reading_binds_the_editions_steps_only_when_the_first_did_not_pass(
+    edition: str, names: tuple[str, str]
+) -> None:
+    chosen = settings(edition, "policy_iteration")
+    failed, passed = Verdict("failed", 0.0, "wrong"), Verdict("passed", 1.0, "right")
+    again = _check(edition).second_plan(chosen, failed, {}, SEED)
+    assert {call.provided for call in again} == {names}
+    assert [call.args[0].name for call in again] == [call.args[0].name for call in _plan(edition)]
+    assert _check(edition).second_plan(chosen, passed, {}, SEED) == []
+    for status in ("error", "timeout", "missing"):
+        assert _check(edition).second_plan(chosen, Verdict(status, 0.0, "x"), {}, SEED)
+
+
+@pytest.mark.parametrize(("helpers", "provided"), [("grader", True), ("student", False)])
+def test_with_one_reading_chosen_there_is_no_second(helpers: str, provided: bool) -> None:
+    chosen = settings("v2024", "policy_iteration", helpers=helpers)
+    assert {bool(call.provided) for call in _plan("v2024", helpers=helpers)} == {provided}
+    assert _check().second_plan(chosen, Verdict("failed", 0.0, "wrong"), {}, SEED) == []
+
+
+def test_the_graders_reading_is_kept_only_when_it_is_better_and_the_feedback_says_which() -> None:
+    chosen = settings("v2024", "policy_iteration")
+    own = Verdict("error", 0.0, f"too many values to unpack. {OWN}")
+    graders = Verdict("passed", 1.0, f"all right. {GRADERS}")
+    kept = _check().keep(chosen, own, graders)
+    assert kept.status == "passed" and kept.fraction == 1.0
+    assert (
+        GRADERS in kept.feedback and "With your own functions it was error: too many values" in kept.feedback
+    )
+    assert kept.measurements["reading"] == "grader"
+    worse = Verdict("failed", 0.0, f"not optimal. {GRADERS}")
+    kept = _check().keep(chosen, own, worse)
+    assert kept.status == "error" and kept.feedback.startswith(own.feedback)
+    assert "Judged again with the grader's own functions in place of yours, it was failed" in kept.feedback
+    assert kept.measurements["reading"] == "own"
+
+
+def test_the_judge_reads_the_reading_from_the_calls() -> None:
+    """A call that bound the grader's steps says so, whatever the settings: the judge reads the calls."""
+    check, chosen = _check(), settings("v2024", "policy_iteration")
+    records = []
+    for call in check.second_plan(chosen, Verdict("failed", 0.0, "wrong"), {}, SEED):
+        args = [arg.as_table() if hasattr(arg, "as_table") else arg for arg in call.args]
+        records.append(CallRecord(outcome(call, wire(solutions.policy_iteration(*args))), []))
+    verdict = check.judge(chosen, records)
+    assert verdict.status == "passed" and GRADERS in verdict.feedback, verdict.feedback
 
 
 def _plan(edition: str, **changes: Any) -> list[Any]:
-    from grader.lab.editions import edition_of
-
-    return (
-        edition_of(edition)
-        .registry.problem("policy_iteration")
-        .check.plan(settings(edition, "policy_iteration", **changes), {}, SEED)
-    )
+    return _check(edition).plan(settings(edition, "policy_iteration", **changes), {}, SEED)
 
 
 def _optimal(P: Any, nS: int, nA: int, beta: float = 1.0, *rest: Any) -> Any:
@@ -98,16 +147,17 @@ def _timing_out(index: int) -> Any:
     return outcomes
 
 
-def test_a_start_that_never_converges_at_discount_1_is_a_named_timeout() -> None:
-    verdict = judged_outcomes("v2024", "policy_iteration", _timing_out(RING))
+def test_a_start_that_never_converges_on_the_labs_example_is_a_named_timeout() -> None:
+    verdict = judged_outcomes("v2024", "policy_iteration", _timing_out(EXAMPLE))
     assert verdict.status == "timeout"
     assert "did not return within 20 seconds" in verdict.feedback
-    assert "your start policy never converges at discount 1" in verdict.feedback
-    assert "np.ones(nS, dtype=int)" in verdict.feedback
+    assert "your start policy never converges" in verdict.feedback
+    assert "walk 0 -> 1 -> 0" in verdict.feedback and "np.ones(nS, dtype=int)" in verdict.feedback
 
 
-def test_a_timeout_below_discount_1_is_not_blamed_on_the_start() -> None:
-    verdict = judged_outcomes("v2024", "policy_iteration", _timing_out(RING_DISCOUNTED))
+@pytest.mark.parametrize("index", [EXAMPLE_DISCOUNTED, GRID], ids=["below-discount-1", "every-policy-ends"])
+def test_a_timeout_where_every_policy_has_a_value_is_not_blamed_on_the_start(index: int) -> None:
+    verdict = judged_outcomes("v2024", "policy_iteration", _timing_out(index))
     assert verdict.status == "timeout"
     assert "never converges" not in verdict.feedback
 
