@@ -5,7 +5,9 @@ and `gymnasium.utils.seeding.np_random` so that unseeded randomness comes from t
 streams. An env that is one of gymnasium's lab games is dealt by its cheaper twin (`envs.cheaper`:
 the same game, the same draws, fewer numpy calls per step). The recorder sits outermost on each env,
 sees the gymnasium-API `reset`/`step` (the compat `gym` shim wraps it in turn), reseeds every reset
-from the grader's stream and logs actions and what the student saw. The parent replays the logs
+from the grader's stream and logs actions and what the made env reported. The chain below it is served to
+student code as levels that step through it (`gym.make(id).env`, `env.unwrapped`:
+`grader.compat.chain`), so an episode played on any of them is recorded too. The parent replays the logs
 (`grader.sandbox.replay`); nothing here is trusted.
 """
 
