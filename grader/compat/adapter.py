@@ -265,7 +265,9 @@ class ClassicEnv:
         if self.level >= len(SERVED_CHAIN):
             raise AttributeError(f"the {self.requested_id} environment has no attribute 'env'")
         if self._inner_view is None:
-            self._inner_view = ClassicEnv(self.gymnasium_env, self.requested_id, self.api, level=self.level + 1)
+            self._inner_view = ClassicEnv(
+                self.gymnasium_env, self.requested_id, self.api, level=self.level + 1
+            )
         return self._inner_view
 
     def _cut_by_time_limit(self) -> bool:

@@ -2,13 +2,13 @@
 
 What `gym.make("FrozenLake-v1")` returned, read from each release's `envs/registration.py` and `core.py`:
 
-| gym | chain, outermost first | attribute reads through wrappers |
-|---|---|---|
-| gym 0.10 - 0.12.0 (2018) | TimeLimit > FrozenLakeEnv | none (`Wrapper.__getattr__` came in 0.12.1): `env.env.P` |
-| gym 0.12.1 - 0.21 (2019-2021) | TimeLimit > FrozenLakeEnv | every public name (`env.P`, `env.nS`) |
-| gym 0.22 - 0.23 (2022) | TimeLimit > OrderEnforcing > FrozenLakeEnv (no `nS`, `nA`) | every public name |
-| gym 0.24, 0.26; gymnasium 0.26 - 1.x | TimeLimit > OrderEnforcing > PassiveEnvChecker > FrozenLakeEnv | every public name (gymnasium 0.29 warns; 1.x none) |
-| gym 0.25 | TimeLimit > OrderEnforcing > StepAPICompatibility > PassiveEnvChecker > FrozenLakeEnv | every public name |
+- gym 0.10 - 0.12.0 (2018): TimeLimit > FrozenLakeEnv; no attribute read through wrappers
+  (`Wrapper.__getattr__` came in 0.12.1), hence the 2018 text's `gym.make(name).env` and `env.env.P`;
+- gym 0.12.1 - 0.21 (2019-2021): TimeLimit > FrozenLakeEnv; every public name forwarded (`env.P`, `env.nS`);
+- gym 0.22 - 0.23 (2022): TimeLimit > OrderEnforcing > FrozenLakeEnv (no more `nS`, `nA`); forwarded;
+- gym 0.24 and 0.26, gymnasium 0.26 - 1.x: TimeLimit > OrderEnforcing > PassiveEnvChecker > FrozenLakeEnv;
+  forwarded (gymnasium 0.29 with a deprecation warning), except in gymnasium 1.x, which forwards nothing;
+- gym 0.25: TimeLimit > OrderEnforcing > StepAPICompatibility > PassiveEnvChecker > FrozenLakeEnv.
 
 `gym.make(id).env` is the chain below `TimeLimit` in every one of them: its episodes have no time limit, the
 second lab's way to play FrozenLake to the end. `env.unwrapped` is the raw env.
@@ -27,6 +27,7 @@ serves the same chain with its own API per level (`grader.compat.adapter.Classic
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 import gymnasium
@@ -134,7 +135,7 @@ class ServedWrapper(gymnasium.Wrapper[Any, Any, Any, Any]):
         self.stepper.close()
 
     @property
-    def spec(self) -> Any:
+    def spec(self) -> Any:  # type: ignore[override]
         """The real wrapper's spec."""
         return self.served.spec
 
@@ -154,6 +155,11 @@ class ServedWrapper(gymnasium.Wrapper[Any, Any, Any, Any]):
         )
         return value
 
+    def __deepcopy__(self, memo: dict[int, Any]) -> Any:
+        """A copy of the real wrapper: a new env, not gym.make's, so not stepped through the stepper (as a
+        copy of gymnasium's own wrapper was not)."""
+        return copy.deepcopy(self.served, memo)
+
     def __str__(self) -> str:
         return str(self.served)
 
@@ -169,7 +175,10 @@ class ServedRaw(gymnasium.Env[Any, Any]):
     and written, its episodes stepped through the chain's stepper (recorded), with no time limit."""
 
     def __init__(
-        self, real: gymnasium.Env[Any, Any], stepper: gymnasium.Env[Any, Any], limit: TimeLimit[Any, Any] | None
+        self,
+        real: gymnasium.Env[Any, Any],
+        stepper: gymnasium.Env[Any, Any],
+        limit: TimeLimit[Any, Any] | None,
     ) -> None:
         """Serve the raw env `real`, stepped through `stepper`; `limit` is the chain's `TimeLimit`, if any."""
         object.__setattr__(self, "served", real)
@@ -179,7 +188,7 @@ class ServedRaw(gymnasium.Env[Any, Any]):
     @staticmethod
     def served_of(level: ServedRaw) -> gymnasium.Env[Any, Any]:
         """The raw env `level` stands for (read by `real_env`)."""
-        return level.served
+        return level.served  # type: ignore[no-any-return]
 
     def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset through the stepper (the recorder deals the start)."""
@@ -202,27 +211,27 @@ class ServedRaw(gymnasium.Env[Any, Any]):
         """Itself: the raw env."""
         return self
 
-    @property  # type: ignore[override]
-    def spec(self) -> Any:
+    @property
+    def spec(self) -> Any:  # type: ignore[override]
         return self.served.spec
 
-    @property  # type: ignore[override]
-    def action_space(self) -> Any:
+    @property
+    def action_space(self) -> Any:  # type: ignore[override]
         return self.served.action_space
 
-    @property  # type: ignore[override]
-    def observation_space(self) -> Any:
+    @property
+    def observation_space(self) -> Any:  # type: ignore[override]
         return self.served.observation_space
 
-    @property  # type: ignore[override]
-    def metadata(self) -> Any:
+    @property
+    def metadata(self) -> Any:  # type: ignore[override]
         return self.served.metadata
 
-    @property  # type: ignore[override]
-    def render_mode(self) -> Any:
+    @property
+    def render_mode(self) -> Any:  # type: ignore[override]
         return self.served.render_mode
 
-    @property
+    @property  # type: ignore[misc]
     def np_random(self) -> Any:
         return self.served.np_random
 
@@ -254,6 +263,14 @@ class ServedRaw(gymnasium.Env[Any, Any]):
             object.__setattr__(self, name, value)
         else:
             setattr(self.served, name, value)
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> Any:
+        """A copy of the raw env, as copying gymnasium's raw env gave (a new env, not stepped through the
+        stepper: code that plays a copy ahead, to peek at its generator, plays it unrecorded as before)."""
+        return copy.deepcopy(self.served, memo)
+
+    def __copy__(self) -> Any:
+        return copy.copy(self.served)
 
     def __str__(self) -> str:
         return str(self.served)

@@ -31,8 +31,8 @@ import numpy as np
 
 from grader.compat import events as compat_events
 from grader.compat import make as compat_make
-from grader.compat.chain import served_levels
 from grader.compat import register_envs, resolve_env_id
+from grader.compat.chain import served_levels
 from grader.sandbox.child import envs
 from grader.sandbox.child.budget import WireBudget
 from grader.sandbox.child.episode_fields import EPISODE_FIELDS, EpisodeHeader, check_declaration
@@ -269,13 +269,13 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         self.passed_by_grader = False
         """Set by the child for an env it made for an `EnvArgument` (`grader.sandbox.child.calls`)."""
 
-    @property  # type: ignore[override]
+    @property
     def env(self) -> gymnasium.Env[Any, Any]:
         """The next level of the made env's chain as student code sees it, made at each read.
 
-        Made anew rather than kept: the levels hold this wrapper (their stepper), and a kept level would make a
-        reference cycle that outlives the student's last reference until the garbage collector runs, so
-        that an env dropped in one call would still be reseeded, and counted, in the next.
+        Made anew rather than kept: the levels hold this wrapper (their stepper), and a kept level would
+        make a reference cycle that outlives the student's last reference until the garbage collector runs,
+        so that an env dropped in one call would still be reseeded, and counted, in the next.
         """
         return served_levels(self.served, self)
 
@@ -288,23 +288,23 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         """The raw env as student code sees it (its steps recorded, `grader.compat.chain.ServedRaw`)."""
         return self.env.unwrapped
 
-    @property  # type: ignore[override]
-    def action_space(self) -> Any:
+    @property  # type: ignore[misc]
+    def action_space(self) -> Any:  # type: ignore[override]
         """The made env's action space."""
         return self.served.action_space
 
-    @property  # type: ignore[override]
-    def observation_space(self) -> Any:
+    @property  # type: ignore[misc]
+    def observation_space(self) -> Any:  # type: ignore[override]
         """The made env's observation space."""
         return self.served.observation_space
 
-    @property  # type: ignore[override]
-    def metadata(self) -> Any:
+    @property  # type: ignore[misc]
+    def metadata(self) -> Any:  # type: ignore[override]
         """The made env's metadata."""
         return self.served.metadata
 
     @property
-    def render_mode(self) -> Any:
+    def render_mode(self) -> Any:  # type: ignore[override]
         """The made env's render mode."""
         return self.served.render_mode
 
@@ -323,7 +323,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         return level.served
 
     @property
-    def spec(self) -> Any:
+    def spec(self) -> Any:  # type: ignore[override]
         """The made env's spec."""
         return self.served.spec
 

@@ -7,6 +7,7 @@ attributes are read (and, on the raw env, written) as each year's gym let studen
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 import gymnasium
@@ -167,3 +168,13 @@ def test_the_compat_gym_s_raw_env_has_no_env() -> None:
     assert raw.level == len(SERVED_CHAIN)
     with pytest.raises(AttributeError, match="the FrozenLake-v1 environment has no attribute 'env'"):
         _ = raw.env
+
+
+def test_a_copy_of_a_level_is_a_new_env_of_gymnasium_s_own_not_stepped_through_the_stepper() -> None:
+    made, stepper = _lake()
+    levels = _levels(made, stepper)
+    made.reset(seed=0)
+    copies = [copy.deepcopy(level) for level in levels]
+    assert [type(duplicate) for duplicate in copies] == [type(real_env(level)) for level in levels]
+    copies[-1].step(DOWN)
+    assert stepper.steps == 0

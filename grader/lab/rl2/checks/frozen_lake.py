@@ -210,15 +210,15 @@ class FrozenLakeCheck:
             return _fail(
                 f"{call}: you played {len(episodes)} episodes; M={m} asks for M episodes with the value-iteration policy, then M with the policy-iteration policy."  # noqa: E501
             )
-        problems = []
+        problems: list[Verdict] = []
         for order in ORDERS:
             found: dict[str, PlainValue] = {}
-            problem = _order_problem(settings, call, lake, returned, order, episodes, found)
-            if problem is None:
+            order_problem = _order_problem(settings, call, lake, returned, order, episodes, found)
+            if order_problem is None:
                 measurements.update(found)
                 measurements[f"{lake.map_name}_order"] = order
                 break
-            problems.append(problem)
+            problems.append(order_problem)
         else:  # no order explains the episodes: the first order's problem is the one told
             measurements.update(problems[0].measurements)
             return Verdict(problems[0].status, problems[0].fraction, problems[0].feedback, measurements)
@@ -313,6 +313,8 @@ class FrozenLakeCheck:
         return None
 
 
+WHOLE = "to the end, past the time limit"
+"""The reading of the time limit that counts each episode to its terminal state (`_mean_problem`)."""
 ORDERS = ("one after the other", "alternating")
 """How frozen_lake's 2M episodes may be ordered: the M value-iteration episodes then the M policy-iteration
 ones (two loops, or two list comprehensions), or alternating, one with each policy per pass of one loop
@@ -358,6 +360,9 @@ def _order_problem(
         verdict = _mean_problem(settings, call, name, group, mean, measurements, key)
         if verdict is not None:
             return verdict
+        off = _off_policy_past_limit(group, policy) if measurements[f"{key}_reading"] == WHOLE else None
+        if off:
+            return _fail(f"{call}: {off}; your {name} mean counts those steps.", measurements)
         test = _bernstein(settings, lake, group, policy, measurements, key)
         if test is not None:
             return _fail(f"{call}: {test}", measurements)
@@ -369,6 +374,23 @@ def _off_policy(episodes: Sequence[Episode], policy: np.ndarray) -> str | None:
         for step, (state, action) in enumerate(episode.decisions()):
             if int(action) != int(policy[int(state)]):
                 return f"episode {number + 1}, step {step + 1}: action {action} in state {int(state)}, but the policy you returned has {int(policy[int(state)])} there"  # noqa: E501
+    return None
+
+
+def _off_policy_past_limit(episodes: Sequence[Episode], policy: np.ndarray) -> str | None:
+    """The first action off `policy` among the steps played past gym.make's time limit, or None.
+
+    Those steps count in the reading "to the end, past the time limit", so they are judged as the steps
+    before the limit are (`_off_policy`): replayed to the episode's end, every action the policy's.
+    """
+    for number, episode in enumerate(episodes):
+        if episode.reached_terminal or not episode.replay.truncated[-1]:
+            continue
+        whole = replay_past_time_limit(episode.log)
+        decisions = zip(whole.observations[: whole.length], episode.log.actions[: whole.length], strict=True)
+        for step, (state, action) in enumerate(decisions):
+            if step >= episode.length and int(action) != int(policy[int(state)]):
+                return f"episode {number + 1}, step {step + 1} (past gym.make's time limit): action {action} in state {int(state)}, but the policy you returned has {int(policy[int(state)])} there"  # noqa: E501
     return None
 
 
@@ -386,7 +408,7 @@ def _mean_problem(
     whole = whole_mean(episodes)
     measurements[f"{key}_returned_mean"] = mean
     measurements[f"{key}_replayed_mean"] = cut
-    for reading, value in (("up to the time limit", cut), ("to the end, past the time limit", whole)):
+    for reading, value in (("up to the time limit", cut), (WHOLE, whole)):
         if value is not None and abs(mean - value) <= 1e-9 * max(1.0, abs(value)):
             measurements[f"{key}_reading"] = reading
             return None
