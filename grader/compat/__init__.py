@@ -47,7 +47,7 @@ The layer's contract:
 - **gym.make's wrapper chain** (`grader.compat.chain`): what each gym's `gym.make` built (TimeLimit over the
   env in gym 0.10-0.21, OrderEnforcing below it from 0.22, PassiveEnvChecker below that from 0.24 and in
   gymnasium), and `SERVED_CHAIN`, the chain served to code of every edition: `gym.make(id).env`,
-  `.env.env`, `.env.env.env` (the raw env, which has no `env`) and `.unwrapped` are levels of one chain,
+  `.env.env` and `.env.env.env` (the raw env, which has no `env`) are levels of one chain,
   each stepping the one env at its top (the sandbox's recorder), below the time limit without its
   truncation, forwarding public attribute reads (`env.P`, `env.nS`) as gym 0.12.1 to gymnasium 0.29 did.
   `ClassicEnv` serves it with the gym API; `served_levels(top, stepper)` serves gymnasium's own chain below

@@ -171,8 +171,8 @@ _RAW_OWN = frozenset({"served", "stepper", "limit"})
 
 
 class ServedRaw(gymnasium.Env[Any, Any]):
-    """The raw env as student code sees it (`env.unwrapped`, the last `env.env`): its own attributes read
-    and written, its episodes stepped through the chain's stepper (recorded), with no time limit."""
+    """The raw env as the last `env.env` of the chain: its own attributes read and written, its episodes
+    stepped through the chain's stepper (recorded), with no time limit."""
 
     def __init__(
         self,
@@ -207,9 +207,10 @@ class ServedRaw(gymnasium.Env[Any, Any]):
         self.stepper.close()
 
     @property
-    def unwrapped(self) -> ServedRaw:
-        """Itself: the raw env."""
-        return self
+    def unwrapped(self) -> gymnasium.Env[Any, Any]:
+        """Gymnasium's raw env itself, as `env.unwrapped` is everywhere (read for `P`; not recorded if
+        stepped: code that rigs `type(env.unwrapped)` rigs gymnasium's class, which the replay tells)."""
+        return self.served  # type: ignore[no-any-return]
 
     @property
     def spec(self) -> Any:  # type: ignore[override]

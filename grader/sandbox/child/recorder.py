@@ -6,7 +6,7 @@ streams. An env that is one of gymnasium's lab games is dealt by its cheaper twi
 the same game, the same draws, fewer numpy calls per step). The recorder sits outermost on each env,
 sees the gymnasium-API `reset`/`step` (the compat `gym` shim wraps it in turn), reseeds every reset
 from the grader's stream and logs actions and what the made env reported. The chain below it is served to
-student code as levels that step through it (`gym.make(id).env`, `env.unwrapped`:
+student code as levels that step through it (`gym.make(id).env`, `env.env.env`:
 `grader.compat.chain`), so an episode played on any of them is recorded too. The parent replays the logs
 (`grader.sandbox.replay`); nothing here is trusted.
 """
@@ -253,7 +253,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
 
     It stands for the env `gymnasium.make` made (`served`, gym.make's `TimeLimit`) and steps it; its `env`
     is the next level of that chain as student code sees it (`grader.compat.chain.served_levels`:
-    `gym.make(id).env` without the time limit, then `env.env`, down to the raw env, also `env.unwrapped`),
+    `gym.make(id).env` without the time limit, then `env.env`, down to the raw env),
     each stepping through this wrapper, so every episode is recorded whichever level is played. The log's
     flags are always the made env's (its time limit's truncation included); a level below the limit only
     hides it from the student, and the replay continues such an episode past the limit
@@ -285,8 +285,8 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
 
     @property
     def unwrapped(self) -> gymnasium.Env[Any, Any]:
-        """The raw env as student code sees it (its steps recorded, `grader.compat.chain.ServedRaw`)."""
-        return self.env.unwrapped
+        """Gymnasium's raw env, as everywhere."""
+        return self.served.unwrapped
 
     @property  # type: ignore[misc]
     def action_space(self) -> Any:  # type: ignore[override]

@@ -92,7 +92,7 @@ STUDENT = textwrap.dedent("""
         flags = [env.step(0)[2:4] for _ in range(120)]  # left at the start: against the wall
         for action in (1, 1, 2, 1, 2, 2):  # down, down, right, down, right, right: the goal
             observation, reward, terminated, truncated, _ = env.step(action)
-        raw = made.unwrapped  # stepped directly: still recorded
+        raw = made.env.env.env  # the raw env at the chain's bottom, stepped directly: still recorded
         raw.reset()
         raw.step(1)
         return [len(table), any(any(pair) for pair in flags), observation, reward, terminated, truncated]
@@ -307,7 +307,7 @@ def test_classic_env_env_runs_past_the_time_limit_and_replays(child: ChildClient
     assert (replayed.matches, replayed.length, replayed.steps_after_done) == (True, 100, 26)
 
 
-def test_gymnasium_env_env_and_unwrapped_are_recorded_without_the_time_limit(child: ChildClient) -> None:
+def test_gymnasium_env_env_and_the_raw_level_are_recorded_without_the_time_limit(child: ChildClient) -> None:
     result = child.call("gymnasium_env_env_without_time_limit", seed=2)
     assert value_of(result) == [16, False, 15, 1.0, True, False]
     below, raw = episodes_of(result)
