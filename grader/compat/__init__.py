@@ -44,6 +44,15 @@ The layer's contract:
   `sys.path`, `register_envs()`, headless SDL); `grader.compat.make(env_id, **kwargs) -> ClassicEnv`
   (what `gym.make` is). The recorder relies on `gymnasium.make` being called directly from
   `grader.compat.make.make`, whose local `env_id` is the requested id (pinned by a test).
+- **gym.make's wrapper chain** (`grader.compat.chain`): what each gym's `gym.make` built (TimeLimit over the
+  env in gym 0.10-0.21, OrderEnforcing below it from 0.22, PassiveEnvChecker below that from 0.24 and in
+  gymnasium), and `SERVED_CHAIN`, the chain served to code of every edition: `gym.make(id).env`,
+  `.env.env` and `.env.env.env` (the raw env, which has no `env`) are levels of one chain,
+  each stepping the one env at its top (the sandbox's recorder), below the time limit without its
+  truncation, forwarding public attribute reads (`env.P`, `env.nS`) as gym 0.12.1 to gymnasium 0.29 did.
+  `ClassicEnv` serves it with the gym API; `served_levels(top, stepper)` serves gymnasium's own chain below
+  `top` to `import gymnasium` code (the recorder's `RecordingEnv.env`); `time_limit_of(env)` finds the real
+  `TimeLimit` through served levels.
 - Beyond the lab's ids the table maps `FrozenLake-v0`/`FrozenLake8x8-v0` -> `-v1` (same transitions) and
   `Pendulum-v0` -> `Pendulum-v1`, which is **not** identical (v0 advanced the angle with the unclipped
   velocity); its `note`, and so its `renamed_id` event, says so.

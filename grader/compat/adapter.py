@@ -10,6 +10,7 @@ from gymnasium import spaces
 from gymnasium.wrappers import TimeLimit
 
 from . import events
+from .chain import SERVED_CHAIN, limit_reached, time_limit_of
 from .detection import Api
 from .dialect import caller_api
 from .errors import UnsupportedRenderModeError
@@ -40,8 +41,10 @@ class ClassicEnv:
     Attribute reads not defined here go down the gymnasium wrapper stack (`env.P`, `env.s`), as
     classic `gym.Wrapper.__getattr__` did; private names are not forwarded. `nS` and `nA`, which classic
     toy-text envs (FrozenLake, Taxi) had and gymnasium's do not, are the sizes of the discrete spaces.
-    `env.env` is classic gym's env inside the time limit: a view of the same env whose episodes end only
-    when the env ends them. The gymnasium env underneath is `gymnasium_env`.
+    `env.env`, `env.env.env` and `env.env.env.env` are the levels of `gym.make`'s chain below the time limit
+    (`grader.compat.chain.SERVED_CHAIN`, then the raw env, which has no `env`): views of the same env whose
+    episodes end only when the env ends them, each stepping the one gymnasium env underneath
+    (`gymnasium_env`), so a recorder sees every step whichever level is played.
     """
 
     def __init__(
@@ -50,7 +53,7 @@ class ClassicEnv:
         requested_id: str,
         api: Api | None = None,
         *,
-        time_limit: bool = True,
+        level: int = 0,
     ) -> None:
         """Wrap `env`, which `gymnasium.make` created for the id `requested_id`.
 
@@ -58,13 +61,14 @@ class ClassicEnv:
             env: the gymnasium environment.
             requested_id: the id the student asked for.
             api: serve this API to every caller; None decides per call site from the calling code.
-            time_limit: False for the view classic `env.env` gives: episodes end only when the env ends
-                them, as classic `gym.make(id).env` (the env inside `TimeLimit`) did.
+            level: the level of `gym.make`'s chain served: 0 is the env `gym.make` returns (with its time
+                limit), 1 `env.env` and so on (no time limit), `len(SERVED_CHAIN)` the raw env.
         """
         self.gymnasium_env = env
         self.requested_id = requested_id
         self.api = api
-        self.time_limit = time_limit
+        self.level = level
+        self.time_limit = level == 0
         self._inner_view: ClassicEnv | None = None
         self._discrete_actions = isinstance(env.action_space, spaces.Discrete)
         self._needs_reset = True
@@ -125,7 +129,7 @@ class ClassicEnv:
                 observation, reward, terminated, truncated, info = self.gymnasium_env.step(action)
         else:
             observation, reward, terminated, truncated, info = self.gymnasium_env.step(action)
-        if truncated and not terminated and not self.time_limit and self._cut_by_time_limit():
+        if truncated and not self.time_limit and self._cut_by_time_limit():
             truncated = False  # classic `env.env` had no time limit: the episode goes on
         if api is Api.GYM026:
             self._done = self._done or bool(terminated or truncated)
@@ -251,22 +255,23 @@ class ClassicEnv:
 
     @property
     def env(self) -> ClassicEnv:
-        """Classic `gym.make(id).env`: the same environment without the time limit (one view, kept).
+        """The next level of `gym.make`'s chain: `gym.make(id).env` has no time limit (one view, kept).
 
-        Classic gym wrapped every made env in `TimeLimit`; the second lab's early texts step
-        `gym.make(name).env` so that FrozenLake episodes run to their end. The view steps the same
-        gymnasium env (so a recorder sees every step) and ignores the truncation the limit reports.
+        Every gym wrapped a made env in `TimeLimit` outermost; the second lab's texts step
+        `gym.make(name).env` so that FrozenLake episodes run to their end, and 2023's files read
+        `env.env.env.P`. The view steps the same gymnasium env (so a recorder sees every step) and ignores
+        the truncation the limit reports. The raw env (`len(SERVED_CHAIN)` levels down) has no `env`.
         """
-        if not self.time_limit:
+        if self.level >= len(SERVED_CHAIN):
             raise AttributeError(f"the {self.requested_id} environment has no attribute 'env'")
         if self._inner_view is None:
-            self._inner_view = ClassicEnv(self.gymnasium_env, self.requested_id, self.api, time_limit=False)
+            self._inner_view = ClassicEnv(
+                self.gymnasium_env, self.requested_id, self.api, level=self.level + 1
+            )
         return self._inner_view
 
     def _cut_by_time_limit(self) -> bool:
-        limit = self._time_limit()
-        elapsed = None if limit is None else limit._elapsed_steps
-        return limit is not None and elapsed is not None and elapsed >= limit._max_episode_steps
+        return limit_reached(self._time_limit())
 
     @property
     def _max_episode_steps(self) -> int | None:
@@ -282,12 +287,7 @@ class ClassicEnv:
         limit._max_episode_steps = steps
 
     def _time_limit(self) -> TimeLimit[Any, Any] | None:
-        env = self.gymnasium_env
-        while isinstance(env, gymnasium.Wrapper):
-            if isinstance(env, TimeLimit):
-                return env
-            env = env.env
-        return None
+        return time_limit_of(self.gymnasium_env)
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("_"):
@@ -298,6 +298,8 @@ class ClassicEnv:
         if name == "env":  # only when the property refused: the view has no inner env
             raise AttributeError(f"the {self.requested_id} environment has no attribute 'env'")
         try:
+            if self.__dict__.get("level", 0) >= len(SERVED_CHAIN):  # the raw env's own attribute
+                return getattr(env.unwrapped, name)
             return env.get_wrapper_attr(name)
         except AttributeError:
             raise AttributeError(f"the {self.requested_id} environment has no attribute {name!r}") from None

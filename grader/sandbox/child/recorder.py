@@ -5,7 +5,9 @@ and `gymnasium.utils.seeding.np_random` so that unseeded randomness comes from t
 streams. An env that is one of gymnasium's lab games is dealt by its cheaper twin (`envs.cheaper`:
 the same game, the same draws, fewer numpy calls per step). The recorder sits outermost on each env,
 sees the gymnasium-API `reset`/`step` (the compat `gym` shim wraps it in turn), reseeds every reset
-from the grader's stream and logs actions and what the student saw. The parent replays the logs
+from the grader's stream and logs actions and what the made env reported. The chain below it is served to
+student code as levels that step through it (`gym.make(id).env`, `env.env.env`:
+`grader.compat.chain`), so an episode played on any of them is recorded too. The parent replays the logs
 (`grader.sandbox.replay`); nothing here is trusted.
 """
 
@@ -30,6 +32,7 @@ import numpy as np
 from grader.compat import events as compat_events
 from grader.compat import make as compat_make
 from grader.compat import register_envs, resolve_env_id
+from grader.compat.chain import served_levels
 from grader.sandbox.child import envs
 from grader.sandbox.child.budget import WireBudget
 from grader.sandbox.child.episode_fields import EPISODE_FIELDS, EpisodeHeader, check_declaration
@@ -246,16 +249,90 @@ class Recorder:
 
 
 class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
-    """The outermost wrapper of every env made in the child: grader-seeded resets, logged steps."""
+    """The outermost wrapper of every env made in the child: grader-seeded resets, logged steps.
+
+    It stands for the env `gymnasium.make` made (`served`, gym.make's `TimeLimit`) and steps it; its `env`
+    is the next level of that chain as student code sees it (`grader.compat.chain.served_levels`:
+    `gym.make(id).env` without the time limit, then `env.env`, down to the raw env),
+    each stepping through this wrapper, so every episode is recorded whichever level is played. The log's
+    flags are always the made env's (its time limit's truncation included); a level below the limit only
+    hides it from the student, and the replay continues such an episode past the limit
+    (`grader.sandbox.replay.replay_past_time_limit`).
+    """
 
     def __init__(self, env: gymnasium.Env[Any, Any], recorder: Recorder, made: MadeEnv) -> None:
-        super().__init__(env)
+        super().__init__(env)  # `Wrapper.__init__`'s `self.env = env` sets `served` (the property's setter)
         self.recorder = recorder
         self.made = made
         self._episode: EpisodeRecord | None = None
         self._fresh = False
         self.passed_by_grader = False
         """Set by the child for an env it made for an `EnvArgument` (`grader.sandbox.child.calls`)."""
+
+    @property
+    def env(self) -> gymnasium.Env[Any, Any]:
+        """The next level of the made env's chain as student code sees it, made at each read.
+
+        Made anew rather than kept: the levels hold this wrapper (their stepper), and a kept level would
+        make a reference cycle that outlives the student's last reference until the garbage collector runs,
+        so that an env dropped in one call would still be reseeded, and counted, in the next.
+        """
+        return served_levels(self.served, self)
+
+    @env.setter
+    def env(self, made: gymnasium.Env[Any, Any]) -> None:
+        self.served = made
+
+    @property
+    def unwrapped(self) -> gymnasium.Env[Any, Any]:
+        """Gymnasium's raw env, as everywhere."""
+        return self.served.unwrapped
+
+    @property  # type: ignore[misc]
+    def action_space(self) -> Any:  # type: ignore[override]
+        """The made env's action space."""
+        return self.served.action_space
+
+    @property  # type: ignore[misc]
+    def observation_space(self) -> Any:  # type: ignore[override]
+        """The made env's observation space."""
+        return self.served.observation_space
+
+    @property  # type: ignore[misc]
+    def metadata(self) -> Any:  # type: ignore[override]
+        """The made env's metadata."""
+        return self.served.metadata
+
+    @property
+    def render_mode(self) -> Any:  # type: ignore[override]
+        """The made env's render mode."""
+        return self.served.render_mode
+
+    @property
+    def np_random(self) -> Any:
+        """The made env's random generator."""
+        return self.served.np_random
+
+    @np_random.setter
+    def np_random(self, generator: Any) -> None:
+        self.served.np_random = generator
+
+    @staticmethod
+    def served_of(level: RecordingEnv) -> gymnasium.Env[Any, Any]:
+        """The env `gymnasium.make` made, which `level` stands for (`grader.compat.chain.real_env`)."""
+        return level.served
+
+    @property
+    def spec(self) -> Any:  # type: ignore[override]
+        """The made env's spec."""
+        return self.served.spec
+
+    def render(self) -> Any:
+        """Render as the made env does."""
+        return self.served.render()
+
+    def __str__(self) -> str:
+        return f"<RecordingEnv{self.served}>"
 
     def __getattr__(self, name: str) -> Any:
         """Read a public attribute of the wrapped envs (`env.P`, `env.nrow`), as gym and gymnasium before
@@ -264,7 +341,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         Only reads reach here (names this wrapper lacks); private names are refused as gymnasium refuses
         them. Nothing new is exposed: `env.unwrapped` gives the same objects.
         """
-        env = self.__dict__.get("env")
+        env = self.__dict__.get("served")
         if name.startswith("_"):
             raise AttributeError(f"accessing private attribute {name!r} of a gym environment is prohibited")
         if env is None:
@@ -288,7 +365,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
                 self.made.requested_id,
                 "env.close() was called on the environment the grader passed",
             )
-        super().close()
+        self.served.close()
 
     def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset with the next seed of the grader's stream, whatever seed the student passed.
@@ -308,7 +385,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
                 f"reset(seed=...) with your seed {shown[:40]} was given the grader's next seed instead: "
                 "the grader deals every start, so results do not depend on seeds you choose",
             )
-        result = self.env.reset(seed=actual_seed, options=options)
+        result = self.served.reset(seed=actual_seed, options=options)
         logged_options = dict(options) if type(options) is dict else options
         self._episode = self.recorder.start_episode(self, actual_seed, student_seed, logged_options)
         self._fresh = True
@@ -323,7 +400,7 @@ class RecordingEnv(gymnasium.Wrapper[Any, Any, Any, Any]):
         until `max_recorded_steps` (then `overflowed`). A reward that is not a number is logged as NaN
         (the replay then reports the mismatch).
         """
-        result = self.env.step(action)
+        result = self.served.step(action)
         recorder = self.recorder
         if recorder.record_call:
             if self._fresh:

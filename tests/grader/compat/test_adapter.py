@@ -250,8 +250,10 @@ def test_env_env_is_the_same_environment_without_its_time_limit() -> None:
     for _ in range(150):  # left from the start bumps into the wall forever
         observation, reward, done, _info = inner.step(0)
         assert (observation, reward, done) == (0, 0.0, False)
+    raw = inner.env.env  # gym 0.26's chain: TimeLimit > OrderEnforcing > PassiveEnvChecker > the env
+    assert (raw.nS, len(raw.P), raw._max_episode_steps) == (16, 16, None)
     with pytest.raises(AttributeError, match="has no attribute 'env'"):
-        _ = inner.env
+        _ = raw.env
 
 
 def test_the_outer_env_keeps_its_time_limit() -> None:

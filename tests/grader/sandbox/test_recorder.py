@@ -21,7 +21,7 @@ from grader.sandbox.child.log_block import log_block
 from grader.sandbox.child.recorder import EpisodeRecord, MadeEnv, Recorder, RecordingEnv
 from grader.sandbox.child.seeding import derive_call_seed, reset_seeds
 from grader.sandbox.episode_log import EpisodeLog, episodes_from_plain
-from grader.sandbox.replay import replay_episode, verify_reset_seeds
+from grader.sandbox.replay import replay_episode, replay_past_time_limit, verify_reset_seeds
 
 STUDENT = textwrap.dedent("""
     import random
@@ -82,6 +82,20 @@ STUDENT = textwrap.dedent("""
         for action in (1, 1, 2, 1, 2, 2):  # down, down, right, down, right, right: the goal
             observation, reward, done, _ = env.step(action)
         return [any(dones), env.nS, observation, reward, done]
+
+
+    def gymnasium_env_env_without_time_limit():
+        made = gymnasium.make("FrozenLake-v1", is_slippery=False)
+        env = made.env  # gymnasium 0.29's idiom: the OrderEnforcing wrapper below the time limit
+        table = env.P
+        env.reset()
+        flags = [env.step(0)[2:4] for _ in range(120)]  # left at the start: against the wall
+        for action in (1, 1, 2, 1, 2, 2):  # down, down, right, down, right, right: the goal
+            observation, reward, terminated, truncated, _ = env.step(action)
+        raw = made.env.env.env  # the raw env at the chain's bottom, stepped directly: still recorded
+        raw.reset()
+        raw.step(1)
+        return [len(table), any(any(pair) for pair in flags), observation, reward, terminated, truncated]
 
 
     def gymnasium_frozen_lake_table():
@@ -291,6 +305,18 @@ def test_classic_env_env_runs_past_the_time_limit_and_replays(child: ChildClient
     # The log agrees with the real env step for step; the replay's episode ends where gym.make's limit cut
     # it (step 100), and the 26 steps the view took past it are counted, not lost.
     assert (replayed.matches, replayed.length, replayed.steps_after_done) == (True, 100, 26)
+
+
+def test_gymnasium_env_env_and_the_raw_level_are_recorded_without_the_time_limit(child: ChildClient) -> None:
+    result = child.call("gymnasium_env_env_without_time_limit", seed=2)
+    assert value_of(result) == [16, False, 15, 1.0, True, False]
+    below, raw = episodes_of(result)
+    # The log keeps the made env's flags (the limit's truncation from step 100); the student never saw it,
+    # and the episode replays to its end past the limit.
+    assert (below.steps, below.truncated[99], below.rewards[-1]) == (126, True, 1.0)
+    whole = replay_past_time_limit(below)
+    assert (whole.matches, whole.length, whole.total_reward) == (True, 126, 1.0)
+    assert (raw.steps, replay_episode(raw).matches) == (1, True)
 
 
 def test_private_env_attributes_are_not_forwarded(child: ChildClient) -> None:

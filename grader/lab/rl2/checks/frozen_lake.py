@@ -7,7 +7,8 @@ vi_total_rewards, pi_value_func, pi_policy, pi_total_rewards`) or six (2024 on: 
 Judged on the lake the lab means, slippery FrozenLake of the asked size:
 
 - the episodes: exactly 2M played in that lake from the grader's seeds (the first lab's integrity rules),
-  the first M with `vi_policy` (every action `vi_policy[state]`), the next M with `pi_policy`;
+  the first M with `vi_policy` (every action `vi_policy[state]`) and the next M with `pi_policy`, or the two
+  alternating (one loop playing one episode with each policy per pass, as many real files do; `ORDERS`);
 - each returned mean: exactly the mean of its M replayed returns (beta = 1, the lab's default), read either
   way the lab's gyms allow: each episode up to its first end (`terminated or truncated`, gym.make's time
   limit of 100 or 200 steps included), or each to its terminal state past the time limit (classic
@@ -209,6 +210,8 @@ class FrozenLakeCheck:
         )
         means = sorted({str(value) for key, value in measurements.items() if key.endswith("_reading")})
         reading += f" Your means count each episode {' and '.join(means)}."
+        if ORDERS[1] in measurements.values():
+            reading += " " + ALTERNATING_READING
         return Verdict(
             "passed",
             1.0,
@@ -244,20 +247,18 @@ class FrozenLakeCheck:
             return _fail(
                 f"{call}: you played {len(episodes)} episodes; M={m} asks for M episodes with the value-iteration policy, then M with the policy-iteration policy."  # noqa: E501
             )
-        halves = (("vi", returned.vi_policy, returned.vi_mean), ("pi", returned.pi_policy, returned.pi_mean))
-        for index, (name, policy, mean) in enumerate(halves):
-            group = episodes[index * m : (index + 1) * m]
-            off = _off_policy(group, policy)
-            if off:
-                half = "first" if index == 0 else "second"
-                return _fail(f"{call}: {off} (the {half} M episodes play {name}_policy).")
-            key = f"{lake.map_name}_{name}"
-            verdict = _mean_problem(settings, call, name, group, mean, measurements, key)
-            if verdict is not None:
-                return verdict
-            test = _bernstein(settings, lake, group, policy, measurements, key)
-            if test is not None:
-                return _fail(f"{call}: {test}")
+        problems: list[Verdict] = []
+        for order in ORDERS:
+            found: dict[str, PlainValue] = {}
+            order_problem = _order_problem(settings, call, lake, returned, order, episodes, found)
+            if order_problem is None:
+                measurements.update(found)
+                measurements[f"{lake.map_name}_order"] = order
+                break
+            problems.append(order_problem)
+        else:  # no order explains the episodes: the first order's problem is the one told
+            measurements.update(problems[0].measurements)
+            return Verdict(problems[0].status, problems[0].fraction, problems[0].feedback, measurements)
         answer = self._answer_problem(settings, lake, returned, own, readings)
         return _fail(f"{call}: {answer}") if answer else None
 
@@ -349,11 +350,84 @@ class FrozenLakeCheck:
         return None
 
 
+WHOLE = "to the end, past the time limit"
+"""The reading of the time limit that counts each episode to its terminal state (`_mean_problem`)."""
+ORDERS = ("one after the other", "alternating")
+"""How frozen_lake's 2M episodes may be ordered: the M value-iteration episodes then the M policy-iteration
+ones (two loops, or two list comprehensions), or alternating, one with each policy per pass of one loop
+(`for _ in range(M): vi += run_simulation(env, vi_policy); pi += run_simulation(env, pi_policy)`, a common
+form in real files). On FrozenLake both policies are usually the same, so the actions cannot tell the orders
+apart: each is tried, the first order under which every episode follows its policy and both means are the
+replayed ones counts; when none does, the first order's problem is reported."""
+ALTERNATING_READING = (
+    "Your episodes alternate between the two policies (one with each per pass of your loop); "
+    "each mean was compared with the replayed episodes of its own policy."
+)
+
+
+def _groups(episodes: Sequence[Episode], order: str) -> tuple[Sequence[Episode], Sequence[Episode]]:
+    """The (vi, pi) episodes under one of `ORDERS`."""
+    if order == ORDERS[0]:
+        m = len(episodes) // 2
+        return episodes[:m], episodes[m:]
+    return episodes[0::2], episodes[1::2]
+
+
+def _order_problem(
+    settings: FrozenLakeConfig,
+    call: str,
+    lake: Lake,
+    returned: Returned,
+    order: str,
+    episodes: Sequence[Episode],
+    measurements: dict[str, PlainValue],
+) -> Verdict | None:
+    """Why the episodes, grouped by `order`, are not the returned policies' play and means, or None."""
+    halves = (("vi", returned.vi_policy, returned.vi_mean), ("pi", returned.pi_policy, returned.pi_mean))
+    for index, ((name, policy, mean), group) in enumerate(zip(halves, _groups(episodes, order), strict=True)):
+        off = _off_policy(group, policy)
+        if off:
+            which = (
+                ("first" if index == 0 else "second") + " M episodes"
+                if order == ORDERS[0]
+                else ("odd" if index == 0 else "even") + "-numbered episodes"
+            )
+            return _fail(f"{call}: {off} (the {which} play {name}_policy).", measurements)
+        key = f"{lake.map_name}_{name}"
+        verdict = _mean_problem(settings, call, name, group, mean, measurements, key)
+        if verdict is not None:
+            return verdict
+        off = _off_policy_past_limit(group, policy) if measurements[f"{key}_reading"] == WHOLE else None
+        if off:
+            return _fail(f"{call}: {off}; your {name} mean counts those steps.", measurements)
+        test = _bernstein(settings, lake, group, policy, measurements, key)
+        if test is not None:
+            return _fail(f"{call}: {test}", measurements)
+    return None
+
+
 def _off_policy(episodes: Sequence[Episode], policy: np.ndarray) -> str | None:
     for number, episode in enumerate(episodes):
         for step, (state, action) in enumerate(episode.decisions()):
             if int(action) != int(policy[int(state)]):
                 return f"episode {number + 1}, step {step + 1}: action {action} in state {int(state)}, but the policy you returned has {int(policy[int(state)])} there"  # noqa: E501
+    return None
+
+
+def _off_policy_past_limit(episodes: Sequence[Episode], policy: np.ndarray) -> str | None:
+    """The first action off `policy` among the steps played past gym.make's time limit, or None.
+
+    Those steps count in the reading "to the end, past the time limit", so they are judged as the steps
+    before the limit are (`_off_policy`): replayed to the episode's end, every action the policy's.
+    """
+    for number, episode in enumerate(episodes):
+        if episode.reached_terminal or not episode.replay.truncated[-1]:
+            continue
+        whole = replay_past_time_limit(episode.log)
+        decisions = zip(whole.observations[: whole.length], episode.log.actions[: whole.length], strict=True)
+        for step, (state, action) in enumerate(decisions):
+            if step >= episode.length and int(action) != int(policy[int(state)]):
+                return f"episode {number + 1}, step {step + 1} (past gym.make's time limit): action {action} in state {int(state)}, but the policy you returned has {int(policy[int(state)])} there"  # noqa: E501
     return None
 
 
@@ -371,7 +445,7 @@ def _mean_problem(
     whole = whole_mean(episodes)
     measurements[f"{key}_returned_mean"] = mean
     measurements[f"{key}_replayed_mean"] = cut
-    for reading, value in (("up to the time limit", cut), ("to the end, past the time limit", whole)):
+    for reading, value in (("up to the time limit", cut), (WHOLE, whole)):
         if value is not None and abs(mean - value) <= 1e-9 * max(1.0, abs(value)):
             measurements[f"{key}_reading"] = reading
             return None

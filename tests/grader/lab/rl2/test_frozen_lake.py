@@ -134,6 +134,30 @@ HOSTILE = {
         """,
         "vi_policy is not optimal",
     ),
+    "leaves_the_policy_past_the_time_limit": (
+        """
+        def _play(env, policy):
+            state, info = env.reset()
+            total, k, terminated = 0.0, 0, False
+            while not terminated:
+                action = (int(policy[state]) + 1) % 4 if k == 100 else int(policy[state])
+                state, reward, terminated, truncated, info = env.step(action)
+                total, k = total + reward, k + 1
+            return total
+
+
+        def frozen_lake(basic_case=True, M=1000, render=False):
+            env = gym.make("FrozenLake-v1", map_name="4x4" if basic_case else "8x8", is_slippery=True).env
+            nS, nA = env.observation_space.n, env.action_space.n
+            V, _ = value_iteration(env.unwrapped.P, nS, nA)
+            policy = policy_improvement(env.unwrapped.P, nS, nA, V)
+            pi_V, pi_policy, _ = policy_iteration(env.unwrapped.P, nS, nA)
+            vi = np.mean([_play(env, policy) for _ in range(M)])
+            pi = np.mean([_play(env, pi_policy) for _ in range(M)])
+            return V, policy, vi, pi_V, pi_policy, pi
+        """,
+        "(past gym.make's time limit)",
+    ),
     "returns_five_results_in_a_six_result_edition": (
         """
         def frozen_lake(basic_case=True, M=1000, render=False):
