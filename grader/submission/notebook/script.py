@@ -1,0 +1,322 @@
+"""A `.py` file read as the notebook it may have been: its cells, and IPython's lines as the exports write them.
+
+Jupyter's "Download as Python" (``jupyter nbconvert --to script``), Colab's "Download .py" and jupytext keep a
+notebook's demo and training cells as top-level statements and write IPython's lines as calls:
+``%matplotlib inline`` becomes ``get_ipython().run_line_magic('matplotlib', 'inline')``, ``!pip install gym``
+``get_ipython().system('pip install gym')``, ``x = !ls`` ``x = get_ipython().getoutput('ls')``, a ``%%time``
+cell ``get_ipython().run_cell_magic('time', '', 'body')``. Such a file is read here into cells that the
+notebook reader (`grader.submission.notebook.building`) reads by its own rules:
+
+- **Cells.** nbconvert's ``# In[N]:`` and jupytext's / VS Code's ``# %%`` markers split the file where
+  present (a marker inside a statement splits nothing); otherwise each top-level statement is its own cell,
+  so a cell magic Colab wrote mid-file is read as the cell it was. A cell keeps its first line in the file
+  (`ScriptCell.first_line`): whatever the report says of a line is the file's own line.
+- **IPython's lines** are turned back into the ``%`` / ``!`` / ``%%`` lines the notebook had (`unexported`),
+  so IPython's transformer reads them as it reads the notebook's (`grader.submission.notebook.ipython`).
+- **Running it** (`runnable_text`): the file as Jupyter's "Run All" of its notebook runs it, with the same
+  lines: each IPython line ``pass``, a ``%%time`` / ``%%capture`` cell's body run by ``exec``, another cell
+  magic's body not run.
+
+`defines_only` says, without the reader child, that a file's top level holds only imports, definitions, a
+docstring and an ``if __name__ == "__main__":`` block: such a file is graded as it is, as it always was.
+
+Pure, and unbounded: run on untrusted text only in the bounded reader child (`bounded.build_script`).
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from dataclasses import dataclass
+
+from collections.abc import Collection
+
+from grader.submission.notebook.building import (
+    _DROPPED_DECORATOR,
+    _listed,
+    globals_needed,
+    unbound_globals,
+    walk_cells,
+)
+from grader.submission.notebook.cells import SCRIPT_CELL
+from grader.submission.notebook.ipython import ESCAPES
+from grader.submission.notebook.models import NotebookModule, NotebookSummary, SkippedCode
+from grader.submission.notebook.reading import Cell, NotebookCells
+from grader.submission.validation import FileVerdict, check_source
+
+IPYTHON = "get_ipython"
+"""The call every export writes IPython's lines with."""
+_MARKER = re.compile(r"^# ?(?:In\s*\[[ \d]*\]:|%%(?!\w))")
+"""A cell marker: nbconvert's ``# In[12]:`` / ``# In[ ]:``, jupytext's / VS Code's ``# %%`` (not ``# %%time``)."""
+PYTHON_CELL_MAGICS = frozenset({"time", "capture"})
+"""Cell magics whose body IPython runs as Python in the notebook's namespace (as the notebook reader says)."""
+_HELP = {"pinfo": "?", "pinfo2": "??"}
+MAX_PADDING = 4_000_000
+"""Blank lines written before the marked cells of a file to run (so each keeps its lines) at most; past it
+the file runs as one cell (a hostile file of thousands of markers must not cost gigabytes)."""
+_IPYTHON_KINDS = frozenset({*ESCAPES.values(), "IPython magic (automagic)", "IPython command"})
+
+
+def build_script(
+    data: bytes, name: str, graded: Collection[str], served: Collection[str] = ()
+) -> NotebookModule | FileVerdict | None:
+    """The module the sandbox imports for a `.py`, read as the notebook it may have been; None when the file
+    is graded as it is (nothing the notebook's rules leave out, but decorators).
+
+    What a notebook's rules leave out is not run at import, unless a graded function uses what it sets or
+    changes (``q = train()`` read by ``taxi()``, ``env.reset()`` on the ``env`` a function plays): then
+    the whole file runs at import, as a `.py` always did, its IPython lines made ``pass``. The globals of
+    ``served`` functions come from running the file's cells before they are called (``compare()``), so
+    they ask nothing of the import.
+
+    Args:
+        data: The file's bytes (UTF-8 Python: `check_source` passed).
+        name: Its name, in messages.
+        graded: The functions problems call.
+        served: Those of them whose globals the file's cells set before the call.
+
+    Returns:
+        The module (every line and cell cited as the file's own line: cell `SCRIPT_CELL`), None to grade the
+        file as it is, or a verdict when the module built is not Python.
+    """
+    text = data.decode("utf-8-sig")
+    cells = script_cells(text)
+    offsets = {number: cell.first_line - 1 for number, cell in enumerate(cells, 1)}
+    builder = walk_cells(as_notebook_cells(cells), name, graded, script=True)
+
+    def in_file(entry: SkippedCode) -> SkippedCode:
+        return entry.model_copy(update={"cell": SCRIPT_CELL, "line": offsets.get(entry.cell, 0) + entry.line})
+
+    listed = [in_file(entry) for entry in builder.skipped + builder.unlisted]
+    ipython = [entry for entry in listed if entry.reason in _IPYTHON_KINDS or entry.reason.startswith("cell magic")]
+    if not ipython and all(entry.reason == _DROPPED_DECORATOR for entry in listed):
+        return None
+    runnable = runnable_text(text)
+    run_cells = _runnable_cells(runnable, [cell.first_line for cell in cells], text)
+    source, origins = _aligned(builder.future, builder.kept, builder.origins, offsets)
+    needed = globals_needed(source, [function for function in graded if function not in served])
+    if needed & (builder.affected | (builder.touched - builder.defined)):
+        if not ipython:
+            return None
+        summary = NotebookSummary(code_cells=len(cells), kept_statements=0, skipped=ipython, script=True)
+        whole = tuple((SCRIPT_CELL, line) for line in range(1, runnable.count("\n") + 1))
+        return NotebookModule(source=runnable, summary=summary, origins=whole, cells=run_cells)
+    verdict = check_source(source.encode(), name)
+    if verdict is not None:
+        return verdict
+    skipped_only = {
+        bound: in_file(where)
+        for bound, where in builder.skipped_bindings.items()
+        if bound not in builder.scope.kinds
+    }
+    summary = NotebookSummary(
+        code_cells=len(cells),
+        kept_statements=builder.kept_statements,
+        skipped=[in_file(entry) for entry in _listed(builder)],
+        unbound_globals=unbound_globals(source, skipped_only, graded),
+        script=True,
+    )
+    return NotebookModule(source=source, summary=summary, origins=origins, cells=run_cells)
+
+
+def _aligned(
+    future: list[str], kept: list[str], origins: list[tuple[int, int] | None], offsets: dict[int, int]
+) -> tuple[str, tuple[tuple[int, int] | None, ...]]:
+    """The kept statements, each on its own line of the file where the lines before it leave room (so a
+    traceback's line is the file's), with each line's (`SCRIPT_CELL`, line in the file)."""
+    lines: list[str] = list(future)
+    placed: list[tuple[int, int] | None] = [None] * len(future)
+    for text, origin in zip("\n".join(kept).split("\n"), origins, strict=True):
+        if origin is None:
+            continue  # the notebook's "# --- cell N ---" headers
+        line = offsets.get(origin[0], 0) + origin[1]
+        while len(lines) < line - 1:
+            lines.append("")
+            placed.append(None)
+        lines.append(text)
+        placed.append((SCRIPT_CELL, line))
+    return "\n".join(lines) + "\n", tuple(placed)
+
+
+def _runnable_cells(runnable: str, starts: list[int], text: str) -> tuple[tuple[int, str], ...]:
+    """What running the file's cells runs: its marked cells (each after blank lines, so its lines are the
+    file's), or the file as one cell; every one a script's (`SCRIPT_CELL`)."""
+    lines = runnable.split("\n")
+    if not _has_markers(text) or sum(starts) > MAX_PADDING:
+        return ((SCRIPT_CELL, runnable),)
+    cells = []
+    for index, start in enumerate(starts):
+        end = starts[index + 1] - 1 if index + 1 < len(starts) else len(lines)
+        cells.append((SCRIPT_CELL, "\n" * (start - 1) + "\n".join(lines[start - 1 : end])))
+    return tuple(cells)
+
+
+def _has_markers(text: str) -> bool:
+    return any(_MARKER.match(line) for line in text.splitlines())
+
+
+@dataclass(frozen=True)
+class ScriptCell:
+    """One cell of a `.py`: its first line in the file and its source, IPython's lines as the notebook had them."""
+
+    first_line: int
+    source: str
+
+
+def defines_only(tree: ast.Module, text: str) -> bool:
+    """True when importing the file runs nothing but imports, definitions and its docstring (an
+    ``if __name__ == "__main__":`` block is not run by an import either) and no IPython line is in it."""
+    if IPYTHON in text:
+        return False
+    for statement in tree.body:
+        match statement:
+            case ast.Import() | ast.ImportFrom() | ast.FunctionDef() | ast.AsyncFunctionDef() | ast.ClassDef():
+                continue
+            case ast.Expr(value=ast.Constant(value=str())):
+                continue
+            case ast.If() if is_main_guard(statement.test):
+                continue
+        return False
+    return True
+
+
+def is_main_guard(test: ast.expr) -> bool:
+    """``__name__ == "__main__"`` (either way round)."""
+    return (
+        isinstance(test, ast.Compare)
+        and any(isinstance(node, ast.Name) and node.id == "__name__" for node in ast.walk(test))
+        and any(isinstance(node, ast.Constant) and node.value == "__main__" for node in ast.walk(test))
+    )
+
+
+def script_cells(text: str) -> list[ScriptCell]:
+    """The file's cells: by its markers, or one per top-level statement; IPython's lines as the notebook had
+    them. The file must parse (`grader.submission.validation.check_source` said so)."""
+    tree = ast.parse(text)
+    lines = text.splitlines()
+    starts = _cell_starts(tree, lines)
+    cells: list[ScriptCell] = []
+    for index, start in enumerate(starts):
+        end = starts[index + 1] - 1 if index + 1 < len(starts) else len(lines)
+        chunk = lines[start - 1 : end]
+        if chunk and _MARKER.match(chunk[0]):
+            chunk[0] = ""  # the marker separates cells; it is no line of the cell
+        if not any(line.strip() for line in chunk):
+            continue
+        statements = [s for s in tree.body if start <= _first_line(s) <= end]
+        cells.append(ScriptCell(start, "\n".join(unexported(chunk, statements, start))))
+    return cells
+
+
+def as_notebook_cells(cells: list[ScriptCell]) -> NotebookCells:
+    """The cells as the notebook reader takes them (numbered 1, 2, ... in the file's order)."""
+    return NotebookCells([Cell(number, None, cell.source) for number, cell in enumerate(cells, 1)], [])
+
+
+def _cell_starts(tree: ast.Module, lines: list[str]) -> list[int]:
+    """First line of each cell: after each marker outside a statement, else at each top-level statement."""
+    inside: set[int] = set()
+    for statement in tree.body:
+        inside.update(range(_first_line(statement) + 1, (statement.end_lineno or statement.lineno) + 1))
+    markers = [number for number, line in enumerate(lines, 1) if _MARKER.match(line) and number not in inside]
+    if markers:
+        return sorted({1, *markers})
+    starts = [_first_line(statement) for statement in tree.body]
+    return sorted({1, *starts[1:]}) if starts else [1]
+
+
+def _first_line(statement: ast.stmt) -> int:
+    decorators = getattr(statement, "decorator_list", [])
+    return min([statement.lineno, *(decorator.lineno for decorator in decorators)])
+
+
+def unexported(chunk: list[str], statements: list[ast.stmt], first_line: int) -> list[str]:
+    """The chunk's lines with each ``get_ipython()`` line written back as the IPython line it came from."""
+    lines = list(chunk)
+    top_level = {id(statement) for statement in statements}
+    found = [(node, call) for statement in statements for node in ast.walk(statement) if (call := _ipython_call(node))]
+    # From the last line up, so a cell magic's body written out below its header moves no line still to do.
+    for node, (method, args) in sorted(found, key=lambda item: -item[0].lineno):  # type: ignore[attr-defined]
+            row = node.lineno - first_line  # type: ignore[attr-defined]
+            if not 0 <= row < len(lines):
+                continue
+            indent = lines[row][: len(lines[row]) - len(lines[row].lstrip())]
+            target = _assigned(node, lines[row])
+            if method == "run_cell_magic":
+                if id(node) not in top_level or target or len(args) != 3:
+                    continue
+                header = f"%%{args[0]} {args[1]}".rstrip()
+                body = args[2].removesuffix("\n").split("\n")
+                replaced = [header, *body]
+            else:
+                replaced = [indent + target + _line_of(method, args)]
+            end = (node.end_lineno or node.lineno) - first_line  # type: ignore[attr-defined]
+            # The escape's line replaces the call's; its other lines (if any) are left empty, and a
+            # cell magic's body follows its header (the cell was that call alone).
+            lines[row : end + 1] = replaced + [""] * max(0, end - row + 1 - len(replaced))
+    return lines
+
+
+def _ipython_call(node: ast.AST) -> tuple[str, list[str]] | None:
+    """(method, its string arguments) for ``get_ipython().method('...', ...)`` as a statement or the value of
+    an assignment to names, else None."""
+    if isinstance(node, ast.Expr):
+        value = node.value
+    elif isinstance(node, ast.Assign) and all(_names(target) for target in node.targets):
+        value = node.value
+    else:
+        return None
+    match value:
+        case ast.Call(
+            func=ast.Attribute(value=ast.Call(func=ast.Name(id="get_ipython"), args=[], keywords=[]), attr=method),
+            args=args,
+            keywords=[],
+        ) if all(isinstance(arg, ast.Constant) and isinstance(arg.value, str) for arg in args):
+            if method in ("run_line_magic", "run_cell_magic", "system", "getoutput"):
+                return method, [arg.value for arg in args]  # type: ignore[attr-defined]
+    return None
+
+
+def _names(target: ast.expr) -> bool:
+    if isinstance(target, ast.Tuple | ast.List):
+        return all(_names(element) for element in target.elts)
+    return isinstance(target, ast.Name)
+
+
+def _assigned(node: ast.AST, line: str) -> str:
+    """``x = `` of ``x = get_ipython().getoutput('ls')`` (its text up to the call), "" for a statement."""
+    if not isinstance(node, ast.Assign) or node.value.lineno != node.lineno:
+        return ""
+    return line[node.col_offset : node.value.col_offset]
+
+
+def _line_of(method: str, args: list[str]) -> str:
+    if method == "run_line_magic" and len(args) == 2:
+        name, rest = args
+        if name in _HELP:
+            return rest + _HELP[name]
+        return f"%{name} {rest}".rstrip()
+    if method == "system" and len(args) == 1:
+        return "!" + args[0]
+    if method == "getoutput" and len(args) == 1:
+        return "!!" + args[0]
+    return f"%{method}"  # an unknown shape: still an IPython line, left out as the notebook's would be
+
+
+def runnable_text(text: str) -> str:
+    """The file as "Run All" of its notebook runs it, line for line: each IPython line ``pass``, a
+    ``%%time`` / ``%%capture`` cell's body run by ``exec`` (it is Python), another cell magic's not run."""
+    tree = ast.parse(text)
+    lines = text.splitlines()
+    for node in ast.walk(tree):
+        call = _ipython_call(node)
+        if call is None:
+            continue
+        method, args = call
+        row, end = node.lineno - 1, (node.end_lineno or node.lineno) - 1  # type: ignore[attr-defined]
+        indent = lines[row][: len(lines[row]) - len(lines[row].lstrip())]
+        statement = "pass"
+        if method == "run_cell_magic" and len(args) == 3 and args[0] in PYTHON_CELL_MAGICS:
+            statement = f"exec({args[2]!r})"
+        lines[row : end + 1] = [indent + statement] + [""] * (end - row)
+    return "\n".join(lines) + "\n"
