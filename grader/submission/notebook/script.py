@@ -81,11 +81,12 @@ def build_script(
     """
     text = data.decode("utf-8-sig")
     cells = script_cells(text)
-    offsets = {number: cell.first_line - 1 for number, cell in enumerate(cells, 1)}
+    by_number = dict(enumerate(cells, 1))
     builder = walk_cells(as_notebook_cells(cells), name, graded, script=True)
 
     def in_file(entry: SkippedCode) -> SkippedCode:
-        return entry.model_copy(update={"cell": SCRIPT_CELL, "line": offsets.get(entry.cell, 0) + entry.line})
+        line = by_number[entry.cell].file_line(entry.line) if entry.cell in by_number else entry.line
+        return entry.model_copy(update={"cell": SCRIPT_CELL, "line": line})
 
     listed = [in_file(entry) for entry in builder.skipped + builder.unlisted]
     ipython = [entry for entry in listed if entry.reason in _IPYTHON_KINDS or entry.reason.startswith("cell magic")]
@@ -93,7 +94,7 @@ def build_script(
         return None
     runnable = runnable_text(text)
     run_cells = _runnable_cells(runnable, [cell.first_line for cell in cells], text)
-    source, origins = _aligned(builder.future, builder.kept, builder.origins, offsets)
+    source, origins = _aligned(builder.future, builder.kept, builder.origins, by_number)
     needed = globals_needed(source, [function for function in graded if function not in served])
     if needed & (builder.affected | (builder.touched - builder.defined)):
         if not ipython:
@@ -120,7 +121,7 @@ def build_script(
 
 
 def _aligned(
-    future: list[str], kept: list[str], origins: list[tuple[int, int] | None], offsets: dict[int, int]
+    future: list[str], kept: list[str], origins: list[tuple[int, int] | None], cells: dict[int, ScriptCell]
 ) -> tuple[str, tuple[tuple[int, int] | None, ...]]:
     """The kept statements, each on its own line of the file where the lines before it leave room (so a
     traceback's line is the file's), with each line's (`SCRIPT_CELL`, line in the file)."""
@@ -129,7 +130,7 @@ def _aligned(
     for text, origin in zip("\n".join(kept).split("\n"), origins, strict=True):
         if origin is None:
             continue  # the notebook's "# --- cell N ---" headers
-        line = offsets.get(origin[0], 0) + origin[1]
+        line = cells[origin[0]].file_line(origin[1]) if origin[0] in cells else origin[1]
         while len(lines) < line - 1:
             lines.append("")
             placed.append(None)
@@ -157,10 +158,20 @@ def _has_markers(text: str) -> bool:
 
 @dataclass(frozen=True)
 class ScriptCell:
-    """One cell of a `.py`: its first line in the file and its source, IPython's lines as the notebook had them."""
+    """One cell of a `.py`: its source, IPython's lines as the notebook had them, and the file's line of each
+    of its lines (a cell magic's body is written out below its header, all on the line of its call)."""
 
-    first_line: int
     source: str
+    lines: tuple[int, ...]
+
+    @property
+    def first_line(self) -> int:
+        """The cell's first line in the file."""
+        return self.lines[0]
+
+    def file_line(self, line: int) -> int:
+        """The file's line of the cell's line ``line`` (1-based)."""
+        return self.lines[min(max(line, 1), len(self.lines)) - 1]
 
 
 def defines_only(tree: ast.Module, text: str) -> bool:
@@ -204,7 +215,8 @@ def script_cells(text: str) -> list[ScriptCell]:
         if not any(line.strip() for line in chunk):
             continue
         statements = [s for s in tree.body if start <= _first_line(s) <= end]
-        cells.append(ScriptCell(start, "\n".join(unexported(chunk, statements, start))))
+        written, numbers = unexported(chunk, statements, start)
+        cells.append(ScriptCell("\n".join(written), tuple(numbers)))
     return cells
 
 
@@ -230,9 +242,11 @@ def _first_line(statement: ast.stmt) -> int:
     return min([statement.lineno, *(decorator.lineno for decorator in decorators)])
 
 
-def unexported(chunk: list[str], statements: list[ast.stmt], first_line: int) -> list[str]:
-    """The chunk's lines with each ``get_ipython()`` line written back as the IPython line it came from."""
+def unexported(chunk: list[str], statements: list[ast.stmt], first_line: int) -> tuple[list[str], list[int]]:
+    """The chunk's lines with each ``get_ipython()`` line written back as the IPython line it came from, and
+    the file's line of each."""
     lines = list(chunk)
+    numbers = list(range(first_line, first_line + len(chunk)))
     top_level = {id(statement) for statement in statements}
     found = [(node, call) for statement in statements for node in ast.walk(statement) if (call := _ipython_call(node))]
     # From the last line up, so a cell magic's body written out below its header moves no line still to do.
@@ -249,12 +263,14 @@ def unexported(chunk: list[str], statements: list[ast.stmt], first_line: int) ->
                 body = args[2].removesuffix("\n").split("\n")
                 replaced = [header, *body]
             else:
-                replaced = [indent + target + _line_of(method, args)]
+                replaced = [indent + target + _line_of(method, args, bool(target))]
             end = (node.end_lineno or node.lineno) - first_line  # type: ignore[attr-defined]
             # The escape's line replaces the call's; its other lines (if any) are left empty, and a
             # cell magic's body follows its header (the cell was that call alone).
-            lines[row : end + 1] = replaced + [""] * max(0, end - row + 1 - len(replaced))
-    return lines
+            padded = replaced + [""] * max(0, end - row + 1 - len(replaced))
+            lines[row : end + 1] = padded
+            numbers[row : end + 1] = [numbers[row] + min(index, end - row) for index in range(len(padded))]
+    return lines, numbers
 
 
 def _ipython_call(node: ast.AST) -> tuple[str, list[str]] | None:
@@ -290,7 +306,7 @@ def _assigned(node: ast.AST, line: str) -> str:
     return line[node.col_offset : node.value.col_offset]
 
 
-def _line_of(method: str, args: list[str]) -> str:
+def _line_of(method: str, args: list[str], assigned: bool) -> str:
     if method == "run_line_magic" and len(args) == 2:
         name, rest = args
         if name in _HELP:
@@ -299,7 +315,7 @@ def _line_of(method: str, args: list[str]) -> str:
     if method == "system" and len(args) == 1:
         return "!" + args[0]
     if method == "getoutput" and len(args) == 1:
-        return "!!" + args[0]
+        return ("!" if assigned else "!!") + args[0]
     return f"%{method}"  # an unknown shape: still an IPython line, left out as the notebook's would be
 
 
