@@ -45,8 +45,8 @@ from grader.sandbox.isolation.scope import sandbox_scope
 from grader.sandbox.runner import require_isolation, sandbox_file_name
 from grader.submission.notebook import MAX_NOTEBOOK_BYTES, NotebookModule, build_module, is_notebook
 from grader.submission.notebook.bounded import build_script
-from grader.submission.notebook.script import defines_only
 from grader.submission.notebook.cells import write_cells
+from grader.submission.notebook.script import defines_only
 from grader.submission.untrusted_file import UnsafeFile, read_untrusted
 from grader.submission.validation import MAX_SUBMISSION_BYTES, FileVerdict, check_source
 

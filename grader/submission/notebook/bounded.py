@@ -306,7 +306,9 @@ def _main() -> None:
         except TransformerUnavailable as error:
             script = FileVerdict("error", _no_transformer_message(name, str(error)))
         except (RecursionError, MemoryError, SyntaxError, ValueError) as error:
-            script = FileVerdict("error", _unreadable_message(name, f"{type(error).__name__} while reading it"))
+            script = FileVerdict(
+                "error", _unreadable_message(name, f"{type(error).__name__} while reading it")
+            )
         reply = _reply(None, script) if script is not None else _Reply(status="as_is")
         sys.stdout.buffer.write(reply.model_dump_json().encode("utf-8"))
         return

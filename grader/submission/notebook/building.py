@@ -241,7 +241,9 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
                 builder.kept.append(text)
                 builder.origins += _origins(lines, statement, dropped, cell.number)
             builder.kept_statements += 1
-            if isinstance(statement, ast.Import | ast.ImportFrom | ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            if isinstance(
+                statement, ast.Import | ast.ImportFrom | ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef
+            ):
                 builder.defined |= bound_names(statement)
             for decorator in dropped:
                 _skip(builder, cell, decorator.lineno, _DROPPED_DECORATOR, "@" + _segment(lines, decorator))
@@ -587,7 +589,8 @@ def bound_names(statement: ast.stmt) -> set[str]:
 
 def touched_names(statement: ast.stmt) -> set[str]:
     """Names whose object a statement may change: stored into (``P[0] = ...``, ``env.seed = 1``), deleted,
-    their methods called (``env.reset()``, ``q.fill(0)``) or passed to a call (``np.random.shuffle(deck)``)."""
+    their methods called (``env.reset()``, ``q.fill(0)``) or passed to a call
+    (``np.random.shuffle(deck)``)."""
     names: set[str] = set()
     for node in ast.walk(statement):
         if isinstance(node, ast.Attribute | ast.Subscript) and isinstance(node.ctx, ast.Store | ast.Del):
@@ -622,13 +625,17 @@ def globals_needed(source: str, graded: Collection[str]) -> set[str]:
             reads.setdefault(child.get_name(), set()).update(_globals_read(child))
     for statement in ast.parse(source).body:
         if isinstance(statement, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
-            made_of = [*statement.decorator_list]
+            made_of: list[ast.expr | None] = [*statement.decorator_list]
             if not isinstance(statement, ast.ClassDef):
                 made_of += [*statement.args.defaults, *statement.args.kw_defaults]
             else:
                 made_of += [*statement.bases, *(keyword.value for keyword in statement.keywords)]
             reads.setdefault(statement.name, set()).update(
-                node.id for part in made_of if part is not None for node in ast.walk(part) if isinstance(node, ast.Name)
+                node.id
+                for part in made_of
+                if part is not None
+                for node in ast.walk(part)
+                if isinstance(node, ast.Name)
             )
     needed = set(graded)
     frontier = [name for name in graded if name in reads]

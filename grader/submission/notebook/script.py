@@ -1,4 +1,4 @@
-"""A `.py` file read as the notebook it may have been: its cells, and IPython's lines as the exports write them.
+"""A `.py` read as the notebook it may have been: its cells, and IPython's lines as the exports write them.
 
 Jupyter's "Download as Python" (``jupyter nbconvert --to script``), Colab's "Download .py" and jupytext keep a
 notebook's demo and training cells as top-level statements and write IPython's lines as calls:
@@ -27,9 +27,8 @@ from __future__ import annotations
 
 import ast
 import re
-from dataclasses import dataclass
-
 from collections.abc import Collection
+from dataclasses import dataclass
 
 from grader.submission.notebook.building import (
     _DROPPED_DECORATOR,
@@ -47,7 +46,8 @@ from grader.submission.validation import FileVerdict, check_source
 IPYTHON = "get_ipython"
 """The call every export writes IPython's lines with."""
 _MARKER = re.compile(r"^# ?(?:In\s*\[[ \d]*\]:|%%(?!\w))")
-"""A cell marker: nbconvert's ``# In[12]:`` / ``# In[ ]:``, jupytext's / VS Code's ``# %%`` (not ``# %%time``)."""
+"""A cell marker: nbconvert's ``# In[12]:`` / ``# In[ ]:``, jupytext's and VS Code's ``# %%`` (not
+``# %%time``)."""
 PYTHON_CELL_MAGICS = frozenset({"time", "capture"})
 """Cell magics whose body IPython runs as Python in the notebook's namespace (as the notebook reader says)."""
 _HELP = {"pinfo": "?", "pinfo2": "??"}
@@ -89,7 +89,9 @@ def build_script(
         return entry.model_copy(update={"cell": SCRIPT_CELL, "line": line})
 
     listed = [in_file(entry) for entry in builder.skipped + builder.unlisted]
-    ipython = [entry for entry in listed if entry.reason in _IPYTHON_KINDS or entry.reason.startswith("cell magic")]
+    ipython = [
+        entry for entry in listed if entry.reason in _IPYTHON_KINDS or entry.reason.startswith("cell magic")
+    ]
     if not ipython and all(entry.reason == _DROPPED_DECORATOR for entry in listed):
         return None
     runnable = runnable_text(text)
@@ -181,7 +183,9 @@ def defines_only(tree: ast.Module, text: str) -> bool:
         return False
     for statement in tree.body:
         match statement:
-            case ast.Import() | ast.ImportFrom() | ast.FunctionDef() | ast.AsyncFunctionDef() | ast.ClassDef():
+            case (
+                ast.Import() | ast.ImportFrom() | ast.FunctionDef() | ast.AsyncFunctionDef() | ast.ClassDef()
+            ):
                 continue
             case ast.Expr(value=ast.Constant(value=str())):
                 continue
@@ -238,7 +242,7 @@ def _cell_starts(tree: ast.Module, lines: list[str]) -> list[int]:
 
 
 def _first_line(statement: ast.stmt) -> int:
-    decorators = getattr(statement, "decorator_list", [])
+    decorators: list[ast.expr] = getattr(statement, "decorator_list", [])
     return min([statement.lineno, *(decorator.lineno for decorator in decorators)])
 
 
@@ -248,43 +252,48 @@ def unexported(chunk: list[str], statements: list[ast.stmt], first_line: int) ->
     lines = list(chunk)
     numbers = list(range(first_line, first_line + len(chunk)))
     top_level = {id(statement) for statement in statements}
-    found = [(node, call) for statement in statements for node in ast.walk(statement) if (call := _ipython_call(node))]
+    found = [
+        (node, call)
+        for statement in statements
+        for node in ast.walk(statement)
+        if (call := _ipython_call(node))
+    ]
     # From the last line up, so a cell magic's body written out below its header moves no line still to do.
     for node, (method, args) in sorted(found, key=lambda item: -item[0].lineno):  # type: ignore[attr-defined]
-            row = node.lineno - first_line  # type: ignore[attr-defined]
-            if not 0 <= row < len(lines):
+        row = node.lineno - first_line  # type: ignore[attr-defined]
+        if not 0 <= row < len(lines):
+            continue
+        indent = lines[row][: len(lines[row]) - len(lines[row].lstrip())]
+        target = _assigned(node, lines[row])
+        if method == "run_cell_magic":
+            if id(node) not in top_level or target or len(args) != 3:
                 continue
-            indent = lines[row][: len(lines[row]) - len(lines[row].lstrip())]
-            target = _assigned(node, lines[row])
-            if method == "run_cell_magic":
-                if id(node) not in top_level or target or len(args) != 3:
-                    continue
-                header = f"%%{args[0]} {args[1]}".rstrip()
-                body = args[2].removesuffix("\n").split("\n")
-                replaced = [header, *body]
-            else:
-                replaced = [indent + target + _line_of(method, args, bool(target))]
-            end = (node.end_lineno or node.lineno) - first_line  # type: ignore[attr-defined]
-            # The escape's line replaces the call's; its other lines (if any) are left empty, and a
-            # cell magic's body follows its header (the cell was that call alone).
-            padded = replaced + [""] * max(0, end - row + 1 - len(replaced))
-            lines[row : end + 1] = padded
-            numbers[row : end + 1] = [numbers[row] + min(index, end - row) for index in range(len(padded))]
+            header = f"%%{args[0]} {args[1]}".rstrip()
+            body = args[2].removesuffix("\n").split("\n")
+            replaced = [header, *body]
+        else:
+            replaced = [indent + target + _line_of(method, args, bool(target))]
+        end = (node.end_lineno or node.lineno) - first_line  # type: ignore[attr-defined]
+        # The escape's line replaces the call's; its other lines (if any) are left empty, and a
+        # cell magic's body follows its header (the cell was that call alone).
+        padded = replaced + [""] * max(0, end - row + 1 - len(replaced))
+        lines[row : end + 1] = padded
+        numbers[row : end + 1] = [numbers[row] + min(index, end - row) for index in range(len(padded))]
     return lines, numbers
 
 
 def _ipython_call(node: ast.AST) -> tuple[str, list[str]] | None:
     """(method, its string arguments) for ``get_ipython().method('...', ...)`` as a statement or the value of
     an assignment to names, else None."""
-    if isinstance(node, ast.Expr):
-        value = node.value
-    elif isinstance(node, ast.Assign) and all(_names(target) for target in node.targets):
-        value = node.value
-    else:
+    assigned = isinstance(node, ast.Assign) and all(_names(target) for target in node.targets)
+    if not isinstance(node, ast.Expr) and not assigned:
         return None
+    value = node.value  # type: ignore[attr-defined]
     match value:
         case ast.Call(
-            func=ast.Attribute(value=ast.Call(func=ast.Name(id="get_ipython"), args=[], keywords=[]), attr=method),
+            func=ast.Attribute(
+                value=ast.Call(func=ast.Name(id="get_ipython"), args=[], keywords=[]), attr=method
+            ),
             args=args,
             keywords=[],
         ) if all(isinstance(arg, ast.Constant) and isinstance(arg.value, str) for arg in args):

@@ -16,7 +16,16 @@ from grader.submission.notebook.models import NotebookModule
 from grader.submission.notebook.script import build_script, script_cells, unexported
 
 SUBMISSIONS = Path(__file__).resolve().parents[4] / "submissions"
-GRADED = ("random_blackjack", "blackjack", "cartpole", "car", "taxi", "find_qvalues", "epsilon_decay", "sarsa0")
+GRADED = (
+    "random_blackjack",
+    "blackjack",
+    "cartpole",
+    "car",
+    "taxi",
+    "find_qvalues",
+    "epsilon_decay",
+    "sarsa0",
+)
 HONEST_NOTEBOOKS = (
     "notebooks/classic_complete.ipynb",
     "notebooks/bad_metadata.ipynb",
@@ -28,7 +37,7 @@ HONEST_NOTEBOOKS = (
 
 
 def _statements(source: str) -> list[str]:
-    """The module's statements, but strings (an export's markdown and Colab's header are string statements)."""
+    """The module's statements but strings (an export's markdown and Colab's header are strings)."""
     body = ast.parse(source).body
     return [ast.dump(s) for s in body if not (isinstance(s, ast.Expr) and isinstance(s.value, ast.Constant))]
 
@@ -65,12 +74,18 @@ def test_a_cell_magic_is_its_cell_and_an_indented_line_keeps_its_indent() -> Non
 
 
 def test_markers_split_cells_outside_statements_only() -> None:
-    text = '# In[1]:\n\n\nimport gym\n\n\n# In[ ]:\n\n\ndef f():\n    """\n# %%\n"""\n    return 1\n# %%\nx = f()\n'
+    text = (
+        '# In[1]:\n\n\nimport gym\n\n\n# In[ ]:\n\n\ndef f():\n    """\n# %%\n"""\n    return 1\n'
+        "# %%\nx = f()\n"
+    )
     assert [cell.first_line for cell in script_cells(text)] == [1, 7, 15]
 
 
 def test_unexported_leaves_other_calls_alone() -> None:
-    assert unexported(["get_ipython().kernel", "print(1)"], [], 1) == (["get_ipython().kernel", "print(1)"], [1, 2])
+    assert unexported(["get_ipython().kernel", "print(1)"], [], 1) == (
+        ["get_ipython().kernel", "print(1)"],
+        [1, 2],
+    )
 
 
 def test_a_module_of_definitions_and_constants_is_graded_as_it_is() -> None:
@@ -109,7 +124,12 @@ def test_a_function_using_what_the_top_level_sets_gets_the_whole_file_as_always(
     built = build_script(text.encode(), "opengym.py", GRADED)
     assert isinstance(built, NotebookModule)
     assert built.summary.kept_statements == 0 and [entry.line for entry in built.summary.skipped] == [2]
-    assert built.source.splitlines()[1:5] == ["pass", "env = gym.make('Taxi-v3')", "env.reset(seed=1)", "print(env)"]
+    assert built.source.splitlines()[1:5] == [
+        "pass",
+        "env = gym.make('Taxi-v3')",
+        "env.reset(seed=1)",
+        "print(env)",
+    ]
     without_ipython = text.replace("get_ipython().system('pip install gym')\n", "")
     assert build_script(without_ipython.encode(), "opengym.py", GRADED) is None
 
