@@ -227,7 +227,10 @@ def _read_as_notebook(data: bytes, shown: str, plan: GradingPlan) -> NotebookMod
     if defines_only(ast.parse(data), data.decode("utf-8-sig")):
         return None
     served = [problem for problem in plan.problems if _runs_cells_first(plan, problem)]
-    built = build_script(data, shown, plan.problems, served)
+    edition = EDITIONS.get(plan.edition)
+    template = [function.name for function in edition.functions] if edition is not None else []
+    # Every function the template defines may be called (a check calls more than its problem's function).
+    built = build_script(data, shown, sorted({*plan.problems, *template}), served)
     return built if isinstance(built, NotebookModule) else None
 
 
