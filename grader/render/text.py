@@ -89,6 +89,7 @@ def notebook_lines(notebook: NotebookSummary) -> list[str]:
             f"{len(notebook.skipped)} statements did not:"
         ]
         lines += [f"  line {entry.line}: {entry.code}  <- {entry.reason}" for entry in notebook.skipped]
+        lines += [f"  note: {note}" for note in notebook.ignored]
         return [*lines, ""]
     lines = [
         f"Notebook: {notebook.kept_statements} imports, definitions and constants from {notebook.code_cells} code cells ran at import; "  # noqa: E501

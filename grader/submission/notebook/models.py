@@ -71,7 +71,7 @@ class NotebookSummary(BaseModel):
     )
     ignored: list[str] = Field(
         default_factory=list,
-        description="What of the file itself the grader ignored to read the cells (metadata that does not follow the nbformat schema, an old format version).",  # noqa: E501
+        description="What of the file itself the grader ignored to read the cells (metadata that does not follow the nbformat schema, an old format version); for a .py, why its whole file ran at import.",  # noqa: E501
     )
     script: bool = Field(
         default=False,

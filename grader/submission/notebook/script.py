@@ -54,6 +54,8 @@ _HELP = {"pinfo": "?", "pinfo2": "??"}
 MAX_PADDING = 4_000_000
 """Blank lines written before the marked cells of a file to run (so each keeps its lines) at most; past it
 the file runs as one cell (a hostile file of thousands of markers must not cost gigabytes)."""
+MAX_NAMED = 5
+"""Globals named in the note saying why a whole file ran at import."""
 _IPYTHON_KINDS = frozenset({*ESCAPES.values(), "IPython magic (automagic)", "IPython command"})
 
 
@@ -98,10 +100,19 @@ def build_script(
     run_cells = _runnable_cells(runnable, [cell.first_line for cell in cells], text)
     source, origins = _aligned(builder.future, builder.kept, builder.origins, by_number)
     needed = globals_needed(source, [function for function in graded if function not in served])
-    if needed & (builder.affected | (builder.touched - builder.defined)):
+    used = sorted(needed & (builder.affected | (builder.touched - builder.defined)))
+    if used:
         if not ipython:
             return None
-        summary = NotebookSummary(code_cells=len(cells), kept_statements=0, skipped=ipython, script=True)
+        listed_names = ", ".join(f"`{name}`" for name in used[:MAX_NAMED])
+        whole_file = (
+            f"your functions use what top-level statements set or change ({listed_names}), so the whole file "
+            "ran at import, as a .py always did, but for its IPython lines"
+        )
+        ran = len(ast.parse(runnable).body) - len(ipython)
+        summary = NotebookSummary(
+            code_cells=len(cells), kept_statements=ran, skipped=ipython, ignored=[whole_file], script=True
+        )
         whole = tuple((SCRIPT_CELL, line) for line in range(1, runnable.count("\n") + 1))
         return NotebookModule(source=runnable, summary=summary, origins=whole, cells=run_cells)
     verdict = check_source(source.encode(), name)
