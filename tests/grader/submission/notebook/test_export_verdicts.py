@@ -57,7 +57,7 @@ class Case:
 
 RL2_NOTEBOOK = "rl2/policy_iteration.ipynb (built from rl2/honest_v2024.py)"
 CASES = [
-    Case("notebooks/classic_complete.ipynb", "classic", ("random_blackjack", "blackjack", "cartpole", "taxi")),
+    Case("notebooks/classic_complete.ipynb", "classic", ("random_blackjack", "cartpole", "taxi")),
     Case("notebooks/bad_metadata.ipynb", "classic", ("random_blackjack", "cartpole")),
     Case("notebooks/old_format_v3.ipynb", "classic", ("cartpole",)),
     Case("editions/rl1_template_honest.ipynb", "rl1", RL1, suite_episodes=3000),
@@ -128,10 +128,10 @@ def test_an_export_gets_its_notebooks_verdicts(
     assert notebook.submission_error is None and exported.submission_error is None, exported.submission_error
     assert exported.grader_errors == []
     honest = "missing" if case.notebook.startswith("templates/") else "passed"  # what the exports are held to
-    assert {problem.status for problem in notebook.problems} == {honest}, [r.feedback for r in notebook.problems]
+    statuses = {problem.status for problem in notebook.problems}
+    assert statuses == {honest}, [problem.feedback for problem in notebook.problems]
     verdicts = {problem.id: (problem.status, problem.score) for problem in notebook.problems}
     feedback = {problem.id: problem.feedback for problem in exported.problems}
     found = {problem.id: (problem.status, problem.score) for problem in exported.problems}
     assert found == verdicts, feedback
     assert exported.notebook is not None and exported.notebook.script  # read as its notebook, and said so
-
