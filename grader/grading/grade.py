@@ -196,12 +196,12 @@ def _prepare(
         return data
     if not is_notebook(path.name):
         verdict = check_source(data, shown)
-        if verdict is not None:
+        read = _read_as_notebook(data, shown, plan, valid=verdict is None)
+        if verdict is not None and read is None:
             return verdict
         module_dir.mkdir()
         module = module_dir / path.name
         note = _edition_note(data, shown, plan)
-        read = _read_as_notebook(data, shown, plan)
         if read is None:
             module.write_bytes(data)
             return Submission(path, data, module, edition_note=note, name=shown)
@@ -219,12 +219,16 @@ def _prepare(
     return Submission(path, data, module, built, edition_note=note, name=shown)
 
 
-def _read_as_notebook(data: bytes, shown: str, plan: GradingPlan) -> NotebookModule | None:
+def _read_as_notebook(data: bytes, shown: str, plan: GradingPlan, *, valid: bool) -> NotebookModule | None:
     """A `.py` read as the notebook it may have been (`grader.submission.notebook.script`): the module
     whose import runs what the notebook's would, or None to grade the file as it is (its top level defines
-    only, the notebook's rules leave out nothing of it, or the reader could not read it: the file compiled,
-    so it is graded as it always was)."""
-    if defines_only(ast.parse(data), data.decode("utf-8-sig")):
+    only, the notebook's rules leave out nothing of it, or the reader could not read it: a file that
+    compiled is graded as it always was, one that did not keeps its verdict). A file that is not ``valid``
+    Python is read only if it may be an export (IPython's lines as they are, a half-written marked cell)."""
+    if not valid:
+        if len(data) > MAX_SUBMISSION_BYTES or b"\0" in data:
+            return None
+    elif defines_only(ast.parse(data), data.decode("utf-8-sig")):
         return None
     served = [problem for problem in plan.problems if _runs_cells_first(plan, problem)]
     edition = EDITIONS.get(plan.edition)

@@ -70,9 +70,11 @@ process (never running student code), and the sandbox imports it like any `.py` 
   notebook's rules. The module keeps each kept statement on its own line of the file where it can (so a
   traceback's line is the file's), and every `SkippedCode`, `UnboundGlobal` and origin is cell
   `SCRIPT_CELL` (0) with the file's own line (`NotebookSummary.script`). `None` (the file graded as it is)
-  when the rules leave out nothing but decorators; the whole file (IPython lines made `pass`, `runnable_text`)
-  when a graded or template function uses what a left-out statement sets or changes (`building.touched_names`,
-  `building.globals_needed`), except the globals of `served` functions (compare()'s, set by its cells run).
+  when the rules leave out nothing but decorators; the whole file (IPython lines made `pass`, as its cells
+  run) when a graded or template function uses what a left-out statement sets or changes
+  (`building.touched_names`, `building.globals_needed`), except the globals of `served` functions
+  (compare()'s, set by its cells run). A file that is not Python as it is is read when IPython's transformer
+  makes it Python (``!pip`` written as it is) or its marked cells hold the error (left out as in a notebook).
   `NotebookModule.cells` of a `.py`: its marked cells, or the file as one cell, each `SCRIPT_CELL` (run as a
   script: `cells.runnable_cells`).
 - `grader/submission/notebook/building.py`: cells -> module. Per cell: size budget (200,000 characters),

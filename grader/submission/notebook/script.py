@@ -13,9 +13,9 @@ notebook reader (`grader.submission.notebook.building`) reads by its own rules:
   (`ScriptCell.first_line`): whatever the report says of a line is the file's own line.
 - **IPython's lines** are turned back into the ``%`` / ``!`` / ``%%`` lines the notebook had (`unexported`),
   so IPython's transformer reads them as it reads the notebook's (`grader.submission.notebook.ipython`).
-- **Running it** (`runnable_text`): the file as Jupyter's "Run All" of its notebook runs it, with the same
-  lines: each IPython line ``pass``, a ``%%time`` / ``%%capture`` cell's body run by ``exec``, another cell
-  magic's body not run.
+- **Running it** (`NotebookModule.cells`): the cells as Jupyter's "Run All" of its notebook runs them, each
+  on the file's own lines: each IPython line ``pass``, a ``%%time`` / ``%%capture`` cell's body, no other
+  cell magic's body.
 
 `defines_only` says, without the reader child, that a file's top level holds only imports, definitions, a
 docstring and an ``if __name__ == "__main__":`` block: such a file is graded as it is, as it always was.
@@ -38,7 +38,7 @@ from grader.submission.notebook.building import (
     walk_cells,
 )
 from grader.submission.notebook.cells import SCRIPT_CELL
-from grader.submission.notebook.ipython import ESCAPES
+from grader.submission.notebook.ipython import ESCAPES, transform_cell
 from grader.submission.notebook.models import NotebookModule, NotebookSummary, SkippedCode
 from grader.submission.notebook.reading import Cell, NotebookCells
 from grader.submission.validation import FileVerdict, check_source
@@ -48,8 +48,6 @@ IPYTHON = "get_ipython"
 _MARKER = re.compile(r"^# ?(?:In\s*\[[ \d]*\]:|%%(?!\w))")
 """A cell marker: nbconvert's ``# In[12]:`` / ``# In[ ]:``, jupytext's and VS Code's ``# %%`` (not
 ``# %%time``)."""
-PYTHON_CELL_MAGICS = frozenset({"time", "capture"})
-"""Cell magics whose body IPython runs as Python in the notebook's namespace (as the notebook reader says)."""
 _HELP = {"pinfo": "?", "pinfo2": "??"}
 MAX_PADDING = 4_000_000
 """Blank lines written before the marked cells of a file to run (so each keeps its lines) at most; past it
@@ -94,27 +92,31 @@ def build_script(
     ipython = [
         entry for entry in listed if entry.reason in _IPYTHON_KINDS or entry.reason.startswith("cell magic")
     ]
-    if not ipython and all(entry.reason == _DROPPED_DECORATOR for entry in listed):
+    if not ipython and not builder.broken and all(entry.reason == _DROPPED_DECORATOR for entry in listed):
         return None
-    runnable = runnable_text(text)
-    run_cells = _runnable_cells(runnable, [cell.first_line for cell in cells], text)
+    runnable = [(by_number[number], source) for number, source in builder.runnable]
+    whole_text, _ = _placed([(cell.lines, source) for cell, source in runnable])
+    run_cells = _runnable_cells(runnable, whole_text, marked=_has_markers(text))
     source, origins = _aligned(builder.future, builder.kept, builder.origins, by_number)
     needed = globals_needed(source, [function for function in graded if function not in served])
     used = sorted(needed & (builder.affected | (builder.touched - builder.defined)))
     if used:
-        if not ipython:
+        if not ipython and not builder.broken:
             return None
         listed_names = ", ".join(f"`{name}`" for name in used[:MAX_NAMED])
         whole_file = (
             f"your functions use what top-level statements set or change ({listed_names}), so the whole file "
             "ran at import, as a .py always did, but for its IPython lines"
         )
-        ran = len(ast.parse(runnable).body) - len(ipython)
+        ran = builder.kept_statements + len(listed) - len(ipython)
         summary = NotebookSummary(
             code_cells=len(cells), kept_statements=ran, skipped=ipython, ignored=[whole_file], script=True
         )
-        whole = tuple((SCRIPT_CELL, line) for line in range(1, runnable.count("\n") + 1))
-        return NotebookModule(source=runnable, summary=summary, origins=whole, cells=run_cells)
+        whole_source, whole = _placed([(cell.lines, source) for cell, source in runnable])
+        verdict = check_source(whole_source.encode(), name)
+        if verdict is not None:
+            return verdict
+        return NotebookModule(source=whole_source, summary=summary, origins=whole, cells=run_cells)
     verdict = check_source(source.encode(), name)
     if verdict is not None:
         return verdict
@@ -138,31 +140,43 @@ def _aligned(
 ) -> tuple[str, tuple[tuple[int, int] | None, ...]]:
     """The kept statements, each on its own line of the file where the lines before it leave room (so a
     traceback's line is the file's), with each line's (`SCRIPT_CELL`, line in the file)."""
-    lines: list[str] = list(future)
-    placed: list[tuple[int, int] | None] = [None] * len(future)
-    for text, origin in zip("\n".join(kept).split("\n"), origins, strict=True):
-        if origin is None:
-            continue  # the notebook's "# --- cell N ---" headers
-        line = cells[origin[0]].file_line(origin[1]) if origin[0] in cells else origin[1]
-        while len(lines) < line - 1:
-            lines.append("")
-            placed.append(None)
-        lines.append(text)
-        placed.append((SCRIPT_CELL, line))
+    lines = [
+        (cells[origin[0]].file_line(origin[1]) if origin[0] in cells else origin[1], text)
+        for text, origin in zip("\n".join(kept).split("\n"), origins, strict=True)
+        if origin is not None  # not the notebook's "# --- cell N ---" headers
+    ]
+    source, placed = _placed([((line,), text) for line, text in lines], first=future)
+    return source, placed
+
+
+def _placed(
+    chunks: list[tuple[tuple[int, ...], str]],
+    first: list[str] = (),  # type: ignore[assignment]
+) -> tuple[str, tuple[tuple[int, int] | None, ...]]:
+    """Each chunk's lines at the file's lines they came from (``chunk[0]``: the file's line of each, or of its
+    first), where the lines before leave room; after ``first`` lines. The source and each line's origin."""
+    lines: list[str] = list(first)
+    placed: list[tuple[int, int] | None] = [None] * len(first)
+    for numbers, text in chunks:
+        for index, line_text in enumerate(text.split("\n")):
+            line = numbers[min(index, len(numbers) - 1)] + max(0, index - len(numbers) + 1)
+            while len(lines) < line - 1:
+                lines.append("")
+                placed.append(None)
+            lines.append(line_text)
+            placed.append((SCRIPT_CELL, line))
     return "\n".join(lines) + "\n", tuple(placed)
 
 
-def _runnable_cells(runnable: str, starts: list[int], text: str) -> tuple[tuple[int, str], ...]:
-    """What running the file's cells runs: its marked cells (each after blank lines, so its lines are the
-    file's), or the file as one cell; every one a script's (`SCRIPT_CELL`)."""
-    lines = runnable.split("\n")
-    if not _has_markers(text) or sum(starts) > MAX_PADDING:
-        return ((SCRIPT_CELL, runnable),)
-    cells = []
-    for index, start in enumerate(starts):
-        end = starts[index + 1] - 1 if index + 1 < len(starts) else len(lines)
-        cells.append((SCRIPT_CELL, "\n" * (start - 1) + "\n".join(lines[start - 1 : end])))
-    return tuple(cells)
+def _runnable_cells(
+    runnable: list[tuple[ScriptCell, str]], whole: str, *, marked: bool
+) -> tuple[tuple[int, str], ...]:
+    """What running the file's cells runs, as Run All runs its notebook's (IPython's lines ``pass``, a
+    ``%%time`` cell's body, no ``%%bash`` cell): its marked cells, each after blank lines so that its lines
+    are the file's, or the file as one cell (``whole``); each a script's (`SCRIPT_CELL`)."""
+    if not marked or sum(cell.first_line for cell, _ in runnable) > MAX_PADDING:
+        return ((SCRIPT_CELL, whole),)
+    return tuple((SCRIPT_CELL, _placed([(cell.lines, source)])[0]) for cell, source in runnable)
 
 
 def _has_markers(text: str) -> bool:
@@ -217,10 +231,33 @@ def is_main_guard(test: ast.expr) -> bool:
 
 def script_cells(text: str) -> list[ScriptCell]:
     """The file's cells: by its markers, or one per top-level statement; IPython's lines as the notebook had
-    them. The file must parse (`grader.submission.validation.check_source` said so)."""
-    tree = ast.parse(text)
+    them.
+
+    A file that is not Python as it is may still be an export: its IPython lines written as they are
+    (``!pip install gym``, which IPython's transformer reads), or a marked cell that is not Python (a
+    half-written cell, left out as the notebook reader leaves it out).
+
+    Raises:
+        SyntaxError: The file is not Python, even read as IPython reads a cell, and has no cell markers.
+    """
     lines = text.splitlines()
-    starts = _cell_starts(tree, lines)
+    tree = _parsed(text) or _parsed(transform_cell(text, ()).source)
+    if tree is None:
+        markers = [number for number, line in enumerate(lines, 1) if _MARKER.match(line)]
+        if not markers:
+            raise SyntaxError("not Python, even as IPython reads a cell, and no cell markers")
+        return _cells(lines, sorted({1, *markers}), None)
+    return _cells(lines, _cell_starts(tree, lines), tree)
+
+
+def _parsed(text: str) -> ast.Module | None:
+    try:
+        return ast.parse(text)
+    except (SyntaxError, ValueError):
+        return None
+
+
+def _cells(lines: list[str], starts: list[int], tree: ast.Module | None) -> list[ScriptCell]:
     cells: list[ScriptCell] = []
     for index, start in enumerate(starts):
         end = starts[index + 1] - 1 if index + 1 < len(starts) else len(lines)
@@ -229,7 +266,13 @@ def script_cells(text: str) -> list[ScriptCell]:
             chunk[0] = ""  # the marker separates cells; it is no line of the cell
         if not any(line.strip() for line in chunk):
             continue
-        statements = [s for s in tree.body if start <= _first_line(s) <= end]
+        if tree is not None:
+            statements = [s for s in tree.body if start <= _first_line(s) <= end]
+        else:  # each marked cell alone; one that is not Python is left out by the notebook's rules
+            alone = _parsed("\n".join(chunk))
+            if alone is not None:
+                ast.increment_lineno(alone, start - 1)
+            statements = alone.body if alone is not None else []
         written, numbers = unexported(chunk, statements, start)
         cells.append(ScriptCell("\n".join(written), tuple(numbers)))
     return cells
@@ -337,22 +380,3 @@ def _line_of(method: str, args: list[str], assigned: bool) -> str:
     if method == "getoutput" and len(args) == 1:
         return ("!" if assigned else "!!") + args[0]
     return f"%{method}"  # an unknown shape: still an IPython line, left out as the notebook's would be
-
-
-def runnable_text(text: str) -> str:
-    """The file as "Run All" of its notebook runs it, line for line: each IPython line ``pass``, a
-    ``%%time`` / ``%%capture`` cell's body run by ``exec`` (it is Python), another cell magic's not run."""
-    tree = ast.parse(text)
-    lines = text.splitlines()
-    for node in ast.walk(tree):
-        call = _ipython_call(node)
-        if call is None:
-            continue
-        method, args = call
-        row, end = node.lineno - 1, (node.end_lineno or node.lineno) - 1  # type: ignore[attr-defined]
-        indent = lines[row][: len(lines[row]) - len(lines[row].lstrip())]
-        statement = "pass"
-        if method == "run_cell_magic" and len(args) == 3 and args[0] in PYTHON_CELL_MAGICS:
-            statement = f"exec({args[2]!r})"
-        lines[row : end + 1] = [indent + statement] + [""] * (end - row)
-    return "\n".join(lines) + "\n"

@@ -173,3 +173,28 @@ def test_an_export_imports_the_module_its_notebook_does(notebook: str, export: s
     exported_lines = text.splitlines()
     for entry in from_export.summary.skipped:  # each cited line is the file's own
         assert exported_lines[entry.line - 1].strip(), entry
+
+
+def test_ipython_lines_written_as_they_are_are_read_as_the_notebook_reads_them() -> None:
+    text = "!pip install gym\n%matplotlib inline\nimport gym\n\ndef car():\n    return 1\n\nprint(car())\n"
+    built = build_script(text.encode(), "opengym.py", GRADED)
+    assert isinstance(built, NotebookModule)
+    assert [(entry.line, entry.reason.split(" (")[0]) for entry in built.summary.skipped] == [
+        (1, "shell command"),
+        (2, "IPython magic"),
+        (8, "call of print(...)"),
+    ]
+    assert built.source.splitlines()[2:6] == ["import gym", "", "def car():", "    return 1"]
+
+
+def test_a_half_written_marked_cell_is_left_out_as_in_the_notebook() -> None:
+    text = "# In[1]:\n\n\ndef cartpole():\n    return 1\n\n\n# In[2]:\n\n\ndef car(:\n    return 2\n"
+    built = build_script(text.encode(), "opengym.py", GRADED)
+    assert isinstance(built, NotebookModule)
+    assert [entry.line for entry in built.summary.skipped] == [11]
+    assert "never defined" in built.source  # car() raises an error naming the cell, as the notebook's would
+
+
+def test_a_file_that_is_not_python_even_so_is_not_read() -> None:
+    with pytest.raises(SyntaxError):  # the reading child's error: the file keeps check_source's verdict
+        build_script(b"def car(:\n    return 2\n", "opengym.py", GRADED)
