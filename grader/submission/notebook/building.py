@@ -587,10 +587,23 @@ def bound_names(statement: ast.stmt) -> set[str]:
     return names
 
 
+_READING_NUMPY = ("mean", "std", "sum", "max", "min", "argmax", "argmin", "round", "array")
+READ_ONLY_CALLS = frozenset(
+    {
+        "print", "display", "len", "str", "repr", "format", "sorted", "sum", "min", "max", "abs", "round",
+        "isinstance", "type", "id", "list", "tuple", "enumerate", "zip", "range",
+        *(f"{numpy}.{name}" for numpy in ("np", "numpy") for name in _READING_NUMPY),
+    }
+)  # fmt: skip
+"""Calls that only read their arguments (with ``plt.`` / ``pyplot.`` ones): passing a value to them, as a
+demo prints or plots it, changes nothing a function reads."""
+_PLOTTING = ("plt.", "pyplot.", "matplotlib.")
+
+
 def touched_names(statement: ast.stmt) -> set[str]:
     """Names whose object a statement may change: stored into (``P[0] = ...``, ``env.seed = 1``), deleted,
-    their methods called (``env.reset()``, ``q.fill(0)``) or passed to a call
-    (``np.random.shuffle(deck)``)."""
+    their methods called (``env.reset()``, ``q.fill(0)``) or passed to a call that may change them
+    (``np.random.shuffle(deck)``; not ``print(q)``, `READ_ONLY_CALLS`)."""
     names: set[str] = set()
     for node in ast.walk(statement):
         if isinstance(node, ast.Attribute | ast.Subscript) and isinstance(node.ctx, ast.Store | ast.Del):
@@ -600,6 +613,9 @@ def touched_names(statement: ast.stmt) -> set[str]:
         elif isinstance(node, ast.Call):
             if isinstance(node.func, ast.Attribute):
                 names.add(_root_name(node.func.value))
+            called = rules.dotted_name(node.func) or ""
+            if called in READ_ONLY_CALLS or called.startswith(_PLOTTING):
+                continue
             for argument in [*node.args, *(keyword.value for keyword in node.keywords)]:
                 if isinstance(argument, ast.Starred):
                     argument = argument.value

@@ -198,3 +198,24 @@ def test_a_half_written_marked_cell_is_left_out_as_in_the_notebook() -> None:
 def test_a_file_that_is_not_python_even_so_is_not_read() -> None:
     with pytest.raises(SyntaxError):  # the reading child's error: the file keeps check_source's verdict
         build_script(b"def car(:\n    return 2\n", "opengym.py", GRADED)
+
+
+@pytest.mark.parametrize(
+    ("demo", "whole_file"),
+    [
+        ("print(N, table[0])", False),
+        ("plt.plot(table[0])", False),
+        ("np.random.shuffle(table)", True),
+        ("table[0, 0] = 1.0", True),
+        ("table.fill(2.0)", True),
+        ("N = int('7')", True),
+    ],
+)
+def test_what_a_left_out_statement_may_change_keeps_the_whole_file(demo: str, whole_file: bool) -> None:
+    text = (
+        "import numpy as np\nfrom matplotlib import pyplot as plt\nN = 3\ntable = np.zeros((500, 6))\n"
+        f"def taxi(q, n=N):\n    return float(table.sum()), 0.0\n{demo}\nget_ipython().system('ls')\n"
+    )
+    built = build_script(text.encode(), "opengym.py", GRADED)
+    assert isinstance(built, NotebookModule)
+    assert (demo in built.source) is whole_file
