@@ -46,7 +46,7 @@ from grader.sandbox.runner import require_isolation, sandbox_file_name
 from grader.submission.notebook import MAX_NOTEBOOK_BYTES, NotebookModule, build_module, is_notebook
 from grader.submission.notebook.bounded import build_script
 from grader.submission.notebook.cells import write_cells
-from grader.submission.notebook.script import defines_only
+from grader.submission.notebook.script import defines_only, may_be_export
 from grader.submission.untrusted_file import UnsafeFile, read_untrusted
 from grader.submission.validation import MAX_SUBMISSION_BYTES, FileVerdict, check_source
 
@@ -227,6 +227,11 @@ def _read_as_notebook(data: bytes, shown: str, plan: GradingPlan, *, valid: bool
     Python is read only if it may be an export (IPython's lines as they are, a half-written marked cell)."""
     if not valid:
         if len(data) > MAX_SUBMISSION_BYTES or b"\0" in data:
+            return None
+        try:
+            if not may_be_export(data.decode("utf-8-sig")):
+                return None
+        except UnicodeDecodeError:
             return None
     elif defines_only(ast.parse(data), data.decode("utf-8-sig")):
         return None

@@ -220,6 +220,15 @@ def defines_only(tree: ast.Module, text: str) -> bool:
     return True
 
 
+_IPYTHON_LINE = re.compile(r"^\s*[!%]|\?\s*$", re.M)
+
+
+def may_be_export(text: str) -> bool:
+    """Whether a file that is not Python may be a notebook's export all the same: a line IPython reads
+    (``!pip install gym``, ``%matplotlib inline``, ``gym.make?``) or a cell marker."""
+    return _IPYTHON_LINE.search(text) is not None or any(_MARKER.match(line) for line in text.splitlines())
+
+
 def is_main_guard(test: ast.expr) -> bool:
     """``__name__ == "__main__"`` (either way round)."""
     return (

@@ -13,7 +13,7 @@ from notebook_exports import colab_export, nbconvert_export
 from grader.submission.notebook.building import build_module
 from grader.submission.notebook.cells import SCRIPT_CELL, runnable_cells, write_cells
 from grader.submission.notebook.models import NotebookModule
-from grader.submission.notebook.script import build_script, script_cells, unexported
+from grader.submission.notebook.script import build_script, may_be_export, script_cells, unexported
 
 SUBMISSIONS = Path(__file__).resolve().parents[4] / "submissions"
 GRADED = (
@@ -219,3 +219,17 @@ def test_what_a_left_out_statement_may_change_keeps_the_whole_file(demo: str, wh
     built = build_script(text.encode(), "opengym.py", GRADED)
     assert isinstance(built, NotebookModule)
     assert (demo in built.source) is whole_file
+
+
+@pytest.mark.parametrize(
+    ("text", "may_be"),
+    [
+        ("def car(:\n    return 1\n", False),
+        ("!pip install gym\n", True),
+        ("    %timeit car()\n", True),
+        ("gym.make?\n", True),
+        ("# %%\ndef car(:\n", True),
+    ],
+)
+def test_only_a_file_with_ipython_lines_or_markers_may_be_an_export(text: str, may_be: bool) -> None:
+    assert may_be_export(text) is may_be
