@@ -238,8 +238,10 @@ def _read_as_notebook(data: bytes, shown: str, plan: GradingPlan, *, valid: bool
     served = [problem for problem in plan.problems if _runs_cells_first(plan, problem)]
     edition = EDITIONS.get(plan.edition)
     template = [function.name for function in edition.functions] if edition is not None else []
-    # Every function the template defines may be called (a check calls more than its problem's function).
-    built = build_script(data, shown, sorted({*plan.problems, *template}), served)
+    # The template's functions that are no problem's may be called too (a check may call a helper); a
+    # problem's function is called only when its problem is graded.
+    helpers = [name for name in template if name not in plan.registry.ids]
+    built = build_script(data, shown, sorted({*plan.problems, *helpers}), served)
     return built if isinstance(built, NotebookModule) else None
 
 
