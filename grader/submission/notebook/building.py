@@ -138,7 +138,7 @@ def build_from_cells(
     summary = NotebookSummary(
         code_cells=len(read.cells),
         kept_statements=builder.kept_statements,
-        skipped=_listed(builder),
+        skipped=listed_skipped(builder),
         unbound_globals=unbound_globals(source, skipped_only, graded),
         ignored=read.ignored,
     )
@@ -170,7 +170,7 @@ def _skip(builder: _Builder, cell: Cell, line: int, reason: str, code: str) -> S
     return entry
 
 
-def _listed(builder: _Builder) -> list[SkippedCode]:
+def listed_skipped(builder: _Builder) -> list[SkippedCode]:
     """The skipped statements as the report lists them: the first ones, then one entry counting the rest."""
     if not builder.unlisted:
         return builder.skipped
@@ -246,7 +246,7 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
             ):
                 builder.defined |= bound_names(statement)
             for decorator in dropped:
-                _skip(builder, cell, decorator.lineno, _DROPPED_DECORATOR, "@" + _segment(lines, decorator))
+                _skip(builder, cell, decorator.lineno, DROPPED_DECORATOR, "@" + _segment(lines, decorator))
             _bind(builder.scope, statement, builder)
         else:
             main_guard = isinstance(statement, ast.If) and _is_main_guard(statement.test)
@@ -269,7 +269,7 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
 
 
 _BROKEN = "the whole cell is left out"
-_DROPPED_DECORATOR = (
+DROPPED_DECORATOR = (
     "decorator not applied: applying it would run code at import (the function is graded without it)"
 )
 

@@ -31,9 +31,9 @@ from collections.abc import Collection
 from dataclasses import dataclass
 
 from grader.submission.notebook.building import (
-    _DROPPED_DECORATOR,
-    _listed,
+    DROPPED_DECORATOR,
     globals_needed,
+    listed_skipped,
     unbound_globals,
     walk_cells,
 )
@@ -92,11 +92,12 @@ def build_script(
     ipython = [
         entry for entry in listed if entry.reason in _IPYTHON_KINDS or entry.reason.startswith("cell magic")
     ]
-    if not ipython and not builder.broken and all(entry.reason == _DROPPED_DECORATOR for entry in listed):
+    if not ipython and not builder.broken and all(entry.reason == DROPPED_DECORATOR for entry in listed):
         return None
     runnable = [(by_number[number], source) for number, source in builder.runnable]
-    whole_text, _ = _placed([(cell.lines, source) for cell, source in runnable])
-    run_cells = _runnable_cells(runnable, whole_text, marked=_has_markers(text))
+    # The whole file as it runs: each cell on its lines, but a cell that is not Python (Run All fails there).
+    whole_source, whole = _placed([(cell.lines, source) for cell, source in runnable if _parsed(source)])
+    run_cells = _runnable_cells(runnable, whole_source, marked=_has_markers(text))
     source, origins = _aligned(builder.future, builder.kept, builder.origins, by_number)
     needed = globals_needed(source, [function for function in graded if function not in served])
     used = sorted(needed & (builder.affected | (builder.touched - builder.defined)))
@@ -112,7 +113,6 @@ def build_script(
         summary = NotebookSummary(
             code_cells=len(cells), kept_statements=ran, skipped=ipython, ignored=[whole_file], script=True
         )
-        whole_source, whole = _placed([(cell.lines, source) for cell, source in runnable])
         verdict = check_source(whole_source.encode(), name)
         if verdict is not None:
             return verdict
@@ -128,7 +128,7 @@ def build_script(
     summary = NotebookSummary(
         code_cells=len(cells),
         kept_statements=builder.kept_statements,
-        skipped=[in_file(entry) for entry in _listed(builder)],
+        skipped=[in_file(entry) for entry in listed_skipped(builder)],
         unbound_globals=unbound_globals(source, skipped_only, graded),
         script=True,
     )
