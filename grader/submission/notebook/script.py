@@ -54,6 +54,7 @@ MAX_PADDING = 4_000_000
 the file runs as one cell (a hostile file of thousands of markers must not cost gigabytes)."""
 MAX_NAMED = 5
 """Globals named in the note saying why a whole file ran at import."""
+_DEFINITIONS = (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
 _IPYTHON_KINDS = frozenset({*ESCAPES.values(), "IPython magic (automagic)", "IPython command"})
 
 
@@ -77,7 +78,8 @@ def build_script(
 
     Returns:
         The module (every line and cell cited as the file's own line: cell `SCRIPT_CELL`), None to grade the
-        file as it is, or a verdict when the module built is not Python.
+        file as it is (also when it defines nothing: what it does at import is then its verdict), or a
+        verdict when the module built is not Python.
     """
     text = data.decode("utf-8-sig")
     cells = script_cells(text)
@@ -99,6 +101,8 @@ def build_script(
     whole_source, whole = _placed([(cell.lines, source) for cell, source in runnable if _parsed(source)])
     run_cells = _runnable_cells(runnable, whole_source, marked=_has_markers(text))
     source, origins = _aligned(builder.future, builder.kept, builder.origins, by_number)
+    if not any(isinstance(kept, _DEFINITIONS) for kept in ast.parse(source).body) and not builder.broken:
+        return None  # nothing to call: what the file does at import is its verdict, as it always was
     needed = globals_needed(source, [function for function in graded if function not in served])
     used = sorted(needed & (builder.affected | (builder.touched - builder.defined)))
     if used:

@@ -233,3 +233,7 @@ def test_what_a_left_out_statement_may_change_keeps_the_whole_file(demo: str, wh
 )
 def test_only_a_file_with_ipython_lines_or_markers_may_be_an_export(text: str, may_be: bool) -> None:
     assert may_be_export(text) is may_be
+
+
+def test_a_file_defining_nothing_is_graded_as_it_is() -> None:
+    assert build_script(b"import os\nraise RuntimeError('boom at import')\n", "opengym.py", GRADED) is None
