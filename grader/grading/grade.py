@@ -201,7 +201,8 @@ def _prepare(
             return verdict
         module_dir.mkdir()
         module = module_dir / path.name
-        note = _edition_note(data, shown, plan)
+        # A file that is Python only as its notebook's export shows its edition in the module read from it.
+        note = _edition_note(data if read is None or verdict is None else read.source.encode(), shown, plan)
         if read is None:
             module.write_bytes(data)
             return Submission(path, data, module, edition_note=note, name=shown)
