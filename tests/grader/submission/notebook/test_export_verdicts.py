@@ -1,6 +1,7 @@
 """Every honest notebook sample, exported as Jupyter's "Download as Python" (nbconvert's `ScriptExporter`, run
 here) and Colab's "Download .py" (`notebook_exports.colab_export`) write it, gets the notebook's verdicts:
-the same status and score for every problem, through the real sandbox.
+the same status and score for every problem, through the real sandbox. Two (whose cells have ``!`` and
+``%`` lines) are graded also as their cells copied into a file as they are (`verbatim_export`).
 
 The second lab has no notebook sample: its honest files are modules (graded as they are, as
 `submissions/rl2/verdicts.toml` pins); its notebook and exports are here too, built from the 2024 module's
@@ -17,7 +18,7 @@ import nbformat
 import pytest
 from grading_support import FAST_OVERRIDES, SUBMISSIONS, write_config
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
-from notebook_exports import colab_export, nbconvert_export
+from notebook_exports import colab_export, nbconvert_export, verbatim_export
 
 from grader.grading.grade import grade_files
 from grader.grading.plan import GradingPlan
@@ -45,6 +46,8 @@ class Case:
     edition: str
     problems: tuple[str, ...]
     suite_episodes: int | None = None
+    verbatim: bool = False
+    """Also graded as its code cells copied into a file as they are (its ``!`` and ``%`` lines not Python)."""
 
     def data(self) -> bytes:
         if self.notebook == RL2_NOTEBOOK:
@@ -57,15 +60,22 @@ class Case:
 
 RL2_NOTEBOOK = "rl2/policy_iteration.ipynb (built from rl2/honest_v2024.py)"
 CASES = [
-    Case("notebooks/classic_complete.ipynb", "classic", ("random_blackjack", "cartpole", "taxi")),
+    Case(
+        "notebooks/classic_complete.ipynb", "classic", ("random_blackjack", "cartpole", "taxi"), verbatim=True
+    ),
     Case("notebooks/bad_metadata.ipynb", "classic", ("random_blackjack", "cartpole")),
     Case("notebooks/old_format_v3.ipynb", "classic", ("cartpole",)),
     Case("editions/rl1_template_honest.ipynb", "rl1", RL1, suite_episodes=3000),
     Case("editions/compare_honest.ipynb", "rl1", ("compare",)),
     Case("templates/rl1.ipynb", "rl1", RL1),
-    Case(RL2_NOTEBOOK, "v2024", ("value_iteration", "policy_iteration", "run_simulation", "frozen_lake")),
+    Case(
+        RL2_NOTEBOOK,
+        "v2024",
+        ("value_iteration", "policy_iteration", "run_simulation", "frozen_lake"),
+        verbatim=True,
+    ),
 ]
-EXPORTS = ("notebook", "nbconvert", "colab")
+EXPORTS = ("notebook", "nbconvert", "colab", "verbatim")
 
 
 def _rl2_notebook() -> bytes:
@@ -111,6 +121,10 @@ def reports(tmp_path_factory: pytest.TempPathFactory) -> dict[tuple[str, str], R
         files["notebook"].write_bytes(data)
         files["nbconvert"].write_text(nbconvert_export(data), encoding="utf-8")
         files["colab"].write_text(colab_export(data, f"{name}.ipynb"), encoding="utf-8")
+        if case.verbatim:
+            files["verbatim"] = folder / "verbatim" / f"{name}.py"
+            files["verbatim"].parent.mkdir()
+            files["verbatim"].write_text(verbatim_export(data), encoding="utf-8")
         plan = GradingPlan.load(_config(directory, case.edition), case.problems)
         graded = grade_files(
             list(files.values()), plan, seed=SEED, workers=2, policy=IsolationPolicy.ALLOW_FALLBACK
@@ -119,8 +133,12 @@ def reports(tmp_path_factory: pytest.TempPathFactory) -> dict[tuple[str, str], R
     return found
 
 
-@pytest.mark.parametrize("export", EXPORTS[1:])
-@pytest.mark.parametrize("case", CASES, ids=[case.notebook for case in CASES])
+GRADED = [(case, export) for case in CASES for export in EXPORTS[1:] if export != "verbatim" or case.verbatim]
+
+
+@pytest.mark.parametrize(
+    ("case", "export"), GRADED, ids=[f"{export}-{case.notebook}" for case, export in GRADED]
+)
 def test_an_export_gets_its_notebooks_verdicts(
     case: Case, export: str, reports: dict[tuple[str, str], Report]
 ) -> None:
