@@ -110,8 +110,8 @@ def build_script(
             return None
         listed_names = ", ".join(f"`{name}`" for name in used[:MAX_NAMED])
         whole_file = (
-            f"your functions use what top-level statements set or change ({listed_names}), so the whole file "
-            "ran at import, as a .py always did, but for its IPython lines"
+            f"your functions use what top-level statements set or change ({listed_names}), "
+            "so the whole file ran at import, as a .py always did, but for its IPython lines"
         )
         ran = builder.kept_statements + len(listed) - len(ipython)
         summary = NotebookSummary(
