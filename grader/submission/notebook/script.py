@@ -109,10 +109,7 @@ def build_script(
         if not ipython and not builder.broken:
             return None
         listed_names = ", ".join(f"`{name}`" for name in used[:MAX_NAMED])
-        whole_file = (
-            f"your functions use what top-level statements set or change ({listed_names}), "
-            "so the whole file ran at import, as a .py always did, but for its IPython lines"
-        )
+        whole_file = f"your functions use what top-level statements set or change ({listed_names}), so the whole file ran at import, as a .py always did, but for its IPython lines"  # noqa: E501
         ran = builder.kept_statements + len(listed) - len(ipython)
         summary = NotebookSummary(
             code_cells=len(cells), kept_statements=ran, skipped=ipython, ignored=[whole_file], script=True
