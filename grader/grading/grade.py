@@ -26,6 +26,7 @@ Its contract:
 
 from __future__ import annotations
 
+import ast
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -42,8 +43,10 @@ from grader.sandbox import IsolationPolicy
 from grader.sandbox.host import usable_cpus
 from grader.sandbox.isolation.scope import sandbox_scope
 from grader.sandbox.runner import require_isolation, sandbox_file_name
-from grader.submission.notebook import MAX_NOTEBOOK_BYTES, build_module, is_notebook
+from grader.submission.notebook import MAX_NOTEBOOK_BYTES, NotebookModule, build_module, is_notebook
+from grader.submission.notebook.bounded import build_script
 from grader.submission.notebook.cells import write_cells
+from grader.submission.notebook.script import defines_only, may_be_export
 from grader.submission.untrusted_file import UnsafeFile, read_untrusted
 from grader.submission.validation import MAX_SUBMISSION_BYTES, FileVerdict, check_source
 
@@ -193,12 +196,19 @@ def _prepare(
         return data
     if not is_notebook(path.name):
         verdict = check_source(data, shown)
-        if verdict is not None:
+        read = _read_as_notebook(data, shown, plan, valid=verdict is None)
+        if verdict is not None and read is None:
             return verdict
         module_dir.mkdir()
         module = module_dir / path.name
-        module.write_bytes(data)
-        return Submission(path, data, module, edition_note=_edition_note(data, shown, plan), name=shown)
+        # A file that is Python only as its notebook's export shows its edition in the module read from it.
+        note = _edition_note(data if read is None or verdict is None else read.source.encode(), shown, plan)
+        if read is None:
+            module.write_bytes(data)
+            return Submission(path, data, module, edition_note=note, name=shown)
+        module.write_text(read.source, encoding="utf-8")
+        write_cells(module, read.cells)
+        return Submission(path, data, module, read, edition_note=note, name=shown)
     built = build_module(data, shown, plan.problems)
     if isinstance(built, FileVerdict):
         return built
@@ -210,6 +220,39 @@ def _prepare(
     return Submission(path, data, module, built, edition_note=note, name=shown)
 
 
+def _read_as_notebook(data: bytes, shown: str, plan: GradingPlan, *, valid: bool) -> NotebookModule | None:
+    """A `.py` read as the notebook it may have been (`grader.submission.notebook.script`): the module
+    whose import runs what the notebook's would, or None to grade the file as it is (its top level defines
+    only, the notebook's rules leave out nothing of it, or the reader could not read it: a file that
+    compiled is graded as it always was, one that did not keeps its verdict). A file that is not ``valid``
+    Python is read only if it may be an export (IPython's lines as they are, a half-written marked cell)."""
+    if not valid:
+        if len(data) > MAX_SUBMISSION_BYTES or b"\0" in data:
+            return None
+        try:
+            if not may_be_export(data.decode("utf-8-sig")):
+                return None
+        except UnicodeDecodeError:
+            return None
+    elif defines_only(ast.parse(data), data.decode("utf-8-sig")):
+        return None
+    served = [problem for problem in plan.problems if _runs_cells_first(plan, problem)]
+    edition = EDITIONS.get(plan.edition)
+    template = [function.name for function in edition.functions] if edition is not None else []
+    # The template's functions that are no problem's may be called too (a check may call a helper); a
+    # problem's function is called only when its problem is graded.
+    helpers = [name for name in template if name not in plan.registry.ids]
+    built = build_script(data, shown, sorted({*plan.problems, *helpers}), served)
+    return built if isinstance(built, NotebookModule) else None
+
+
+def _runs_cells_first(plan: GradingPlan, problem: str) -> bool:
+    """Whether the problem's check runs the file's cells before calling its function (compare()'s
+    `run_cells`), so the globals it reads come from them, not from the import."""
+    settings = plan.registry.problem(problem).settings(plan.assignment)
+    return bool(getattr(settings, "run_cells", False))
+
+
 def _sandbox_name(submission: Submission) -> str:
     """The name the sandbox's messages give a file (``--name``), or "" to let them name its copy as before:
     given only when the file is shown by another name than the sandbox would call its copy (a class's zip
@@ -218,7 +261,8 @@ def _sandbox_name(submission: Submission) -> str:
     ``<notebook>.py``); so the sandbox's messages say what the grader's own do, whoever wrote the copy."""
     if not submission.name:
         return ""
-    shown = f"{submission.name}.py" if submission.notebook is not None else submission.name
+    notebook = submission.notebook is not None and not submission.notebook.summary.script
+    shown = f"{submission.name}.py" if notebook else submission.name
     return "" if shown == sandbox_file_name(submission.module.name) else shown
 
 

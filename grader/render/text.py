@@ -83,6 +83,14 @@ def lab_name(name: str) -> str:
 
 def notebook_lines(notebook: NotebookSummary) -> list[str]:
     """What of a notebook ran at import, and every statement that did not, cell by cell."""
+    if notebook.script:
+        lines = [
+            f"Your file, read as the notebook it came from: {notebook.kept_statements} imports, definitions and constants ran at import; "  # noqa: E501
+            f"{len(notebook.skipped)} statements did not:"
+        ]
+        lines += [f"  line {entry.line}: {entry.code}  <- {entry.reason}" for entry in notebook.skipped]
+        lines += [f"  note: {note}" for note in notebook.ignored]
+        return [*lines, ""]
     lines = [
         f"Notebook: {notebook.kept_statements} imports, definitions and constants from {notebook.code_cells} code cells ran at import; "  # noqa: E501
         f"{len(notebook.skipped)} statements did not:"

@@ -61,6 +61,22 @@ process (never running student code), and the sandbox imports it like any `.py` 
   Decorators outside `KEPT_DECORATORS` are dropped (the function is graded undecorated, with a note). Classes
   are kept when their bases are SAFE or plain student classes (no `__init_subclass__`, no student metaclass,
   not Enum) and every statement of their body is keepable.
+- `grader/submission/notebook/script.py`: a `.py` read as the notebook it came from (Jupyter's, Colab's,
+  jupytext's exports). `build_script(data, name, graded, served)` (run by `bounded.build_script` in the
+  reading child; `grader.grading.grade._prepare` calls it for every `.py` whose top level does more than
+  import and define, `script.defines_only`): cells by nbconvert's `# In[N]:` / jupytext's `# %%` markers,
+  else one per top-level statement; ``get_ipython().run_line_magic / .run_cell_magic / .system /
+  .getoutput`` lines written back as the `%`, `%%` and `!` lines they were, then read by `building` with the
+  notebook's rules. The module keeps each kept statement on its own line of the file where it can (so a
+  traceback's line is the file's), and every `SkippedCode`, `UnboundGlobal` and origin is cell
+  `SCRIPT_CELL` (0) with the file's own line (`NotebookSummary.script`). `None` (the file graded as it is)
+  when the rules leave out nothing but decorators; the whole file (IPython lines made `pass`, as its cells
+  run) when a graded or template function uses what a left-out statement sets or changes
+  (`building.touched_names`, `building.globals_needed`), except the globals of `served` functions
+  (compare()'s, set by its cells run). A file that is not Python as it is is read when IPython's transformer
+  makes it Python (``!pip`` written as it is) or its marked cells hold the error (left out as in a notebook).
+  `NotebookModule.cells` of a `.py`: its marked cells, or the file as one cell, each `SCRIPT_CELL` (run as a
+  script: `cells.runnable_cells`).
 - `grader/submission/notebook/building.py`: cells -> module. Per cell: size budget (200,000 characters),
   IPython transformation, `ast.parse`, depth budget (500, measured without recursion); a cell failing any of
   these is skipped as a whole with a note, the graded functions it defines get a stand-in raising

@@ -75,7 +75,7 @@ class _Reply(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    status: Literal["module", "read", "missing", "error"]
+    status: Literal["module", "read", "missing", "error", "as_is"]
     message: str = ""
     source: str = ""
     summary: NotebookSummary | None = None
@@ -178,6 +178,35 @@ def build_module(data: bytes, name: str, graded: Collection[str] | None = ()) ->
     )
 
 
+def build_script(
+    data: bytes, name: str, graded: Collection[str], served: Collection[str] = ()
+) -> NotebookModule | FileVerdict | None:
+    """A `.py` read as the notebook it may have been, in a bounded child
+    (`grader.submission.notebook.script.build_script`).
+
+    Args:
+        data: The file's bytes (untrusted, UTF-8 Python: `check_source` passed).
+        name: Its name, in messages.
+        graded: The functions problems call.
+        served: Those whose globals the file's cells set before they are called.
+
+    Returns:
+        The module, None when the file is graded as it is, or a verdict (the module is not Python, or the
+        reader died on the file: the caller may grade the file as it is).
+    """
+    request: dict[str, object] = {"mode": "script", "graded": sorted(graded), "served": sorted(served)}
+    reply = _run(data, name, request)
+    if isinstance(reply, FileVerdict):
+        return reply
+    if reply.status == "as_is":
+        return None
+    if reply.status != "module" or reply.summary is None:
+        return FileVerdict(_status(reply), reply.message)
+    return NotebookModule(
+        source=reply.source, summary=reply.summary, origins=tuple(reply.origins), cells=tuple(reply.cells)
+    )
+
+
 def _key(data: bytes, name: str) -> tuple[bytes, str]:
     return hashlib.blake2b(data, digest_size=20).digest(), name
 
@@ -269,6 +298,20 @@ def _main() -> None:
     name, graded = str(header["name"]), header.get("graded")
     built: NotebookModule | FileVerdict | None = None
     read: NotebookCells | FileVerdict | None = None
+    if header["mode"] == "script":
+        from grader.submission.notebook.script import build_script as build_script_module
+
+        try:
+            script = build_script_module(data, name, graded, header.get("served", []))
+        except TransformerUnavailable as error:
+            script = FileVerdict("error", _no_transformer_message(name, str(error)))
+        except (RecursionError, MemoryError, SyntaxError, ValueError) as error:
+            script = FileVerdict(
+                "error", _unreadable_message(name, f"{type(error).__name__} while reading it")
+            )
+        reply = _reply(None, script) if script is not None else _Reply(status="as_is")
+        sys.stdout.buffer.write(reply.model_dump_json().encode("utf-8"))
+        return
     try:
         if header.get("input") == "read":
             read = _Read.model_validate_json(data).cells()

@@ -75,6 +75,15 @@ class _Builder:
     postponed_annotations: bool = False
     graded: Collection[str] | None = None
     runnable: list[tuple[int, str]] = field(default_factory=list)
+    script: bool = False
+    """Reading a `.py` (`grader.submission.notebook.script`): its ``if __name__ == "__main__":`` block is
+    not listed (an import never ran it), and what the left-out statements set or change is kept in
+    `affected`."""
+    affected: set[str] = field(default_factory=set)
+    touched: set[str] = field(default_factory=set)
+    defined: set[str] = field(default_factory=set)
+    """Names kept imports, definitions and classes bind (a module's attribute set, a function called, by a
+    left-out statement is no global value it changed)."""
 
     @property
     def bound(self) -> set[str]:
@@ -109,9 +118,7 @@ def build_from_cells(
 ) -> NotebookModule | FileVerdict:
     """`build_module` of a notebook whose code cells are read already
     (`grader.submission.notebook.reading`)."""
-    builder = _Builder(name, graded=graded)
-    for cell in read.cells:
-        _add_cell(builder, cell)
+    builder = walk_cells(read, name, graded)
     if builder.kept_statements == 0:
         if builder.broken:
             return FileVerdict("error", builder.broken[0])
@@ -131,7 +138,7 @@ def build_from_cells(
     summary = NotebookSummary(
         code_cells=len(read.cells),
         kept_statements=builder.kept_statements,
-        skipped=_listed(builder),
+        skipped=listed_skipped(builder),
         unbound_globals=unbound_globals(source, skipped_only, graded),
         ignored=read.ignored,
     )
@@ -139,6 +146,16 @@ def build_from_cells(
     return NotebookModule(
         source=source, summary=summary, origins=tuple(origins), cells=tuple(builder.runnable)
     )
+
+
+def walk_cells(
+    read: NotebookCells, name: str, graded: Collection[str] | None, *, script: bool = False
+) -> _Builder:
+    """Every cell read in order: what is kept, what is left out and why."""
+    builder = _Builder(name, graded=graded, script=script)
+    for cell in read.cells:
+        _add_cell(builder, cell)
+    return builder
 
 
 def _skip(builder: _Builder, cell: Cell, line: int, reason: str, code: str) -> SkippedCode:
@@ -153,7 +170,7 @@ def _skip(builder: _Builder, cell: Cell, line: int, reason: str, code: str) -> S
     return entry
 
 
-def _listed(builder: _Builder) -> list[SkippedCode]:
+def listed_skipped(builder: _Builder) -> list[SkippedCode]:
     """The skipped statements as the report lists them: the first ones, then one entry counting the rest."""
     if not builder.unlisted:
         return builder.skipped
@@ -224,18 +241,35 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
                 builder.kept.append(text)
                 builder.origins += _origins(lines, statement, dropped, cell.number)
             builder.kept_statements += 1
+            if isinstance(
+                statement, ast.Import | ast.ImportFrom | ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef
+            ):
+                builder.defined |= bound_names(statement)
             for decorator in dropped:
-                _skip(builder, cell, decorator.lineno, _DROPPED_DECORATOR, "@" + _segment(lines, decorator))
+                _skip(builder, cell, decorator.lineno, DROPPED_DECORATOR, "@" + _segment(lines, decorator))
             _bind(builder.scope, statement, builder)
         else:
-            skipped = _skip(builder, cell, _first_line(statement), reason, text)
+            main_guard = isinstance(statement, ast.If) and _is_main_guard(statement.test)
+            if builder.script and main_guard:
+                skipped = SkippedCode(
+                    cell=cell.number,
+                    execution_count=None,
+                    line=_first_line(statement),
+                    reason=reason,
+                    code=_shortened(text),
+                )
+            else:
+                skipped = _skip(builder, cell, _first_line(statement), reason, text)
+                if builder.script:
+                    builder.affected |= bound_names(statement)
+                    builder.touched |= touched_names(statement)
             for bound_name in bound_names(statement):
                 if bound_name not in builder.scope.kinds:
                     builder.skipped_bindings.setdefault(bound_name, skipped)
 
 
 _BROKEN = "the whole cell is left out"
-_DROPPED_DECORATOR = (
+DROPPED_DECORATOR = (
     "decorator not applied: applying it would run code at import (the function is graded without it)"
 )
 
@@ -551,6 +585,83 @@ def bound_names(statement: ast.stmt) -> set[str]:
                     if isinstance(inner, ast.Name) and isinstance(inner.ctx, ast.Store)
                 }
     return names
+
+
+_READING_NUMPY = ("mean", "std", "sum", "max", "min", "argmax", "argmin", "round", "array")
+READ_ONLY_CALLS = frozenset(
+    {
+        "print", "display", "len", "str", "repr", "format", "sorted", "sum", "min", "max", "abs", "round",
+        "isinstance", "type", "id", "list", "tuple", "enumerate", "zip", "range",
+        *(f"{numpy}.{name}" for numpy in ("np", "numpy") for name in _READING_NUMPY),
+    }
+)  # fmt: skip
+"""Calls that only read their arguments (with ``plt.`` / ``pyplot.`` ones): passing a value to them, as a
+demo prints or plots it, changes nothing a function reads."""
+_PLOTTING = ("plt.", "pyplot.", "matplotlib.")
+
+
+def touched_names(statement: ast.stmt) -> set[str]:
+    """Names whose object a statement may change: stored into (``P[0] = ...``, ``env.seed = 1``), deleted,
+    their methods called (``env.reset()``, ``q.fill(0)``) or passed to a call that may change them
+    (``np.random.shuffle(deck)``; not ``print(q)``, `READ_ONLY_CALLS`)."""
+    names: set[str] = set()
+    for node in ast.walk(statement):
+        if isinstance(node, ast.Attribute | ast.Subscript) and isinstance(node.ctx, ast.Store | ast.Del):
+            names.add(_root_name(node))
+        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Del):
+            names.add(node.id)
+        elif isinstance(node, ast.Call):
+            if isinstance(node.func, ast.Attribute):
+                names.add(_root_name(node.func.value))
+            called = rules.dotted_name(node.func) or ""
+            if called in READ_ONLY_CALLS or called.startswith(_PLOTTING):
+                continue
+            for argument in [*node.args, *(keyword.value for keyword in node.keywords)]:
+                if isinstance(argument, ast.Starred):
+                    argument = argument.value
+                names.add(_root_name(argument))
+    names.discard("")
+    return names
+
+
+def _root_name(node: ast.expr) -> str:
+    while isinstance(node, ast.Attribute | ast.Subscript):
+        node = node.value
+    return node.id if isinstance(node, ast.Name) else ""
+
+
+def globals_needed(source: str, graded: Collection[str]) -> set[str]:
+    """The module-level names the ``graded`` functions use when called: their own names, the globals their
+    bodies read (through the top-level functions and classes they reach, found with ``symtable``), and the
+    names their defaults and decorators were made of."""
+    module = symtable.symtable(source, "script", "exec")
+    reads: dict[str, set[str]] = {}
+    for child in module.get_children():
+        if child.get_type() in ("function", "class"):
+            reads.setdefault(child.get_name(), set()).update(_globals_read(child))
+    for statement in ast.parse(source).body:
+        if isinstance(statement, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            made_of: list[ast.expr | None] = [*statement.decorator_list]
+            if not isinstance(statement, ast.ClassDef):
+                made_of += [*statement.args.defaults, *statement.args.kw_defaults]
+            else:
+                made_of += [*statement.bases, *(keyword.value for keyword in statement.keywords)]
+            reads.setdefault(statement.name, set()).update(
+                node.id
+                for part in made_of
+                if part is not None
+                for node in ast.walk(part)
+                if isinstance(node, ast.Name)
+            )
+    needed = set(graded)
+    frontier = [name for name in graded if name in reads]
+    while frontier:
+        for name in reads[frontier.pop()]:
+            if name not in needed:
+                needed.add(name)
+                if name in reads:
+                    frontier.append(name)
+    return needed
 
 
 def unbound_globals(

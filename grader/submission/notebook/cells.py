@@ -4,8 +4,10 @@ A problem such as edition 4's `compare()` reads the globals the notebook's own t
 configuration may ask for the cells to run first (in the sandbox, `grader.sandbox.child.cells`). Building
 the graded module (`grader.submission.notebook.building`) keeps every code cell Jupyter's "Run All" would
 run; the grading run writes them beside the module it imports (`write_cells`), and the problem's run reads
-them back (`runnable_cells`) into the argument of the sandbox's cells call. A `.py` submission has no cells:
-its whole file runs as a script (`python opengym.py`, so its `if __name__ == "__main__":` block too).
+them back (`runnable_cells`) into the argument of the sandbox's cells call. A `.py` runs as a script
+(`python opengym.py`, so its `if __name__ == "__main__":` block too): graded as it is, the whole file; read as
+the notebook it came from (`grader.submission.notebook.script`), the export's cells with IPython's lines read
+as the notebook's were, each numbered `SCRIPT_CELL` and starting on its own line of the file.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ RAN_CELLS = "ran_notebook_cells"
 """The measurement a problem's result carries when the notebook's cells ran before its calls (its globals
 were set, so the report adds no "global set by a skipped statement" note)."""
 SCRIPT_CELL = 0
-"""The cell number of a `.py` submission run whole as a script."""
+"""The cell number of a `.py` submission's code run as a script (a notebook's cells are numbered from 1)."""
 
 
 def cells_path(module: Path) -> Path:
@@ -38,12 +40,13 @@ def runnable_cells(module: Path) -> list[dict[str, Any]]:
 
     Returns:
         One ``{"cell": number, "source": python, "script": False}`` per code cell of a notebook, in order;
-        for a `.py` submission one ``{"cell": 0, "source": the file, "script": True}``.
+        for a `.py` submission ``{"cell": 0, "source": python, "script": True}``: the file, or each cell of
+        the export it was read as.
     """
     kept = cells_path(module)
     if kept.is_file():
         return [
-            {"cell": int(number), "source": str(source), "script": False}
+            {"cell": int(number), "source": str(source), "script": int(number) == SCRIPT_CELL}
             for number, source in json.loads(kept.read_text(encoding="utf-8"))
         ]
     source = module.read_bytes().decode("utf-8", errors="replace")

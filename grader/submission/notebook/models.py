@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from grader.submission.notebook.cells import SCRIPT_CELL
+
 
 class SkippedCode(BaseModel):
     """One statement (or cell) of a notebook the grader did not run."""
@@ -37,6 +39,12 @@ class UnboundGlobal(BaseModel):
 
     def note(self) -> str:
         """The sentence added to the feedback of the problem named after ``function``."""
+        if self.cell == SCRIPT_CELL:
+            return (
+                f"Your file: {self.function}() reads the global `{self.name}`, which only a skipped top-level statement sets (line {self.line}: `{self.code}`). "  # noqa: E501
+                f"The grader reads a .py as the notebook it came from and runs only imports, definitions and simple constants at import, so there is no `{self.name}` when {self.function}() is called: "  # noqa: E501
+                "compute it inside the function."
+            )
         if self.broken_cell:
             return (
                 f"Notebook: {self.function}() uses `{self.name}`, which only cell {self.cell} defines, "
@@ -63,7 +71,11 @@ class NotebookSummary(BaseModel):
     )
     ignored: list[str] = Field(
         default_factory=list,
-        description="What of the file itself the grader ignored to read the cells (metadata that does not follow the nbformat schema, an old format version).",  # noqa: E501
+        description="What of the file itself the grader ignored to read the cells (metadata that does not follow the nbformat schema, an old format version); for a .py, why its whole file ran at import.",  # noqa: E501
+    )
+    script: bool = Field(
+        default=False,
+        description="Read from a .py file (a notebook's export) by the notebook's rules: every entry's cell is 0 and its line is the file's own.",  # noqa: E501
     )
 
     def notes_for(self, function: str) -> list[str]:
@@ -90,13 +102,19 @@ class NotebookModule:
     cells: tuple[tuple[int, str], ...] = ()
 
     def cited(self, text: str, module_name: str) -> str:
-        """``text`` with ``File ".../<module_name>", line N`` rewritten to the notebook's cell and line."""
+        """``text`` with ``File ".../<module_name>", line N`` rewritten to the notebook's cell and line (a
+        `.py` read as a notebook: to the file's own line; its module has the file's name, ``module_name``
+        without the ``.py`` a notebook's module adds)."""
+        if self.summary.script:
+            module_name = module_name.removesuffix(".py")
 
         def replace(match: re.Match[str]) -> str:
             number = int(match.group("line"))
             origin = self.origins[number - 1] if 0 < number <= len(self.origins) else None
             if origin is None:
                 return match.group(0)
+            if origin[0] == SCRIPT_CELL:
+                return f'File "{match.group("name")}", line {origin[1]}'
             return f'File "{match.group("name").removesuffix(".py")}", cell {origin[0]}, line {origin[1]}'
 
         pattern = rf'File "(?:[^"]*/)?(?P<name>{re.escape(module_name)})", line (?P<line>\d+)'
