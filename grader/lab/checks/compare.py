@@ -44,6 +44,7 @@ import numpy as np
 import numpy.typing as npt
 from pydantic import Field, model_validator
 
+from grader.lab.checks.compare_tables import LEARNERS, bound_tables
 from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
 from grader.lab.checks.episodes import Episode, played_episodes
 from grader.lab.checks.integrity import NO_EPISODES, games_budget, integrity_problem
@@ -72,6 +73,11 @@ class CompareConfig(PlayedProblemConfig):
         default=True,
         description="Run the notebook's code cells in the sandbox (in order, as Run All does) before calling compare() (the default); "  # noqa: E501
         "false turns it off: compare() is not gradable in isolation, so it is skipped and worth 0 points whatever `points` says.",  # noqa: E501
+    )
+    bind_tables: bool = Field(
+        default=True,
+        description="Bind the grader's own tables (seeded, exact greedy returns known) to the globals compare() reads instead of running the training cells (the default: seconds); "  # noqa: E501
+        "the cells still run where binding cannot serve a compare() (the feedback says why). false runs every cell, as Run All does.",  # noqa: E501
     )
     cells_seconds: float = Field(
         default=1800.0,
@@ -106,6 +112,8 @@ class NotebookTable:
     decay: bool | None
     episodes: int | None
     table: npt.NDArray[np.float64]
+    bound: bool = False
+    """The grader's table, bound in place of the learner call (else one the notebook's cells made)."""
 
     @property
     def label(self) -> str:
@@ -117,7 +125,8 @@ class NotebookTable:
             f"decay={self.decay}" if self.decay is not None else "",
             f"N={self.episodes}" if self.episodes else "",
         ]
-        return f"{name} (from {self.learner}({', '.join(filter(None, made))}))"
+        call = f"{self.learner}({', '.join(filter(None, made))})"
+        return f"{name} (bound for {call})" if self.bound else f"{name} (from {call})"
 
 
 @dataclass(frozen=True)
@@ -125,14 +134,18 @@ class CompareCheck:
     """The notebook's cells, then compare(): both halves replayed, greedy on notebook tables, exact means."""
 
     def plan(self, settings: CompareConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
-        """The cells call (own time limit, unrecorded), then a recorded compare(); none without run_cells."""
+        """The cells call (own time limit, unrecorded; with the grader's tables to bind when `bind_tables`),
+        then a recorded compare(); none without run_cells."""
         if not settings.run_cells:
             return []
         budget = games_budget(2 * settings.episodes_per_table, EPISODE_STEPS)
+        kwargs: dict[str, PlainValue] = {"then": "compare"}
+        if settings.bind_tables:
+            kwargs["bind"] = bound_tables(seed)
         return [
             Call(
                 RUN_CELLS,
-                kwargs={"then": "compare"},
+                kwargs=kwargs,
                 record_episodes=False,
                 budget=NO_EPISODES,
                 seconds=settings.cells_seconds,
@@ -156,20 +169,29 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
     cells = records[0].outcome
     if cells.status is not OutcomeStatus.OK:
         return _cells_failed(settings, cells.status, cells.message)
-    ran, tables = _cells_value(cells.value)
-    # No wall time here (the problem's timings carry it): the verdict is the same for the same bytes and seed.
-    preface = (
-        f"Ran your notebook's {len(ran)} code cell{'' if len(ran) == 1 else 's'} in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
-        if not (ran and ran[0] == SCRIPT_CELL)
-        else f"Ran your file as a script in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
-    )
-    measurements: dict[str, PlainValue] = {"cells_run": len(ran), "notebook_tables": len(tables)}
+    bound = _bound_tables(cells.value, cells.call.kwargs.get("bind"))
+    if bound is not None:
+        ran, tables = [], bound
+        preface = _bound_preface(bound)
+    else:
+        ran, tables = _cells_value(cells.value)
+        # No wall time here (the problem's timings carry it): same bytes and seed, same verdict.
+        preface = _fallback_preface(cells.value) + (
+            f"Ran your notebook's {len(ran)} code cell{'' if len(ran) == 1 else 's'} in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
+            if not (ran and ran[0] == SCRIPT_CELL)
+            else f"Ran your file as a script in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
+        )
+    measurements: dict[str, PlainValue] = {
+        "cells_run": len(ran),
+        "notebook_tables": 0 if bound else len(tables),
+        "tables_bound": len(bound or ()),
+    }
     if len(records) < 2:
         return Verdict("error", 0.0, f"{preface}; compare() was not called.", measurements)
     compare = records[1].outcome
     early = outcome_verdict(records[1:])
     if early is not None and compare.status is OutcomeStatus.EPISODE_LIMIT:
-        hint = f" compare() plays the tables your notebook's cells already trained; training inside compare() plays thousands of games (the cells left {_listed(tables)})."  # noqa: E501
+        hint = f" compare() plays the tables your notebook's cells already trained; training inside compare() plays thousands of games ({_left(tables)} {_listed(tables)})."  # noqa: E501
         return Verdict(
             "failed", 0.0, f"{preface}: {early.feedback}.{hint}", {**early.measurements, **measurements}
         )
@@ -241,11 +263,11 @@ def _judge_compare(
         table, wrong, steps = _revealed(half, tables)
         if table is None:
             if wrong > steps * RANDOM_SHARE:
-                why = f"{wrong} of its {steps} actions were not the argmax of any of your notebook's tables, as in random play: act with np.argmax(table[state])"  # noqa: E501
+                why = f"{wrong} of its {steps} actions were not the argmax of any of {_whose(tables)}, as in random play: act with np.argmax(table[state])"  # noqa: E501
             else:
                 why = (
-                    "its actions are greedy on no table your notebook's cells made (compare() must not train or load tables of its own: "  # noqa: E501
-                    f"read the globals the cells set; the cells left {_listed(tables)})"
+                    f"its actions are greedy on no table {_made(tables)} (compare() must not train or load tables of its own: "  # noqa: E501
+                    f"read the globals the cells set; {_left(tables)} {_listed(tables)})"
                 )
             return _fail(f"{preface}: in the {which} {per_table} episodes {why}.", measurements)
         played.append(table)
@@ -288,6 +310,98 @@ def _judge_compare(
             measurements,
         )
     return Verdict("passed", 1.0, f"{preface}: {story}, and returned those two means.", measurements)
+
+
+MAX_NAME_CHARS = 60
+"""A global's name as the child reported it, cut to this length for the feedback."""
+
+
+def _bound_tables(value: PlainValue, planned: PlainValue) -> list[NotebookTable] | None:
+    """The grader's tables as the child bound them (None: nothing bound, the cells ran).
+
+    The tables are the plan's own (`planned`, never the child's); the child says only which names it bound
+    to which learner's table, which the feedback reports and which orders the expected means.
+    """
+    if not isinstance(value, dict) or not isinstance(value.get("bound"), list) or not isinstance(planned, dict):
+        return None
+    groups: dict[tuple[str, str], dict[str, Any]] = {}
+    for entry in value["bound"]:
+        if not isinstance(entry, dict) or entry.get("learner") not in LEARNERS or not isinstance(entry.get("name"), str):
+            continue
+        decay = entry.get("decay") if type(entry.get("decay")) is bool else None
+        key = (str(entry["learner"]), "constant" if decay is False else "decay")
+        group = groups.setdefault(key, {"names": [], "read": [], "decay": decay, "N": None, "where": []})
+        name = entry["name"][:MAX_NAME_CHARS]
+        group["names"].append(name)
+        if entry.get("read") is True:
+            group["read"].append(name)
+        if type(entry.get("N")) is int and group["N"] is None:
+            group["N"] = entry["N"]
+        statement, cell = entry.get("statement"), entry.get("cell")
+        if isinstance(statement, str) and type(cell) is int:
+            group["where"].append((name, cell, statement[:MAX_STATEMENT_CHARS]))
+    tables = []
+    for (learner, schedule), group in groups.items():
+        table = planned.get(learner, {}).get(schedule) if isinstance(planned.get(learner), dict) else None
+        if table is None:
+            continue
+        tables.append(
+            BoundTable(
+                names=tuple(group["names"][:5]),
+                learner=learner,
+                decay=group["decay"],
+                episodes=group["N"],
+                table=np.asarray(table, dtype=np.float64),
+                bound=True,
+                read=tuple(group["read"]),
+                where=tuple(group["where"]),
+            )
+        )
+    return tables or None
+
+
+MAX_STATEMENT_CHARS = 120
+"""A training statement as the child quoted it, cut to this length for the feedback."""
+
+
+@dataclass(frozen=True)
+class BoundTable(NotebookTable):
+    """A table of the grader's bound to globals the notebook's training would set."""
+
+    read: tuple[str, ...] = ()
+    """The names compare() reads (the others were bound because a training statement sets them)."""
+    where: tuple[tuple[str, int, str], ...] = ()
+    """(name, cell, statement) of the training statements that set its names."""
+
+
+_LEARNER_NAMES = {"qlearn": "Q-learning", "sarsa0": "SARSA"}
+
+
+def _bound_preface(tables: Sequence[NotebookTable]) -> str:
+    parts = []
+    for table in tables:
+        if not isinstance(table, BoundTable) or not table.read:
+            continue
+        schedule = "constant-epsilon " if table.decay is False else ""
+        names = " and ".join(f"`{name}`" for name in table.read)
+        statements = [f"`{statement}` in {_cell(cell)}" for name, cell, statement in table.where if name in table.read]
+        source = f"as your {statements[0]} sets it" if statements else "by its name"
+        parts.append(f"{names} <- the {schedule}{_LEARNER_NAMES[table.learner or 'qlearn']} table ({source})")
+    return (
+        "Bound the grader's own Taxi tables (drawn from the grading seed, exact greedy returns known) to the globals compare() reads instead of running your training, "  # noqa: E501
+        f"since compare()'s verdict does not depend on what training learns: {'; '.join(parts)}; then called compare()"
+    )
+
+
+def _cell(cell: int) -> str:
+    return "your file" if cell == SCRIPT_CELL else f"cell {cell}"
+
+
+def _fallback_preface(value: PlainValue) -> str:
+    reason = value.get("fallback") if isinstance(value, dict) else None
+    if not isinstance(reason, str):
+        return ""
+    return f"The grader's tables could not stand in for your training: {reason[:300]}. "
 
 
 def _cells_value(value: PlainValue) -> tuple[list[int], list[NotebookTable]]:
@@ -376,6 +490,18 @@ def _not_decayed(played: Sequence[NotebookTable], tables: Sequence[NotebookTable
                 f"a decaying epsilon: your notebook has {decayed[0].label}."
             )
     return None
+
+
+def _whose(tables: Sequence[NotebookTable]) -> str:
+    return "the tables bound to your globals" if tables and tables[0].bound else "your notebook's tables"
+
+
+def _made(tables: Sequence[NotebookTable]) -> str:
+    return "bound to your globals" if tables and tables[0].bound else "your notebook's cells made"
+
+
+def _left(tables: Sequence[NotebookTable]) -> str:
+    return "the grader bound" if tables and tables[0].bound else "the cells left"
 
 
 def _listed(tables: Sequence[NotebookTable]) -> str:
