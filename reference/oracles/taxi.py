@@ -270,7 +270,7 @@ def walled_q_table(walls: tuple[tuple[int, int, int], ...], gamma: float = 0.6) 
         raise InvalidParameterError(f"expected a discount factor gamma in [0, 1), found {gamma!r}")
     model = taxi_model()
     next_state, reward = model.next_state.copy(), model.reward.copy()
-    blocked = {(row, column): [] for row, column, _ in walls}
+    blocked: dict[tuple[int, int], list[int]] = {(row, column): [] for row, column, _ in walls}
     for row, column, action in walls:
         blocked[(row, column)].append(action)
     for state in range(STATES):

@@ -44,8 +44,8 @@ import numpy as np
 import numpy.typing as npt
 from pydantic import Field, model_validator
 
-from grader.lab.checks.compare_tables import LEARNERS, bound_tables
 from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.lab.checks.compare_tables import LEARNERS, bound_tables
 from grader.lab.checks.episodes import Episode, played_episodes
 from grader.lab.checks.integrity import NO_EPISODES, games_budget, integrity_problem
 from grader.lab.checks.taxi import EPISODE_STEPS
@@ -170,6 +170,8 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
     if cells.status is not OutcomeStatus.OK:
         return _cells_failed(settings, cells.status, cells.message)
     bound = _bound_tables(cells.value, cells.call.kwargs.get("bind"))
+    ran: list[int]
+    tables: list[NotebookTable]
     if bound is not None:
         ran, tables = [], bound
         preface = _bound_preface(bound)
@@ -322,11 +324,19 @@ def _bound_tables(value: PlainValue, planned: PlainValue) -> list[NotebookTable]
     The tables are the plan's own (`planned`, never the child's); the child says only which names it bound
     to which learner's table, which the feedback reports and which orders the expected means.
     """
-    if not isinstance(value, dict) or not isinstance(value.get("bound"), list) or not isinstance(planned, dict):
+    if (
+        not isinstance(value, dict)
+        or not isinstance(value.get("bound"), list)
+        or not isinstance(planned, dict)
+    ):
         return None
     groups: dict[tuple[str, str], dict[str, Any]] = {}
     for entry in value["bound"]:
-        if not isinstance(entry, dict) or entry.get("learner") not in LEARNERS or not isinstance(entry.get("name"), str):
+        if (
+            not isinstance(entry, dict)
+            or entry.get("learner") not in LEARNERS
+            or not isinstance(entry.get("name"), str)
+        ):
             continue
         decay = entry.get("decay") if type(entry.get("decay")) is bool else None
         key = (str(entry["learner"]), "constant" if decay is False else "decay")
@@ -340,7 +350,7 @@ def _bound_tables(value: PlainValue, planned: PlainValue) -> list[NotebookTable]
         statement, cell = entry.get("statement"), entry.get("cell")
         if isinstance(statement, str) and type(cell) is int:
             group["where"].append((name, cell, statement[:MAX_STATEMENT_CHARS]))
-    tables = []
+    tables: list[NotebookTable] = []
     for (learner, schedule), group in groups.items():
         table = planned.get(learner, {}).get(schedule) if isinstance(planned.get(learner), dict) else None
         if table is None:
@@ -384,12 +394,14 @@ def _bound_preface(tables: Sequence[NotebookTable]) -> str:
             continue
         schedule = "constant-epsilon " if table.decay is False else ""
         names = " and ".join(f"`{name}`" for name in table.read)
-        statements = [f"`{statement}` in {_cell(cell)}" for name, cell, statement in table.where if name in table.read]
+        statements = [
+            f"`{statement}` in {_cell(cell)}" for name, cell, statement in table.where if name in table.read
+        ]
         source = f"as your {statements[0]} sets it" if statements else "by its name"
         parts.append(f"{names} <- the {schedule}{_LEARNER_NAMES[table.learner or 'qlearn']} table ({source})")
     return (
         "Bound the grader's own Taxi tables (drawn from the grading seed, exact greedy returns known) to the globals compare() reads instead of running your training, "  # noqa: E501
-        f"since compare()'s verdict does not depend on what training learns: {'; '.join(parts)}; then called compare()"
+        f"since compare()'s verdict does not depend on what training learns: {'; '.join(parts)}; then called compare()"  # noqa: E501
     )
 
 

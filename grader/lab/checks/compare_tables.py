@@ -59,7 +59,7 @@ def _segments() -> list[tuple[tuple[int, int, int], tuple[int, int, int]]]:
 def _greedy_routes(actions: npt.NDArray[np.int64]) -> tuple[bool, list[list[int]]]:
     """Whether greedy play ends from every start within the time limit, and each start's route."""
     model = taxi_model()
-    routes = []
+    routes: list[list[int]] = []
     for start in np.flatnonzero(model.initial_distribution > 0):
         state, route = int(start), []
         for _ in range(TIME_LIMIT):

@@ -116,9 +116,9 @@ def bind_tables(
         which = "Q-learning" if missing[0] == "qlearn" else "SARSA"
         listed = ", ".join(f"`{name}`" for name in read)
         return f"{function}() reads {listed}, none of which is the {which} table (no training statement sets it and its name does not say so)"  # noqa: E501
-    for name, entry in assigned.items():
-        if entry.learner is not None and entry.table and name not in roles:
-            roles[name] = (entry.learner, entry.decay)
+    for name, statement in assigned.items():
+        if statement.learner is not None and statement.table and name not in roles:
+            roles[name] = (statement.learner, statement.decay)
     copies: dict[tuple[str, str], Any] = {}
     bound = []
     for name, (learner, decay) in roles.items():
@@ -248,8 +248,9 @@ def _assigned_by(
         names = target.elts if isinstance(target, ast.Tuple | ast.List) else [target]
         for index, element in enumerate(names):
             if isinstance(element, ast.Name):
-                yield element.id, Assignment(
-                    cell, statement.lineno, text, learner, decay, episodes, index == 0, callee
+                yield (
+                    element.id,
+                    Assignment(cell, statement.lineno, text, learner, decay, episodes, index == 0, callee),
                 )
 
 
@@ -261,7 +262,8 @@ def _call_arguments(call: ast.expr, learner: Any) -> tuple[bool | None, int | No
         return None, None
     try:
         signature = inspect.signature(learner)
-        bound = signature.bind(*call.args, **{keyword.arg: keyword.value for keyword in call.keywords})  # type: ignore[misc]
+        keywords = {str(keyword.arg): keyword.value for keyword in call.keywords}
+        bound = signature.bind(*call.args, **keywords)
         bound.apply_defaults()
     except (TypeError, ValueError):
         return None, None

@@ -103,7 +103,11 @@ def run_cells(
         except MemoryError:
             raise
         except BaseException as error:  # SystemExit and KeyboardInterrupt in a cell stop "Run All" too
-            why = f" (the cells ran because the grader's tables could not stand in for the training: {fallback['fallback']})" if fallback else ""  # noqa: E501
+            why = (
+                f" (the cells ran because the grader's tables could not stand in for the training: {fallback['fallback']})"  # noqa: E501
+                if fallback
+                else ""
+            )
             raise NotebookCellError(_described(number, script, filename, error) + why) from None
         finally:
             if script:

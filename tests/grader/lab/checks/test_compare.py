@@ -10,13 +10,13 @@ from grader.lab.assignment import load_config
 from grader.lab.checks.base import CallRecord, Verdict
 from grader.lab.checks.compare import NOT_GRADABLE, CompareConfig, NotebookTable
 from grader.lab.checks.compare_tables import bound_tables
-from reference.oracles import greedy_policy_return
 from grader.lab.editions.rl1 import RL1
 from grader.sandbox.child.cells import RUN_CELLS, NotAttemptedError, NotebookCellError
 from grader.sandbox.outcome import IMPORT_TIMEOUT, OutcomeStatus
 from grader.simulated_students import compare as students
 from grader.simulated_students.simulation import simulate_calls
 from grader.submission.notebook.cells import RAN_CELLS
+from reference.oracles import greedy_policy_return
 
 from .support import deal_only_hard_starts
 
@@ -119,7 +119,10 @@ def test_the_bound_tables_are_the_plans_whatever_the_child_sends(seed: int) -> N
 
 def test_a_fallback_says_why_the_cells_ran(seed: int) -> None:
     def fell_back(lab: Any, *args: Any, **kwargs: Any) -> dict[str, Any]:
-        return {**students.cells(lab), "fallback": "compare() calls qlearn() itself, so it trains its own tables"}
+        return {
+            **students.cells(lab),
+            "fallback": "compare() calls qlearn() itself, so it trains its own tables",
+        }
 
     verdict = _judge(students.honest, seed, fell_back)
     assert verdict.status == "passed", verdict.feedback
