@@ -105,7 +105,9 @@ def bounded_training(notebook: Path) -> list[str]:
 
 def main() -> None:
     """Measure all four, print each and the ratios."""
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--notebook", type=Path, default=NOTEBOOK)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--skip-plain", action="store_true", help="leave out the 10-minute plain Run All")
@@ -121,7 +123,11 @@ def main() -> None:
     )
     print(f"  feedback: {bound['feedback']}", flush=True)
     check = whole_check(notebook)
-    print(f"whole gymgrade check: {check['wall']:.1f} s wall, exit {check['exit']}, {check['score']}; load {os.getloadavg()}", flush=True)  # noqa: E501
+    print(
+        f"whole gymgrade check: {check['wall']:.1f} s wall, exit {check['exit']}, {check['score']}; "
+        f"load {os.getloadavg()}",
+        flush=True,
+    )
     print("bounded training of the notebook's own learners:", flush=True)
     for line in bounded_training(notebook):
         print(line, flush=True)
@@ -134,7 +140,9 @@ def main() -> None:
         flush=True,
     )
     ratio = float(bound["problem_wall"]) / plain["wall"]  # type: ignore[arg-type]
-    print(f"ratio bound compare problem / plain Run All: {ratio:.3f} (wall); whole check {check['wall']:.1f} s")
+    print(
+        f"ratio bound compare problem / plain Run All: {ratio:.3f} (wall); whole check {check['wall']:.1f} s"
+    )
 
 
 if __name__ == "__main__":

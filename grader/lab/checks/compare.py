@@ -1,16 +1,25 @@
-"""Edition rl1, problem 7: `compare()` plays the notebook's own Q-learning and SARSA tables greedily.
+"""Edition rl1, problem 7: `compare()` plays the notebook's Q-learning and SARSA tables greedily.
 
-`compare()` takes no arguments: it reads the tables the notebook's training cells made. With `run_cells` in
-`[problems.compare]` the grader runs the notebook's code cells in the sandbox first (one unrecorded call
-with its own time limit, `cells_seconds`; `grader.sandbox.child.cells`), then calls `compare()` (recorded
-and replayed). The cells call returns every Taxi Q-table the cells left behind, labelled with the learner
-that made it. The judge finds, for each half of compare()'s replayed episodes, the notebook table whose
-greedy actions they all are (a row's maximisers), so the episodes reveal which tables were played; the
-returned pair must be the two replayed means, Q-learning's first, and each mean must lie within its z-test
-tolerance of the exact greedy return of the table its episodes reveal (`reference.oracles`).
+`compare()` takes no arguments: it reads the tables the notebook's training cells would leave in its globals.
+Its verdict does not depend on what the training learned: the judge finds, for each half of compare()'s
+replayed episodes, the table whose greedy actions they all are (a row's maximisers), so the episodes reveal
+which tables were played; the returned pair must be the two replayed means, Q-learning's first, and each mean
+must lie within its z-test tolerance of the exact greedy return of the table its episodes reveal
+(`reference.oracles`). So by default (`bind_tables`) no training runs:
 
-`run_cells` is on by default; an instructor who turns it off gets compare() `skipped`, worth 0 points, with a
-note saying why (the function cannot be graded in isolation: it reads globals nothing else sets).
+- **Bound** (the default): the plan's cells call carries the grader's tables (`compare_tables.bound_tables`,
+  drawn from the problem's seed: tie-free, every start delivered, each pair of tables told apart by their
+  greedy routes), one per learner and epsilon schedule. In the child, `grader.sandbox.child.binding` binds
+  them to the globals compare() reads (its code's `LOAD_GLOBAL`s, through the module's functions it calls),
+  Q-learning's and SARSA's told apart by the file's own `qlearn(...)`/`sarsa0(...)` statements, then by the
+  names, and runs no cell. The judge takes the tables from its own plan, never from the child; the child says
+  only which names it bound to which (the feedback quotes it).
+- **Cells** (the fallback where binding cannot serve, said in the feedback; or every time with
+  `bind_tables = false`): the notebook's code cells run in the sandbox first (one unrecorded call with its
+  own time limit, `cells_seconds`; `grader.sandbox.child.cells`), which returns every Taxi Q-table they left
+  behind, labelled with the learner that made it; those are the tables the episodes may reveal.
+
+`run_cells = false` turns the problem off: compare() is `skipped`, worth 0 points, with a note saying why.
 
 The data flows in one chain:
 
@@ -20,18 +29,20 @@ The data flows in one chain:
   (`grader.submission.notebook.cells.write_cells`).
 - A check plans `Call(RUN_CELLS, seconds=...)` (its own wall-clock limit) before its own calls;
   `grader.grading.execution.run_problem` fills in the argument (`runnable_cells`: the notebook's cells, or a
-  `.py` file whole as a script) because only it knows the submission.
+  `.py` file whole as a script) because only it knows the submission. The binding reads the same cells (never
+  runs them) for the training statements.
 - In the child, `grader.sandbox.child.calls` runs a `RUN_CELLS` call with
-  `grader.sandbox.child.cells.run_cells`: the cells run in the module's globals (the same child then serves
-  the problem's calls), the first failing cell raises `NotebookCellError` (the outcome is an exception, so the
-  run stops there), and the value is plain data: each cell's time and the Taxi Q-tables left behind, labelled
-  by learner.
+  `grader.sandbox.child.cells.run_cells`: bound, its value names what was bound; else the cells run in the
+  module's globals (the same child then serves the problem's calls), the first failing cell raises
+  `NotebookCellError` (the outcome is an exception, so the run stops there; the message says why the cells
+  ran), and the value is plain data: each cell's time and the Taxi Q-tables left behind, labelled by learner,
+  with why nothing was bound.
 - The check judges with that value and the replayed episodes of its own calls (`grader.lab.checks.compare`);
-  its result carries the `ran_notebook_cells` measurement, so `with_notebook` adds no "global only a
-  skipped statement sets" note to it. Cells that left no table and a compare() that then raises is
-  `failed`, saying where a `.py` (under `if __name__ == "__main__":`) or a notebook trains the tables; a
-  file that did not import within `import_seconds` (training at its top level) is `timeout` with the
-  runner's message (`grader.sandbox.outcome.IMPORT_TIMEOUT`).
+  its result carries the `ran_notebook_cells` measurement (the globals were set, bound or by the cells), so
+  `with_notebook` adds no "global only a skipped statement sets" note to it. Cells that left no table and a
+  compare() that then raises is `failed`, saying where a `.py` (under `if __name__ == "__main__":`) or a
+  notebook trains the tables; a file that did not import within `import_seconds` (training at its top level)
+  is `timeout` with the runner's message (`grader.sandbox.outcome.IMPORT_TIMEOUT`).
 """
 
 from __future__ import annotations
@@ -61,8 +72,8 @@ RETURN_TOLERANCE = 1e-6
 RANDOM_SHARE = 0.25
 """More non-greedy actions than this share of a half's steps reads as random play."""
 NOT_GRADABLE = (
-    "Not graded: compare() takes no arguments and reads the tables your notebook's own training cells made, so it cannot be graded in isolation; it is worth 0 points in this assignment. "  # noqa: E501
-    "Instructors: this assignment's [problems.compare] says run_cells = false; the default, run_cells = true, runs the notebook's cells in the sandbox (bounded by cells_seconds) before calling compare() (docs/editions.md)."  # noqa: E501
+    "Not graded: compare() takes no arguments and reads the tables your notebook's own training cells made; this assignment does not grade it, so it is worth 0 points. "  # noqa: E501
+    "Instructors: this assignment's [problems.compare] says run_cells = false; the default, run_cells = true, binds the grader's tables to the globals compare() reads (or runs the notebook's cells in the sandbox where that cannot serve) before calling compare() (docs/editions.md)."  # noqa: E501
 )
 
 
@@ -71,8 +82,8 @@ class CompareConfig(PlayedProblemConfig):
 
     run_cells: bool = Field(
         default=True,
-        description="Run the notebook's code cells in the sandbox (in order, as Run All does) before calling compare() (the default); "  # noqa: E501
-        "false turns it off: compare() is not gradable in isolation, so it is skipped and worth 0 points whatever `points` says.",  # noqa: E501
+        description="Grade compare() (the default): its tables bound (`bind_tables`) or the notebook's code cells run in the sandbox (in order, as Run All does) before calling it; "  # noqa: E501
+        "false turns it off: compare() is skipped and worth 0 points whatever `points` says.",
     )
     bind_tables: bool = Field(
         default=True,
@@ -127,6 +138,24 @@ class NotebookTable:
         ]
         call = f"{self.learner}({', '.join(filter(None, made))})"
         return f"{name} (bound for {call})" if self.bound else f"{name} (from {call})"
+
+
+MAX_NAME_CHARS = 60
+"""A global's name as the child reported it, cut to this length for the feedback."""
+
+
+MAX_STATEMENT_CHARS = 120
+"""A training statement as the child quoted it, cut to this length for the feedback."""
+
+
+@dataclass(frozen=True)
+class BoundTable(NotebookTable):
+    """A table of the grader's bound to globals the notebook's training would set."""
+
+    read: tuple[str, ...] = ()
+    """The names compare() reads (the others were bound because a training statement sets them)."""
+    where: tuple[tuple[str, int, str], ...] = ()
+    """(name, cell, statement) of the training statements that set its names."""
 
 
 @dataclass(frozen=True)
@@ -314,10 +343,6 @@ def _judge_compare(
     return Verdict("passed", 1.0, f"{preface}: {story}, and returned those two means.", measurements)
 
 
-MAX_NAME_CHARS = 60
-"""A global's name as the child reported it, cut to this length for the feedback."""
-
-
 def _bound_tables(value: PlainValue, planned: PlainValue) -> list[NotebookTable] | None:
     """The grader's tables as the child bound them (None: nothing bound, the cells ran).
 
@@ -368,20 +393,6 @@ def _bound_tables(value: PlainValue, planned: PlainValue) -> list[NotebookTable]
             )
         )
     return tables or None
-
-
-MAX_STATEMENT_CHARS = 120
-"""A training statement as the child quoted it, cut to this length for the feedback."""
-
-
-@dataclass(frozen=True)
-class BoundTable(NotebookTable):
-    """A table of the grader's bound to globals the notebook's training would set."""
-
-    read: tuple[str, ...] = ()
-    """The names compare() reads (the others were bound because a training statement sets them)."""
-    where: tuple[tuple[str, int, str], ...] = ()
-    """(name, cell, statement) of the training statements that set its names."""
 
 
 _LEARNER_NAMES = {"qlearn": "Q-learning", "sarsa0": "SARSA"}
