@@ -19,7 +19,7 @@ import numpy.typing as npt
 from grader.lab.checks.taxi_tables import grader_tables
 from grader.simulated_students.simulation import Lab
 from grader.simulated_students.taxi_tables import EPISODES, _play
-from reference.oracles import optimal_q_table
+from reference.oracles import greedy_policy_return, optimal_q_table
 from reference.oracles.taxi import ACTIONS
 
 GAMMA = 0.6
@@ -137,6 +137,12 @@ def own_tables(lab: Lab) -> tuple[float, float]:
     return _play(lab, q_table, EPISODES), _play(lab, own, EPISODES)
 
 
+def exact_constants(_lab: Lab) -> tuple[float, float]:
+    """Plays nothing: returns the exact greedy returns of the tables it reads (as if it knew the oracle)."""
+    q_table, sarsa_table = _tables()
+    return greedy_policy_return(q_table).mean, greedy_policy_return(sarsa_table).mean
+
+
 def final_reward(lab: Lab) -> tuple[float, float]:
     q_table, sarsa_table = _tables()
     return _play(lab, q_table, EPISODES, final_only=True), _play(lab, sarsa_table, EPISODES, final_only=True)
@@ -150,5 +156,6 @@ MISTAKES: dict[str, tuple[Any, str]] = {
     "constant_epsilon_table": (constant_epsilon_table, "trained with a constant epsilon"),
     "own_tables": (own_tables, "greedy on no table"),
     "final_reward": (final_reward, "which are not those means"),
+    "exact_constants": (exact_constants, "it played no episode"),
 }
 """Mistakes: (the function, words its feedback must contain). Each must fail."""

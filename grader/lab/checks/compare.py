@@ -277,7 +277,13 @@ def _judge_compare(
     per_table = settings.episodes_per_table
     measurements["episodes_replayed"] = len(episodes)
     if len(episodes) < 2 * per_table:
-        few = "a single episode per table" if len(episodes) <= 2 else f"{len(episodes)} episodes in all"
+        few = (
+            "no episode"
+            if not episodes
+            else "a single episode per table"
+            if len(episodes) <= 2
+            else f"{len(episodes)} episodes in all"
+        )
         return _fail(
             f"{preface}: it played {few}; the lab asks for {per_table} greedy episodes with each table and the means of their total rewards.",  # noqa: E501
             measurements,
