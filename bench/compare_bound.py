@@ -111,8 +111,14 @@ def main() -> None:
     parser.add_argument("--notebook", type=Path, default=NOTEBOOK)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--skip-plain", action="store_true", help="leave out the 10-minute plain Run All")
+    parser.add_argument("--skip-bounded", action="store_true", help="leave out the bounded training")
+    parser.add_argument("--only-bounded", action="store_true", help="only the bounded training")
     arguments = parser.parse_args()
     notebook = arguments.notebook
+    if arguments.only_bounded:
+        for line in bounded_training(notebook):
+            print(line, flush=True)
+        return
     print(f"notebook {notebook.name}; load average before: {os.getloadavg()}", flush=True)
     bound = graded_run(notebook, arguments.seed)
     print(
@@ -128,9 +134,10 @@ def main() -> None:
         f"load {os.getloadavg()}",
         flush=True,
     )
-    print("bounded training of the notebook's own learners:", flush=True)
-    for line in bounded_training(notebook):
-        print(line, flush=True)
+    if not arguments.skip_bounded:
+        print("bounded training of the notebook's own learners:", flush=True)
+        for line in bounded_training(notebook):
+            print(line, flush=True)
     if arguments.skip_plain:
         return
     with tempfile.TemporaryDirectory() as temporary:

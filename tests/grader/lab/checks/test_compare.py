@@ -373,3 +373,26 @@ def test_two_decayed_tables_of_one_learner_are_no_constant_epsilon_table(seed: i
 
     verdict = _judge(students.honest, seed, cells=cells_with_a_copy)
     assert verdict.status == "passed", verdict.feedback
+
+
+@pytest.mark.slow  # grades a notebook three times through the sandbox
+def test_bound_tables_make_the_same_report_for_the_same_bytes_and_seed(tmp_path: Any) -> None:
+    from pathlib import Path
+
+    from grader.grading.grade import grade_files
+    from grader.grading.plan import GradingPlan
+    from grader.sandbox import IsolationPolicy
+
+    notebook = Path(__file__).parents[4] / "submissions" / "editions" / "compare_honest.ipynb"
+    plan = GradingPlan.load(RL1.default_config, ["compare"])
+
+    def grade(seed: int) -> Any:
+        (report,) = grade_files([notebook], plan, seed=seed, workers=1, policy=IsolationPolicy.ALLOW_FALLBACK)
+        return report
+
+    first, again, other = grade(5), grade(5), grade(6)
+    assert first.problems[0].status == "passed", first.problems[0].feedback
+    assert first.graded_view() == again.graded_view()
+    assert first.problems[0].measurements["tables_bound"] == 2
+    exact = first.problems[0].measurements["exact_q_mean"], other.problems[0].measurements["exact_q_mean"]
+    assert exact[0] != exact[1]  # another seed, other tables
