@@ -416,10 +416,8 @@ def _bound_preface(tables: Sequence[NotebookTable]) -> str:
         ]
         source = f"as your {statements[0]} sets it" if statements else "by its name"
         parts.append(f"{names} <- the {schedule}{_LEARNER_NAMES[table.learner or 'qlearn']} table ({source})")
-    return (
-        "Bound the grader's own Taxi tables (drawn from the grading seed, exact greedy returns known) to the globals compare() reads instead of running your training, "  # noqa: E501
-        f"since compare()'s verdict does not depend on what training learns: {'; '.join(parts)}; then called compare()"  # noqa: E501
-    )
+    bound = "; ".join(parts)
+    return f"Bound the grader's own Taxi tables (drawn from the grading seed, exact greedy returns known) to the globals compare() reads instead of running your training, since compare()'s verdict does not depend on what training learns: {bound}; then called compare()"  # noqa: E501
 
 
 def _cell(cell: int) -> str:
