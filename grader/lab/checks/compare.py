@@ -52,11 +52,17 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 from pydantic import Field, model_validator
 
 from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
-from grader.lab.checks.compare_tables import LEARNERS, bound_tables
+from grader.lab.checks.compare_tables import bound_tables
+from grader.lab.checks.compare_values import (
+    NotebookTable,
+    bound_preface,
+    bound_tables_of,
+    cells_value,
+    fallback_preface,
+)
 from grader.lab.checks.episodes import Episode, played_episodes
 from grader.lab.checks.integrity import NO_EPISODES, games_budget, integrity_problem
 from grader.lab.checks.taxi import EPISODE_STEPS
@@ -115,50 +121,6 @@ class CompareConfig(PlayedProblemConfig):
 
 
 @dataclass(frozen=True)
-class NotebookTable:
-    """A Taxi Q-table the notebook's cells left behind (untrusted values, validated shape)."""
-
-    names: tuple[str, ...]
-    learner: str | None
-    decay: bool | None
-    episodes: int | None
-    table: npt.NDArray[np.float64]
-    bound: bool = False
-    """The grader's table, bound in place of the learner call (else one the notebook's cells made)."""
-
-    @property
-    def label(self) -> str:
-        """How the feedback names it: its globals and the learner call that made it."""
-        name = " / ".join(f"`{name}`" for name in self.names) or "a table"
-        if self.learner is None:
-            return name
-        made = [
-            f"decay={self.decay}" if self.decay is not None else "",
-            f"N={self.episodes}" if self.episodes else "",
-        ]
-        call = f"{self.learner}({', '.join(filter(None, made))})"
-        return f"{name} (bound for {call})" if self.bound else f"{name} (from {call})"
-
-
-MAX_NAME_CHARS = 60
-"""A global's name as the child reported it, cut to this length for the feedback."""
-
-
-MAX_STATEMENT_CHARS = 120
-"""A training statement as the child quoted it, cut to this length for the feedback."""
-
-
-@dataclass(frozen=True)
-class BoundTable(NotebookTable):
-    """A table of the grader's bound to globals the notebook's training would set."""
-
-    read: tuple[str, ...] = ()
-    """The names compare() reads (the others were bound because a training statement sets them)."""
-    where: tuple[tuple[str, int, str], ...] = ()
-    """(name, cell, statement) of the training statements that set its names."""
-
-
-@dataclass(frozen=True)
 class CompareCheck:
     """The notebook's cells, then compare(): both halves replayed, greedy on notebook tables, exact means."""
 
@@ -198,16 +160,16 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
     cells = records[0].outcome
     if cells.status is not OutcomeStatus.OK:
         return _cells_failed(settings, cells.status, cells.message)
-    bound = _bound_tables(cells.value, cells.call.kwargs.get("bind"))
+    bound = bound_tables_of(cells.value, cells.call.kwargs.get("bind"))
     ran: list[int]
     tables: list[NotebookTable]
     if bound is not None:
         ran, tables = [], bound
-        preface = _bound_preface(bound)
+        preface = bound_preface(bound)
     else:
-        ran, tables = _cells_value(cells.value)
+        ran, tables = cells_value(cells.value)
         # No wall time here (the problem's timings carry it): same bytes and seed, same verdict.
-        preface = _fallback_preface(cells.value) + (
+        preface = fallback_preface(cells.value) + (
             f"Ran your notebook's {len(ran)} code cell{'' if len(ran) == 1 else 's'} in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
             if not (ran and ran[0] == SCRIPT_CELL)
             else f"Ran your file as a script in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
@@ -347,124 +309,6 @@ def _judge_compare(
             measurements,
         )
     return Verdict("passed", 1.0, f"{preface}: {story}, and returned those two means.", measurements)
-
-
-def _bound_tables(value: PlainValue, planned: PlainValue) -> list[NotebookTable] | None:
-    """The grader's tables as the child bound them (None: nothing bound, the cells ran).
-
-    The tables are the plan's own (`planned`, never the child's); the child says only which names it bound
-    to which learner's table, which the feedback reports and which orders the expected means.
-    """
-    if (
-        not isinstance(value, dict)
-        or not isinstance(value.get("bound"), list)
-        or not isinstance(planned, dict)
-    ):
-        return None
-    groups: dict[tuple[str, str], dict[str, Any]] = {}
-    for entry in value["bound"]:
-        if (
-            not isinstance(entry, dict)
-            or entry.get("learner") not in LEARNERS
-            or not isinstance(entry.get("name"), str)
-        ):
-            continue
-        decay = entry.get("decay") if type(entry.get("decay")) is bool else None
-        key = (str(entry["learner"]), "constant" if decay is False else "decay")
-        group = groups.setdefault(key, {"names": [], "read": [], "decay": decay, "N": None, "where": []})
-        name = entry["name"][:MAX_NAME_CHARS]
-        group["names"].append(name)
-        if entry.get("read") is True:
-            group["read"].append(name)
-        if type(entry.get("N")) is int and group["N"] is None:
-            group["N"] = entry["N"]
-        statement, cell = entry.get("statement"), entry.get("cell")
-        if isinstance(statement, str) and type(cell) is int:
-            group["where"].append((name, cell, statement[:MAX_STATEMENT_CHARS]))
-    tables: list[NotebookTable] = []
-    for (learner, schedule), group in groups.items():
-        table = planned.get(learner, {}).get(schedule) if isinstance(planned.get(learner), dict) else None
-        if table is None:
-            continue
-        tables.append(
-            BoundTable(
-                names=tuple(group["names"][:5]),
-                learner=learner,
-                decay=group["decay"],
-                episodes=group["N"],
-                table=np.asarray(table, dtype=np.float64),
-                bound=True,
-                read=tuple(group["read"]),
-                where=tuple(group["where"]),
-            )
-        )
-    return tables or None
-
-
-_LEARNER_NAMES = {"qlearn": "Q-learning", "sarsa0": "SARSA"}
-
-
-def _bound_preface(tables: Sequence[NotebookTable]) -> str:
-    parts = []
-    for table in tables:
-        if not isinstance(table, BoundTable) or not table.read:
-            continue
-        schedule = "constant-epsilon " if table.decay is False else ""
-        names = " and ".join(f"`{name}`" for name in table.read)
-        statements = [
-            f"`{statement}` in {_cell(cell)}" for name, cell, statement in table.where if name in table.read
-        ]
-        source = f"as your {statements[0]} sets it" if statements else "by its name"
-        parts.append(f"{names} <- the {schedule}{_LEARNER_NAMES[table.learner or 'qlearn']} table ({source})")
-    bound = "; ".join(parts)
-    return f"Bound the grader's own Taxi tables (drawn from the grading seed, exact greedy returns known) to the globals compare() reads instead of running your training, since compare()'s verdict does not depend on what training learns: {bound}; then called compare()"  # noqa: E501
-
-
-def _cell(cell: int) -> str:
-    return "your file" if cell == SCRIPT_CELL else f"cell {cell}"
-
-
-def _fallback_preface(value: PlainValue) -> str:
-    reason = value.get("fallback") if isinstance(value, dict) else None
-    if not isinstance(reason, str):
-        return ""
-    return f"The grader's tables could not stand in for your training: {reason[:300]}. "
-
-
-def _cells_value(value: PlainValue) -> tuple[list[int], list[NotebookTable]]:
-    """The cells call's value, validated (it comes from the student's process): the numbers of the cells
-    that ran (their seconds are the problem's timings, not the verdict's) and the tables they left."""
-    ran: list[int] = []
-    tables: list[NotebookTable] = []
-    if not isinstance(value, dict):
-        return ran, tables
-    for entry in value.get("cells", []) if isinstance(value.get("cells"), list) else []:
-        if isinstance(entry, dict) and type(entry.get("cell")) is int:
-            ran.append(entry["cell"])
-    for entry in value.get("tables", []) if isinstance(value.get("tables"), list) else []:
-        if not isinstance(entry, dict):
-            continue
-        table = np.asarray(entry.get("table"), dtype=object)
-        if table.shape != (500, 6):
-            continue
-        try:
-            numbers = np.asarray(table, dtype=np.float64)
-        except (TypeError, ValueError):
-            continue
-        if not np.all(np.isfinite(numbers)):
-            continue
-        names = entry.get("names")
-        learner, decay, episodes = entry.get("learner"), entry.get("decay"), entry.get("N")
-        tables.append(
-            NotebookTable(
-                names=tuple(str(name)[:60] for name in names[:5]) if isinstance(names, list) else (),
-                learner=learner if learner in ("qlearn", "sarsa0") else None,
-                decay=decay if type(decay) is bool else None,
-                episodes=episodes if type(episodes) is int else None,
-                table=numbers,
-            )
-        )
-    return ran, tables
 
 
 def _revealed(
