@@ -125,10 +125,17 @@ def plain_child(calls_file: Path, submission: Path, child_envs: bool = False) ->
     print(json.dumps(summary))
 
 
-def _run_cells_plainly(module: Any, cells: list[dict[str, Any]], then: str | None = None) -> None:
+def _run_cells_plainly(
+    module: Any, cells: list[dict[str, Any]], then: str | None = None, bind: dict[str, Any] | None = None
+) -> None:
     """The grader's cells call (compare()'s), as Run All runs them: each cell in the module's namespace,
-    a script with ``__name__ == "__main__"``; no labelling of tables, no limits."""
+    a script with ``__name__ == "__main__"``; no labelling of tables, no limits. With `bind`, the grader's
+    tables are bound as the child binds them and no cell runs where that serves (the default)."""
+    from grader.sandbox.child.binding import bind_tables
+
     namespace = vars(module)
+    if bind is not None and isinstance(bind_tables(namespace, cells, bind, then or "compare"), list):
+        return
     for entry in cells:
         script, name = bool(entry["script"]), namespace.get("__name__")
         filename = module.__file__ if script else f"<notebook cell {entry['cell']}>"

@@ -248,15 +248,34 @@ def detour_q_table(gamma: float = 0.6) -> FloatArray:
     Raises:
         InvalidParameterError: `gamma` is outside [0, 1).
     """
+    return walled_q_table(DETOUR_WALL, gamma) - 1e-6 * np.arange(ACTIONS)
+
+
+def walled_q_table(walls: tuple[tuple[int, int, int], ...], gamma: float = 0.6) -> FloatArray:
+    """Optimal action values for Taxi with extra walls, by value iteration (ties left as they fall).
+
+    Args:
+        walls: (row, column, action) triples: that move from that cell is blocked (the taxi stays, the
+            step costs -1000, so no greedy policy takes it); block both sides of a wall to make one.
+        gamma: discount factor in [0, 1).
+
+    Returns:
+        A new (500, 6) float64 array. Where every blocked move has an unblocked alternative, greedy play
+        on it in the real Taxi takes the walled map's optimal routes.
+
+    Raises:
+        InvalidParameterError: `gamma` is outside [0, 1).
+    """
     if not 0.0 <= gamma < 1.0:
         raise InvalidParameterError(f"expected a discount factor gamma in [0, 1), found {gamma!r}")
     model = taxi_model()
     next_state, reward = model.next_state.copy(), model.reward.copy()
+    blocked: dict[tuple[int, int], list[int]] = {(row, column): [] for row, column, _ in walls}
+    for row, column, action in walls:
+        blocked[(row, column)].append(action)
     for state in range(STATES):
-        row, column = state // 100, (state // 20) % 5
-        for wall_row, wall_column, action in DETOUR_WALL:
-            if (row, column) == (wall_row, wall_column):
-                next_state[state, action], reward[state, action] = state, -1000.0
+        for action in blocked.get((state // 100, (state // 20) % 5), ()):
+            next_state[state, action], reward[state, action] = state, -1000.0
     q_table = np.zeros((STATES, ACTIONS))
     while True:
         bootstrap = np.where(model.terminates, 0.0, q_table.max(axis=1)[next_state])
@@ -264,4 +283,4 @@ def detour_q_table(gamma: float = 0.6) -> FloatArray:
         delta = float(np.max(np.abs(updated - q_table)))
         q_table = updated
         if gamma * delta <= VALUE_ITERATION_TOLERANCE * (1.0 - gamma):
-            return q_table - 1e-6 * np.arange(ACTIONS)
+            return q_table

@@ -1,4 +1,5 @@
-"""Edition rl1, problem 7: compare() after the notebook's own cells ran, judged on its replayed episodes."""
+"""Edition rl1, problem 7: compare() on the grader's bound tables (or after the notebook's cells ran), judged
+on its replayed episodes."""
 
 from grader.grading.plugin import GradeCase, ProblemCase
 from grader.lab.editions.rl1 import RL1

@@ -1,16 +1,25 @@
-"""Edition rl1, problem 7: `compare()` plays the notebook's own Q-learning and SARSA tables greedily.
+"""Edition rl1, problem 7: `compare()` plays the notebook's Q-learning and SARSA tables greedily.
 
-`compare()` takes no arguments: it reads the tables the notebook's training cells made. With `run_cells` in
-`[problems.compare]` the grader runs the notebook's code cells in the sandbox first (one unrecorded call
-with its own time limit, `cells_seconds`; `grader.sandbox.child.cells`), then calls `compare()` (recorded
-and replayed). The cells call returns every Taxi Q-table the cells left behind, labelled with the learner
-that made it. The judge finds, for each half of compare()'s replayed episodes, the notebook table whose
-greedy actions they all are (a row's maximisers), so the episodes reveal which tables were played; the
-returned pair must be the two replayed means, Q-learning's first, and each mean must lie within its z-test
-tolerance of the exact greedy return of the table its episodes reveal (`reference.oracles`).
+`compare()` takes no arguments: it reads the tables the notebook's training cells would leave in its globals.
+Its verdict does not depend on what the training learned: the judge finds, for each half of compare()'s
+replayed episodes, the table whose greedy actions they all are (a row's maximisers), so the episodes reveal
+which tables were played; the returned pair must be the two replayed means, Q-learning's first, and each mean
+must lie within its z-test tolerance of the exact greedy return of the table its episodes reveal
+(`reference.oracles`). So by default (`bind_tables`) no training runs:
 
-`run_cells` is on by default; an instructor who turns it off gets compare() `skipped`, worth 0 points, with a
-note saying why (the function cannot be graded in isolation: it reads globals nothing else sets).
+- **Bound** (the default): the plan's cells call carries the grader's tables (`compare_tables.bound_tables`,
+  drawn from the problem's seed: tie-free, every start delivered, each pair of tables told apart by their
+  greedy routes), one per learner and epsilon schedule. In the child, `grader.sandbox.child.binding` binds
+  them to the globals compare() reads (its code's `LOAD_GLOBAL`s, through the module's functions it calls),
+  Q-learning's and SARSA's told apart by the file's own `qlearn(...)`/`sarsa0(...)` statements, then by the
+  names, and runs no cell. The judge takes the tables from its own plan, never from the child; the child says
+  only which names it bound to which (the feedback quotes it).
+- **Cells** (the fallback where binding cannot serve, said in the feedback; or every time with
+  `bind_tables = false`): the notebook's code cells run in the sandbox first (one unrecorded call with its
+  own time limit, `cells_seconds`; `grader.sandbox.child.cells`), which returns every Taxi Q-table they left
+  behind, labelled with the learner that made it; those are the tables the episodes may reveal.
+
+`run_cells = false` turns the problem off: compare() is `skipped`, worth 0 points, with a note saying why.
 
 The data flows in one chain:
 
@@ -20,18 +29,20 @@ The data flows in one chain:
   (`grader.submission.notebook.cells.write_cells`).
 - A check plans `Call(RUN_CELLS, seconds=...)` (its own wall-clock limit) before its own calls;
   `grader.grading.execution.run_problem` fills in the argument (`runnable_cells`: the notebook's cells, or a
-  `.py` file whole as a script) because only it knows the submission.
+  `.py` file whole as a script) because only it knows the submission. The binding reads the same cells (never
+  runs them) for the training statements.
 - In the child, `grader.sandbox.child.calls` runs a `RUN_CELLS` call with
-  `grader.sandbox.child.cells.run_cells`: the cells run in the module's globals (the same child then serves
-  the problem's calls), the first failing cell raises `NotebookCellError` (the outcome is an exception, so the
-  run stops there), and the value is plain data: each cell's time and the Taxi Q-tables left behind, labelled
-  by learner.
+  `grader.sandbox.child.cells.run_cells`: bound, its value names what was bound; else the cells run in the
+  module's globals (the same child then serves the problem's calls), the first failing cell raises
+  `NotebookCellError` (the outcome is an exception, so the run stops there; the message says why the cells
+  ran), and the value is plain data: each cell's time and the Taxi Q-tables left behind, labelled by learner,
+  with why nothing was bound.
 - The check judges with that value and the replayed episodes of its own calls (`grader.lab.checks.compare`);
-  its result carries the `ran_notebook_cells` measurement, so `with_notebook` adds no "global only a
-  skipped statement sets" note to it. Cells that left no table and a compare() that then raises is
-  `failed`, saying where a `.py` (under `if __name__ == "__main__":`) or a notebook trains the tables; a
-  file that did not import within `import_seconds` (training at its top level) is `timeout` with the
-  runner's message (`grader.sandbox.outcome.IMPORT_TIMEOUT`).
+  its result carries the `ran_notebook_cells` measurement (the globals were set, bound or by the cells), so
+  `with_notebook` adds no "global only a skipped statement sets" note to it. Cells that left no table and a
+  compare() that then raises is `failed`, saying where a `.py` (under `if __name__ == "__main__":`) or a
+  notebook trains the tables; a file that did not import within `import_seconds` (training at its top level)
+  is `timeout` with the runner's message (`grader.sandbox.outcome.IMPORT_TIMEOUT`).
 """
 
 from __future__ import annotations
@@ -41,10 +52,17 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 from pydantic import Field, model_validator
 
 from grader.lab.checks.base import CallRecord, Verdict, outcome_verdict, paused_gc
+from grader.lab.checks.compare_tables import bound_tables
+from grader.lab.checks.compare_values import (
+    NotebookTable,
+    bound_preface,
+    bound_tables_of,
+    cells_value,
+    fallback_preface,
+)
 from grader.lab.checks.episodes import Episode, played_episodes
 from grader.lab.checks.integrity import NO_EPISODES, games_budget, integrity_problem
 from grader.lab.checks.taxi import EPISODE_STEPS
@@ -60,8 +78,8 @@ RETURN_TOLERANCE = 1e-6
 RANDOM_SHARE = 0.25
 """More non-greedy actions than this share of a half's steps reads as random play."""
 NOT_GRADABLE = (
-    "Not graded: compare() takes no arguments and reads the tables your notebook's own training cells made, so it cannot be graded in isolation; it is worth 0 points in this assignment. "  # noqa: E501
-    "Instructors: this assignment's [problems.compare] says run_cells = false; the default, run_cells = true, runs the notebook's cells in the sandbox (bounded by cells_seconds) before calling compare() (docs/editions.md)."  # noqa: E501
+    "Not graded: compare() takes no arguments and reads the tables your notebook's own training cells made; this assignment does not grade it, so it is worth 0 points. "  # noqa: E501
+    "Instructors: this assignment's [problems.compare] says run_cells = false; the default, run_cells = true, binds the grader's tables to the globals compare() reads (or runs the notebook's cells in the sandbox where that cannot serve) before calling compare() (docs/editions.md)."  # noqa: E501
 )
 
 
@@ -70,8 +88,13 @@ class CompareConfig(PlayedProblemConfig):
 
     run_cells: bool = Field(
         default=True,
-        description="Run the notebook's code cells in the sandbox (in order, as Run All does) before calling compare() (the default); "  # noqa: E501
-        "false turns it off: compare() is not gradable in isolation, so it is skipped and worth 0 points whatever `points` says.",  # noqa: E501
+        description="Grade compare() (the default): its tables bound (`bind_tables`) or the notebook's code cells run in the sandbox (in order, as Run All does) before calling it; "  # noqa: E501
+        "false turns it off: compare() is skipped and worth 0 points whatever `points` says.",
+    )
+    bind_tables: bool = Field(
+        default=True,
+        description="Bind the grader's own tables (seeded, exact greedy returns known) to the globals compare() reads instead of running the training cells (the default: seconds); "  # noqa: E501
+        "the cells still run where binding cannot serve a compare() (the feedback says why). false runs every cell, as Run All does.",  # noqa: E501
     )
     cells_seconds: float = Field(
         default=1800.0,
@@ -98,41 +121,22 @@ class CompareConfig(PlayedProblemConfig):
 
 
 @dataclass(frozen=True)
-class NotebookTable:
-    """A Taxi Q-table the notebook's cells left behind (untrusted values, validated shape)."""
-
-    names: tuple[str, ...]
-    learner: str | None
-    decay: bool | None
-    episodes: int | None
-    table: npt.NDArray[np.float64]
-
-    @property
-    def label(self) -> str:
-        """How the feedback names it: its globals and the learner call that made it."""
-        name = " / ".join(f"`{name}`" for name in self.names) or "a table"
-        if self.learner is None:
-            return name
-        made = [
-            f"decay={self.decay}" if self.decay is not None else "",
-            f"N={self.episodes}" if self.episodes else "",
-        ]
-        return f"{name} (from {self.learner}({', '.join(filter(None, made))}))"
-
-
-@dataclass(frozen=True)
 class CompareCheck:
     """The notebook's cells, then compare(): both halves replayed, greedy on notebook tables, exact means."""
 
     def plan(self, settings: CompareConfig, functions: Mapping[str, FunctionInfo], seed: int) -> list[Call]:
-        """The cells call (own time limit, unrecorded), then a recorded compare(); none without run_cells."""
+        """The cells call (own time limit, unrecorded; with the grader's tables to bind when `bind_tables`),
+        then a recorded compare(); none without run_cells."""
         if not settings.run_cells:
             return []
         budget = games_budget(2 * settings.episodes_per_table, EPISODE_STEPS)
+        kwargs: dict[str, PlainValue] = {"then": "compare"}
+        if settings.bind_tables:
+            kwargs["bind"] = bound_tables(seed)
         return [
             Call(
                 RUN_CELLS,
-                kwargs={"then": "compare"},
+                kwargs=kwargs,
                 record_episodes=False,
                 budget=NO_EPISODES,
                 seconds=settings.cells_seconds,
@@ -156,20 +160,31 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
     cells = records[0].outcome
     if cells.status is not OutcomeStatus.OK:
         return _cells_failed(settings, cells.status, cells.message)
-    ran, tables = _cells_value(cells.value)
-    # No wall time here (the problem's timings carry it): the verdict is the same for the same bytes and seed.
-    preface = (
-        f"Ran your notebook's {len(ran)} code cell{'' if len(ran) == 1 else 's'} in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
-        if not (ran and ran[0] == SCRIPT_CELL)
-        else f"Ran your file as a script in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
-    )
-    measurements: dict[str, PlainValue] = {"cells_run": len(ran), "notebook_tables": len(tables)}
+    bound = bound_tables_of(cells.value, cells.call.kwargs.get("bind"))
+    ran: list[int]
+    tables: list[NotebookTable]
+    if bound is not None:
+        ran, tables = [], bound
+        preface = bound_preface(bound)
+    else:
+        ran, tables = cells_value(cells.value)
+        # No wall time here (the problem's timings carry it): same bytes and seed, same verdict.
+        preface = fallback_preface(cells.value) + (
+            f"Ran your notebook's {len(ran)} code cell{'' if len(ran) == 1 else 's'} in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
+            if not (ran and ran[0] == SCRIPT_CELL)
+            else f"Ran your file as a script in the sandbox (within the limit of {settings.cells_seconds:g} s), then called compare()"  # noqa: E501
+        )
+    measurements: dict[str, PlainValue] = {
+        "cells_run": len(ran),
+        "notebook_tables": 0 if bound else len(tables),
+        "tables_bound": len(bound or ()),
+    }
     if len(records) < 2:
         return Verdict("error", 0.0, f"{preface}; compare() was not called.", measurements)
     compare = records[1].outcome
     early = outcome_verdict(records[1:])
     if early is not None and compare.status is OutcomeStatus.EPISODE_LIMIT:
-        hint = f" compare() plays the tables your notebook's cells already trained; training inside compare() plays thousands of games (the cells left {_listed(tables)})."  # noqa: E501
+        hint = f" compare() plays the tables your notebook's cells already trained; training inside compare() plays thousands of games ({_left(tables)} {_listed(tables)})."  # noqa: E501
         return Verdict(
             "failed", 0.0, f"{preface}: {early.feedback}.{hint}", {**early.measurements, **measurements}
         )
@@ -224,7 +239,13 @@ def _judge_compare(
     per_table = settings.episodes_per_table
     measurements["episodes_replayed"] = len(episodes)
     if len(episodes) < 2 * per_table:
-        few = "a single episode per table" if len(episodes) <= 2 else f"{len(episodes)} episodes in all"
+        few = (
+            "no episode"
+            if not episodes
+            else "a single episode per table"
+            if len(episodes) <= 2
+            else f"{len(episodes)} episodes in all"
+        )
         return _fail(
             f"{preface}: it played {few}; the lab asks for {per_table} greedy episodes with each table and the means of their total rewards.",  # noqa: E501
             measurements,
@@ -241,11 +262,11 @@ def _judge_compare(
         table, wrong, steps = _revealed(half, tables)
         if table is None:
             if wrong > steps * RANDOM_SHARE:
-                why = f"{wrong} of its {steps} actions were not the argmax of any of your notebook's tables, as in random play: act with np.argmax(table[state])"  # noqa: E501
+                why = f"{wrong} of its {steps} actions were not the argmax of any of {_whose(tables)}, as in random play: act with np.argmax(table[state])"  # noqa: E501
             else:
                 why = (
-                    "its actions are greedy on no table your notebook's cells made (compare() must not train or load tables of its own: "  # noqa: E501
-                    f"read the globals the cells set; the cells left {_listed(tables)})"
+                    f"its actions are greedy on no table {_made(tables)} (compare() must not train or load tables of its own: "  # noqa: E501
+                    f"read the globals the cells set; {_left(tables)} {_listed(tables)})"
                 )
             return _fail(f"{preface}: in the {which} {per_table} episodes {why}.", measurements)
         played.append(table)
@@ -288,42 +309,6 @@ def _judge_compare(
             measurements,
         )
     return Verdict("passed", 1.0, f"{preface}: {story}, and returned those two means.", measurements)
-
-
-def _cells_value(value: PlainValue) -> tuple[list[int], list[NotebookTable]]:
-    """The cells call's value, validated (it comes from the student's process): the numbers of the cells
-    that ran (their seconds are the problem's timings, not the verdict's) and the tables they left."""
-    ran: list[int] = []
-    tables: list[NotebookTable] = []
-    if not isinstance(value, dict):
-        return ran, tables
-    for entry in value.get("cells", []) if isinstance(value.get("cells"), list) else []:
-        if isinstance(entry, dict) and type(entry.get("cell")) is int:
-            ran.append(entry["cell"])
-    for entry in value.get("tables", []) if isinstance(value.get("tables"), list) else []:
-        if not isinstance(entry, dict):
-            continue
-        table = np.asarray(entry.get("table"), dtype=object)
-        if table.shape != (500, 6):
-            continue
-        try:
-            numbers = np.asarray(table, dtype=np.float64)
-        except (TypeError, ValueError):
-            continue
-        if not np.all(np.isfinite(numbers)):
-            continue
-        names = entry.get("names")
-        learner, decay, episodes = entry.get("learner"), entry.get("decay"), entry.get("N")
-        tables.append(
-            NotebookTable(
-                names=tuple(str(name)[:60] for name in names[:5]) if isinstance(names, list) else (),
-                learner=learner if learner in ("qlearn", "sarsa0") else None,
-                decay=decay if type(decay) is bool else None,
-                episodes=episodes if type(episodes) is int else None,
-                table=numbers,
-            )
-        )
-    return ran, tables
 
 
 def _revealed(
@@ -376,6 +361,18 @@ def _not_decayed(played: Sequence[NotebookTable], tables: Sequence[NotebookTable
                 f"a decaying epsilon: your notebook has {decayed[0].label}."
             )
     return None
+
+
+def _whose(tables: Sequence[NotebookTable]) -> str:
+    return "the tables bound to your globals" if tables and tables[0].bound else "your notebook's tables"
+
+
+def _made(tables: Sequence[NotebookTable]) -> str:
+    return "bound to your globals" if tables and tables[0].bound else "your notebook's cells made"
+
+
+def _left(tables: Sequence[NotebookTable]) -> str:
+    return "the grader bound" if tables and tables[0].bound else "the cells left"
 
 
 def _listed(tables: Sequence[NotebookTable]) -> str:

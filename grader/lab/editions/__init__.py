@@ -65,8 +65,8 @@ every configuration and report that names no edition keeps its meaning), `gym026
 same problems: the compatibility layer runs their APIs; `cartpole()`/`car()` are called without arguments, so
 `render=False` keeps its default), and `rl1` (4, the current one: problems 1-4 are `PROBLEMS`' own
 declarations, reused, plus `epsilon_decay` and the two-table `taxi` (the same id as edition 1's `taxi`,
-another `Problem`: ids are unique within an edition), `sarsa0` and `compare()` (the notebook's cells run
-first, by default); `qlearn` is a provided function, listed in `not_graded`). Templates are
+another `Problem`: ids are unique within an edition), `sarsa0` and `compare()` (the grader's tables bound
+to the globals it reads, by default); `qlearn` is a provided function, listed in `not_graded`). Templates are
 `submissions/template.py` (classic) and `submissions/templates/<edition>.py`; references are
 `submissions/*_complete.py` and `submissions/editions/rl1_complete.py`; `rl1`'s default configuration is
 `grader/lab/editions/rl1.toml` (the others use the bundled `grader/lab/assignment.toml`).

@@ -3,8 +3,8 @@
 Problems 1-4 are the shared declarations of `grader.lab.problems`; `epsilon_decay` and the two-table
 `taxi(q_table, q_table_decay)` are this edition's own, and `sarsa0` (given the environment's name, as the
 course's template has it), verified by replaying its updates (`grader.lab.checks.sarsa`). `compare()` is
-graded after the notebook's cells ran in the sandbox (`run_cells`, on by default; off, it is skipped, worth 0:
-`grader.lab.checks.compare`).
+graded on the grader's tables bound to the globals it reads (`bind_tables`; the notebook's cells run in the
+sandbox where that cannot serve; `run_cells = false`: skipped, worth 0: `grader.lab.checks.compare`).
 """
 
 from grader.lab.checks.compare import CompareCheck, CompareConfig
@@ -84,8 +84,8 @@ RL1 = Edition(
         (
             "qlearn",
             "provided by the template; taxi gets the grader's own tables, so no verdict needs it; "
-            "it runs only inside the notebook's cells, before compare()",
+            "it runs only where the notebook's cells run before compare() (binding cannot serve)",
         ),
     ),
 )
-"""The current edition: problems 1-7 graded (compare() after the notebook's cells); qlearn not graded."""
+"""The current edition: problems 1-7 graded (compare() on bound tables); qlearn not graded."""

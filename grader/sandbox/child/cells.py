@@ -11,6 +11,10 @@ The value returned is plain data for the judge: how long each cell took, and eve
 left behind (globals holding a 500 x 6 array, and each table the notebook's `qlearn` or `sarsa0` returned,
 with the learner and its `decay` and `N`). Learners are labelled by wrapping the notebook's `qlearn` and
 `sarsa0` after the cell that defines them; the wrapper only notes what the learner returned.
+
+With `bind` (the grader's tables, `grader.sandbox.child.binding`), no cell runs where the tables can be bound
+to the globals the function called after the cells reads: the value is then ``{"bound": [...], "cells": [],
+"tables": []}``. Where they cannot, the cells run as without it and the value says why (``"fallback"``).
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from collections.abc import Callable
 from types import ModuleType, TracebackType
 from typing import Any
 
+from grader.sandbox.child.binding import bind_tables
 from grader.sandbox.child.stubs import stub_body
 
 RUN_CELLS = "notebook cells"
@@ -45,7 +50,12 @@ class NotAttemptedError(Exception):
     """Raised before any cell runs when the function called after the cells is missing or a template stub."""
 
 
-def run_cells(module: ModuleType, cells: list[dict[str, Any]], then: str | None = None) -> dict[str, Any]:
+def run_cells(
+    module: ModuleType,
+    cells: list[dict[str, Any]],
+    then: str | None = None,
+    bind: dict[str, dict[str, Any]] | None = None,
+) -> dict[str, Any]:
     """Run `cells` in order in `module`'s namespace and describe what they left behind.
 
     Args:
@@ -54,9 +64,14 @@ def run_cells(module: ModuleType, cells: list[dict[str, Any]], then: str | None 
             ``__name__ == "__main__"``.
         then: The function the problem calls after the cells: when the submission lacks it or it is still
             the template's stub, no cell runs (a template's training cells would cost minutes for nothing).
+        bind: ``{learner: {"decay": table, "constant": table}}``: bind these to the globals `then` reads
+            instead of running the cells, where binding can serve (`bind_tables`).
 
     Returns:
-        ``{"cells": [{"cell", "seconds"}], "tables": [{"names", "learner", "decay", "N", "table"}]}``.
+        ``{"cells": [{"cell", "seconds"}], "tables": [{"names", "learner", "decay", "N", "table"}]}``, with
+        ``"fallback"`` (why nothing was bound) when `bind` was given; or, bound,
+        ``{"bound": [{"name", "learner", "decay", "N", "cell", "line", "statement", "read"}], "cells": [],
+        "tables": []}``.
 
     Raises:
         NotebookCellError: A cell raised (the run stops there, as "Run All" does).
@@ -66,6 +81,12 @@ def run_cells(module: ModuleType, cells: list[dict[str, Any]], then: str | None 
     namespace = vars(module)
     if then is not None:
         _check_attempted(namespace, then)
+    fallback: dict[str, str] = {}
+    if bind is not None:
+        bound = bind_tables(namespace, cells, bind, then or "compare")
+        if isinstance(bound, list):
+            return {"bound": bound, "cells": [], "tables": []}
+        fallback["fallback"] = bound
     learned: dict[int, dict[str, Any]] = {}
     kept: list[Any] = []  # the learners' tables stay alive, so their ids stay theirs
     ran: list[dict[str, Any]] = []
@@ -82,13 +103,18 @@ def run_cells(module: ModuleType, cells: list[dict[str, Any]], then: str | None 
         except MemoryError:
             raise
         except BaseException as error:  # SystemExit and KeyboardInterrupt in a cell stop "Run All" too
-            raise NotebookCellError(_described(number, script, filename, error)) from None
+            why = (
+                f" (the cells ran because the grader's tables could not stand in for the training: {fallback['fallback']})"  # noqa: E501
+                if fallback
+                else ""
+            )
+            raise NotebookCellError(_described(number, script, filename, error) + why) from None
         finally:
             if script:
                 namespace["__name__"] = name
         ran.append({"cell": number, "seconds": time.perf_counter() - started})
         _label_learners(namespace, learned, kept)
-    return {"cells": ran, "tables": _tables(namespace, learned, kept)}
+    return {"cells": ran, "tables": _tables(namespace, learned, kept), **fallback}
 
 
 def _check_attempted(namespace: dict[str, Any], name: str) -> None:

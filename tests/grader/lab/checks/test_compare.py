@@ -9,12 +9,14 @@ import pytest
 from grader.lab.assignment import load_config
 from grader.lab.checks.base import CallRecord, Verdict
 from grader.lab.checks.compare import NOT_GRADABLE, CompareConfig, NotebookTable
+from grader.lab.checks.compare_tables import bound_tables
 from grader.lab.editions.rl1 import RL1
 from grader.sandbox.child.cells import RUN_CELLS, NotAttemptedError, NotebookCellError
 from grader.sandbox.outcome import IMPORT_TIMEOUT, OutcomeStatus
 from grader.simulated_students import compare as students
 from grader.simulated_students.simulation import simulate_calls
 from grader.submission.notebook.cells import RAN_CELLS
+from reference.oracles import greedy_policy_return
 
 from .support import deal_only_hard_starts
 
@@ -28,17 +30,24 @@ def _settings(**fields: Any) -> CompareConfig:
     return CompareConfig.model_validate(data).for_problem("compare", PROBLEM.games)
 
 
-def _judge(function: Any, seed: int, cells: Any = students.cells) -> Verdict:
-    settings = _settings()
+def _judge(function: Any, seed: int, cells: Any = students.binds, **fields: Any) -> Verdict:
+    settings = _settings(**fields)
     calls = PROBLEM.check.plan(settings, {}, 0)
     return PROBLEM.check.judge(settings, simulate_calls(calls, {RUN_CELLS: cells, "compare": function}, seed))
 
 
 def test_the_plan_runs_the_cells_with_their_own_limit_then_records_compare() -> None:
-    cells, compare = PROBLEM.check.plan(_settings(cells_seconds=123.0), {}, 0)
+    cells, compare = PROBLEM.check.plan(_settings(cells_seconds=123.0, bind_tables=False), {}, 0)
     assert (cells.function, cells.seconds, cells.record_episodes) == (RUN_CELLS, 123.0, False)
     assert cells.kwargs == {"then": "compare"}  # a missing or stub compare() runs no cell
     assert (compare.function, compare.seconds, compare.record_episodes) == ("compare", None, True)
+
+
+def test_by_default_the_cells_call_carries_the_seeds_tables_to_bind() -> None:
+    cells, _ = PROBLEM.check.plan(_settings(cells_seconds=123.0), {}, 7)
+    assert (cells.function, cells.seconds, cells.kwargs["then"]) == (RUN_CELLS, 123.0, "compare")
+    assert cells.kwargs["bind"] is bound_tables(7)  # the fallback runs the cells within the same limit
+    assert CompareConfig.model_fields["bind_tables"].default is True
 
 
 def test_the_default_configuration_runs_the_cells_for_its_points() -> None:
@@ -66,8 +75,25 @@ def test_accepted_envs_are_taxis() -> None:
 
 
 @pytest.mark.parametrize("function", [students.honest, students.sarsa_first], ids=["honest", "sarsa_first"])
-def test_honest_play_passes_and_says_what_ran(function: Any, seed: int) -> None:
+def test_honest_play_on_bound_tables_passes_and_says_what_was_bound(function: Any, seed: int) -> None:
     verdict = _judge(function, seed)
+    assert verdict.status == "passed", verdict.feedback
+    assert verdict.feedback.startswith(
+        "Bound the grader's own Taxi tables (drawn from the grading seed, exact greedy returns known) to the globals compare() reads instead of running your training"  # noqa: E501
+    )
+    assert (
+        '`q_table_decay` <- the Q-learning table (as your `q_table_decay, _ = qlearn("Taxi-v3", decay=True)` in cell 20 sets it)'  # noqa: E501
+        in verdict.feedback
+    )
+    assert "`sarsa_table_decay` (bound for sarsa0(decay=True, N=70000))" in verdict.feedback
+    assert verdict.measurements["tables_bound"] == 3  # q_table's too: a training statement sets it
+    assert verdict.measurements["cells_run"] == 0
+    assert verdict.measurements[RAN_CELLS] is True
+
+
+@pytest.mark.parametrize("function", [students.honest, students.sarsa_first], ids=["honest", "sarsa_first"])
+def test_honest_play_after_every_cell_ran_passes_and_says_what_ran(function: Any, seed: int) -> None:
+    verdict = _judge(function, seed, students.cells, bind_tables=False)
     assert verdict.status == "passed", verdict.feedback
     assert verdict.feedback.startswith(
         "Ran your notebook's 4 code cells in the sandbox (within the limit of 1800 s), then called compare()"
@@ -76,11 +102,43 @@ def test_honest_play_passes_and_says_what_ran(function: Any, seed: int) -> None:
     assert verdict.measurements[RAN_CELLS] is True
 
 
+def test_the_bound_tables_are_the_plans_whatever_the_child_sends(seed: int) -> None:
+    def forged(lab: Any, *args: Any, bind: Any, **kwargs: Any) -> dict[str, Any]:
+        value = students.binds(lab, *args, bind=bind, **kwargs)
+        return {**value, "tables": [{"names": ["x"], "learner": "qlearn", "table": np.zeros((500, 6))}]}
+
+    settings = _settings()
+    calls = PROBLEM.check.plan(settings, {}, 5)
+    records = simulate_calls(calls, {RUN_CELLS: forged, "compare": students.honest}, seed)
+    verdict = PROBLEM.check.judge(settings, records)
+    assert verdict.status == "passed", verdict.feedback
+    assert verdict.measurements["exact_q_mean"] == pytest.approx(
+        greedy_policy_return(bound_tables(5)["qlearn"]["decay"]).mean
+    )
+
+
+def test_a_fallback_says_why_the_cells_ran(seed: int) -> None:
+    def fell_back(lab: Any, *args: Any, **kwargs: Any) -> dict[str, Any]:
+        return {
+            **students.cells(lab),
+            "fallback": "compare() calls qlearn() itself, so it trains its own tables",
+        }
+
+    verdict = _judge(students.honest, seed, fell_back)
+    assert verdict.status == "passed", verdict.feedback
+    assert verdict.feedback.startswith(
+        "The grader's tables could not stand in for your training: compare() calls qlearn() itself, so it trains its own tables. "  # noqa: E501
+        "Ran your notebook's 4 code cells in the sandbox"
+    )
+    assert verdict.measurements["tables_bound"] == 0
+
+
 @pytest.mark.slow  # trains every mistaken table, tens of seconds each
+@pytest.mark.parametrize("bind", [True, False], ids=["bound", "cells_ran"])
 @pytest.mark.parametrize(("name", "mistake"), students.MISTAKES.items(), ids=list(students.MISTAKES))
-def test_each_mistake_fails_and_is_named(name: str, mistake: tuple[Any, str], seed: int) -> None:
+def test_each_mistake_fails_and_is_named(name: str, mistake: tuple[Any, str], bind: bool, seed: int) -> None:
     function, words = mistake
-    verdict = _judge(function, seed)
+    verdict = _judge(function, seed, students.binds if bind else students.cells, bind_tables=bind)
     assert verdict.status == "failed", name
     assert words in verdict.feedback, verdict.feedback
 
@@ -315,3 +373,26 @@ def test_two_decayed_tables_of_one_learner_are_no_constant_epsilon_table(seed: i
 
     verdict = _judge(students.honest, seed, cells=cells_with_a_copy)
     assert verdict.status == "passed", verdict.feedback
+
+
+@pytest.mark.slow  # grades a notebook three times through the sandbox
+def test_bound_tables_make_the_same_report_for_the_same_bytes_and_seed(tmp_path: Any) -> None:
+    from pathlib import Path
+
+    from grader.grading.grade import grade_files
+    from grader.grading.plan import GradingPlan
+    from grader.sandbox import IsolationPolicy
+
+    notebook = Path(__file__).parents[4] / "submissions" / "editions" / "compare_honest.ipynb"
+    plan = GradingPlan.load(RL1.default_config, ["compare"])
+
+    def grade(seed: int) -> Any:
+        (report,) = grade_files([notebook], plan, seed=seed, workers=1, policy=IsolationPolicy.ALLOW_FALLBACK)
+        return report
+
+    first, again, other = grade(5), grade(5), grade(6)
+    assert first.problems[0].status == "passed", first.problems[0].feedback
+    assert first.graded_view() == again.graded_view()
+    assert first.problems[0].measurements["tables_bound"] == 2
+    exact = first.problems[0].measurements["exact_q_mean"], other.problems[0].measurements["exact_q_mean"]
+    assert exact[0] != exact[1]  # another seed, other tables
