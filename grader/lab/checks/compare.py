@@ -28,8 +28,8 @@ The data flows in one chain:
   `grader.grading.grade._prepare` writes them beside the module
   (`grader.submission.notebook.cells.write_cells`).
 - A check plans `Call(RUN_CELLS, seconds=...)` (its own wall-clock limit) before its own calls;
-  `grader.grading.execution.run_problem` fills in the argument (`runnable_cells`: the notebook's cells, or a
-  `.py` file whole as a script) because only it knows the submission. The binding reads the same cells (never
+  `grader.grading.execution.run_problem` fills in the argument (`runnable_cells`: the notebook's cells, a `.py`
+  export's cells, or a plain `.py` module whole as a script) because only it knows the submission. The binding reads the same cells (never
   runs them) for the training statements.
 - In the child, `grader.sandbox.child.calls` runs a `RUN_CELLS` call with
   `grader.sandbox.child.cells.run_cells`: bound, its value names what was bound; else the cells run in the
@@ -205,7 +205,7 @@ def _judge_after_cells(settings: CompareConfig, records: Sequence[CallRecord]) -
 
 _TRAINING = '`q_table_decay, _ = qlearn("Taxi-v3", decay=True)` and `sarsa_table_decay = sarsa0("Taxi-v3", decay=True)`'  # noqa: E501
 _NO_TABLES_SCRIPT = (
-    "Run as a script, your file left no Taxi Q-table for compare() to play: compare() plays the tables the notebook's training cells make (the lab's Problem 7), and a .py file has no cells. "  # noqa: E501
+    "Run as a script, your file left no Taxi Q-table for compare() to play: compare() plays the tables the notebook's training cells make (the lab's Problem 7), and your .py's cells (or, unmarked, its whole file) trained none. "  # noqa: E501
     f'Train them where a script runs them, under `if __name__ == "__main__":` (as the notebook\'s cells do: {_TRAINING}), or submit the notebook'  # noqa: E501
 )
 _NO_TABLES_NOTEBOOK = (
