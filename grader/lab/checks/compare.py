@@ -28,9 +28,9 @@ The data flows in one chain:
   `grader.grading.grade._prepare` writes them beside the module
   (`grader.submission.notebook.cells.write_cells`).
 - A check plans `Call(RUN_CELLS, seconds=...)` (its own wall-clock limit) before its own calls;
-  `grader.grading.execution.run_problem` fills in the argument (`runnable_cells`: the notebook's cells, a `.py`
-  export's cells, or a plain `.py` module whole as a script) because only it knows the submission. The binding reads the same cells (never
-  runs them) for the training statements.
+  `grader.grading.execution.run_problem` fills in the argument (`runnable_cells`: the notebook's cells, a
+  `.py` export's cells, or a plain `.py` module whole as a script) because only it knows the submission.
+  The binding reads the same cells (never runs them) for the training statements.
 - In the child, `grader.sandbox.child.calls` runs a `RUN_CELLS` call with
   `grader.sandbox.child.cells.run_cells`: bound, its value names what was bound; else the cells run in the
   module's globals (the same child then serves the problem's calls), the first failing cell raises
