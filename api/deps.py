@@ -17,11 +17,12 @@ from sqlalchemy.orm import Session
 
 from api.auth import Principal, authenticate
 from api.context import ServiceContext
+from api.courses import default_assignment
 from api.disclosure import Disclosure, disclosure_for
 from api.errors import NotAuthenticated
 from api.jobs.job_queue import Dispatcher
 from api.lti.sessions import SESSION_PARAMETER, SESSION_PREFIX, session_caller
-from api.models import Student
+from api.models import Assignment, Student
 from api.settings import Settings
 
 SESSION_COOKIE = "gymgrade_token"
@@ -78,9 +79,17 @@ def get_caller(
 CallerDep = Annotated[Principal, Depends(get_caller)]
 
 
-async def get_disclosure(caller: CallerDep, settings: SettingsDep) -> Disclosure:
-    """What the caller may see of reports: everything (instructor) or the student's view."""
-    return disclosure_for(caller, settings)
+def get_assignment(session: SessionDep) -> Assignment:
+    """The assignment the request is about: the embedded default's."""
+    return default_assignment(session)
+
+
+AssignmentDep = Annotated[Assignment, Depends(get_assignment)]
+
+
+async def get_disclosure(caller: CallerDep, assignment: AssignmentDep) -> Disclosure:
+    """What the caller may see of the assignment's reports: everything (staff) or the student's view."""
+    return disclosure_for(caller, assignment)
 
 
 DisclosureDep = Annotated[Disclosure, Depends(get_disclosure)]

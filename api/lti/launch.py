@@ -26,7 +26,7 @@ from api.errors import LaunchRefused, LtiRequestInvalid
 from api.lti import claims as names
 from api.lti.claims import Role, role_of
 from api.lti.keys import ALGORITHM, published_keys, sign
-from api.lti.people import display_name, ensure_link, ensure_member, ensure_user
+from api.lti.people import course_of, display_name, ensure_enrolment, ensure_link, ensure_member, ensure_user
 from api.lti.platforms import PlatformKeys, find_platform
 from api.lti.sessions import SESSION_PREFIX
 from api.models import LtiLink, LtiNonce, LtiPlatform, LtiSession, LtiUser, utcnow
@@ -284,11 +284,11 @@ def accept_launch(session: Session, launch: Launch, *, session_seconds: float) -
             "open the assignment in the LMS again"
         ) from None
     sub = launch.claims["sub"]
-    user = ensure_user(session, launch.platform, sub, display_name(launch.claims, sub), launch.role)
+    user = ensure_user(session, launch.platform, sub, display_name(launch.claims, sub))
     link = None
     if launch.message_type == names.RESOURCE_LINK_REQUEST:
         link = ensure_link(session, launch.platform, launch.deployment_id, launch.claims)
-        if launch.role is Role.LEARNER:
+        if ensure_enrolment(session, course_of(session, link), user, launch.role) is not None:
             ensure_member(session, link, user)
     token = SESSION_PREFIX + secrets.token_urlsafe(32)
     session.add(

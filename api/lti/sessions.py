@@ -9,7 +9,8 @@ from sqlalchemy import select
 from sqlalchemy.orm import Session
 
 from api.auth import Principal
-from api.models import LtiSession, LtiUser, Student, utcnow
+from api.courses import DEFAULT_COURSE_ID
+from api.models import Assignment, LtiLink, LtiSession, LtiUser, Student, utcnow
 from api.security import token_digest
 
 SESSION_PREFIX = "ggl_"
@@ -26,7 +27,7 @@ def session_caller(session: Session, token: str) -> Principal | None:
     user = session.get(LtiUser, row.user_id)
     if user is None:
         return None
-    student = session.get(Student, user.student_id) if user.student_id is not None else None
+    student = _enrolment(session, row, user)
     name = student.name if student is not None else user.name
     return Principal(
         name=name,
@@ -35,6 +36,14 @@ def session_caller(session: Session, token: str) -> Principal | None:
         session_token=token,
         lti_link_id=row.link_id,
     )
+
+
+def _enrolment(session: Session, row: LtiSession, user: LtiUser) -> Student | None:
+    """The enrolment the session's user is in the course of the link it was launched from (None: staff)."""
+    link = session.get(LtiLink, row.link_id) if row.link_id is not None else None
+    course_id = session.get_one(Assignment, link.assignment_id).course_id if link else DEFAULT_COURSE_ID
+    query = select(Student).where(Student.course_id == course_id, Student.lti_user_id == user.id)
+    return session.scalars(query).first()
 
 
 _IN_A_URL = re.compile(rf"({SESSION_PARAMETER}=)[^&\s\"']+")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter
 
-from api.deps import InstructorDep, SessionDep
+from api.deps import AssignmentDep, InstructorDep, SessionDep
 from api.errors import (
     InstructorOnly,
     InvalidRequest,
@@ -35,7 +35,9 @@ router = APIRouter(tags=["students"])
         InvalidStudentName,
     ),
 )
-def post_student(body: StudentCreate, session: SessionDep, _instructor: InstructorDep) -> StudentCreated:
+def post_student(
+    body: StudentCreate, session: SessionDep, assignment: AssignmentDep, _instructor: InstructorDep
+) -> StudentCreated:
     """Create a student; the token in the response is shown only this once."""
-    student, token = create_student(session, body.name)
+    student, token = create_student(session, assignment.course_id, body.name)
     return StudentCreated(name=student.name, token=token)

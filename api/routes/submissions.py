@@ -7,6 +7,7 @@ from typing import Annotated, Any
 from fastapi import APIRouter, File, Query, Request, Response, UploadFile
 
 from api.deps import (
+    AssignmentDep,
     CallerDep,
     DisclosureDep,
     DispatcherDep,
@@ -85,13 +86,14 @@ def post_submission(
     session: SessionDep,
     settings: SettingsDep,
     dispatcher: DispatcherDep,
+    assignment: AssignmentDep,
     student: StudentDep,
     file: Annotated[UploadFile, File()],
 ) -> SubmissionAccepted:
     """Upload a file for grading; poll GET /submissions/{id} for the result."""
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
-    submission = create_submission(session, settings, student, upload, dispatcher)
+    submission = create_submission(session, settings, assignment, student, upload, dispatcher)
     response.headers["Location"] = request.app.url_path_for("get_one_submission", submission_id=submission.id)
     return SubmissionAccepted(id=submission.id)
 
@@ -103,10 +105,14 @@ def post_submission(
     responses=error_responses(NotAuthenticated, SubmissionNotFound, InvalidRequest),
 )
 def get_one_submission(
-    submission_id: int, session: SessionDep, caller: CallerDep, disclosure: DisclosureDep
+    submission_id: int,
+    session: SessionDep,
+    assignment: AssignmentDep,
+    caller: CallerDep,
+    disclosure: DisclosureDep,
 ) -> SubmissionDetail:
     """A submission's status, the problems finished so far, and its report once done."""
-    submission = get_submission(session, caller, submission_id)
+    submission = get_submission(session, caller, assignment, submission_id)
     return detail(submission, disclosure, overrides_shown(session, submission, disclosure))
 
 
@@ -117,12 +123,13 @@ def get_one_submission(
 )
 def get_submissions(
     session: SessionDep,
+    assignment: AssignmentDep,
     caller: CallerDep,
     disclosure: DisclosureDep,
     student: str | None = Query(default=None, description="Instructor only: one student's submissions."),
 ) -> list[SubmissionSummary]:
     """The caller's submissions, newest first (the instructor sees everyone's)."""
-    return [summary(item, disclosure) for item in list_submissions(session, caller, student)]
+    return [summary(item, disclosure) for item in list_submissions(session, caller, assignment, student)]
 
 
 def document_upload_rules(openapi: dict[str, Any], max_upload_bytes: int) -> None:
@@ -153,11 +160,12 @@ def post_regrade(
     submission_id: int,
     session: SessionDep,
     dispatcher: DispatcherDep,
+    assignment: AssignmentDep,
     instructor: InstructorDep,
 ) -> SubmissionAccepted:
     """Grade one upload again on its recorded seed (after a fix to the grader or the configuration); poll
     GET /submissions/{id}. The instructor's overrides stay."""
-    regrade(session, [get_submission(session, instructor, submission_id)], dispatcher)
+    regrade(session, [get_submission(session, instructor, assignment, submission_id)], dispatcher)
     response.headers["Location"] = request.app.url_path_for("get_one_submission", submission_id=submission_id)
     return SubmissionAccepted(id=submission_id)
 
@@ -171,8 +179,12 @@ def post_regrade(
     ),
 )
 def post_student_regrade(
-    name: str, session: SessionDep, dispatcher: DispatcherDep, instructor: InstructorDep
+    name: str,
+    session: SessionDep,
+    dispatcher: DispatcherDep,
+    assignment: AssignmentDep,
+    instructor: InstructorDep,
 ) -> list[SubmissionAccepted]:
     """Grade every upload of one student again, each on its recorded seed; nobody else's is touched."""
-    ids = regrade(session, list_submissions(session, instructor, name), dispatcher)
+    ids = regrade(session, list_submissions(session, instructor, assignment, name), dispatcher)
     return [SubmissionAccepted(id=submission_id) for submission_id in ids]
