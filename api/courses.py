@@ -1,4 +1,5 @@
-"""Courses and their assignments: the embedded default kept as the settings say, and what an assignment's
+"""Courses, their staff and assignments: made by the operator (and a course's instructors), found from a
+request's path (:func:`scope_of`), the embedded default kept as the settings say, and what an assignment's
 row means to the rest of the service (its late policy with the extensions of its enrolments).
 
 The embedded default is course 1 (``default``) with assignment 1 (``default``): what `gymgrade serve`
@@ -10,15 +11,21 @@ start, so the row is what grading, disclosure and the gradebook read for every a
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
 from sqlalchemy import select
+from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
-from api.models import Assignment, Extension, Student
+from api.errors import CourseExists, CourseNotFound, InvalidRequest
+from api.models import Assignment, Course, Extension, Staff, Student
+from api.security import new_token, token_digest
 from api.settings import GradebookPolicy, SeedPolicy, Settings
+from api.students import normalise_name
 from grader.classroom.late import LatePolicy, read_late_policy
+from grader.seeds import PRACTICE_SEED
 
 DEFAULT_COURSE_ID = 1
 DEFAULT_ASSIGNMENT_ID = 1
@@ -109,3 +116,112 @@ def late_policy_of(session: Session, assignment: Assignment) -> LatePolicy | Non
     for row in session.scalars(select(Extension).where(Extension.assignment_id == assignment.id)):
         extensions[identity(row.student_id)] = row.due.replace(tzinfo=UTC).isoformat()
     return LatePolicy.model_validate({**table, "extensions": extensions})
+
+
+@dataclass(frozen=True)
+class Scope:
+    """What a request is about: a course, and one of its assignments (None on a course's own routes)."""
+
+    course: Course
+    assignment: Assignment | None
+
+
+def scope_of(session: Session, course_slug: str | None, assignment_slug: str | None) -> Scope:
+    """The course and assignment a request's path names; the embedded default's when it names none.
+
+    Raises:
+        CourseNotFound: No course, or no assignment of it, has that slug.
+    """
+    if course_slug is None:
+        return Scope(session.get_one(Course, DEFAULT_COURSE_ID), default_assignment(session))
+    course = session.scalars(select(Course).where(Course.slug == course_slug)).first()
+    if course is None:
+        raise CourseNotFound(f"no course {course_slug!r} among yours; list yours with GET /courses")
+    if assignment_slug is None:
+        return Scope(course, None)
+    assignment = session.scalars(
+        select(Assignment).where(Assignment.course_id == course.id, Assignment.slug == assignment_slug)
+    ).first()
+    if assignment is None:
+        raise CourseNotFound(
+            f"no assignment {assignment_slug!r} in course {course_slug!r}; list them with GET /courses/{course_slug}/assignments"  # noqa: E501
+        )
+    return Scope(course, assignment)
+
+
+def create_course(session: Session, slug: str, title: str) -> Course:
+    """Make a course (committed).
+
+    Raises:
+        CourseExists: The slug is taken.
+        InvalidStudentName: The title is not printable text (the rules of a name).
+    """
+    course = Course(slug=slug, title=normalise_name(title))
+    session.add(course)
+    _commit_new(session, f"a course with slug {slug!r} exists already; choose another slug")
+    return course
+
+
+def create_staff(session: Session, course: Course, name: str, role: str) -> tuple[Staff, str]:
+    """Add an instructor or teaching assistant to a course, with their token (committed).
+
+    Returns:
+        The staff row and the token in clear (never stored; only its SHA-256 is).
+    """
+    token = new_token()
+    staff = Staff(course_id=course.id, role=role, name=normalise_name(name), token_sha256=token_digest(token))
+    session.add(staff)
+    session.commit()
+    return staff, token
+
+
+def create_assignment(session: Session, course: Course, values: dict[str, Any]) -> Assignment:
+    """Add an assignment to a course (committed): ``values`` are its columns but ``course_id``.
+
+    Raises:
+        InvalidRequest: The lab or edition is unknown, or the edition is not of the lab.
+        CourseExists: The course has an assignment with that slug.
+    """
+    from grader.lab.editions.choice import service_edition  # the packs import the checks: only here
+    from grader.lab.editions.errors import LabConflict, UnknownEdition, UnknownLab
+
+    if values.get("seed_policy") == SeedPolicy.FIXED.value and values.get("seed") == PRACTICE_SEED:
+        message = (
+            f"seed_policy fixed with seed {PRACTICE_SEED}: the public practice seed of `gymgrade check`; "
+            "expected the random policy or a secret seed"
+        )
+        raise InvalidRequest(message, [(["body", "seed"], message, "value_error")])
+    try:
+        service_edition(values.get("edition"), values.get("lab"))
+    except (UnknownEdition, UnknownLab, LabConflict) as error:
+        field = "edition" if isinstance(error, UnknownEdition) else "lab"
+        raise InvalidRequest(str(error), [(["body", field], str(error), "value_error")]) from None
+    assignment = Assignment(course_id=course.id, **{**values, "title": normalise_name(values["title"])})
+    session.add(assignment)
+    _commit_new(
+        session, f"course {course.slug!r} has an assignment {values['slug']!r} already; choose another slug"
+    )
+    return assignment
+
+
+def _commit_new(session: Session, taken: str) -> None:
+    try:
+        session.commit()
+    except IntegrityError:
+        session.rollback()
+        raise CourseExists(taken) from None
+
+
+def courses_of(session: Session, course_id: int | None) -> list[Course]:
+    """Every course (the operator's, ``course_id`` None), or the one course of a staff member or student."""
+    query = select(Course).order_by(Course.id)
+    if course_id is not None:
+        query = query.where(Course.id == course_id)
+    return list(session.scalars(query))
+
+
+def assignments_of(session: Session, course: Course) -> list[Assignment]:
+    """The course's assignments, oldest first."""
+    return list(
+        session.scalars(select(Assignment).where(Assignment.course_id == course.id).order_by(Assignment.id))
+    )

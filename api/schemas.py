@@ -165,3 +165,87 @@ class OverrideView(BaseModel):
     reason: str
     author: str = Field(description="Who made it (the instructor).")
     created_at: UtcDateTime
+
+
+SLUG_PATTERN = r"^[a-z0-9][a-z0-9-]{0,63}$"
+"""A course's or assignment's slug, as its URLs show it (``/courses/{course}/assignments/{assignment}``)."""
+Slug = Annotated[str, Field(pattern=SLUG_PATTERN, description="Lower-case letters, digits and dashes.")]
+Name = Annotated[
+    str,
+    Field(
+        description=f"1 to {MAX_NAME_CHARS} printable characters once whitespace around them is trimmed.",
+        json_schema_extra={"pattern": name_pattern()},
+    ),
+]
+
+
+class CourseCreate(BaseModel):
+    """A new course (the operator's)."""
+
+    slug: Slug
+    title: Name
+
+
+class CourseView(BaseModel):
+    """A course."""
+
+    id: int
+    slug: str
+    title: str
+
+
+class StaffCreate(BaseModel):
+    """A new member of a course's staff: an instructor, or a teaching assistant (``ta``)."""
+
+    name: Name
+    role: Literal["instructor", "ta"] = "instructor"
+
+
+class StaffCreated(BaseModel):
+    """The new staff member and their bearer token (shown once; only its SHA-256 is stored)."""
+
+    name: str
+    role: Literal["instructor", "ta"]
+    token: str
+
+
+class LateTable(BaseModel):
+    """An assignment's late policy, as the assignment configuration's ``[late]`` table (extensions apart)."""
+
+    due: UtcDateTime = Field(description="The due time, ISO 8601 (UTC when no offset is given).")
+    penalty_per_day: float = Field(ge=0.0, le=1.0)
+    max_penalty: float = Field(default=1.0, ge=0.0, le=1.0)
+    grace_minutes: float = Field(default=0.0, ge=0.0, le=7 * 24 * 60)
+
+
+class AssignmentCreate(BaseModel):
+    """A new assignment of a course: what is graded (lab, edition) and how."""
+
+    slug: Slug
+    title: Name
+    lab: str | None = Field(default=None, pattern=r"^[a-z][a-z0-9_]{0,31}$", description="opengym or rl2.")
+    edition: str | None = Field(
+        default=None, pattern=r"^[a-z][a-z0-9_]{0,31}$", description="An edition of the lab."
+    )
+    seed_policy: Literal["random", "fixed"] = "random"
+    seed: int = Field(default=0, ge=0, le=2**31 - 1)
+    release_seeds: bool = False
+    due_date: UtcDateTime | None = Field(default=None, description="When after_due_date problems are shown.")
+    gradebook_policy: Literal["latest", "best"] = "latest"
+    late: LateTable | None = None
+
+
+class AssignmentView(BaseModel):
+    """An assignment of a course."""
+
+    id: int
+    course: str
+    slug: str
+    title: str
+    lab: str | None
+    edition: str | None
+    seed_policy: str
+    release_seeds: bool
+    due_date: UtcDateTime | None
+    gradebook_policy: str
+    late: dict[str, Any] | None

@@ -237,8 +237,9 @@ def _send(session: Session, tokens: AccessTokens, policy: PublishPolicy, row: Lt
     return 1
 
 
-def publishing_status(session: Session) -> list[dict[str, Any]]:
-    """Each student's row: the kept score, the one the LMS holds, the state, the attempts, the last error."""
+def publishing_status(session: Session, course_id: int) -> list[dict[str, Any]]:
+    """Each student's row of the course: the kept score, the one the LMS holds, the state, the attempts, the
+    last error."""
     rows = session.execute(
         select(LtiScore, LtiMember, Student)
         .join(LtiMember, LtiMember.id == LtiScore.member_id)
@@ -248,6 +249,7 @@ def publishing_status(session: Session) -> list[dict[str, Any]]:
             Student,
             (Student.lti_user_id == LtiMember.user_id) & (Student.course_id == Assignment.course_id),
         )
+        .where(Assignment.course_id == course_id)
         .order_by(Student.name, LtiMember.link_id)
     ).all()
     return [

@@ -8,7 +8,7 @@ from fastapi import APIRouter, Query
 from fastapi.responses import Response
 
 from api.deps import AssignmentDep, InstructorDep, SessionDep
-from api.errors import InstructorOnly, InvalidRequest, NotAuthenticated
+from api.errors import CourseNotFound, InstructorOnly, InvalidRequest, NotAuthenticated
 from api.gradebook import GRADEBOOK_FORMATS, gradebook_export
 from api.handlers import error_responses
 from grader.classroom.gradebooks import Assignment as GradebookNames
@@ -21,7 +21,7 @@ router = APIRouter(tags=["gradebook"])
     response_class=Response,
     responses={
         200: {"content": {"text/csv": {}}, "description": "One row per student, one column per problem."},
-        **error_responses(NotAuthenticated, InstructorOnly, InvalidRequest),
+        **error_responses(NotAuthenticated, CourseNotFound, InstructorOnly, InvalidRequest),
     },
 )
 def get_gradebook(

@@ -7,6 +7,7 @@ from fastapi import APIRouter
 
 from api.deps import AssignmentDep, InstructorDep, SessionDep
 from api.errors import (
+    CourseNotFound,
     InstructorOnly,
     InvalidRequest,
     MalformedBody,
@@ -44,6 +45,7 @@ def _view(override: Override, student: str) -> OverrideView:
     responses=error_responses(
         MalformedBody,
         NotAuthenticated,
+        CourseNotFound,
         InstructorOnly,
         StudentNotFound,
         SubmissionNotFound,
@@ -73,7 +75,9 @@ def post_override(
 @router.get(
     "/students/{name}/overrides",
     response_model=list[OverrideView],
-    responses=error_responses(NotAuthenticated, InstructorOnly, StudentNotFound, InvalidRequest),
+    responses=error_responses(
+        NotAuthenticated, CourseNotFound, InstructorOnly, StudentNotFound, InvalidRequest
+    ),
 )
 def get_overrides(
     name: str, session: SessionDep, assignment: AssignmentDep, _instructor: InstructorDep

@@ -17,6 +17,7 @@ from api.deps import (
     StudentDep,
 )
 from api.errors import (
+    CourseNotFound,
     GradingInProgress,
     InstructorOnly,
     InvalidRequest,
@@ -71,6 +72,7 @@ ACCEPTED_RESPONSE: dict[str, Any] = {
         **error_responses(
             MalformedBody,
             NotAuthenticated,
+            CourseNotFound,
             StudentOnly,
             LengthRequired,
             UploadTooLarge,
@@ -94,7 +96,7 @@ def post_submission(
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
     submission = create_submission(session, settings, assignment, student, upload, dispatcher)
-    response.headers["Location"] = request.app.url_path_for("get_one_submission", submission_id=submission.id)
+    response.headers["Location"] = f"{request.url.path}/{submission.id}"  # under the assignment's prefix too
     return SubmissionAccepted(id=submission.id)
 
 
@@ -102,7 +104,7 @@ def post_submission(
     "/submissions/{submission_id}",
     response_model=SubmissionDetail,
     operation_id=GET_ONE_OPERATION,
-    responses=error_responses(NotAuthenticated, SubmissionNotFound, InvalidRequest),
+    responses=error_responses(NotAuthenticated, CourseNotFound, SubmissionNotFound, InvalidRequest),
 )
 def get_one_submission(
     submission_id: int,
@@ -119,7 +121,7 @@ def get_one_submission(
 @router.get(
     "/submissions",
     response_model=list[SubmissionSummary],
-    responses=error_responses(NotAuthenticated, StudentNotFound, InvalidRequest),
+    responses=error_responses(NotAuthenticated, CourseNotFound, StudentNotFound, InvalidRequest),
 )
 def get_submissions(
     session: SessionDep,
@@ -140,10 +142,13 @@ def document_upload_rules(openapi: dict[str, Any], max_upload_bytes: int) -> Non
         max_upload_bytes: GYMGRADE_MAX_UPLOAD_BYTES, the limit the schema states.
     """
     content, encoding = upload_rules(max_upload_bytes)
-    media = openapi["paths"]["/submissions"]["post"]["requestBody"]["content"]["multipart/form-data"]
-    body_name = media["schema"]["$ref"].rsplit("/", 1)[-1]
-    openapi["components"]["schemas"][body_name]["properties"]["file"].update(content)
-    media["encoding"] = {"file": encoding}
+    for path, item in openapi["paths"].items():
+        if not path.endswith("/submissions") or "post" not in item:
+            continue  # the default assignment's upload, and every assignment's under its prefix
+        media = item["post"]["requestBody"]["content"]["multipart/form-data"]
+        body_name = media["schema"]["$ref"].rsplit("/", 1)[-1]
+        openapi["components"]["schemas"][body_name]["properties"]["file"].update(content)
+        media["encoding"] = {"file": encoding}
 
 
 @router.post(
@@ -151,7 +156,12 @@ def document_upload_rules(openapi: dict[str, Any], max_upload_bytes: int) -> Non
     status_code=202,
     response_model=SubmissionAccepted,
     responses=error_responses(
-        NotAuthenticated, InstructorOnly, SubmissionNotFound, GradingInProgress, InvalidRequest
+        NotAuthenticated,
+        CourseNotFound,
+        InstructorOnly,
+        SubmissionNotFound,
+        GradingInProgress,
+        InvalidRequest,
     ),
 )
 def post_regrade(
@@ -166,7 +176,7 @@ def post_regrade(
     """Grade one upload again on its recorded seed (after a fix to the grader or the configuration); poll
     GET /submissions/{id}. The instructor's overrides stay."""
     regrade(session, [get_submission(session, instructor, assignment, submission_id)], dispatcher)
-    response.headers["Location"] = request.app.url_path_for("get_one_submission", submission_id=submission_id)
+    response.headers["Location"] = request.url.path.removesuffix("/regrade")
     return SubmissionAccepted(id=submission_id)
 
 
@@ -175,7 +185,7 @@ def post_regrade(
     status_code=202,
     response_model=list[SubmissionAccepted],
     responses=error_responses(
-        NotAuthenticated, InstructorOnly, StudentNotFound, GradingInProgress, InvalidRequest
+        NotAuthenticated, CourseNotFound, InstructorOnly, StudentNotFound, GradingInProgress, InvalidRequest
     ),
 )
 def post_student_regrade(

@@ -12,9 +12,9 @@ from sqlalchemy.orm import Session
 from api.auth import Principal, authenticate
 from api.deps import (
     SESSION_COOKIE,
-    AssignmentDep,
     ContextDep,
     DispatcherDep,
+    PageAssignmentDep,
     PageCallerDep,
     SessionDep,
     SettingsDep,
@@ -74,7 +74,7 @@ def home(
     session: SessionDep,
     caller: PageCallerDep,
     settings: SettingsDep,
-    assignment: AssignmentDep,
+    assignment: PageAssignmentDep,
 ) -> Response:
     """The start page: the sign-in form, or the caller's submissions and the upload form."""
     if caller is None:
@@ -127,7 +127,7 @@ def upload(
     session: SessionDep,
     settings: SettingsDep,
     dispatcher: DispatcherDep,
-    assignment: AssignmentDep,
+    assignment: PageAssignmentDep,
     caller: PageCallerDep,
     file: Annotated[UploadFile, File()],
 ) -> Response:
@@ -145,7 +145,7 @@ def submission_page(
     submission_id: int,
     session: SessionDep,
     caller: PageCallerDep,
-    assignment: AssignmentDep,
+    assignment: PageAssignmentDep,
 ) -> Response:
     """A submission's page; its live part is refreshed from the fragment below until grading ends."""
     return _submission(request, "submission.html", session, _signed_in(caller), assignment, submission_id)
@@ -157,7 +157,7 @@ def submission_fragment(
     submission_id: int,
     session: SessionDep,
     caller: PageCallerDep,
-    assignment: AssignmentDep,
+    assignment: PageAssignmentDep,
 ) -> Response:
     """The live part of a submission's page: status, finished problems, report."""
     return _submission(request, "_live.html", session, _signed_in(caller), assignment, submission_id)
@@ -182,7 +182,7 @@ def override(
     request: Request,
     session: SessionDep,
     settings: SettingsDep,
-    assignment: AssignmentDep,
+    assignment: PageAssignmentDep,
     caller: PageCallerDep,
     student: Annotated[str, Form()] = "",
     problem: Annotated[str, Form()] = "",
@@ -232,14 +232,14 @@ def _home(
     submissions = [summary(item, disclosure) for item in list_submissions(session, caller, assignment)]
     context = {
         "caller": caller, "submissions": submissions, "max_upload_bytes": settings.max_upload_bytes,
-        "lms_scores": publishing_status(session) if caller.is_instructor else [],
+        "lms_scores": publishing_status(session, assignment.course_id) if caller.is_instructor else [],
         "override_message": message, "override_error": error,
     }  # fmt: skip
     return _page(request, "home.html", context, status_code=422 if error else 200)
 
 
 @router.get("/ui/gradebook.csv")
-def gradebook_download(session: SessionDep, assignment: AssignmentDep, caller: PageCallerDep) -> Response:
+def gradebook_download(session: SessionDep, assignment: PageAssignmentDep, caller: PageCallerDep) -> Response:
     """The gradebook for the signed-in instructor."""
     _signed_in(caller).require_instructor()
     return Response(

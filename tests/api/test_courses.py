@@ -80,3 +80,146 @@ def test_an_extension_is_an_enrolments_not_a_names(make_settings: SettingsFactor
             "ada": ("1", "1"),
             "robert": ("0", "2"),
         }
+
+
+A = "/courses/a/assignments/lab1"
+B = "/courses/b/assignments/lab1"
+
+
+def _graded(client: TestClient, prefix: str, token: str, score: float) -> int:
+    """Upload to the assignment under ``prefix`` and complete its job as a worker would."""
+    response = client.post(
+        f"{prefix}/submissions", files={"file": ("opengym.py", b"x = 1\n")}, headers=bearer(token)
+    )
+    assert response.status_code == 202, response.text
+    submission_id: int = response.json()["id"]
+    assert response.headers["Location"] == f"{prefix}/submissions/{submission_id}"
+    jobs = client.app.state.context.jobs  # type: ignore[attr-defined]
+    job = jobs.claim("test-worker", submission_id)
+    report = {"score": score, "max_score": 1.0, "problems": [{"id": "car", "score": score, "max_score": 1.0}]}
+    assert job is not None and jobs.complete(submission_id, "test-worker", report)
+    return submission_id
+
+
+def _course(client: TestClient, slug: str, lab: str) -> dict[str, str]:
+    """A course with assignment lab1, its instructor and TA, and a student ada: their tokens."""
+    operator = instructor_headers()
+    assert (
+        client.post("/courses", json={"slug": slug, "title": f"Course {slug}"}, headers=operator).status_code
+        == 201
+    )
+    tokens = {
+        role: client.post(
+            f"/courses/{slug}/staff", json={"name": f"{role} of {slug}", "role": role}, headers=operator
+        ).json()["token"]
+        for role in ("instructor", "ta")
+    }
+    assignment = {"slug": "lab1", "title": "Lab 1", "lab": lab}
+    created = client.post(
+        f"/courses/{slug}/assignments", json=assignment, headers=bearer(tokens["instructor"])
+    )
+    assert created.status_code == 201, created.text
+    student = client.post(
+        f"/courses/{slug}/students", json={"name": "ada"}, headers=bearer(tokens["instructor"])
+    )
+    tokens["student"] = student.json()["token"]
+    return tokens
+
+
+def test_staff_and_students_of_one_course_reach_nothing_of_another(make_settings: SettingsFactory) -> None:
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        a, b = _course(client, "a", "opengym"), _course(client, "b", "rl2")
+        mine = _graded(client, A, a["student"], 1.0)
+        theirs = _graded(client, B, b["student"], 0.0)
+        default = add_student(client, "dee")  # the embedded default course's
+        graded_upload(client, default, {"car": 1.0})
+        attempts = [
+            ("get", f"{A}/submissions", None),
+            ("get", f"{A}/submissions/{mine}", None),
+            ("get", f"{A}/gradebook.csv", None),
+            ("post", f"{A}/students/ada/overrides", {"problem": "car", "points": 0, "reason": "x"}),
+            ("get", f"{A}/students/ada/overrides", None),
+            ("post", f"{A}/submissions/{mine}/regrade", None),
+            ("post", f"{A}/students/ada/regrade", None),
+            ("post", "/courses/a/students", {"name": "mallory"}),
+            ("post", "/courses/a/staff", {"name": "mallory", "role": "instructor"}),
+            ("post", "/courses/a/assignments", {"slug": "lab2", "title": "Lab 2"}),
+            ("get", "/courses/a/assignments", None),
+            ("get", "/submissions", None),  # the default course's, the routes without a prefix
+            ("get", "/gradebook.csv", None),
+            ("post", "/students", {"name": "mallory"}),
+            ("get", "/students/dee/overrides", None),
+            ("get", "/lti/links", None),
+            ("get", "/lti/scores", None),
+            ("post", "/lti/links/1/roster", None),
+        ]
+        for role in ("instructor", "ta", "student"):
+            for method, path, body in attempts:
+                response = client.request(method, path, json=body, headers=bearer(b[role]))
+                assert response.status_code == 404, (role, method, path, response.status_code, response.text)
+        upload = client.post(
+            f"{A}/submissions", files={"file": ("opengym.py", b"x\n")}, headers=bearer(b["student"])
+        )
+        assert upload.status_code == 404
+        # their own assignment does not show another's upload by its id either
+        assert client.get(f"{B}/submissions/{mine}", headers=bearer(b["instructor"])).status_code == 404
+        # and nothing of A changed
+        rows = client.get(f"{A}/gradebook.csv", headers=bearer(a["ta"])).text.splitlines()
+        assert [row.split(",")[:2] for row in rows[1:]] == [["ada", str(mine)]]
+        assert client.get(f"{A}/students/ada/overrides", headers=bearer(a["instructor"])).json() == []
+        assert [item["id"] for item in client.get(f"{B}/submissions", headers=bearer(b["ta"])).json()] == [
+            theirs
+        ]
+        assert [c["slug"] for c in client.get("/courses", headers=bearer(b["ta"])).json()] == ["b"]
+        assert [c["slug"] for c in client.get("/courses", headers=instructor_headers()).json()] == [
+            "default", "a", "b"
+        ]  # fmt: skip
+
+
+def test_a_teaching_assistant_grades_but_does_not_manage_the_course(make_settings: SettingsFactory) -> None:
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        a = _course(client, "a", "opengym")
+        mine = _graded(client, A, a["student"], 0.0)
+        ta = bearer(a["ta"])
+        kept = client.post(
+            f"{A}/students/ada/overrides",
+            json={"problem": "car", "points": 1, "reason": "by hand"},
+            headers=ta,
+        )
+        assert (kept.status_code, kept.json()["author"]) == (201, "ta of a")
+        rows = client.get(f"{A}/gradebook.csv", headers=ta).text.splitlines()
+        assert rows[1].split(",")[:2] == ["ada", str(mine)] and "car overridden to 1" in rows[1]
+        assert client.post(f"{A}/submissions/{mine}/regrade", headers=ta).status_code == 202
+        refused = [
+            client.post("/courses/a/staff", json={"name": "x", "role": "ta"}, headers=ta),
+            client.post("/courses/a/assignments", json={"slug": "lab2", "title": "Lab 2"}, headers=ta),
+            client.post("/courses/a/students", json={"name": "bob"}, headers=ta),
+            client.post("/courses", json={"slug": "c", "title": "C"}, headers=bearer(a["instructor"])),
+            client.post("/lti/keys/rotate", headers=bearer(a["instructor"])),
+        ]
+        assert [response.status_code for response in refused] == [403] * 5
+
+
+def test_an_assignment_grades_as_its_own_lab_and_a_name_is_unique_in_its_course_only(
+    make_settings: SettingsFactory,
+) -> None:
+    with TestClient(create_app(make_settings(lab="opengym"), run_workers=False)) as client:
+        _course(client, "a", "rl2")  # its ada is not the default course's
+        assert client.post("/students", json={"name": "ada"}, headers=instructor_headers()).status_code == 201
+        again = client.post("/courses/a/students", json={"name": "ada"}, headers=instructor_headers())
+        assert again.status_code == 409
+        token = client.post("/courses/a/students", json={"name": "bea"}, headers=instructor_headers()).json()[
+            "token"
+        ]
+        client.post(f"{A}/submissions", files={"file": ("opengym.py", b"x = 1\n")}, headers=bearer(token))
+        job = client.app.state.context.jobs.claim("w")  # type: ignore[attr-defined]
+        assert job.assignment == ("rl2", None)
+        wrong = client.post(
+            "/courses/a/assignments", json={"slug": "x", "title": "X", "lab": "rl2", "edition": "classic"},
+            headers=instructor_headers(),
+        )  # fmt: skip
+        assert wrong.status_code == 422 and "classic" in wrong.json()["detail"]
+        taken = client.post(
+            "/courses/a/assignments", json={"slug": "lab1", "title": "X"}, headers=instructor_headers()
+        )
+        assert taken.status_code == 409

@@ -168,7 +168,7 @@ def test_a_student_without_a_graded_submission_gets_no_row(session: Session) -> 
     student, _ = _member(session, "cy")
     _graded(session, student, 0.0, status="running")
     assert _sync(session, GradebookPolicy.LATEST) == 0
-    assert publishing_status(session) == []
+    assert publishing_status(session, DEFAULT_COURSE_ID) == []
 
 
 def test_going_back_to_the_score_the_lms_holds_sends_nothing(session: Session) -> None:
@@ -194,7 +194,7 @@ def test_the_instructor_sees_each_students_state_and_error(session: Session) -> 
     row.status, row.attempts, row.error = RETRYING, 2, "publishing the score: the LMS answered 500"
     row.next_attempt_at = utcnow() + timedelta(seconds=4)
     session.commit()
-    (shown,) = publishing_status(session)
+    (shown,) = publishing_status(session, DEFAULT_COURSE_ID)
     assert shown["student"] == "eve"
     assert (shown["status"], shown["attempts"], shown["error"]) == (
         RETRYING,
