@@ -131,6 +131,12 @@ def final_grades(session: Session, assignment: Assignment, chosen: dict[int, Any
     }
 
 
+def final_total(final: FinalGrade, picked: Any, *, late: bool) -> float | None:
+    """The total a gradebook shows and the LMS receives: the decisions' (overrides, a late policy) when there
+    are any, else the machine's score of the kept submission ``picked``."""
+    return final.total if final.overridden or late else picked.score
+
+
 def _final(
     student_id: int,
     picked: Any,
@@ -224,7 +230,7 @@ def gradebook_csv(session: Session, assignment: Assignment) -> str:
                 picked.sha256,
                 *(_number(scores.get(problem_id)) for problem_id in problem_ids),
                 *([_number(final.late_penalty)] if late else []),
-                _number(final.total if final.overridden or late else picked.score),
+                _number(final_total(final, picked, late=late)),
                 _number(picked.max_score),
                 safe_cell("; ".join(final.notes)),
             ]

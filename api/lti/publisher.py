@@ -5,8 +5,10 @@ only.
 The row holds the kept score (``score`` None: nothing graded yet, a submission is being graded: the LMS
 is told ``Submitted``/``Pending`` without a score; once graded, ``Completed``/``FullyGraded`` with it).
 
-Each round (``GYMGRADE_LTI_PUBLISH_SECONDS``) first brings every row up to the score the gradebook policy
-keeps now, read from the submission rows (the only truth: a regrade or a better upload changes it), then
+Each round (``GYMGRADE_LTI_PUBLISH_SECONDS``) first brings every row up to the final score of the submission
+the assignment's gradebook policy keeps now: the instructor's overrides and the late penalty applied, as every
+gradebook file computes it (``api.gradebook.final_grades``), read from the rows (the only truth: a regrade, a
+better upload, an override or a changed late policy changes it, and the LMS is sent the new score), then
 sends the rows that are due. A row is sent only while the kept score differs from the one the platform
 last accepted, so the same score is never sent as two results; a refused send is retried with doubling
 waits and its error shown to the instructor (``GET /lti/scores``), never touching the grading. Several
@@ -25,7 +27,7 @@ from sqlalchemy import func, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
 from api.courses import gradebook_policy_of
-from api.gradebook import kept_submissions
+from api.gradebook import final_grades, final_total, kept_submissions
 from api.lti.claims import SCOPE_LINEITEM, SCOPE_LINEITEM_READONLY, SCOPE_SCORE
 from api.lti.services import AccessTokens, ServiceFailed, line_item, publish_score
 from api.models import (
@@ -91,6 +93,10 @@ def sync_outbox(session: Session) -> int:
         )
         for assignment_id in {assignment_id for _, _, assignment_id, _ in members}
     }
+    finals = {
+        assignment_id: _final_totals(session, assignment_id, kept)
+        for assignment_id, (kept, _) in wanted_by_assignment.items()
+    }
     rows = {row.member_id: row for row in session.scalars(select(LtiScore))}
     changed = 0
     now = utcnow()
@@ -100,7 +106,7 @@ def sync_outbox(session: Session) -> int:
         if chosen is not None:
             wanted: tuple[int, float | None, float | None] = (
                 chosen.id,
-                float(chosen.score or 0.0),
+                float(finals[assignment_id][student_id] or 0.0),
                 float(chosen.max_score or 0.0),
             )
         elif student_id in in_progress and lineitem_url and _holds_no_score(rows.get(member_id)):
@@ -126,6 +132,17 @@ def sync_outbox(session: Session) -> int:
     return changed
 
 
+def _final_totals(session: Session, assignment_id: int, kept: dict[int, Any]) -> dict[int, float | None]:
+    """The final total of each kept submission: overrides and late penalty applied, as every gradebook file
+    computes it (``api.gradebook.final_grades``)."""
+    assignment = session.get_one(Assignment, assignment_id)
+    late = assignment.late_policy is not None
+    return {
+        student_id: final_total(final, kept[student_id], late=late)
+        for student_id, final in final_grades(session, assignment, kept).items()
+    }
+
+
 def _kept(session: Session, assignment_id: int, students: set[int]) -> tuple[dict[int, Any], dict[int, int]]:
     """The submission of the assignment each of ``students`` is represented by, and their newest one being
     graded (by enrolment id)."""
@@ -136,7 +153,8 @@ def _kept(session: Session, assignment_id: int, students: set[int]) -> tuple[dic
             Submission.student_id,
             Submission.score,
             Submission.max_score,
-            Submission.finished_at,
+            Submission.created_at,
+            Submission.report,
         )
         .where(
             Submission.assignment_id == assignment_id,

@@ -33,6 +33,7 @@ from api.models import (
     Submission,
     utcnow,
 )
+from api.overrides import record_override
 from api.settings import GradebookPolicy
 
 
@@ -287,3 +288,26 @@ def test_the_publisher_counts_its_finished_rounds_and_says_when_it_stopped(
     stopped = publisher.progress()
     assert not stopped["running"] and stopped["rounds"] >= running["rounds"]
     assert stopped["last_round_at"] >= running["last_round_at"]
+
+
+def test_the_lms_is_sent_the_final_score_again_when_an_override_or_the_late_policy_changes_it(
+    session: Session,
+) -> None:
+    student, member = _member(session, "ida")
+    submission = _graded(session, student, 2.0)
+    submission.report = {"problems": [{"id": "car", "score": 2.0, "max_score": 3.0}]}
+    assignment = session.get_one(Assignment, DEFAULT_ASSIGNMENT_ID)
+    _sync(session, GradebookPolicy.LATEST)
+    _as_sent(session, member)
+    record_override(
+        session, assignment, student_name="ida", problem="car", points=3.0, reason="by hand", author="t"
+    )
+    assert _sync(session, GradebookPolicy.LATEST) == 1
+    assert (_row(session, member).status, _row(session, member).score) == (PENDING, 3.0)
+    _as_sent(session, member)
+    due = submission.created_at - timedelta(days=1, seconds=1)  # two days late: half the maximum (3) taken
+    assignment.late_policy = {"due": due.isoformat() + "+00:00", "penalty_per_day": 0.25}
+    session.commit()
+    assert _sync(session, GradebookPolicy.LATEST) == 1
+    assert (_row(session, member).status, _row(session, member).score) == (PENDING, 1.5)
+    assert _sync(session, GradebookPolicy.LATEST) == 0, "an unchanged final score is not sent again"
