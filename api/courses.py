@@ -19,11 +19,12 @@ from sqlalchemy import select
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
+from api.auth import Principal
 from api.errors import CourseExists, CourseNotFound, InvalidRequest
-from api.models import Assignment, Course, Extension, Staff, Student
+from api.models import Assignment, Course, Extension, LtiLink, Staff, Student
 from api.security import new_token, token_digest
 from api.settings import GradebookPolicy, SeedPolicy, Settings
-from api.students import normalise_name
+from api.students import printable
 from grader.classroom.late import LatePolicy, read_late_policy
 from grader.seeds import PRACTICE_SEED
 
@@ -154,9 +155,8 @@ def create_course(session: Session, slug: str, title: str) -> Course:
 
     Raises:
         CourseExists: The slug is taken.
-        InvalidStudentName: The title is not printable text (the rules of a name).
     """
-    course = Course(slug=slug, title=normalise_name(title))
+    course = Course(slug=slug, title=printable(title, slug))
     session.add(course)
     _commit_new(session, f"a course with slug {slug!r} exists already; choose another slug")
     return course
@@ -169,7 +169,9 @@ def create_staff(session: Session, course: Course, name: str, role: str) -> tupl
         The staff row and the token in clear (never stored; only its SHA-256 is).
     """
     token = new_token()
-    staff = Staff(course_id=course.id, role=role, name=normalise_name(name), token_sha256=token_digest(token))
+    staff = Staff(
+        course_id=course.id, role=role, name=printable(name, role), token_sha256=token_digest(token)
+    )
     session.add(staff)
     session.commit()
     return staff, token
@@ -196,7 +198,9 @@ def create_assignment(session: Session, course: Course, values: dict[str, Any]) 
     except (UnknownEdition, UnknownLab, LabConflict) as error:
         field = "edition" if isinstance(error, UnknownEdition) else "lab"
         raise InvalidRequest(str(error), [(["body", field], str(error), "value_error")]) from None
-    assignment = Assignment(course_id=course.id, **{**values, "title": normalise_name(values["title"])})
+    assignment = Assignment(
+        course_id=course.id, **{**values, "title": printable(values["title"], values["slug"])}
+    )
     session.add(assignment)
     _commit_new(
         session, f"course {course.slug!r} has an assignment {values['slug']!r} already; choose another slug"
@@ -225,3 +229,23 @@ def assignments_of(session: Session, course: Course) -> list[Assignment]:
     return list(
         session.scalars(select(Assignment).where(Assignment.course_id == course.id).order_by(Assignment.id))
     )
+
+
+def launch_scope(session: Session, caller: Principal) -> Scope:
+    """The course and assignment of an LTI launch's pages: its course, and the assignment of the link it was
+    launched from (without one, the course's first assignment).
+
+    Raises:
+        CourseNotFound: The course has no assignment yet.
+    """
+    course = session.get_one(Course, caller.course() or DEFAULT_COURSE_ID)
+    assignment = None
+    if caller.lti_link_id is not None:
+        link = session.get(LtiLink, caller.lti_link_id)
+        assignment = session.get(Assignment, link.assignment_id) if link is not None else None
+    if assignment is None:
+        first = assignments_of(session, course)
+        if not first:
+            raise CourseNotFound("this course has no assignment yet: open one from the LMS")
+        assignment = first[0]
+    return Scope(course, assignment)

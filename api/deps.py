@@ -17,7 +17,7 @@ from sqlalchemy.orm import Session
 
 from api.auth import Principal, authenticate
 from api.context import ServiceContext
-from api.courses import Scope, scope_of
+from api.courses import Scope, launch_scope, scope_of
 from api.disclosure import Disclosure, disclosure_for
 from api.errors import NotAuthenticated
 from api.jobs.job_queue import Dispatcher
@@ -193,6 +193,8 @@ def get_page_caller(request: Request, session: SessionDep, settings: SettingsDep
     if launched.startswith(SESSION_PREFIX):
         caller = session_caller(session, launched)
         request.state.lti_caller = caller
+        if caller is not None:  # the pages of a launch are its course's and its link's assignment's
+            request.state.scope = launch_scope(session, caller)
     else:
         token = request.cookies.get(SESSION_COOKIE)
         try:
@@ -204,14 +206,15 @@ def get_page_caller(request: Request, session: SessionDep, settings: SettingsDep
     return caller
 
 
-def get_page_assignment(request: Request, session: SessionDep) -> Assignment:
-    """The assignment of the pages: the default's."""
+PageCallerDep = Annotated[Principal | None, Depends(get_page_caller)]
+
+
+def get_page_assignment(request: Request, session: SessionDep, _caller: PageCallerDep) -> Assignment:
+    """The assignment of the pages: an LTI launch's link's, else the default's (the caller is known first:
+    a launch's session decides the scope)."""
     assignment = get_scope(request, session).assignment
-    assert assignment is not None  # the default scope has its assignment
+    assert assignment is not None  # the default scope and a launch's have their assignment
     return assignment
 
 
 PageAssignmentDep = Annotated[Assignment, Depends(get_page_assignment)]
-
-
-PageCallerDep = Annotated[Principal | None, Depends(get_page_caller)]

@@ -281,13 +281,16 @@ class LtiMember(Base):
 
 
 class LtiSession(Base):
-    """A signed-in browser after a launch: only the SHA-256 of its token is stored; no student = staff."""
+    """A signed-in browser after a launch: only the SHA-256 of its token is stored. It reaches the course of
+    the launch's context only (``course_id``; None in a session of before courses: the default course), as
+    that course's staff or as its enrolment."""
 
     __tablename__ = "lti_sessions"
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
     token_sha256: Mapped[str] = mapped_column(String(64), unique=True)
     user_id: Mapped[int] = mapped_column(ForeignKey("lti_users.id"))
+    course_id: Mapped[int | None] = mapped_column(ForeignKey("courses.id"), nullable=True)
     link_id: Mapped[int | None] = mapped_column(ForeignKey("lti_links.id"), nullable=True)
     frame_origin: Mapped[str] = mapped_column(String(500))
     expires_at: Mapped[datetime] = mapped_column(DateTime)

@@ -173,8 +173,10 @@ Slug = Annotated[str, Field(pattern=SLUG_PATTERN, description="Lower-case letter
 Name = Annotated[
     str,
     Field(
-        description=f"1 to {MAX_NAME_CHARS} printable characters once whitespace around them is trimmed.",
-        json_schema_extra={"pattern": name_pattern()},
+        min_length=1,
+        max_length=MAX_NAME_CHARS,
+        description="A title or a person's name, shown as given without control, format (bidi, zero-width), "
+        "private-use or line-separator characters and the whitespace around it.",
     ),
 ]
 

@@ -40,6 +40,13 @@ def normalise_name(name: str) -> str:
     return trimmed
 
 
+def printable(text: str, fallback: str) -> str:
+    """``text`` to show (a course's title, a staff member's name): without the characters a name may not hold
+    and the whitespace around it, at most ``MAX_NAME_CHARS`` characters; ``fallback`` when nothing is left."""
+    kept = "".join(c for c in text if unicodedata.category(c) not in FORBIDDEN_NAME_CATEGORIES).strip()
+    return kept[:MAX_NAME_CHARS].strip() or fallback
+
+
 def _spelled(code_point: int) -> str:
     # \uXXXX reads the same in ECMA-262 and Python patterns; beyond the BMP only the character itself does.
     return f"\\u{code_point:04x}" if code_point <= 0xFFFF else chr(code_point)

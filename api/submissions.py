@@ -12,7 +12,7 @@ from sqlalchemy.orm import Session, joinedload
 from api.auth import Principal
 from api.courses import seed_policy_of
 from api.disclosure import Disclosure, problem_view, report_view, withholds_any
-from api.errors import GradingInProgress, RateLimited, SubmissionNotFound
+from api.errors import CourseNotFound, GradingInProgress, RateLimited, SubmissionNotFound
 from api.jobs.job_queue import Dispatcher
 from api.models import Assignment, JobStatus, Student, Submission, utcnow
 from api.schemas import OverrideShown, SubmissionDetail, SubmissionSummary
@@ -52,6 +52,8 @@ def create_submission(
         RateLimited: The student already uploaded GYMGRADE_RATE_LIMIT_PER_MINUTE files to the assignment in
             the last minute.
     """
+    if student.course_id != assignment.course_id:  # the routes' scopes see to it; never mix two courses
+        raise CourseNotFound("no such assignment among your course's; open it from your own course")
     now = utcnow()
     recent = session.execute(
         select(func.count(Submission.id), func.min(Submission.created_at)).where(

@@ -1,6 +1,13 @@
-"""Platform users, links and members: a learner's enrolment (student row) in the link's course is made on
-first sight (launch or roster). A platform user is one person of a platform; in each course they are one
-enrolment (or staff), so a learner in two courses is two enrolments whose scores never mix."""
+"""Courses of LMS contexts, platform users, links and members.
+
+A course is one context of one deployment of a platform, made by the first launch from it (the first context
+ever launched from takes the embedded default course, so a single-course service stays what it was). A link
+is keyed by (platform, deployment, resource link id) and opens its own assignment of its context's course
+(the default course's first link, the default assignment; every other new link, a new assignment configured
+as the default one). A platform user is one person of a platform; in each course they are one enrolment
+(student row, made on first sight by a launch or a roster import) or one staff row (instructor or TA, as the
+launch's roles say), so a learner in two courses is two enrolments whose scores never mix, and a role counts
+in its launch's context only."""
 
 from __future__ import annotations
 
@@ -10,12 +17,13 @@ from typing import Any
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
-from api.courses import DEFAULT_ASSIGNMENT_ID
+from api.auth import StaffRole
+from api.courses import DEFAULT_ASSIGNMENT_ID, DEFAULT_COURSE_ID
 from api.lti import claims as names
 from api.lti.claims import Role
-from api.models import Assignment, LtiLink, LtiMember, LtiPlatform, LtiUser, Student
+from api.models import Assignment, Course, LtiLink, LtiMember, LtiPlatform, LtiUser, Staff, Student
 from api.security import token_digest
-from api.students import MAX_NAME_CHARS, name_taken, normalise_name
+from api.students import MAX_NAME_CHARS, name_taken, normalise_name, printable
 
 
 def display_name(claims: dict[str, Any], sub: str) -> str:
@@ -81,11 +89,81 @@ def ensure_enrolment(session: Session, course_id: int, user: LtiUser, role: Role
     return student
 
 
+def ensure_course(
+    session: Session, platform: LtiPlatform, deployment_id: str, claims: dict[str, Any]
+) -> Course:
+    """The course of the launch's context: found by (platform, deployment, context id), else the unclaimed
+    default course, else a new course titled after the context. Nothing is committed."""
+    context = claims.get(names.CONTEXT) or {}
+    context_id = str(context.get("id") or "")[:255]
+    course = session.scalars(
+        select(Course).where(
+            Course.lti_platform_id == platform.id,
+            Course.lti_deployment_id == deployment_id,
+            Course.lti_context_id == context_id,
+        )
+    ).first()
+    if course is not None:
+        return course
+    default = session.get_one(Course, DEFAULT_COURSE_ID)
+    if default.lti_context_id is None:
+        course = default
+    else:
+        title = printable(str(context.get("title") or context.get("label") or context_id), "LMS course")
+        course = Course(slug=f"lti-{secrets.token_hex(6)}", title=title)
+        session.add(course)
+    course.lti_platform_id, course.lti_deployment_id, course.lti_context_id = (
+        platform.id,
+        deployment_id,
+        context_id,
+    )
+    session.flush()
+    return course
+
+
+def _assignment_for_new_link(session: Session, course: Course, title: str) -> int:
+    """The assignment a new link of the course opens: the default assignment for the default course's first
+    link, else a new one configured as the default assignment (the service's lab, edition and policies)."""
+    if course.id == DEFAULT_COURSE_ID:
+        linked = session.scalars(
+            select(LtiLink.id).where(LtiLink.assignment_id == DEFAULT_ASSIGNMENT_ID)
+        ).first()
+        if linked is None:
+            return DEFAULT_ASSIGNMENT_ID
+    default = session.get_one(Assignment, DEFAULT_ASSIGNMENT_ID)
+    columns = ("lab", "edition", "config_toml", "seed_policy", "seed", "release_seeds", "due_date")
+    assignment = Assignment(
+        course_id=course.id,
+        slug=f"lti-{secrets.token_hex(6)}",
+        title=printable(title, "LMS assignment"),
+        gradebook_policy=default.gradebook_policy,
+        late_policy=default.late_policy,
+        **{column: getattr(default, column) for column in columns},
+    )
+    session.add(assignment)
+    session.flush()
+    return assignment.id
+
+
+def ensure_staff(session: Session, course_id: int, user: LtiUser, teaching_assistant: bool) -> Staff:
+    """The user as the course's staff, with the role the launch's roles give (a TA, or an instructor)."""
+    role = (StaffRole.TA if teaching_assistant else StaffRole.INSTRUCTOR).value
+    staff = session.scalars(
+        select(Staff).where(Staff.course_id == course_id, Staff.lti_user_id == user.id)
+    ).first()
+    if staff is None:
+        staff = Staff(course_id=course_id, lti_user_id=user.id, name=user.name[:100], role=role)
+        session.add(staff)
+    staff.role = role
+    session.flush()
+    return staff
+
+
 def ensure_link(
     session: Session, platform: LtiPlatform, deployment_id: str, claims: dict[str, Any]
 ) -> LtiLink:
     """The resource link a launch names, keyed by (platform, deployment, link id), its service URLs and
-    custom parameters brought up to date; a new link opens the default assignment."""
+    custom parameters brought up to date; a new link opens a new assignment of its context's course."""
     resource = claims.get(names.RESOURCE_LINK) or {}
     context = claims.get(names.CONTEXT) or {}
     ags = claims.get(names.AGS_ENDPOINT) or {}
@@ -99,11 +177,13 @@ def ensure_link(
         )
     ).first()
     if link is None:
+        course = ensure_course(session, platform, deployment_id, claims)
+        title = str(resource.get("title") or context.get("title") or "")
         link = LtiLink(
             platform_id=platform.id,
             deployment_id=deployment_id,
             resource_link_id=link_id,
-            assignment_id=DEFAULT_ASSIGNMENT_ID,
+            assignment_id=_assignment_for_new_link(session, course, title),
             lineitem_url=None,
         )
         session.add(link)

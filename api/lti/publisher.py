@@ -255,10 +255,10 @@ def _send(session: Session, tokens: AccessTokens, policy: PublishPolicy, row: Lt
     return 1
 
 
-def publishing_status(session: Session, course_id: int) -> list[dict[str, Any]]:
-    """Each student's row of the course: the kept score, the one the LMS holds, the state, the attempts, the
-    last error."""
-    rows = session.execute(
+def publishing_status(session: Session, course_id: int | None) -> list[dict[str, Any]]:
+    """Each student's row of the course (None: of every course): the kept score, the one the LMS holds, the
+    state, the attempts, the last error."""
+    query = (
         select(LtiScore, LtiMember, Student)
         .join(LtiMember, LtiMember.id == LtiScore.member_id)
         .join(LtiLink, LtiLink.id == LtiMember.link_id)
@@ -267,9 +267,11 @@ def publishing_status(session: Session, course_id: int) -> list[dict[str, Any]]:
             Student,
             (Student.lti_user_id == LtiMember.user_id) & (Student.course_id == Assignment.course_id),
         )
-        .where(Assignment.course_id == course_id)
         .order_by(Student.name, LtiMember.link_id)
-    ).all()
+    )
+    if course_id is not None:
+        query = query.where(Assignment.course_id == course_id)
+    rows = session.execute(query).all()
     return [
         {
             "student": student.name,

@@ -24,7 +24,6 @@ from api.errors import (
     CourseNotFound,
     InstructorOnly,
     InvalidRequest,
-    InvalidStudentName,
     MalformedBody,
     NotAuthenticated,
     OperatorOnly,
@@ -77,7 +76,6 @@ def _assignment_view(course: Course, assignment: Assignment) -> AssignmentView:
         CourseExists,
         UploadTooLarge,
         InvalidRequest,
-        InvalidStudentName,
     ),
 )
 def post_course(body: CourseCreate, session: SessionDep, _operator: OperatorDep) -> CourseView:
@@ -106,7 +104,6 @@ def get_courses(session: SessionDep, caller: AnyCallerDep) -> list[CourseView]:
         CourseNotFound,
         UploadTooLarge,
         InvalidRequest,
-        InvalidStudentName,
     ),
 )
 def post_staff(
@@ -130,7 +127,6 @@ def post_staff(
         CourseExists,
         UploadTooLarge,
         InvalidRequest,
-        InvalidStudentName,
     ),
 )
 def post_assignment(
@@ -139,8 +135,14 @@ def post_assignment(
     """Add an assignment to the course: the lab and edition its uploads are graded as, its seeds, due date,
     gradebook and late policy. Its routes are under /courses/{course}/assignments/{assignment}."""
     values = body.model_dump(exclude={"late", "due_date"})
-    values["due_date"] = body.due_date.astimezone(UTC).replace(tzinfo=None) if body.due_date else None
-    values["late_policy"] = body.late.model_dump(mode="json") if body.late is not None else None
+    try:
+        values["due_date"] = body.due_date.astimezone(UTC).replace(tzinfo=None) if body.due_date else None
+        values["late_policy"] = body.late.model_dump(mode="json") if body.late is not None else None
+        if body.late is not None:
+            body.late.due.astimezone(UTC)
+    except OverflowError:
+        message = "a date in UTC falls outside the years 1 to 9999; give a date within them"
+        raise InvalidRequest(message, [(["body", "due_date"], message, "value_error")]) from None
     return _assignment_view(course, create_assignment(session, course, values))
 
 

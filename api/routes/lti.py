@@ -258,8 +258,11 @@ def rotate_keys(session: SessionDep, _operator: OperatorDep) -> dict[str, str]:
 
 
 @router.get("/lti/links")
-def get_links(session: SessionDep, _instructor: InstructorDep, course: CourseDep) -> list[dict[str, Any]]:
-    """The resource links students launched from, of the course's assignments."""
+def get_links(session: SessionDep, instructor: InstructorDep, course: CourseDep) -> list[dict[str, Any]]:
+    """The resource links students launched from, of the course's assignments (the operator's: all)."""
+    query = select(LtiLink).join(Assignment, Assignment.id == LtiLink.assignment_id).order_by(LtiLink.id)
+    if not instructor.is_operator:
+        query = query.where(Assignment.course_id == course.id)
     return [
         {
             "id": link.id,
@@ -270,22 +273,18 @@ def get_links(session: SessionDep, _instructor: InstructorDep, course: CourseDep
             "lineitem_url": link.lineitem_url,
             "custom": link.custom,
         }
-        for link in session.scalars(
-            select(LtiLink)
-            .join(Assignment, Assignment.id == LtiLink.assignment_id)
-            .where(Assignment.course_id == course.id)
-            .order_by(LtiLink.id)
-        )
+        for link in session.scalars(query)
     ]
 
 
 @router.post("/lti/links/{link_id}/roster")
 def post_roster(
-    link_id: int, session: SessionDep, context: ContextDep, _instructor: InstructorDep, course: CourseDep
+    link_id: int, session: SessionDep, context: ContextDep, instructor: InstructorDep, course: CourseDep
 ) -> dict[str, int]:
-    """Import the link's course roster (Names and Role Provisioning): a link of the course's only."""
+    """Import the link's course roster (Names and Role Provisioning): a link of the course's only (the
+    operator's: any)."""
     link = session.get(LtiLink, link_id)
-    if link is None or course_of(session, link) != course.id:
+    if link is None or not (instructor.is_operator or course_of(session, link) == course.id):
         raise LtiRequestInvalid(f"no LTI link has id {link_id}; list them with GET /lti/links")
     found = import_roster(session, link, context.access_tokens)
     return {"learners": found.learners, "staff": found.staff, "skipped": found.skipped}
@@ -300,6 +299,7 @@ def get_publisher(context: ContextDep, _operator: OperatorDep) -> dict[str, Any]
 
 
 @router.get("/lti/scores")
-def get_scores(session: SessionDep, _instructor: InstructorDep, course: CourseDep) -> list[dict[str, Any]]:
-    """Each student's score publishing to the LMS: kept score, the one the LMS holds, state, last error."""
-    return publishing_status(session, course.id)
+def get_scores(session: SessionDep, instructor: InstructorDep, course: CourseDep) -> list[dict[str, Any]]:
+    """Each student's score publishing to the LMS: kept score, the one the LMS holds, state, last error (the
+    course's; the operator's: every course's)."""
+    return publishing_status(session, None if instructor.is_operator else course.id)

@@ -34,6 +34,9 @@ def upgrade() -> None:
     _students(bind, sqlite)
     for table in ("submissions", "overrides", "lti_links"):
         _belong_to_the_default_assignment(table)
+    with op.batch_alter_table("lti_sessions") as batch:
+        batch.add_column(sa.Column("course_id", sa.Integer(), nullable=True))
+        batch.create_foreign_key("fk_lti_sessions_course_id", "courses", ["course_id"], ["id"])
     with op.batch_alter_table("lti_links") as batch:
         batch.drop_constraint("uq_lti_links_platform_link", type_="unique")
         batch.create_unique_constraint(

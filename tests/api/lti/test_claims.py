@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from api.lti.claims import Role, role_of
+from api.lti.claims import Role, is_teaching_assistant, role_of
 from api.lti.launch import Launch, frame_origins
 from api.lti.sessions import redacted
 from api.models import LtiPlatform
@@ -78,3 +78,20 @@ def test_the_lms_pages_that_may_frame_the_tool(presentation: dict[str, str], exp
 )
 def test_session_tokens_are_kept_out_of_the_logs(line: str, expected: str) -> None:
     assert redacted(line) == expected
+
+
+@pytest.mark.parametrize(
+    ("roles", "teaching_assistant"),
+    [
+        ([f"{MEMBERSHIP}#Instructor"], False),
+        ([f"{MEMBERSHIP}#Administrator"], False),
+        ([f"{MEMBERSHIP}#Instructor", f"{MEMBERSHIP}/Instructor#TeachingAssistant"], True),
+        ([f"{MEMBERSHIP}#TeachingAssistant"], True),
+    ],
+    ids=["instructor", "administrator", "canvas-ta", "membership-ta"],
+)
+def test_a_teaching_assistant_is_told_apart_from_an_instructor(
+    roles: list[str], teaching_assistant: bool
+) -> None:
+    assert role_of(roles) is Role.STAFF
+    assert is_teaching_assistant(roles) is teaching_assistant
