@@ -26,7 +26,6 @@ from api.security import new_token, token_digest
 from api.settings import GradebookPolicy, SeedPolicy, Settings
 from api.students import printable
 from grader.classroom.late import LatePolicy, read_late_policy
-from grader.seeds import PRACTICE_SEED
 
 DEFAULT_COURSE_ID = 1
 DEFAULT_ASSIGNMENT_ID = 1
@@ -187,12 +186,6 @@ def create_assignment(session: Session, course: Course, values: dict[str, Any]) 
     from grader.lab.editions.choice import service_edition  # the packs import the checks: only here
     from grader.lab.editions.errors import LabConflict, UnknownEdition, UnknownLab
 
-    if values.get("seed_policy") == SeedPolicy.FIXED.value and values.get("seed") == PRACTICE_SEED:
-        message = (
-            f"seed_policy fixed with seed {PRACTICE_SEED}: the public practice seed of `gymgrade check`; "
-            "expected the random policy or a secret seed"
-        )
-        raise InvalidRequest(message, [(["body", "seed"], message, "value_error")])
     try:
         service_edition(values.get("edition"), values.get("lab"))
     except (UnknownEdition, UnknownLab, LabConflict) as error:

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 from datetime import UTC, datetime
+from enum import Enum
 from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 from api.students import MAX_NAME_CHARS, name_pattern
+from grader.lab.editions import EDITIONS
 
 Status = Literal["queued", "running", "done", "failed"]
 
@@ -220,17 +222,27 @@ class LateTable(BaseModel):
     grace_minutes: float = Field(default=0.0, ge=0.0, le=7 * 24 * 60)
 
 
+EditionName = Enum("EditionName", {name: name for name in EDITIONS}, type=str)  # type: ignore[misc]
+"""The editions of every lab (grader/lab/editions)."""
+
+
 class AssignmentCreate(BaseModel):
     """A new assignment of a course: what is graded (lab, edition) and how."""
 
     slug: Slug
     title: Name
-    lab: str | None = Field(default=None, pattern=r"^[a-z][a-z0-9_]{0,31}$", description="opengym or rl2.")
-    edition: str | None = Field(
-        default=None, pattern=r"^[a-z][a-z0-9_]{0,31}$", description="An edition of the lab."
+    edition: EditionName | None = Field(
+        default=None,
+        description="The edition every upload is graded as (its lab with it: the rl2 editions are the second "
+        "lab's); unset: the first edition, classic.",
     )
     seed_policy: Literal["random", "fixed"] = "random"
-    seed: int = Field(default=0, ge=0, le=2**31 - 1)
+    seed: int | None = Field(
+        default=None,
+        ge=1,
+        le=2**31 - 1,
+        description="The fixed policy's seed (never the practice seed 0); unset: a secret one is drawn.",
+    )
     release_seeds: bool = False
     due_date: UtcDateTime | None = Field(default=None, description="When after_due_date problems are shown.")
     gradebook_policy: Literal["latest", "best"] = "latest"

@@ -39,6 +39,8 @@ from api.schemas import (
     StaffCreate,
     StaffCreated,
 )
+from grader.lab.editions.choice import service_edition
+from grader.seeds import held_out_seed
 
 router = APIRouter(tags=["courses"])
 course_router = APIRouter(tags=["courses"], prefix="/courses/{course}", dependencies=[Depends(in_course)])
@@ -55,7 +57,7 @@ def _assignment_view(course: Course, assignment: Assignment) -> AssignmentView:
         course=course.slug,
         slug=assignment.slug,
         title=assignment.title,
-        lab=assignment.lab,
+        lab=service_edition(assignment.edition, assignment.lab).lab.name,
         edition=assignment.edition,
         seed_policy=assignment.seed_policy,
         release_seeds=assignment.release_seeds,
@@ -134,7 +136,9 @@ def post_assignment(
 ) -> AssignmentView:
     """Add an assignment to the course: the lab and edition its uploads are graded as, its seeds, due date,
     gradebook and late policy. Its routes are under /courses/{course}/assignments/{assignment}."""
-    values = body.model_dump(exclude={"late", "due_date"})
+    values = body.model_dump(exclude={"late", "due_date", "edition", "seed"})
+    values["lab"], values["edition"] = None, body.edition.value if body.edition is not None else None
+    values["seed"] = body.seed if body.seed is not None else held_out_seed(2**31 - 1)
     try:
         values["due_date"] = body.due_date.astimezone(UTC).replace(tzinfo=None) if body.due_date else None
         values["late_policy"] = body.late.model_dump(mode="json") if body.late is not None else None

@@ -101,7 +101,7 @@ def _graded(client: TestClient, prefix: str, token: str, score: float) -> int:
     return submission_id
 
 
-def _course(client: TestClient, slug: str, lab: str) -> dict[str, str]:
+def _course(client: TestClient, slug: str, edition: str) -> dict[str, str]:
     """A course with assignment lab1, its instructor and TA, and a student ada: their tokens."""
     operator = instructor_headers()
     assert (
@@ -114,7 +114,7 @@ def _course(client: TestClient, slug: str, lab: str) -> dict[str, str]:
         ).json()["token"]
         for role in ("instructor", "ta")
     }
-    assignment = {"slug": "lab1", "title": "Lab 1", "lab": lab}
+    assignment = {"slug": "lab1", "title": "Lab 1", "edition": edition}
     created = client.post(
         f"/courses/{slug}/assignments", json=assignment, headers=bearer(tokens["instructor"])
     )
@@ -128,7 +128,7 @@ def _course(client: TestClient, slug: str, lab: str) -> dict[str, str]:
 
 def test_staff_and_students_of_one_course_reach_nothing_of_another(make_settings: SettingsFactory) -> None:
     with TestClient(create_app(make_settings(), run_workers=False)) as client:
-        a, b = _course(client, "a", "opengym"), _course(client, "b", "rl2")
+        a, b = _course(client, "a", "rl1"), _course(client, "b", "v2024")
         mine = _graded(client, A, a["student"], 1.0)
         theirs = _graded(client, B, b["student"], 0.0)
         default = add_student(client, "dee")  # the embedded default course's
@@ -178,7 +178,7 @@ def test_staff_and_students_of_one_course_reach_nothing_of_another(make_settings
 
 def test_a_teaching_assistant_grades_but_does_not_manage_the_course(make_settings: SettingsFactory) -> None:
     with TestClient(create_app(make_settings(), run_workers=False)) as client:
-        a = _course(client, "a", "opengym")
+        a = _course(client, "a", "rl1")
         mine = _graded(client, A, a["student"], 0.0)
         ta = bearer(a["ta"])
         kept = client.post(
@@ -204,7 +204,7 @@ def test_an_assignment_grades_as_its_own_lab_and_a_name_is_unique_in_its_course_
     make_settings: SettingsFactory,
 ) -> None:
     with TestClient(create_app(make_settings(lab="opengym"), run_workers=False)) as client:
-        _course(client, "a", "rl2")  # its ada is not the default course's
+        _course(client, "a", "v2024")  # its ada is not the default course's
         assert client.post("/students", json={"name": "ada"}, headers=instructor_headers()).status_code == 201
         again = client.post("/courses/a/students", json={"name": "ada"}, headers=instructor_headers())
         assert again.status_code == 409
@@ -213,12 +213,23 @@ def test_an_assignment_grades_as_its_own_lab_and_a_name_is_unique_in_its_course_
         ]
         client.post(f"{A}/submissions", files={"file": ("opengym.py", b"x = 1\n")}, headers=bearer(token))
         job = client.app.state.context.jobs.claim("w")  # type: ignore[attr-defined]
-        assert job.assignment == ("rl2", None)
+        assert job.assignment == (None, "v2024")
+        listed = client.get("/courses/a/assignments", headers=bearer(token)).json()
+        assert [(item["slug"], item["lab"], item["edition"]) for item in listed] == [("lab1", "rl2", "v2024")]
         wrong = client.post(
-            "/courses/a/assignments", json={"slug": "x", "title": "X", "lab": "rl2", "edition": "classic"},
+            "/courses/a/assignments",
+            json={"slug": "x", "title": "X", "edition": "v1999"},
             headers=instructor_headers(),
-        )  # fmt: skip
-        assert wrong.status_code == 422 and "classic" in wrong.json()["detail"]
+        )
+        assert wrong.status_code == 422 and "edition" in wrong.json()["detail"]
+        fixed = client.post(
+            "/courses/a/assignments",
+            json={"slug": "y", "title": "Y", "seed_policy": "fixed"},
+            headers=instructor_headers(),
+        )
+        assert fixed.status_code == 201  # a secret seed drawn: never the practice seed
+        with client.app.state.context.sessions() as session:  # type: ignore[attr-defined]
+            assert session.query(Assignment).filter_by(slug="y").one().seed > 0
         taken = client.post(
             "/courses/a/assignments", json={"slug": "lab1", "title": "X"}, headers=instructor_headers()
         )
