@@ -21,8 +21,8 @@ from api.web import STATIC_DIR
 
 DESCRIPTION = (
     "Students upload `opengym.py` and get their grade; "
-    "the operator creates courses and their staff; a course's staff create students, see every submission of "
-    "their course's assignments and export each assignment's gradebook. "
+    "the operator creates courses and their staff; "
+    "a course's staff create students, see every submission of their course's assignments and export each assignment's gradebook. "  # noqa: E501
     "The routes without a `/courses/{course}` prefix are the embedded default course's and assignment's. "
     "Authenticate with `Authorization: Bearer <token>`."
 )

@@ -177,8 +177,8 @@ Name = Annotated[
     Field(
         min_length=1,
         max_length=MAX_NAME_CHARS,
-        description="A title or a person's name, shown as given without control, format (bidi, zero-width), "
-        "private-use or line-separator characters and the whitespace around it.",
+        description="A title or a person's name. "
+        "It is shown without the whitespace around it and without control, format, private-use or line-separator characters.",  # noqa: E501
     ),
 ]
 
@@ -216,10 +216,12 @@ class StaffCreated(BaseModel):
 class LateTable(BaseModel):
     """An assignment's late policy, as the assignment configuration's ``[late]`` table (extensions apart)."""
 
+    model_config = ConfigDict(extra="forbid")
+
     due: UtcDateTime = Field(description="The due time, ISO 8601 (UTC when no offset is given).")
-    penalty_per_day: float = Field(ge=0.0, le=1.0)
-    max_penalty: float = Field(default=1.0, ge=0.0, le=1.0)
-    grace_minutes: float = Field(default=0.0, ge=0.0, le=7 * 24 * 60)
+    penalty_per_day: float = Field(ge=0.0, le=1.0, strict=True)
+    max_penalty: float = Field(default=1.0, ge=0.0, le=1.0, strict=True)
+    grace_minutes: float = Field(default=0.0, ge=0.0, le=7 * 24 * 60, strict=True)
 
 
 EditionName = Enum("EditionName", {name: name for name in EDITIONS}, type=str)  # type: ignore[misc]
@@ -233,8 +235,8 @@ class AssignmentCreate(BaseModel):
     title: Name
     edition: EditionName | None = Field(
         default=None,
-        description="The edition every upload is graded as (its lab with it: the rl2 editions are the second "
-        "lab's); unset: the first edition, classic.",
+        description="The edition every upload is graded as; its lab follows from it. "
+        "Unset: the first edition, classic.",
     )
     seed_policy: Literal["random", "fixed"] = "random"
     seed: int | None = Field(

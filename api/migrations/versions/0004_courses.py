@@ -155,10 +155,8 @@ def _students(bind: sa.Connection, sqlite: bool) -> None:
         batch.add_column(sa.Column("course_id", sa.Integer(), nullable=True))
         batch.add_column(sa.Column("lti_user_id", sa.Integer(), nullable=True))
     op.execute(f"UPDATE students SET course_id = {DEFAULT_COURSE_ID}")
-    op.execute(
-        "UPDATE students SET lti_user_id = "
-        "(SELECT lti_users.id FROM lti_users WHERE lti_users.student_id = students.id)"
-    )
+    learner = "SELECT lti_users.id FROM lti_users WHERE lti_users.student_id = students.id"
+    op.execute(f"UPDATE students SET lti_user_id = ({learner})")
     with op.batch_alter_table("lti_users", naming_convention=SQLITE_NAMES if sqlite else None) as batch:
         if sqlite:
             batch.drop_constraint("uq_lti_users_student_id", type_="unique")
