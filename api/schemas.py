@@ -6,7 +6,7 @@ from datetime import UTC, datetime
 from enum import Enum
 from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
 
 from api.students import MAX_NAME_CHARS, name_pattern
 from grader.lab.editions import EDITIONS
@@ -213,12 +213,23 @@ class StaffCreated(BaseModel):
     token: str
 
 
+def _written(value: object) -> object:
+    # An RFC 3339 date-time is text: a number is not read as seconds since 1970.
+    if not isinstance(value, str | datetime):
+        raise ValueError("expected an ISO 8601 date-time such as 2026-03-01T23:59:00-05:00")
+    return value
+
+
+WrittenDateTime = Annotated[datetime, BeforeValidator(_written), AfterValidator(_as_utc)]
+"""A date-time given as text (UTC when it has no offset)."""
+
+
 class LateTable(BaseModel):
     """An assignment's late policy, as the assignment configuration's ``[late]`` table (extensions apart)."""
 
     model_config = ConfigDict(extra="forbid")
 
-    due: UtcDateTime = Field(description="The due time, ISO 8601 (UTC when no offset is given).")
+    due: WrittenDateTime = Field(description="The due time, ISO 8601 (UTC when no offset is given).")
     penalty_per_day: float = Field(ge=0.0, le=1.0, strict=True)
     max_penalty: float = Field(default=1.0, ge=0.0, le=1.0, strict=True)
     grace_minutes: float = Field(default=0.0, ge=0.0, le=7 * 24 * 60, strict=True)
@@ -246,7 +257,9 @@ class AssignmentCreate(BaseModel):
         description="The fixed policy's seed (never the practice seed 0); unset: a secret one is drawn.",
     )
     release_seeds: bool = False
-    due_date: UtcDateTime | None = Field(default=None, description="When after_due_date problems are shown.")
+    due_date: WrittenDateTime | None = Field(
+        default=None, description="When after_due_date problems are shown."
+    )
     gradebook_policy: Literal["latest", "best"] = "latest"
     late: LateTable | None = None
 
