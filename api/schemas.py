@@ -252,11 +252,12 @@ class AssignmentCreate(BaseModel):
     seed_policy: Literal["random", "fixed"] = "random"
     seed: int | None = Field(
         default=None,
+        strict=True,
         ge=1,
         le=2**31 - 1,
         description="The fixed policy's seed (never the practice seed 0); unset: a secret one is drawn.",
     )
-    release_seeds: bool = False
+    release_seeds: bool = Field(default=False, strict=True)
     due_date: WrittenDateTime | None = Field(
         default=None, description="When after_due_date problems are shown."
     )
