@@ -220,14 +220,19 @@ def _written(value: object) -> object:
     return value
 
 
+def _a_number(value: object) -> object:
+    # A JSON number (2 or 2.0) is an integer of JSON Schema's; text and booleans are not.
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ValueError("expected a whole number")
+    return value
+
+
 WrittenDateTime = Annotated[datetime, BeforeValidator(_written), AfterValidator(_as_utc)]
 """A date-time given as text (UTC when it has no offset)."""
 
 
 class LateTable(BaseModel):
     """An assignment's late policy, as the assignment configuration's ``[late]`` table (extensions apart)."""
-
-    model_config = ConfigDict(extra="forbid")
 
     due: WrittenDateTime = Field(description="The due time, ISO 8601 (UTC when no offset is given).")
     penalty_per_day: float = Field(ge=0.0, le=1.0, strict=True)
@@ -250,9 +255,8 @@ class AssignmentCreate(BaseModel):
         "Unset: the first edition, classic.",
     )
     seed_policy: Literal["random", "fixed"] = "random"
-    seed: int | None = Field(
+    seed: Annotated[int, BeforeValidator(_a_number)] | None = Field(
         default=None,
-        strict=True,
         ge=1,
         le=2**31 - 1,
         description="The fixed policy's seed (never the practice seed 0); unset: a secret one is drawn.",
