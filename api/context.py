@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from sqlalchemy import Engine
 from sqlalchemy.orm import Session, sessionmaker
 
+from api.courses import sync_default
 from api.database import make_engine, make_session_factory, migrate
 from api.jobs.job_queue import Dispatcher, JobQueue
 from api.jobs.local import DatabaseQueue, PollingDispatcher
@@ -43,13 +44,16 @@ class ServiceContext:
 
     @classmethod
     def open(cls, settings: Settings, *, pool_size: int, publish: bool = True) -> ServiceContext:
-        """Connect, migrate the schema, and start grading: ``pool_size`` in-process workers (none when 0),
-        or, with GYMGRADE_BROKER_URL, no grading here but Celery tasks and their reconciler; and, when
+        """Connect, migrate the schema, bring the default assignment to the settings, and start grading:
+        ``pool_size`` in-process workers (none when 0), or, with GYMGRADE_BROKER_URL, no grading here but
+        Celery tasks and their reconciler; and, when
         ``publish`` (the server; not `gymgrade worker`), publish scores to the LMSs (LTI AGS)."""
         engine = make_engine(settings)
         migrate(engine)
         sessions = make_session_factory(engine)
         protect_keys(sessions, settings)
+        with sessions() as session:
+            sync_default(session, settings)
         publisher = ScorePublisher(sessions, settings) if publish else None
         if publisher is not None:
             publisher.start()

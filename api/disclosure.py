@@ -27,7 +27,8 @@ from datetime import UTC, datetime
 from typing import Any
 
 from api.auth import Principal
-from api.settings import Settings
+from api.courses import due_date_of
+from api.models import Assignment
 from grader.report import errors_shown, withheld_ids
 
 JsonObject = dict[str, Any]
@@ -61,20 +62,21 @@ FULL = Disclosure(seeds=True, shown=EVERY_VISIBILITY)
 """The instructor's view: everything."""
 
 
-def disclosure_for(caller: Principal, settings: Settings, now: datetime | None = None) -> Disclosure:
-    """What ``caller`` may see now.
+def disclosure_for(caller: Principal, assignment: Assignment, now: datetime | None = None) -> Disclosure:
+    """What ``caller`` may see now of the assignment's reports.
 
     Args:
-        caller: The instructor or a student.
-        settings: GYMGRADE_RELEASE_SEEDS and GYMGRADE_DUE_DATE.
+        caller: The staff or a student.
+        assignment: Whether it releases seeds, and its due date (the default assignment's are
+            GYMGRADE_RELEASE_SEEDS and GYMGRADE_DUE_DATE).
         now: The current time (aware); the clock when None.
     """
     if caller.is_instructor:
         return FULL
     moment = now or datetime.now(UTC)
-    due = settings.due_date
+    due = due_date_of(assignment)
     shown = {"visible"} | ({"after_due_date"} if due is not None and moment >= due else set())
-    return Disclosure(seeds=settings.release_seeds, shown=frozenset(shown), due_date=due)
+    return Disclosure(seeds=assignment.release_seeds, shown=frozenset(shown), due_date=due)
 
 
 def problem_view(problem: JsonObject, disclosure: Disclosure) -> JsonObject:

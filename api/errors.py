@@ -50,7 +50,19 @@ class NotAuthenticated(ServiceError):
 
 
 class InstructorOnly(ServiceError):
-    """Raised when a student's token is used on an instructor's endpoint."""
+    """Raised when a student's (or a teaching assistant's) token is used on an instructor's endpoint."""
+
+
+class OperatorOnly(ServiceError):
+    """Raised when a course's token is used on the operator's endpoint (courses, LTI platforms and keys)."""
+
+
+class CourseNotFound(ServiceError):
+    """Raised when a course or assignment does not exist, or is not the caller's."""
+
+
+class CourseExists(ServiceError):
+    """Raised when a course or assignment is created under a slug that is already taken."""
 
 
 class StudentOnly(ServiceError):

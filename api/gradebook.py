@@ -1,5 +1,7 @@
-"""The gradebook: one CSV row per student with their latest or best graded submission, in gymgrade's own
-columns or in the import format of Canvas, Gradescope or GitHub Classroom (grader.classroom.gradebooks)."""
+"""An assignment's gradebook: one CSV row per enrolment of its course with their latest or best graded
+submission of it, in gymgrade's own columns or in the import format of Canvas, Gradescope or GitHub Classroom
+(grader.classroom.gradebooks). :func:`final_grades` is the one computation of a final grade (overrides and
+late penalty applied) that every format, and the score the LMS receives, read."""
 
 from __future__ import annotations
 
@@ -12,12 +14,14 @@ from typing import Any
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
-from api.models import JobStatus, Override, Student, Submission
+from api.courses import gradebook_policy_of, identity, late_policy_of
+from api.models import Assignment, JobStatus, Override, Student, Submission
 from api.overrides import as_decided, counted_overrides, maxima_of
-from api.settings import GradebookPolicy, Settings
+from api.settings import GradebookPolicy
 from grader.classroom.decisions import Decisions, FinalGrade, final_grade
-from grader.classroom.gradebooks import GRADEBOOKS, Assignment, GradeRow
-from grader.classroom.late import LatePolicy, read_late_policy
+from grader.classroom.gradebooks import GRADEBOOKS, GradeRow
+from grader.classroom.gradebooks import Assignment as GradebookNames
+from grader.classroom.late import LatePolicy
 from grader.classroom.model import Member
 from grader.classroom.model import Submission as ClassSubmission
 from grader.classroom.roster import RosterEntry
@@ -28,8 +32,12 @@ GRADEBOOK_FORMATS = ("gymgrade", *GRADEBOOKS)
 """The ``format`` values of the export: gymgrade's own columns, then every ``gymgrade grade --gradebook``."""
 
 
-def _chosen(session: Session, policy: GradebookPolicy) -> tuple[list[Student], dict[int, Any]]:
-    students = list(session.scalars(select(Student).order_by(Student.name)))
+def _chosen(session: Session, assignment: Assignment) -> tuple[list[Student], dict[int, Any]]:
+    students = list(
+        session.scalars(
+            select(Student).where(Student.course_id == assignment.course_id).order_by(Student.name)
+        )
+    )
     graded = session.execute(
         select(
             Submission.id,
@@ -40,10 +48,10 @@ def _chosen(session: Session, policy: GradebookPolicy) -> tuple[list[Student], d
             Submission.max_score,
             Submission.report,
         )
-        .where(Submission.status == JobStatus.DONE.value)
+        .where(Submission.assignment_id == assignment.id, Submission.status == JobStatus.DONE.value)
         .order_by(Submission.id)
     ).all()
-    return students, kept_submissions(graded, policy)
+    return students, kept_submissions(graded, gradebook_policy_of(assignment))
 
 
 def kept_submissions(graded: Iterable[Any], policy: GradebookPolicy) -> dict[int, Any]:
@@ -69,11 +77,7 @@ def kept_submissions(graded: Iterable[Any], policy: GradebookPolicy) -> dict[int
 
 
 def gradebook_export(
-    session: Session,
-    policy: GradebookPolicy,
-    gradebook_format: str,
-    assignment: Assignment,
-    late: LatePolicy | None = None,
+    session: Session, assignment: Assignment, gradebook_format: str, names: GradebookNames
 ) -> str:
     """The gradebook in one of ``GRADEBOOK_FORMATS``: ``gymgrade`` is :func:`gradebook_csv`; the others are
     the LMS import CSVs of ``gymgrade grade --gradebook``, with each student's name as their identity (name
@@ -84,19 +88,19 @@ def gradebook_export(
         grader.classroom.errors.GradebookError: The format lacks what it needs (Canvas: the assignment id).
     """
     if gradebook_format == "gymgrade":
-        return gradebook_csv(session, policy, late)
+        return gradebook_csv(session, assignment)
     if gradebook_format not in GRADEBOOKS:
         raise ValueError(
             f"unknown gradebook format {gradebook_format!r}: use one of {', '.join(GRADEBOOK_FORMATS)}"
         )
-    students, chosen = _chosen(session, policy)
+    students, chosen = _chosen(session, assignment)
     problem_ids = _problem_ids(row.report for row in chosen.values())
-    counted = counted_overrides(session, chosen)
+    finals = final_grades(session, assignment, chosen)
     rows = []
     for student in students:
         picked = chosen.get(student.id)
         report = _report(picked)
-        final = _final(student.name, picked, report, counted.get(student.id, {}), late)
+        final = finals[student.id] if student.id in finals else _final(student.id, None, None, {}, None)
         rows.append(
             GradeRow(
                 member=Member(student.name, student.name),
@@ -110,23 +114,39 @@ def gradebook_export(
             )
         )
     _, write = GRADEBOOKS[gradebook_format]
-    return write(rows, problem_ids, assignment)
+    return write(rows, problem_ids, names)
 
 
-def late_policy_of(settings: Settings) -> LatePolicy | None:
-    """The late policy of ``GYMGRADE_LATE_POLICY`` (checked when the settings were made), None when unset."""
-    return read_late_policy(settings.late_policy) if settings.late_policy is not None else None
+def final_grades(session: Session, assignment: Assignment, chosen: dict[int, Any]) -> dict[int, FinalGrade]:
+    """The final grade of each enrolment's kept submission (``chosen``: enrolment id -> its row, with
+    ``id``, ``created_at``, ``score``, ``max_score``, ``report``): the instructor's overrides that count for
+    it and the assignment's late penalty by its upload time applied. What every gradebook format shows and
+    what the LMS receives.
+    """
+    counted = counted_overrides(session, assignment.id, chosen)
+    late = late_policy_of(session, assignment)
+    return {
+        student_id: _final(student_id, picked, _report(picked), counted.get(student_id, {}), late)
+        for student_id, picked in chosen.items()
+    }
+
+
+def final_total(final: FinalGrade, picked: Any, *, late: bool) -> float | None:
+    """The total a gradebook shows and the LMS receives: the decisions' (overrides, a late policy) when there
+    are any, else the machine's score of the kept submission ``picked``."""
+    return final.total if final.overridden or late else picked.score
 
 
 def _final(
-    name: str,
+    student_id: int,
     picked: Any,
     report: Report | None,
     overrides: dict[str, Override],
     late: LatePolicy | None = None,
 ) -> FinalGrade:
-    """The student's grade after the instructor's overrides and the late policy, by the upload's time (the
-    machine's when there are neither)."""
+    """The enrolment's grade after the instructor's overrides and the late policy, by the upload's time
+    (the machine's when there are neither)."""
+    name = identity(student_id)
     decisions = Decisions(
         overrides=as_decided(name, overrides), late=late, maxima=maxima_of(picked.report if picked else None)
     )
@@ -158,22 +178,24 @@ def _report(picked: Any) -> Report | None:
     )
 
 
-def gradebook_csv(session: Session, policy: GradebookPolicy, late: LatePolicy | None = None) -> str:
-    """Build the gradebook of every student.
+def gradebook_csv(session: Session, assignment: Assignment) -> str:
+    """Build the assignment's gradebook, a row per enrolment of its course.
 
     Args:
         session: A database session.
-        policy: Which graded submission represents a student: the latest, or the best (latest among ties).
-        late: The late policy (``GYMGRADE_LATE_POLICY``); None: no penalties, no ``late_penalty`` column.
+        assignment: The assignment: its gradebook policy says which graded submission represents a student
+            (the latest, or the best, latest among ties); its late policy (None: no penalties, no
+            ``late_penalty`` column).
 
     Returns:
         CSV text: ``student, submission_id, submitted_at, sha256``, one column per problem (its score),
         ``score, max_score`` (after the instructor's overrides), ``note`` (each override with the machine's
         verdict and its reason); students without a graded submission have empty cells.
     """
-    students, chosen = _chosen(session, policy)
+    students, chosen = _chosen(session, assignment)
     problem_ids = _problem_ids(row.report for row in chosen.values())
-    counted = counted_overrides(session, chosen)
+    finals = final_grades(session, assignment, chosen)
+    late = assignment.late_policy is not None
     output = io.StringIO()
     writer = csv.writer(output, lineterminator="\n")
     writer.writerow(
@@ -195,7 +217,7 @@ def gradebook_csv(session: Session, policy: GradebookPolicy, late: LatePolicy | 
             blanks = [""] * (len(problem_ids) + (1 if late else 0))
             writer.writerow([safe_cell(student.name), "", "", "", *blanks, "", "", ""])
             continue
-        final = _final(student.name, picked, _report(picked), counted.get(student.id, {}), late)
+        final = finals[student.id]
         scores = {
             problem.get("id"): problem.get("score") for problem in (picked.report or {}).get("problems", [])
         }
@@ -208,7 +230,7 @@ def gradebook_csv(session: Session, policy: GradebookPolicy, late: LatePolicy | 
                 picked.sha256,
                 *(_number(scores.get(problem_id)) for problem_id in problem_ids),
                 *([_number(final.late_penalty)] if late else []),
-                _number(final.total if final.overridden or late else picked.score),
+                _number(final_total(final, picked, late=late)),
                 _number(picked.max_score),
                 safe_cell("; ".join(final.notes)),
             ]

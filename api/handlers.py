@@ -16,6 +16,8 @@ from starlette.exceptions import HTTPException
 from starlette.routing import Match, Mount
 
 from api.errors import (
+    CourseExists,
+    CourseNotFound,
     GradingInProgress,
     InstructorOnly,
     InternalError,
@@ -29,6 +31,7 @@ from api.errors import (
     MethodNotAllowed,
     NotAuthenticated,
     NothingGradedYet,
+    OperatorOnly,
     PathNotFound,
     PlatformExists,
     PlatformUnreachable,
@@ -48,13 +51,16 @@ HTTP_STATUS: dict[type[ServiceError], int] = {
     LtiRequestInvalid: 400,
     NotAuthenticated: 401,
     InstructorOnly: 403,
+    OperatorOnly: 403,
     StudentOnly: 403,
     LaunchRefused: 403,
     PathNotFound: 404,
     SubmissionNotFound: 404,
     StudentNotFound: 404,
+    CourseNotFound: 404,
     MethodNotAllowed: 405,
     StudentExists: 409,
+    CourseExists: 409,
     GradingInProgress: 409,
     NothingGradedYet: 409,
     PlatformExists: 409,

@@ -1,4 +1,12 @@
-"""The database tables: students and their submissions (each submission row is also its grading job)."""
+"""The database tables: courses with their staff, students (enrolments) and assignments; each assignment's
+submissions (each submission row is also its grading job), overrides and extensions; the LTI tool's state.
+
+A course is one class of the department; its ``students`` rows are its enrolments (a person in two courses
+is two rows, with two tokens or, under LTI, one platform user in two contexts). An assignment names what is
+graded and how (lab, edition, configuration, seed policy, due date, gradebook and late policy); every
+submission, override and extension belongs to one assignment and one enrolment of its course. Course 1 with
+its assignment 1 is the embedded default, whose configuration follows the service's settings
+(``api.courses.sync_default``): what a database of before courses migrates into."""
 
 from __future__ import annotations
 
@@ -6,7 +14,18 @@ from datetime import UTC, datetime
 from enum import StrEnum
 from typing import Any
 
-from sqlalchemy import JSON, DateTime, Float, ForeignKey, Integer, LargeBinary, String, Text, UniqueConstraint
+from sqlalchemy import (
+    JSON,
+    Boolean,
+    DateTime,
+    Float,
+    ForeignKey,
+    Integer,
+    LargeBinary,
+    String,
+    Text,
+    UniqueConstraint,
+)
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column, relationship
 
 
@@ -28,14 +47,82 @@ class Base(DeclarativeBase):
     """Declarative base of the service's tables."""
 
 
-class Student(Base):
-    """A student; only the SHA-256 of their token is stored."""
+class Course(Base):
+    """A course of the department: its staff, students (enrolments) and assignments. Under LTI it is one
+    context of one deployment of a platform (made by its first staff launch); else made by the operator."""
 
-    __tablename__ = "students"
+    __tablename__ = "courses"
+    __table_args__ = (
+        UniqueConstraint(
+            "lti_platform_id", "lti_deployment_id", "lti_context_id", name="uq_courses_lti_context"
+        ),
+    )
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
-    name: Mapped[str] = mapped_column(String(100), unique=True)
+    slug: Mapped[str] = mapped_column(String(64), unique=True)
+    title: Mapped[str] = mapped_column(String(200))
+    lti_platform_id: Mapped[int | None] = mapped_column(ForeignKey("lti_platforms.id"), nullable=True)
+    lti_deployment_id: Mapped[str | None] = mapped_column(String(255), nullable=True)
+    lti_context_id: Mapped[str | None] = mapped_column(String(255), nullable=True)
+    created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
+
+
+class Assignment(Base):
+    """What one course grades and how: the lab and edition, the assignment configuration (points and
+    visibility; None: the edition's bundled one), the seed policy, the due date of ``after_due_date``
+    problems, the gradebook policy and the late policy (``[late]`` without extensions: those are rows)."""
+
+    __tablename__ = "assignments"
+    __table_args__ = (UniqueConstraint("course_id", "slug", name="uq_assignments_course_slug"),)
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    course_id: Mapped[int] = mapped_column(ForeignKey("courses.id"), index=True)
+    slug: Mapped[str] = mapped_column(String(64))
+    title: Mapped[str] = mapped_column(String(200))
+    lab: Mapped[str | None] = mapped_column(String(32), nullable=True)
+    edition: Mapped[str | None] = mapped_column(String(32), nullable=True)
+    config_toml: Mapped[str | None] = mapped_column(Text, nullable=True)
+    seed_policy: Mapped[str] = mapped_column(String(16))
+    seed: Mapped[int] = mapped_column(Integer)
+    release_seeds: Mapped[bool] = mapped_column(Boolean)
+    due_date: Mapped[datetime | None] = mapped_column(DateTime, nullable=True)
+    gradebook_policy: Mapped[str] = mapped_column(String(16))
+    late_policy: Mapped[dict[str, Any] | None] = mapped_column(JSON, nullable=True)
+    created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
+
+
+class Staff(Base):
+    """A course's instructor or teaching assistant: with an API token (only its SHA-256 is stored), or a
+    platform user whose launches from the course's context are staff launches."""
+
+    __tablename__ = "staff"
+    __table_args__ = (UniqueConstraint("course_id", "lti_user_id", name="uq_staff_course_lti_user"),)
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    course_id: Mapped[int] = mapped_column(ForeignKey("courses.id"), index=True)
+    role: Mapped[str] = mapped_column(String(16))
+    name: Mapped[str] = mapped_column(String(100))
+    token_sha256: Mapped[str | None] = mapped_column(String(64), unique=True, nullable=True)
+    lti_user_id: Mapped[int | None] = mapped_column(ForeignKey("lti_users.id"), nullable=True)
+    created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
+
+
+class Student(Base):
+    """A student's enrolment in one course: a name unique in the course, a token (only its SHA-256 is
+    stored) and, under LTI, the platform user it is (one enrolment per course: (platform, deployment,
+    context, sub))."""
+
+    __tablename__ = "students"
+    __table_args__ = (
+        UniqueConstraint("course_id", "name", name="uq_students_course_name"),
+        UniqueConstraint("course_id", "lti_user_id", name="uq_students_course_lti_user"),
+    )
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    course_id: Mapped[int] = mapped_column(ForeignKey("courses.id"), index=True)
+    name: Mapped[str] = mapped_column(String(100))
     token_sha256: Mapped[str] = mapped_column(String(64), unique=True)
+    lti_user_id: Mapped[int | None] = mapped_column(ForeignKey("lti_users.id"), nullable=True)
     created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
 
     submissions: Mapped[list[Submission]] = relationship(back_populates="student")
@@ -47,6 +134,7 @@ class Submission(Base):
     __tablename__ = "submissions"
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    assignment_id: Mapped[int] = mapped_column(ForeignKey("assignments.id"), index=True)
     student_id: Mapped[int] = mapped_column(ForeignKey("students.id"), index=True)
     filename: Mapped[str] = mapped_column(String(100))
     sha256: Mapped[str] = mapped_column(String(64))
@@ -70,16 +158,35 @@ class Submission(Base):
 
 
 class Override(Base):
-    """An instructor's override of one student's score for a problem (or their ``total``), with its reason,
-    who made it and when. Every override is kept; for a student, problem and upload the latest counts."""
+    """An instructor's override of one enrolment's score for a problem (or their ``total``) of one
+    assignment, with its reason, who made it and when. Every override is kept; for an enrolment, problem
+    and upload the latest counts."""
 
     __tablename__ = "overrides"
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    assignment_id: Mapped[int] = mapped_column(ForeignKey("assignments.id"), index=True)
     student_id: Mapped[int] = mapped_column(ForeignKey("students.id"), index=True)
     submission_id: Mapped[int | None] = mapped_column(ForeignKey("submissions.id"), nullable=True)
     problem: Mapped[str] = mapped_column(String(64))
     points: Mapped[float] = mapped_column(Float)
+    reason: Mapped[str] = mapped_column(Text)
+    author: Mapped[str] = mapped_column(String(100))
+    created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
+
+
+class Extension(Base):
+    """An enrolment's own due time for one assignment's late policy, with who granted it and why."""
+
+    __tablename__ = "extensions"
+    __table_args__ = (
+        UniqueConstraint("assignment_id", "student_id", name="uq_extensions_assignment_student"),
+    )
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    assignment_id: Mapped[int] = mapped_column(ForeignKey("assignments.id"))
+    student_id: Mapped[int] = mapped_column(ForeignKey("students.id"))
+    due: Mapped[datetime] = mapped_column(DateTime)
     reason: Mapped[str] = mapped_column(Text)
     author: Mapped[str] = mapped_column(String(100))
     created_at: Mapped[datetime] = mapped_column(DateTime, default=utcnow)
@@ -139,7 +246,8 @@ class LtiNonce(Base):
 
 
 class LtiUser(Base):
-    """A platform user, keyed by (platform, sub): a learner's student row, or none for staff."""
+    """A platform user, keyed by (platform, sub): in each course, an enrolment (``Student.lti_user_id``) or
+    a staff row (``Staff.lti_user_id``)."""
 
     __tablename__ = "lti_users"
     __table_args__ = (UniqueConstraint("platform_id", "sub", name="uq_lti_users_platform_sub"),)
@@ -147,18 +255,23 @@ class LtiUser(Base):
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
     platform_id: Mapped[int] = mapped_column(ForeignKey("lti_platforms.id"))
     sub: Mapped[str] = mapped_column(String(255))
-    student_id: Mapped[int | None] = mapped_column(ForeignKey("students.id"), nullable=True, unique=True)
     name: Mapped[str] = mapped_column(String(255))
 
 
 class LtiLink(Base):
-    """A resource link of a platform's context, with its Advantage service URLs and its line item."""
+    """A resource link of a platform's deployment and context, keyed by (platform, deployment, link id):
+    the assignment it opens, its Advantage service URLs and the assignment's line item there."""
 
     __tablename__ = "lti_links"
-    __table_args__ = (UniqueConstraint("platform_id", "resource_link_id", name="uq_lti_links_platform_link"),)
+    __table_args__ = (
+        UniqueConstraint(
+            "platform_id", "deployment_id", "resource_link_id", name="uq_lti_links_platform_deployment_link"
+        ),
+    )
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
     platform_id: Mapped[int] = mapped_column(ForeignKey("lti_platforms.id"))
+    assignment_id: Mapped[int] = mapped_column(ForeignKey("assignments.id"), index=True)
     deployment_id: Mapped[str] = mapped_column(String(255))
     context_id: Mapped[str] = mapped_column(String(255))
     resource_link_id: Mapped[str] = mapped_column(String(255))
@@ -182,13 +295,16 @@ class LtiMember(Base):
 
 
 class LtiSession(Base):
-    """A signed-in browser after a launch: only the SHA-256 of its token is stored; no student = staff."""
+    """A signed-in browser after a launch: only the SHA-256 of its token is stored. It reaches the course of
+    the launch's context only (``course_id``; None in a session of before courses: the default course), as
+    that course's staff or as its enrolment."""
 
     __tablename__ = "lti_sessions"
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
     token_sha256: Mapped[str] = mapped_column(String(64), unique=True)
     user_id: Mapped[int] = mapped_column(ForeignKey("lti_users.id"))
+    course_id: Mapped[int | None] = mapped_column(ForeignKey("courses.id"), nullable=True)
     link_id: Mapped[int | None] = mapped_column(ForeignKey("lti_links.id"), nullable=True)
     frame_origin: Mapped[str] = mapped_column(String(500))
     browser_sha256: Mapped[str | None] = mapped_column(String(64), nullable=True)

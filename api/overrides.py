@@ -1,7 +1,9 @@
 """The instructor's overrides in the service: recorded with who and when, checked as ``gymgrade grade
 --overrides`` checks a file's rows (``grader.classroom.overrides``), applied by the gradebook.
 
-An override is a student's (``submission_id`` None: whatever upload the gradebook counts) or one upload's
+An override belongs to one assignment and one enrolment of its course (never a display name: the
+decisions read it by the enrolment's id, ``api.courses.identity``). It is the enrolment's
+(``submission_id`` None: whatever upload of the assignment the gradebook counts) or one upload's
 (it counts while that upload is the one the gradebook shows). Every override is kept; for a student,
 problem and upload the latest counts. What a problem is worth is read from the student's graded report.
 """
@@ -16,7 +18,7 @@ from sqlalchemy.orm import Session
 
 from api.disclosure import Disclosure
 from api.errors import InvalidRequest, NothingGradedYet, SubmissionNotFound
-from api.models import JobStatus, Override, Student, Submission
+from api.models import Assignment, JobStatus, Override, Student, Submission
 from api.schemas import OverrideShown
 from api.students import find_student
 from grader.classroom.errors import OverridesError
@@ -25,9 +27,13 @@ from grader.classroom.overrides import Override as Cell
 from grader.report import withheld_ids
 
 
-def _graded(session: Session, student: Student, submission_id: int | None) -> Submission:
+def _graded(
+    session: Session, assignment: Assignment, student: Student, submission_id: int | None
+) -> Submission:
     query = select(Submission).where(
-        Submission.student_id == student.id, Submission.status == JobStatus.DONE.value
+        Submission.assignment_id == assignment.id,
+        Submission.student_id == student.id,
+        Submission.status == JobStatus.DONE.value,
     )
     if submission_id is not None:
         query = query.where(Submission.id == submission_id)
@@ -54,6 +60,7 @@ def maxima_of(report: Mapping[str, Any] | None) -> dict[str, float]:
 
 def record_override(
     session: Session,
+    assignment: Assignment,
     *,
     student_name: str,
     problem: str,
@@ -70,14 +77,14 @@ def record_override(
         InvalidRequest: An unknown problem, points outside what it is worth, or no reason (the message says
             what was expected, as ``gymgrade grade --overrides`` does).
     """
-    student = find_student(session, student_name)
-    graded = _graded(session, student, submission_id)
+    student = find_student(session, assignment.course_id, student_name)
+    graded = _graded(session, assignment, student, submission_id)
     reason = reason.strip()
     if not reason:
         raise InvalidRequest(
             "an override needs a reason: say why", [(["body", "reason"], "empty", "missing")]
         )
-    cell = Cell(student.name, problem, points, reason[:MAX_REASON_CHARS], 1)
+    cell = Cell(student.name, problem, points, reason[:MAX_REASON_CHARS], 1)  # named for the messages
     try:
         check_overrides(
             [cell], students=[student.name], maxima=maxima_of(graded.report), where="the override"
@@ -89,6 +96,7 @@ def record_override(
             [(["body", "problem" if "problem" in fault else "points"], fault, "value_error")],
         ) from None
     override = Override(
+        assignment_id=assignment.id,
         student_id=student.id,
         submission_id=submission_id,
         problem=problem,
@@ -101,19 +109,29 @@ def record_override(
     return override
 
 
-def list_overrides(session: Session, student_name: str) -> list[Override]:
-    """Every override of a student, oldest first."""
-    student = find_student(session, student_name)
+def list_overrides(session: Session, assignment: Assignment, student_name: str) -> list[Override]:
+    """Every override of an enrolment in the assignment, oldest first."""
+    student = find_student(session, assignment.course_id, student_name)
     return list(
-        session.scalars(select(Override).where(Override.student_id == student.id).order_by(Override.id))
+        session.scalars(
+            select(Override)
+            .where(Override.assignment_id == assignment.id, Override.student_id == student.id)
+            .order_by(Override.id)
+        )
     )
 
 
-def counted_overrides(session: Session, chosen: Mapping[int, Any]) -> dict[int, dict[str, Override]]:
-    """The overrides that count for each student (by id), by problem: the latest of those made for the
-    student or for the upload the gradebook shows (``chosen``: student id -> its row, with ``id``)."""
+def counted_overrides(
+    session: Session, assignment_id: int, chosen: Mapping[int, Any]
+) -> dict[int, dict[str, Override]]:
+    """The overrides of the assignment that count for each enrolment (by id), by problem: the latest of those
+    made for the enrolment or for the upload the gradebook shows (``chosen``: enrolment id -> its row, with
+    ``id``)."""
     counted: dict[int, dict[str, Override]] = {}
-    for override in session.scalars(select(Override).order_by(Override.id)):
+    query = select(Override).where(Override.assignment_id == assignment_id)
+    if len(chosen) == 1:
+        query = query.where(Override.student_id.in_(list(chosen)))
+    for override in session.scalars(query.order_by(Override.id)):
         shown = chosen.get(override.student_id)
         if override.submission_id is not None and (shown is None or shown.id != override.submission_id):
             continue
@@ -126,7 +144,9 @@ def overrides_shown(session: Session, submission: Submission, disclosure: Disclo
     ``disclosure`` allows: none of a withheld problem, and no ``total`` while any problem is withheld."""
     if submission.status != JobStatus.DONE.value:
         return []
-    counted = counted_overrides(session, {submission.student_id: submission}).get(submission.student_id, {})
+    counted = counted_overrides(session, submission.assignment_id, {submission.student_id: submission}).get(
+        submission.student_id, {}
+    )
     problems = (submission.report or {}).get("problems", [])
     withheld = withheld_ids(problems, disclosure.shown)
     return [
@@ -137,7 +157,7 @@ def overrides_shown(session: Session, submission: Submission, disclosure: Disclo
 
 
 def as_decided(name: str, overrides: Mapping[str, Override]) -> Overrides:
-    """A student's counted overrides as ``grader.classroom`` reads them (their name as the student)."""
+    """An enrolment's counted overrides as ``grader.classroom`` reads them (``name``: its identity)."""
     return Overrides(
         {name: {problem: Cell(name, problem, o.points, o.reason, o.id) for problem, o in overrides.items()}}
     )

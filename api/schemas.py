@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 from datetime import UTC, datetime
+from enum import Enum
 from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
 
 from api.students import MAX_NAME_CHARS, name_pattern
+from grader.lab.editions import EDITIONS
 
 Status = Literal["queued", "running", "done", "failed"]
 
@@ -165,3 +167,112 @@ class OverrideView(BaseModel):
     reason: str
     author: str = Field(description="Who made it (the instructor).")
     created_at: UtcDateTime
+
+
+SLUG_PATTERN = r"^[a-z0-9][a-z0-9-]{0,63}$"
+"""A course's or assignment's slug, as its URLs show it (``/courses/{course}/assignments/{assignment}``)."""
+Slug = Annotated[str, Field(pattern=SLUG_PATTERN, description="Lower-case letters, digits and dashes.")]
+Name = Annotated[
+    str,
+    Field(
+        min_length=1,
+        max_length=MAX_NAME_CHARS,
+        description="A title or a person's name. "
+        "It is shown without the whitespace around it and without control, format, private-use or line-separator characters.",  # noqa: E501
+    ),
+]
+
+
+class CourseCreate(BaseModel):
+    """A new course (the operator's)."""
+
+    slug: Slug
+    title: Name
+
+
+class CourseView(BaseModel):
+    """A course."""
+
+    id: int
+    slug: str
+    title: str
+
+
+class StaffCreate(BaseModel):
+    """A new member of a course's staff: an instructor, or a teaching assistant (``ta``)."""
+
+    name: Name
+    role: Literal["instructor", "ta"] = "instructor"
+
+
+class StaffCreated(BaseModel):
+    """The new staff member and their bearer token (shown once; only its SHA-256 is stored)."""
+
+    name: str
+    role: Literal["instructor", "ta"]
+    token: str
+
+
+def _written(value: object) -> object:
+    # An RFC 3339 date-time is text: a number is not read as seconds since 1970.
+    if not isinstance(value, str | datetime):
+        raise ValueError("expected an ISO 8601 date-time such as 2026-03-01T23:59:00-05:00")
+    return value
+
+
+WrittenDateTime = Annotated[datetime, BeforeValidator(_written), AfterValidator(_as_utc)]
+"""A date-time given as text (UTC when it has no offset)."""
+
+
+class LateTable(BaseModel):
+    """An assignment's late policy, as the assignment configuration's ``[late]`` table (extensions apart)."""
+
+    due: WrittenDateTime = Field(description="The due time, ISO 8601 (UTC when no offset is given).")
+    penalty_per_day: float = Field(ge=0.0, le=1.0, strict=True)
+    max_penalty: float = Field(default=1.0, ge=0.0, le=1.0, strict=True)
+    grace_minutes: float = Field(default=0.0, ge=0.0, le=7 * 24 * 60, strict=True)
+
+
+EditionName = Enum("EditionName", {name: name for name in EDITIONS}, type=str)  # type: ignore[misc]
+"""The editions of every lab (grader/lab/editions)."""
+
+
+class AssignmentCreate(BaseModel):
+    """A new assignment of a course: what is graded (lab, edition) and how."""
+
+    slug: Slug
+    title: Name
+    edition: EditionName | None = Field(
+        default=None,
+        description="The edition every upload is graded as; its lab follows from it. "
+        "Unset: the first edition, classic.",
+    )
+    seed_policy: Literal["random", "fixed"] = "random"
+    seed: int | None = Field(
+        default=None,
+        ge=1,
+        le=2**31 - 1,
+        description="The fixed policy's seed (never the practice seed 0); unset: a secret one is drawn.",
+    )
+    release_seeds: bool = Field(default=False, strict=True)
+    due_date: WrittenDateTime | None = Field(
+        default=None, description="When after_due_date problems are shown."
+    )
+    gradebook_policy: Literal["latest", "best"] = "latest"
+    late: LateTable | None = None
+
+
+class AssignmentView(BaseModel):
+    """An assignment of a course."""
+
+    id: int
+    course: str
+    slug: str
+    title: str
+    lab: str | None
+    edition: str | None
+    seed_policy: str
+    release_seeds: bool
+    due_date: UtcDateTime | None
+    gradebook_policy: str
+    late: dict[str, Any] | None

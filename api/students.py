@@ -1,4 +1,4 @@
-"""Creating students and looking them up."""
+"""Creating students (a course's enrolments, each with its own token) and finding them by name in a course."""
 
 from __future__ import annotations
 
@@ -40,6 +40,13 @@ def normalise_name(name: str) -> str:
     return trimmed
 
 
+def printable(text: str, fallback: str) -> str:
+    """``text`` to show (a course's title, a staff member's name): without the characters a name may not hold
+    and the whitespace around it, at most ``MAX_NAME_CHARS`` characters; ``fallback`` when nothing is left."""
+    kept = "".join(c for c in text if unicodedata.category(c) not in FORBIDDEN_NAME_CATEGORIES).strip()
+    return kept[:MAX_NAME_CHARS].strip() or fallback
+
+
 def _spelled(code_point: int) -> str:
     # \uXXXX reads the same in ECMA-262 and Python patterns; beyond the BMP only the character itself does.
     return f"\\u{code_point:04x}" if code_point <= 0xFFFF else chr(code_point)
@@ -75,25 +82,26 @@ def name_pattern() -> str:
     return f"^{around}*{edge}(?:{inner}{{0,{MAX_NAME_CHARS - 2}}}{edge})?{around}*$"
 
 
-def create_student(session: Session, name: str) -> tuple[Student, str]:
-    """Create a student and their token.
+def create_student(session: Session, course_id: int, name: str) -> tuple[Student, str]:
+    """Enrol a student in a course and make their token.
 
     Args:
         session: A database session (committed here).
-        name: The requested name.
+        course_id: The course.
+        name: The requested name (unique in the course).
 
     Returns:
         The student and the token in clear (never stored; only its SHA-256 is).
 
     Raises:
         InvalidStudentName: See :func:`normalise_name`.
-        StudentExists: The name is taken.
+        StudentExists: The name is taken in the course.
     """
     clean = normalise_name(name)
-    if session.scalars(select(Student.id).where(Student.name == clean)).first() is not None:
+    if name_taken(session, course_id, clean):
         raise StudentExists(f"a student named {clean!r} already exists; choose another name")
     token = new_token()
-    student = Student(name=clean, token_sha256=token_digest(token))
+    student = Student(course_id=course_id, name=clean, token_sha256=token_digest(token))
     session.add(student)
     try:
         session.commit()
@@ -103,17 +111,24 @@ def create_student(session: Session, name: str) -> tuple[Student, str]:
     return student, token
 
 
-def find_student(session: Session, name: str) -> Student:
-    """The student called ``name``.
+def name_taken(session: Session, course_id: int, name: str) -> bool:
+    """Whether an enrolment of the course is called ``name`` (normalised)."""
+    query = select(Student.id).where(Student.course_id == course_id, Student.name == name)
+    return session.scalars(query).first() is not None
+
+
+def find_student(session: Session, course_id: int, name: str) -> Student:
+    """The course's student called ``name``.
 
     Raises:
-        StudentNotFound: Nobody has that name.
+        StudentNotFound: Nobody of the course has that name.
     """
     try:
         clean = normalise_name(name)
     except InvalidStudentName:
         clean = None  # no stored name can match; never send such text to the database
-    student = session.scalars(select(Student).where(Student.name == clean)).first() if clean else None
+    query = select(Student).where(Student.course_id == course_id, Student.name == clean)
+    student = session.scalars(query).first() if clean else None
     if student is None:
         raise StudentNotFound(f"no student is named {name!r}; list names with GET /gradebook.csv")
     return student

@@ -1,4 +1,4 @@
-"""Storing uploads as queued jobs, and reading them back for their owner or the instructor."""
+"""Storing uploads to an assignment as queued jobs, and reading them back for their owner or the staff."""
 
 from __future__ import annotations
 
@@ -10,10 +10,11 @@ from sqlalchemy import func, select
 from sqlalchemy.orm import Session, joinedload
 
 from api.auth import Principal
+from api.courses import seed_policy_of
 from api.disclosure import Disclosure, problem_view, report_view, withholds_any
-from api.errors import GradingInProgress, RateLimited, SubmissionNotFound
+from api.errors import CourseNotFound, GradingInProgress, RateLimited, SubmissionNotFound
 from api.jobs.job_queue import Dispatcher
-from api.models import JobStatus, Student, Submission, utcnow
+from api.models import Assignment, JobStatus, Student, Submission, utcnow
 from api.schemas import OverrideShown, SubmissionDetail, SubmissionSummary
 from api.settings import SeedPolicy, Settings
 from api.students import find_student
@@ -26,15 +27,21 @@ MAX_ID = 2**31 - 1  # the largest id every database's integer column holds
 
 
 def create_submission(
-    session: Session, settings: Settings, student: Student, upload: CheckedUpload, dispatcher: Dispatcher
+    session: Session,
+    settings: Settings,
+    assignment: Assignment,
+    student: Student,
+    upload: CheckedUpload,
+    dispatcher: Dispatcher,
 ) -> Submission:
-    """Store an upload as a queued grading job, then tell the workers (the row is stored first: an upload
-    accepted while the broker is down is enqueued later by the reconciler).
+    """Store an upload to an assignment as a queued grading job, then tell the workers (the row is stored
+    first: an upload accepted while the broker is down is enqueued later by the reconciler).
 
     Args:
         session: A database session (committed here).
-        settings: Service settings (rate limit, seed policy).
-        student: The uploading student.
+        settings: Service settings (rate limit).
+        assignment: The assignment (its seed policy).
+        student: The uploading student, enrolled in the assignment's course.
         upload: The checked file.
         dispatcher: Tells the workers about the new job.
 
@@ -42,12 +49,17 @@ def create_submission(
         The stored submission, status queued.
 
     Raises:
-        RateLimited: The student already uploaded GYMGRADE_RATE_LIMIT_PER_MINUTE files in the last minute.
+        RateLimited: The student already uploaded GYMGRADE_RATE_LIMIT_PER_MINUTE files to the assignment in
+            the last minute.
     """
+    if student.course_id != assignment.course_id:  # the routes' scopes see to it; never mix two courses
+        raise CourseNotFound("no such assignment among your course's; open it from your own course")
     now = utcnow()
     recent = session.execute(
         select(func.count(Submission.id), func.min(Submission.created_at)).where(
-            Submission.student_id == student.id, Submission.created_at > now - RATE_WINDOW
+            Submission.assignment_id == assignment.id,
+            Submission.student_id == student.id,
+            Submission.created_at > now - RATE_WINDOW,
         )
     ).one()
     count, oldest = recent
@@ -57,8 +69,10 @@ def create_submission(
             f"at most {settings.rate_limit_per_minute} uploads per minute; try again in {max(wait, 1)} s",
             retry_after_seconds=max(wait, 1),
         )
-    seed = settings.seed if settings.seed_policy is SeedPolicy.FIXED else held_out_seed(MAX_SEED + 1)
+    fixed = seed_policy_of(assignment) is SeedPolicy.FIXED
+    seed = assignment.seed if fixed else held_out_seed(MAX_SEED + 1)
     submission = Submission(
+        assignment_id=assignment.id,
         student_id=student.id,
         filename=upload.display_name,
         sha256=upload.sha256,
@@ -106,17 +120,24 @@ def regrade(session: Session, submissions: list[Submission], dispatcher: Dispatc
     return [item.id for item in submissions]
 
 
-def get_submission(session: Session, caller: Principal, submission_id: int) -> Submission:
-    """The submission ``submission_id`` if the caller may see it.
+def get_submission(
+    session: Session, caller: Principal, assignment: Assignment, submission_id: int
+) -> Submission:
+    """The submission ``submission_id`` of the assignment if the caller may see it.
 
     Raises:
-        SubmissionNotFound: It does not exist, or it is another student's (indistinguishable on purpose).
+        SubmissionNotFound: It does not exist, is another assignment's, or is another student's
+            (indistinguishable on purpose).
     """
     in_range = 1 <= submission_id <= MAX_ID
     submission = (
         session.get(Submission, submission_id, options=[joinedload(Submission.student)]) if in_range else None
     )
-    if submission is None or (caller.student is not None and submission.student_id != caller.student.id):
+    if (
+        submission is None
+        or submission.assignment_id != assignment.id
+        or (caller.student is not None and submission.student_id != caller.student.id)
+    ):
         raise SubmissionNotFound(
             f"no submission {submission_id} among yours; list them with GET /submissions"
         )
@@ -124,14 +145,21 @@ def get_submission(session: Session, caller: Principal, submission_id: int) -> S
 
 
 def list_submissions(
-    session: Session, caller: Principal, student_name: str | None = None
+    session: Session, caller: Principal, assignment: Assignment, student_name: str | None = None
 ) -> list[Submission]:
-    """The caller's submissions (all of them, or one student's, for the instructor), newest first."""
-    query = select(Submission).options(joinedload(Submission.student)).order_by(Submission.id.desc())
+    """The caller's submissions to the assignment (all of them, or one student's, for its staff), newest
+    first."""
+    query = (
+        select(Submission)
+        .options(joinedload(Submission.student))
+        .where(Submission.assignment_id == assignment.id)
+        .order_by(Submission.id.desc())
+    )
     if caller.student is not None:
         query = query.where(Submission.student_id == caller.student.id)
     elif student_name is not None:
-        query = query.where(Submission.student_id == find_student(session, student_name).id)
+        student = find_student(session, assignment.course_id, student_name)
+        query = query.where(Submission.student_id == student.id)
     return list(session.scalars(query))
 
 

@@ -22,6 +22,9 @@ class ClaimedJob:
     shown_name: str | None = None
     """The file's own name as its messages and report show it (a class's download name, sent by the batch
     that read it, neutralised again on receipt); ``filename`` when None. Only ever shown, never a path."""
+    assignment: tuple[str | None, str | None] | None = None
+    """The (lab, edition) of the submission's assignment, as ``service_edition`` reads them; None (a
+    batch's file): the worker's own GYMGRADE_LAB and GYMGRADE_EDITION."""
 
 
 class JobQueue(Protocol):

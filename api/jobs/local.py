@@ -9,7 +9,7 @@ from sqlalchemy import ColumnElement, and_, or_, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
 from api.jobs.job_queue import ClaimedJob
-from api.models import JobStatus, Submission, utcnow
+from api.models import Assignment, JobStatus, Submission, utcnow
 
 _CLAIM_TRIES = 10
 
@@ -60,7 +60,16 @@ class DatabaseQueue:
                 session.commit()
                 if claimed.rowcount == 1:  # type: ignore[attr-defined]
                     row = session.get_one(Submission, candidate_id)
-                    return ClaimedJob(candidate_id, row.filename, row.content, row.seed, attempts + 1)
+                    assignment = session.get_one(Assignment, row.assignment_id)
+                    return ClaimedJob(
+                        candidate_id,
+                        row.filename,
+                        row.content,
+                        row.seed,
+                        attempts + 1,
+                        config_toml=assignment.config_toml,
+                        assignment=(assignment.lab, assignment.edition),
+                    )
         return None
 
     def state(self, submission_id: int) -> tuple[JobStatus, int] | None:

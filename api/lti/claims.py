@@ -45,6 +45,12 @@ STAFF_ROLES = frozenset(
         "TeachingAssistant",
     }
 )
+TEACHING_ASSISTANT_ROLES = frozenset(
+    {f"{MEMBERSHIP}/Instructor#TeachingAssistant", f"{MEMBERSHIP}#TeachingAssistant", "TeachingAssistant"}
+)
+"""The roles by which an LMS says a member of the staff is a teaching assistant (Canvas sends the
+sub-role beside ``#Instructor``): such a member is the course's TA, never its instructor."""
+STAFF_ROLES = STAFF_ROLES | TEACHING_ASSISTANT_ROLES
 LEARNER_ROLES = frozenset({f"{MEMBERSHIP}#Learner", f"{MEMBERSHIP}/Learner#Learner", "Learner"})
 
 
@@ -53,6 +59,11 @@ class Role(StrEnum):
 
     STAFF = "staff"
     LEARNER = "learner"
+
+
+def is_teaching_assistant(roles: Iterable[str]) -> bool:
+    """Whether a staff launch's roles say it is a teaching assistant's (not an instructor's)."""
+    return bool(set(roles) & TEACHING_ASSISTANT_ROLES)
 
 
 def role_of(roles: Iterable[str]) -> Role | None:

@@ -26,9 +26,18 @@ from sqlalchemy.orm import Session
 from api.errors import LaunchRefused, LtiRequestInvalid
 from api.lti import claims as names
 from api.lti.binding import matches
-from api.lti.claims import Role, role_of
+from api.lti.claims import Role, is_teaching_assistant, role_of
 from api.lti.keys import ALGORITHM, published_keys, sign
-from api.lti.people import display_name, ensure_link, ensure_member, ensure_user
+from api.lti.people import (
+    course_of,
+    display_name,
+    ensure_course,
+    ensure_enrolment,
+    ensure_link,
+    ensure_member,
+    ensure_staff,
+    ensure_user,
+)
 from api.lti.platforms import PlatformKeys, find_platform
 from api.lti.sessions import SESSION_PREFIX
 from api.models import LtiLink, LtiNonce, LtiPlatform, LtiSession, LtiUser, utcnow
@@ -336,17 +345,24 @@ def accept_launch(
             "open the assignment in the LMS again"
         ) from None
     sub = launch.claims["sub"]
-    user = ensure_user(session, launch.platform, sub, display_name(launch.claims, sub), launch.role)
+    user = ensure_user(session, launch.platform, sub, display_name(launch.claims, sub))
     link = None
     if launch.message_type == names.RESOURCE_LINK_REQUEST:
         link = ensure_link(session, launch.platform, launch.deployment_id, launch.claims)
-        if launch.role is Role.LEARNER:
-            ensure_member(session, link, user)
+        course_id = course_of(session, link)
+    else:
+        course_id = ensure_course(session, launch.platform, launch.deployment_id, launch.claims).id
+    # The launch's roles count in its own context's course only: staff there, or an enrolment there.
+    if launch.role is Role.STAFF:
+        ensure_staff(session, course_id, user, is_teaching_assistant(launch.claims.get(names.ROLES) or []))
+    elif link is not None and ensure_enrolment(session, course_id, user, launch.role) is not None:
+        ensure_member(session, link, user)
     token = SESSION_PREFIX + secrets.token_urlsafe(32)
     session.add(
         LtiSession(
             token_sha256=token_digest(token),
             user_id=user.id,
+            course_id=course_id,
             link_id=link.id if link is not None else None,
             frame_origin=frame_origins(launch),
             browser_sha256=browser_digest,

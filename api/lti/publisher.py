@@ -1,10 +1,14 @@
-"""Scores to the LMS (LTI AGS) from a durable outbox: one ``lti_scores`` row per (link, student).
+"""Scores to the LMS (LTI AGS) from a durable outbox: one ``lti_scores`` row per (link, member); a link opens
+one assignment, and a member's score is their enrolment's in that assignment's course, of that assignment
+only.
 
 The row holds the kept score (``score`` None: nothing graded yet, a submission is being graded: the LMS
 is told ``Submitted``/``Pending`` without a score; once graded, ``Completed``/``FullyGraded`` with it).
 
-Each round (``GYMGRADE_LTI_PUBLISH_SECONDS``) first brings every row up to the score the gradebook policy
-keeps now, read from the submission rows (the only truth: a regrade or a better upload changes it), then
+Each round (``GYMGRADE_LTI_PUBLISH_SECONDS``) first brings every row up to the final score of the submission
+the assignment's gradebook policy keeps now: the instructor's overrides and the late penalty applied, as every
+gradebook file computes it (``api.gradebook.final_grades``), read from the rows (the only truth: a regrade, a
+better upload, an override or a changed late policy changes it, and the LMS is sent the new score), then
 sends the rows that are due. A row is sent only while the kept score differs from the one the platform
 last accepted, so the same score is never sent as two results; a refused send is retried with doubling
 waits and its error shown to the instructor (``GET /lti/scores``), never touching the grading. Several
@@ -22,11 +26,13 @@ from typing import Any
 from sqlalchemy import func, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
-from api.gradebook import kept_submissions
+from api.courses import gradebook_policy_of
+from api.gradebook import final_grades, final_total, kept_submissions
 from api.lti.claims import SCOPE_LINEITEM, SCOPE_LINEITEM_READONLY, SCOPE_SCORE
 from api.lti.outbound import Outbound, OutboundPolicy
 from api.lti.services import AccessTokens, ServiceFailed, line_item, publish_score
 from api.models import (
+    Assignment,
     JobStatus,
     LtiLink,
     LtiMember,
@@ -37,7 +43,7 @@ from api.models import (
     Submission,
     utcnow,
 )
-from api.settings import GradebookPolicy, Settings
+from api.settings import Settings
 
 log = logging.getLogger(__name__)
 
@@ -53,64 +59,55 @@ PENDING, SENT, RETRYING, FAILED = "pending", "sent", "retrying", "failed"
 
 @dataclass(frozen=True)
 class PublishPolicy:
-    """How scores are published: which score is kept, how often a refused one is retried."""
+    """How scores are published: how often a refused one is retried (which score is kept is each
+    assignment's gradebook policy)."""
 
-    gradebook: GradebookPolicy
     attempts: int
     retry_seconds: float
 
     @classmethod
     def of(cls, settings: Settings) -> PublishPolicy:
         """The policy the settings give."""
-        return cls(settings.gradebook_policy, settings.lti_publish_attempts, settings.lti_retry_seconds)
+        return cls(settings.lti_publish_attempts, settings.lti_retry_seconds)
 
     def wait(self, attempts: int) -> float:
         """Seconds before the next send after ``attempts`` refused ones (doubling, at most 10 minutes)."""
         return float(min(self.retry_seconds * 2 ** max(attempts - 1, 0), MAX_RETRY_SECONDS))
 
 
-def sync_outbox(session: Session, policy: GradebookPolicy) -> int:
-    """Bring each member's row to the score the policy keeps now; return how many rows changed."""
+def sync_outbox(session: Session) -> int:
+    """Bring each member's row to the score its link's assignment keeps now; return how many rows changed."""
     members = session.execute(
-        select(LtiMember.id, LtiUser.student_id, LtiLink.lineitem_url)
-        .join(LtiUser, LtiUser.id == LtiMember.user_id)
+        select(LtiMember.id, Student.id, LtiLink.assignment_id, LtiLink.lineitem_url)
         .join(LtiLink, LtiLink.id == LtiMember.link_id)
-        .where(LtiUser.student_id.is_not(None))
+        .join(Assignment, Assignment.id == LtiLink.assignment_id)
+        .join(
+            Student,
+            (Student.lti_user_id == LtiMember.user_id) & (Student.course_id == Assignment.course_id),
+        )
     ).all()
     if not members:
         return 0
-    students = {student_id for _, student_id, _ in members}
-    graded = session.execute(
-        select(
-            Submission.id,
-            Submission.student_id,
-            Submission.score,
-            Submission.max_score,
-            Submission.finished_at,
+    wanted_by_assignment = {
+        assignment_id: _kept(
+            session, assignment_id, {student for _, student, a, _ in members if a == assignment_id}
         )
-        .where(Submission.status == JobStatus.DONE.value, Submission.student_id.in_(students))
-        .order_by(Submission.id)
-    ).all()
-    kept = kept_submissions(graded, policy)
-    in_progress = dict(
-        session.execute(
-            select(Submission.student_id, func.max(Submission.id))
-            .where(
-                Submission.status.in_((JobStatus.QUEUED.value, JobStatus.RUNNING.value)),
-                Submission.student_id.in_(students),
-            )
-            .group_by(Submission.student_id)
-        ).all()
-    )
+        for assignment_id in {assignment_id for _, _, assignment_id, _ in members}
+    }
+    finals = {
+        assignment_id: _final_totals(session, assignment_id, kept)
+        for assignment_id, (kept, _) in wanted_by_assignment.items()
+    }
     rows = {row.member_id: row for row in session.scalars(select(LtiScore))}
     changed = 0
     now = utcnow()
-    for member_id, student_id, lineitem_url in members:
-        chosen = kept.get(student_id) if student_id is not None else None
+    for member_id, student_id, assignment_id, lineitem_url in members:
+        kept, in_progress = wanted_by_assignment[assignment_id]
+        chosen = kept.get(student_id)
         if chosen is not None:
             wanted: tuple[int, float | None, float | None] = (
                 chosen.id,
-                float(chosen.score or 0.0),
+                float(finals[assignment_id][student_id] or 0.0),
                 float(chosen.max_score or 0.0),
             )
         elif student_id in in_progress and lineitem_url and _holds_no_score(rows.get(member_id)):
@@ -134,6 +131,51 @@ def sync_outbox(session: Session, policy: GradebookPolicy) -> int:
         changed += 1
     session.commit()
     return changed
+
+
+def _final_totals(session: Session, assignment_id: int, kept: dict[int, Any]) -> dict[int, float | None]:
+    """The final total of each kept submission: overrides and late penalty applied, as every gradebook file
+    computes it (``api.gradebook.final_grades``)."""
+    assignment = session.get_one(Assignment, assignment_id)
+    late = assignment.late_policy is not None
+    return {
+        student_id: final_total(final, kept[student_id], late=late)
+        for student_id, final in final_grades(session, assignment, kept).items()
+    }
+
+
+def _kept(session: Session, assignment_id: int, students: set[int]) -> tuple[dict[int, Any], dict[int, int]]:
+    """The submission of the assignment each of ``students`` is represented by, and their newest one being
+    graded (by enrolment id)."""
+    assignment = session.get_one(Assignment, assignment_id)
+    graded = session.execute(
+        select(
+            Submission.id,
+            Submission.student_id,
+            Submission.score,
+            Submission.max_score,
+            Submission.created_at,
+            Submission.report,
+        )
+        .where(
+            Submission.assignment_id == assignment_id,
+            Submission.status == JobStatus.DONE.value,
+            Submission.student_id.in_(students),
+        )
+        .order_by(Submission.id)
+    ).all()
+    in_progress = dict(
+        session.execute(
+            select(Submission.student_id, func.max(Submission.id))
+            .where(
+                Submission.assignment_id == assignment_id,
+                Submission.status.in_((JobStatus.QUEUED.value, JobStatus.RUNNING.value)),
+                Submission.student_id.in_(students),
+            )
+            .group_by(Submission.student_id)
+        ).all()
+    )
+    return kept_submissions(graded, gradebook_policy_of(assignment)), in_progress
 
 
 def _holds_no_score(row: LtiScore | None) -> bool:
@@ -214,15 +256,23 @@ def _send(session: Session, tokens: AccessTokens, policy: PublishPolicy, row: Lt
     return 1
 
 
-def publishing_status(session: Session) -> list[dict[str, Any]]:
-    """Each student's row: the kept score, the one the LMS holds, the state, the attempts, the last error."""
-    rows = session.execute(
+def publishing_status(session: Session, course_id: int | None) -> list[dict[str, Any]]:
+    """Each student's row of the course (None: of every course): the kept score, the one the LMS holds, the
+    state, the attempts, the last error."""
+    query = (
         select(LtiScore, LtiMember, Student)
         .join(LtiMember, LtiMember.id == LtiScore.member_id)
-        .join(LtiUser, LtiUser.id == LtiMember.user_id)
-        .join(Student, Student.id == LtiUser.student_id)
+        .join(LtiLink, LtiLink.id == LtiMember.link_id)
+        .join(Assignment, Assignment.id == LtiLink.assignment_id)
+        .join(
+            Student,
+            (Student.lti_user_id == LtiMember.user_id) & (Student.course_id == Assignment.course_id),
+        )
         .order_by(Student.name, LtiMember.link_id)
-    ).all()
+    )
+    if course_id is not None:
+        query = query.where(Assignment.course_id == course_id)
+    rows = session.execute(query).all()
     return [
         {
             "student": student.name,
@@ -270,7 +320,7 @@ class ScorePublisher:
     def run_once(self) -> int:
         """One round; returns the scores the platforms accepted."""
         with self._sessions() as session:
-            sync_outbox(session, self._policy.gradebook)
+            sync_outbox(session)
             return send_due(session, self._tokens, self._policy)
 
     def progress(self) -> dict[str, Any]:

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 from sqlalchemy.orm import Session
 
 from api.errors import LtiRequestInvalid, PlatformUnreachable
-from api.lti.claims import SCOPE_MEMBERSHIPS, Role, role_of
-from api.lti.people import display_name, ensure_member, ensure_user
+from api.lti.claims import SCOPE_MEMBERSHIPS, role_of
+from api.lti.people import course_of, display_name, ensure_enrolment, ensure_member, ensure_user
 from api.lti.services import AccessTokens, ServiceFailed, roster
 from api.models import LtiLink, LtiPlatform
 
@@ -41,14 +41,15 @@ def import_roster(session: Session, link: LtiLink, tokens: AccessTokens) -> Rost
     except ServiceFailed as error:
         raise PlatformUnreachable(str(error)) from None
     learners = staff = skipped = 0
+    course_id = course_of(session, link)
     for member in roster(link.memberships_url, grant):
         sub = str(member.get("user_id") or "")
         role = role_of(member.get("roles") or [])
         if not sub or member.get("status", "Active") != "Active" or role is None:
             skipped += 1
             continue
-        user = ensure_user(session, platform, sub, display_name(member, sub), role)
-        if role is Role.LEARNER:
+        user = ensure_user(session, platform, sub, display_name(member, sub))
+        if ensure_enrolment(session, course_id, user, role) is not None:
             ensure_member(session, link, user)
             learners += 1
         else:

@@ -9,9 +9,10 @@ import re
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
-from api.auth import Principal
+from api.auth import Principal, StaffRole
+from api.courses import DEFAULT_COURSE_ID
 from api.lti.binding import matches
-from api.models import LtiSession, LtiUser, Student, utcnow
+from api.models import Assignment, LtiLink, LtiSession, LtiUser, Staff, Student, utcnow
 from api.security import token_digest
 
 SESSION_PREFIX = "ggl_"
@@ -21,8 +22,9 @@ SESSION_PARAMETER = "lti_session"
 
 
 def session_caller(session: Session, token: str, browser_secret: str | None) -> Principal | None:
-    """The caller of an unexpired launch session (a student, or the context's staff as instructor), when
-    the browser sends the cookie the session is bound to (``browser_secret``; api/lti/binding.py)."""
+    """The caller of an unexpired launch session: the staff (instructor or TA) of its launch's course, or
+    that course's enrolment, when the browser sends the cookie the session is bound to (``browser_secret``;
+    api/lti/binding.py); None when it is neither (or expired, or another browser)."""
     row = session.scalars(select(LtiSession).where(LtiSession.token_sha256 == token_digest(token))).first()
     if row is None or row.expires_at < utcnow():
         return None
@@ -31,7 +33,13 @@ def session_caller(session: Session, token: str, browser_secret: str | None) -> 
     user = session.get(LtiUser, row.user_id)
     if user is None:
         return None
-    student = session.get(Student, user.student_id) if user.student_id is not None else None
+    course_id = _course_of(session, row)
+    staff = session.scalars(
+        select(Staff).where(Staff.course_id == course_id, Staff.lti_user_id == user.id)
+    ).first()
+    student = None if staff is not None else _enrolment(session, course_id, user)
+    if staff is None and student is None:
+        return None
     name = student.name if student is not None else user.name
     return Principal(
         name=name,
@@ -39,7 +47,23 @@ def session_caller(session: Session, token: str, browser_secret: str | None) -> 
         frame_origin=row.frame_origin,
         session_token=token,
         lti_link_id=row.link_id,
+        course_id=course_id,
+        role=StaffRole(staff.role) if staff is not None else StaffRole.INSTRUCTOR,
     )
+
+
+def _course_of(session: Session, row: LtiSession) -> int:
+    """The course of the session's launch (a session of before courses: its link's, else the default)."""
+    if row.course_id is not None:
+        return row.course_id
+    link = session.get(LtiLink, row.link_id) if row.link_id is not None else None
+    return session.get_one(Assignment, link.assignment_id).course_id if link else DEFAULT_COURSE_ID
+
+
+def _enrolment(session: Session, course_id: int, user: LtiUser) -> Student | None:
+    """The user's enrolment in the course (None: none)."""
+    query = select(Student).where(Student.course_id == course_id, Student.lti_user_id == user.id)
+    return session.scalars(query).first()
 
 
 SECRET_PARAMETERS = (SESSION_PARAMETER, "ticket", "registration_token")

@@ -7,11 +7,11 @@ from typing import Annotated
 from fastapi import APIRouter, Query
 from fastapi.responses import Response
 
-from api.deps import InstructorDep, SessionDep, SettingsDep
-from api.errors import InstructorOnly, InvalidRequest, NotAuthenticated
-from api.gradebook import GRADEBOOK_FORMATS, gradebook_export, late_policy_of
+from api.deps import AssignmentDep, InstructorDep, SessionDep
+from api.errors import CourseNotFound, InstructorOnly, InvalidRequest, NotAuthenticated
+from api.gradebook import GRADEBOOK_FORMATS, gradebook_export
 from api.handlers import error_responses
-from grader.classroom.gradebooks import Assignment
+from grader.classroom.gradebooks import Assignment as GradebookNames
 
 router = APIRouter(tags=["gradebook"])
 
@@ -21,12 +21,12 @@ router = APIRouter(tags=["gradebook"])
     response_class=Response,
     responses={
         200: {"content": {"text/csv": {}}, "description": "One row per student, one column per problem."},
-        **error_responses(NotAuthenticated, InstructorOnly, InvalidRequest),
+        **error_responses(NotAuthenticated, CourseNotFound, InstructorOnly, InvalidRequest),
     },
 )
 def get_gradebook(
     session: SessionDep,
-    settings: SettingsDep,
+    assignment: AssignmentDep,
     _instructor: InstructorDep,
     format: Annotated[str, Query(pattern=f"^({'|'.join(GRADEBOOK_FORMATS)})$")] = "gymgrade",
     assignment_title: str | None = None,
@@ -43,10 +43,9 @@ def get_gradebook(
     return Response(
         gradebook_export(
             session,
-            settings.gradebook_policy,
+            assignment,
             format,
-            Assignment(assignment_title or _lab_title(settings.edition, settings.lab), assignment_id),
-            late_policy_of(settings),
+            GradebookNames(assignment_title or _lab_title(assignment.edition, assignment.lab), assignment_id),
         ),
         media_type="text/csv; charset=utf-8",
         headers={"Content-Disposition": 'attachment; filename="gradebook.csv"'},

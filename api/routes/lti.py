@@ -1,7 +1,9 @@
 """The LTI 1.3 tool's routes: keys, registration, login and launch, deep linking, roster and scores.
 
-Browser-facing routes (login, launch, register, the lab picker) are reached from the LMS; the instructor's
-are JSON with the instructor's bearer token. None is part of the OpenAPI schema of the grading API.
+Browser-facing routes (login, launch, register, the lab picker) are reached from the LMS; the platform,
+registration and key routes are the operator's; the links, rosters and scores are the default course's
+staff's (and the operator's). All of them are JSON with a bearer token. None is part of the OpenAPI schema
+of the grading API.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from sqlalchemy import select
 from sqlalchemy.orm import Session
 from starlette.concurrency import run_in_threadpool
 
-from api.deps import ContextDep, InstructorDep, SessionDep, SettingsDep
+from api.deps import ContextDep, CourseDep, InstructorDep, OperatorDep, SessionDep, SettingsDep
 from api.errors import LtiRequestInvalid
 from api.lti import claims as names
 from api.lti.binding import (
@@ -46,12 +48,13 @@ from api.lti.launch import (
     tool_state,
     verify_launch,
 )
+from api.lti.people import course_of
 from api.lti.platforms import PlatformRegistration, add_deployment, checked_origins, register_platform
 from api.lti.publisher import publishing_status
 from api.lti.registration import ToolUrls, check_ticket, register_dynamically, registration_ticket
 from api.lti.roster import import_roster
 from api.lti.sessions import SESSION_PARAMETER
-from api.models import LtiLink, LtiPlatform
+from api.models import Assignment, LtiLink, LtiPlatform
 from api.settings import Settings
 from api.web import page_headers, templates
 
@@ -304,7 +307,7 @@ class RegistrationUrl(BaseModel):
 
 @router.post("/lti/registrations", status_code=201)
 def new_registration(
-    request: Request, session: SessionDep, settings: SettingsDep, _instructor: InstructorDep
+    request: Request, session: SessionDep, settings: SettingsDep, _operator: OperatorDep
 ) -> RegistrationUrl:
     """A dynamic registration URL carrying a ticket the tool signed."""
     base = tool_urls(request, settings).base
@@ -342,7 +345,7 @@ def _platform_view(row: LtiPlatform) -> dict[str, Any]:
 
 @router.post("/lti/platforms", status_code=201)
 def post_platform(
-    body: PlatformIn, session: SessionDep, settings: SettingsDep, _instructor: InstructorDep
+    body: PlatformIn, session: SessionDep, settings: SettingsDep, _operator: OperatorDep
 ) -> dict[str, Any]:
     """Register a platform by hand."""
     row = register_platform(
@@ -369,7 +372,7 @@ class DeploymentIn(BaseModel):
 
 @router.post("/lti/platforms/{platform_id}/deployments")
 def post_deployment(
-    platform_id: int, body: DeploymentIn, session: SessionDep, _instructor: InstructorDep
+    platform_id: int, body: DeploymentIn, session: SessionDep, _operator: OperatorDep
 ) -> dict[str, Any]:
     """Accept launches from one more deployment of a platform."""
     platform = session.get(LtiPlatform, platform_id)
@@ -391,7 +394,7 @@ def put_frame_ancestors(
     body: FrameAncestorsIn,
     session: SessionDep,
     settings: SettingsDep,
-    _instructor: InstructorDep,
+    _operator: OperatorDep,
 ) -> dict[str, Any]:
     """Set the origins that may frame the tool's pages after a launch from this platform."""
     platform = session.get(LtiPlatform, platform_id)
@@ -403,13 +406,13 @@ def put_frame_ancestors(
 
 
 @router.get("/lti/platforms")
-def get_platforms(session: SessionDep, _instructor: InstructorDep) -> list[dict[str, Any]]:
+def get_platforms(session: SessionDep, _operator: OperatorDep) -> list[dict[str, Any]]:
     """The registered platforms."""
     return [_platform_view(row) for row in session.scalars(select(LtiPlatform).order_by(LtiPlatform.id))]
 
 
 @router.get("/lti/tool")
-def tool_configuration(request: Request, settings: SettingsDep, _instructor: InstructorDep) -> dict[str, str]:
+def tool_configuration(request: Request, settings: SettingsDep, _operator: OperatorDep) -> dict[str, str]:
     """The URLs an administrator enters in the LMS when registering the tool by hand."""
     urls = tool_urls(request, settings)
     return {
@@ -421,14 +424,17 @@ def tool_configuration(request: Request, settings: SettingsDep, _instructor: Ins
 
 
 @router.post("/lti/keys/rotate")
-def rotate_keys(session: SessionDep, settings: SettingsDep, _instructor: InstructorDep) -> dict[str, str]:
+def rotate_keys(session: SessionDep, settings: SettingsDep, _operator: OperatorDep) -> dict[str, str]:
     """Make a new signing key; the old ones stay published for GYMGRADE_LTI_KEY_GRACE_SECONDS."""
     return {"kid": rotate(session, settings.lti_key_grace_seconds)}
 
 
 @router.get("/lti/links")
-def get_links(session: SessionDep, _instructor: InstructorDep) -> list[dict[str, Any]]:
-    """The resource links students launched from."""
+def get_links(session: SessionDep, instructor: InstructorDep, course: CourseDep) -> list[dict[str, Any]]:
+    """The resource links students launched from, of the course's assignments (the operator's: all)."""
+    query = select(LtiLink).join(Assignment, Assignment.id == LtiLink.assignment_id).order_by(LtiLink.id)
+    if not instructor.is_operator:
+        query = query.where(Assignment.course_id == course.id)
     return [
         {
             "id": link.id,
@@ -439,24 +445,25 @@ def get_links(session: SessionDep, _instructor: InstructorDep) -> list[dict[str,
             "lineitem_url": link.lineitem_url,
             "custom": link.custom,
         }
-        for link in session.scalars(select(LtiLink).order_by(LtiLink.id))
+        for link in session.scalars(query)
     ]
 
 
 @router.post("/lti/links/{link_id}/roster")
 def post_roster(
-    link_id: int, session: SessionDep, context: ContextDep, _instructor: InstructorDep
+    link_id: int, session: SessionDep, context: ContextDep, instructor: InstructorDep, course: CourseDep
 ) -> dict[str, int]:
-    """Import the link's course roster (Names and Role Provisioning)."""
+    """Import the link's course roster (Names and Role Provisioning): a link of the course's only (the
+    operator's: any)."""
     link = session.get(LtiLink, link_id)
-    if link is None:
+    if link is None or not (instructor.is_operator or course_of(session, link) == course.id):
         raise LtiRequestInvalid(f"no LTI link has id {link_id}; list them with GET /lti/links")
     found = import_roster(session, link, context.access_tokens)
     return {"learners": found.learners, "staff": found.staff, "skipped": found.skipped}
 
 
 @router.get("/lti/publisher")
-def get_publisher(context: ContextDep, _instructor: InstructorDep) -> dict[str, Any]:
+def get_publisher(context: ContextDep, _operator: OperatorDep) -> dict[str, Any]:
     """This server's publishing thread: running, its period, the rounds it finished, the last one's end."""
     if context.publisher is None:
         return {"running": False, "period_seconds": None, "rounds": 0, "last_round_at": None}
@@ -464,6 +471,7 @@ def get_publisher(context: ContextDep, _instructor: InstructorDep) -> dict[str, 
 
 
 @router.get("/lti/scores")
-def get_scores(session: SessionDep, _instructor: InstructorDep) -> list[dict[str, Any]]:
-    """Each student's score publishing to the LMS: kept score, the one the LMS holds, state, last error."""
-    return publishing_status(session)
+def get_scores(session: SessionDep, instructor: InstructorDep, course: CourseDep) -> list[dict[str, Any]]:
+    """Each student's score publishing to the LMS: kept score, the one the LMS holds, state, last error (the
+    course's; the operator's: every course's)."""
+    return publishing_status(session, None if instructor.is_operator else course.id)

@@ -5,8 +5,9 @@ from __future__ import annotations
 
 from fastapi import APIRouter
 
-from api.deps import InstructorDep, SessionDep
+from api.deps import AssignmentDep, InstructorDep, SessionDep
 from api.errors import (
+    CourseNotFound,
     InstructorOnly,
     InvalidRequest,
     MalformedBody,
@@ -44,6 +45,7 @@ def _view(override: Override, student: str) -> OverrideView:
     responses=error_responses(
         MalformedBody,
         NotAuthenticated,
+        CourseNotFound,
         InstructorOnly,
         StudentNotFound,
         SubmissionNotFound,
@@ -53,12 +55,13 @@ def _view(override: Override, student: str) -> OverrideView:
     ),
 )
 def post_override(
-    name: str, body: OverrideCreate, session: SessionDep, instructor: InstructorDep
+    name: str, body: OverrideCreate, session: SessionDep, assignment: AssignmentDep, instructor: InstructorDep
 ) -> OverrideView:
     """Override a student's score for one problem (or their total), with a reason; every gradebook then
     shows it, the machine's verdict and the reason in the row's note."""
     override = record_override(
         session,
+        assignment,
         student_name=name,
         problem=body.problem,
         points=body.points,
@@ -72,8 +75,12 @@ def post_override(
 @router.get(
     "/students/{name}/overrides",
     response_model=list[OverrideView],
-    responses=error_responses(NotAuthenticated, InstructorOnly, StudentNotFound, InvalidRequest),
+    responses=error_responses(
+        NotAuthenticated, CourseNotFound, InstructorOnly, StudentNotFound, InvalidRequest
+    ),
 )
-def get_overrides(name: str, session: SessionDep, _instructor: InstructorDep) -> list[OverrideView]:
+def get_overrides(
+    name: str, session: SessionDep, assignment: AssignmentDep, _instructor: InstructorDep
+) -> list[OverrideView]:
     """Every override of a student, oldest first (the latest per problem and upload counts)."""
-    return [_view(override, name) for override in list_overrides(session, name)]
+    return [_view(override, name) for override in list_overrides(session, assignment, name)]

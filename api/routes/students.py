@@ -1,11 +1,12 @@
-"""POST /students: the instructor creates a student and receives their token."""
+"""POST /students: a course's instructor (or the operator) enrols a student and receives their token."""
 
 from __future__ import annotations
 
 from fastapi import APIRouter
 
-from api.deps import InstructorDep, SessionDep
+from api.deps import CourseDep, CourseInstructorDep, SessionDep
 from api.errors import (
+    CourseNotFound,
     InstructorOnly,
     InvalidRequest,
     InvalidStudentName,
@@ -29,13 +30,16 @@ router = APIRouter(tags=["students"])
         MalformedBody,
         NotAuthenticated,
         InstructorOnly,
+        CourseNotFound,
         StudentExists,
         UploadTooLarge,
         InvalidRequest,
         InvalidStudentName,
     ),
 )
-def post_student(body: StudentCreate, session: SessionDep, _instructor: InstructorDep) -> StudentCreated:
-    """Create a student; the token in the response is shown only this once."""
-    student, token = create_student(session, body.name)
+def post_student(
+    body: StudentCreate, session: SessionDep, _instructor: CourseInstructorDep, course: CourseDep
+) -> StudentCreated:
+    """Enrol a student in the course; the token in the response is shown only this once."""
+    student, token = create_student(session, course.id, body.name)
     return StudentCreated(name=student.name, token=token)

@@ -7,6 +7,7 @@ from typing import Annotated, Any
 from fastapi import APIRouter, File, Query, Request, Response, UploadFile
 
 from api.deps import (
+    AssignmentDep,
     CallerDep,
     DisclosureDep,
     DispatcherDep,
@@ -16,6 +17,7 @@ from api.deps import (
     StudentDep,
 )
 from api.errors import (
+    CourseNotFound,
     GradingInProgress,
     InstructorOnly,
     InvalidRequest,
@@ -70,6 +72,7 @@ ACCEPTED_RESPONSE: dict[str, Any] = {
         **error_responses(
             MalformedBody,
             NotAuthenticated,
+            CourseNotFound,
             StudentOnly,
             LengthRequired,
             UploadTooLarge,
@@ -85,14 +88,15 @@ def post_submission(
     session: SessionDep,
     settings: SettingsDep,
     dispatcher: DispatcherDep,
+    assignment: AssignmentDep,
     student: StudentDep,
     file: Annotated[UploadFile, File()],
 ) -> SubmissionAccepted:
     """Upload a file for grading; poll GET /submissions/{id} for the result."""
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
-    submission = create_submission(session, settings, student, upload, dispatcher)
-    response.headers["Location"] = request.app.url_path_for("get_one_submission", submission_id=submission.id)
+    submission = create_submission(session, settings, assignment, student, upload, dispatcher)
+    response.headers["Location"] = f"{request.url.path}/{submission.id}"  # under the assignment's prefix too
     return SubmissionAccepted(id=submission.id)
 
 
@@ -100,29 +104,34 @@ def post_submission(
     "/submissions/{submission_id}",
     response_model=SubmissionDetail,
     operation_id=GET_ONE_OPERATION,
-    responses=error_responses(NotAuthenticated, SubmissionNotFound, InvalidRequest),
+    responses=error_responses(NotAuthenticated, CourseNotFound, SubmissionNotFound, InvalidRequest),
 )
 def get_one_submission(
-    submission_id: int, session: SessionDep, caller: CallerDep, disclosure: DisclosureDep
+    submission_id: int,
+    session: SessionDep,
+    assignment: AssignmentDep,
+    caller: CallerDep,
+    disclosure: DisclosureDep,
 ) -> SubmissionDetail:
     """A submission's status, the problems finished so far, and its report once done."""
-    submission = get_submission(session, caller, submission_id)
+    submission = get_submission(session, caller, assignment, submission_id)
     return detail(submission, disclosure, overrides_shown(session, submission, disclosure))
 
 
 @router.get(
     "/submissions",
     response_model=list[SubmissionSummary],
-    responses=error_responses(NotAuthenticated, StudentNotFound, InvalidRequest),
+    responses=error_responses(NotAuthenticated, CourseNotFound, StudentNotFound, InvalidRequest),
 )
 def get_submissions(
     session: SessionDep,
+    assignment: AssignmentDep,
     caller: CallerDep,
     disclosure: DisclosureDep,
     student: str | None = Query(default=None, description="Instructor only: one student's submissions."),
 ) -> list[SubmissionSummary]:
     """The caller's submissions, newest first (the instructor sees everyone's)."""
-    return [summary(item, disclosure) for item in list_submissions(session, caller, student)]
+    return [summary(item, disclosure) for item in list_submissions(session, caller, assignment, student)]
 
 
 def document_upload_rules(openapi: dict[str, Any], max_upload_bytes: int) -> None:
@@ -133,10 +142,13 @@ def document_upload_rules(openapi: dict[str, Any], max_upload_bytes: int) -> Non
         max_upload_bytes: GYMGRADE_MAX_UPLOAD_BYTES, the limit the schema states.
     """
     content, encoding = upload_rules(max_upload_bytes)
-    media = openapi["paths"]["/submissions"]["post"]["requestBody"]["content"]["multipart/form-data"]
-    body_name = media["schema"]["$ref"].rsplit("/", 1)[-1]
-    openapi["components"]["schemas"][body_name]["properties"]["file"].update(content)
-    media["encoding"] = {"file": encoding}
+    for path, item in openapi["paths"].items():
+        if not path.endswith("/submissions") or "post" not in item:
+            continue  # the default assignment's upload, and every assignment's under its prefix
+        media = item["post"]["requestBody"]["content"]["multipart/form-data"]
+        body_name = media["schema"]["$ref"].rsplit("/", 1)[-1]
+        openapi["components"]["schemas"][body_name]["properties"]["file"].update(content)
+        media["encoding"] = {"file": encoding}
 
 
 @router.post(
@@ -144,7 +156,12 @@ def document_upload_rules(openapi: dict[str, Any], max_upload_bytes: int) -> Non
     status_code=202,
     response_model=SubmissionAccepted,
     responses=error_responses(
-        NotAuthenticated, InstructorOnly, SubmissionNotFound, GradingInProgress, InvalidRequest
+        NotAuthenticated,
+        CourseNotFound,
+        InstructorOnly,
+        SubmissionNotFound,
+        GradingInProgress,
+        InvalidRequest,
     ),
 )
 def post_regrade(
@@ -153,12 +170,13 @@ def post_regrade(
     submission_id: int,
     session: SessionDep,
     dispatcher: DispatcherDep,
+    assignment: AssignmentDep,
     instructor: InstructorDep,
 ) -> SubmissionAccepted:
     """Grade one upload again on its recorded seed (after a fix to the grader or the configuration); poll
     GET /submissions/{id}. The instructor's overrides stay."""
-    regrade(session, [get_submission(session, instructor, submission_id)], dispatcher)
-    response.headers["Location"] = request.app.url_path_for("get_one_submission", submission_id=submission_id)
+    regrade(session, [get_submission(session, instructor, assignment, submission_id)], dispatcher)
+    response.headers["Location"] = request.url.path.removesuffix("/regrade")
     return SubmissionAccepted(id=submission_id)
 
 
@@ -167,12 +185,16 @@ def post_regrade(
     status_code=202,
     response_model=list[SubmissionAccepted],
     responses=error_responses(
-        NotAuthenticated, InstructorOnly, StudentNotFound, GradingInProgress, InvalidRequest
+        NotAuthenticated, CourseNotFound, InstructorOnly, StudentNotFound, GradingInProgress, InvalidRequest
     ),
 )
 def post_student_regrade(
-    name: str, session: SessionDep, dispatcher: DispatcherDep, instructor: InstructorDep
+    name: str,
+    session: SessionDep,
+    dispatcher: DispatcherDep,
+    assignment: AssignmentDep,
+    instructor: InstructorDep,
 ) -> list[SubmissionAccepted]:
     """Grade every upload of one student again, each on its recorded seed; nobody else's is touched."""
-    ids = regrade(session, list_submissions(session, instructor, name), dispatcher)
+    ids = regrade(session, list_submissions(session, instructor, assignment, name), dispatcher)
     return [SubmissionAccepted(id=submission_id) for submission_id in ids]

@@ -10,7 +10,15 @@ from fastapi.responses import RedirectResponse, Response
 from sqlalchemy.orm import Session
 
 from api.auth import Principal, authenticate
-from api.deps import SESSION_COOKIE, ContextDep, DispatcherDep, PageCallerDep, SessionDep, SettingsDep
+from api.deps import (
+    SESSION_COOKIE,
+    ContextDep,
+    DispatcherDep,
+    PageAssignmentDep,
+    PageCallerDep,
+    SessionDep,
+    SettingsDep,
+)
 from api.disclosure import disclosure_for
 from api.errors import (
     InvalidRequest,
@@ -20,11 +28,11 @@ from api.errors import (
     StudentNotFound,
     SubmissionNotFound,
 )
-from api.gradebook import gradebook_csv, late_policy_of
+from api.gradebook import gradebook_csv
 from api.lti.publisher import publishing_status
 from api.lti.roster import import_roster
 from api.lti.sessions import SESSION_PARAMETER
-from api.models import JobStatus, LtiLink
+from api.models import Assignment, JobStatus, LtiLink
 from api.overrides import overrides_shown, record_override
 from api.settings import Settings
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
@@ -61,11 +69,17 @@ def _signed_in(caller: Principal | None) -> Principal:
 
 
 @router.get("/")
-def home(request: Request, session: SessionDep, caller: PageCallerDep, settings: SettingsDep) -> Response:
+def home(
+    request: Request,
+    session: SessionDep,
+    caller: PageCallerDep,
+    settings: SettingsDep,
+    assignment: PageAssignmentDep,
+) -> Response:
     """The start page: the sign-in form, or the caller's submissions and the upload form."""
     if caller is None:
         return _page(request, "signin.html", {})
-    return _home(request, session, caller, settings, None)
+    return _home(request, session, caller, settings, assignment, None)
 
 
 @router.post("/ui/lti/roster")
@@ -113,6 +127,7 @@ def upload(
     session: SessionDep,
     settings: SettingsDep,
     dispatcher: DispatcherDep,
+    assignment: PageAssignmentDep,
     caller: PageCallerDep,
     file: Annotated[UploadFile, File()],
 ) -> Response:
@@ -120,24 +135,32 @@ def upload(
     student = _signed_in(caller).require_student()
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
-    submission = create_submission(session, settings, student, upload, dispatcher)
+    submission = create_submission(session, settings, assignment, student, upload, dispatcher)
     return RedirectResponse(f"/ui/submissions/{submission.id}{_session_query(caller)}", status_code=303)
 
 
 @router.get("/ui/submissions/{submission_id}")
 def submission_page(
-    request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep, settings: SettingsDep
+    request: Request,
+    submission_id: int,
+    session: SessionDep,
+    caller: PageCallerDep,
+    assignment: PageAssignmentDep,
 ) -> Response:
     """A submission's page; its live part is refreshed from the fragment below until grading ends."""
-    return _submission(request, "submission.html", session, _signed_in(caller), settings, submission_id)
+    return _submission(request, "submission.html", session, _signed_in(caller), assignment, submission_id)
 
 
 @router.get("/ui/submissions/{submission_id}/live")
 def submission_fragment(
-    request: Request, submission_id: int, session: SessionDep, caller: PageCallerDep, settings: SettingsDep
+    request: Request,
+    submission_id: int,
+    session: SessionDep,
+    caller: PageCallerDep,
+    assignment: PageAssignmentDep,
 ) -> Response:
     """The live part of a submission's page: status, finished problems, report."""
-    return _submission(request, "_live.html", session, _signed_in(caller), settings, submission_id)
+    return _submission(request, "_live.html", session, _signed_in(caller), assignment, submission_id)
 
 
 def _submission(
@@ -145,11 +168,11 @@ def _submission(
     template: str,
     session: Session,
     caller: Principal,
-    settings: Settings,
+    assignment: Assignment,
     submission_id: int,
 ) -> Response:
-    disclosure = disclosure_for(caller, settings)
-    submission = get_submission(session, caller, submission_id)
+    disclosure = disclosure_for(caller, assignment)
+    submission = get_submission(session, caller, assignment, submission_id)
     view = detail(submission, disclosure, overrides_shown(session, submission, disclosure))
     return _page(request, template, {"submission": view, "final": view.status in FINAL_STATUSES})
 
@@ -159,6 +182,7 @@ def override(
     request: Request,
     session: SessionDep,
     settings: SettingsDep,
+    assignment: PageAssignmentDep,
     caller: PageCallerDep,
     student: Annotated[str, Form()] = "",
     problem: Annotated[str, Form()] = "",
@@ -173,15 +197,24 @@ def override(
         value = float(points)
         upload = int(submission_id) if submission_id.strip() else None
     except ValueError:
-        return _home(request, session, signed_in, settings, f"points {points!r} is not a number", error=True)
+        return _home(
+            request,
+            session,
+            signed_in,
+            settings,
+            assignment,
+            f"points {points!r} is not a number",
+            error=True,
+        )
     try:
         record_override(
-            session, student_name=student, problem=problem.strip(), points=value, reason=reason,
+            session, assignment, student_name=student, problem=problem.strip(), points=value, reason=reason,
             author=signed_in.name, submission_id=upload,
         )  # fmt: skip
     except (InvalidRequest, NothingGradedYet, StudentNotFound, SubmissionNotFound) as refused:
-        return _home(request, session, signed_in, settings, str(refused), error=True)
-    return _home(request, session, signed_in, settings, f"{problem} of {student} set to {value:g}: {reason}")
+        return _home(request, session, signed_in, settings, assignment, str(refused), error=True)
+    kept = f"{problem} of {student} set to {value:g}: {reason}"
+    return _home(request, session, signed_in, settings, assignment, kept)
 
 
 def _home(
@@ -189,27 +222,28 @@ def _home(
     session: Session,
     caller: Principal,
     settings: Settings,
+    assignment: Assignment,
     message: str | None,
     *,
     error: bool = False,
 ) -> Response:
     """The start page of a signed-in caller, with the outcome of an override when there is one."""
-    disclosure = disclosure_for(caller, settings)
-    submissions = [summary(item, disclosure) for item in list_submissions(session, caller)]
+    disclosure = disclosure_for(caller, assignment)
+    submissions = [summary(item, disclosure) for item in list_submissions(session, caller, assignment)]
     context = {
         "caller": caller, "submissions": submissions, "max_upload_bytes": settings.max_upload_bytes,
-        "lms_scores": publishing_status(session) if caller.is_instructor else [],
+        "lms_scores": publishing_status(session, assignment.course_id) if caller.is_instructor else [],
         "override_message": message, "override_error": error,
     }  # fmt: skip
     return _page(request, "home.html", context, status_code=422 if error else 200)
 
 
 @router.get("/ui/gradebook.csv")
-def gradebook_download(session: SessionDep, settings: SettingsDep, caller: PageCallerDep) -> Response:
+def gradebook_download(session: SessionDep, assignment: PageAssignmentDep, caller: PageCallerDep) -> Response:
     """The gradebook for the signed-in instructor."""
     _signed_in(caller).require_instructor()
     return Response(
-        gradebook_csv(session, settings.gradebook_policy, late_policy_of(settings)),
+        gradebook_csv(session, assignment),
         media_type="text/csv; charset=utf-8",
         headers={"Content-Disposition": 'attachment; filename="gradebook.csv"'},
     )

@@ -11,9 +11,10 @@ from api_testing import INSTRUCTOR_TOKEN, SettingsFactory, add_student, bearer, 
 from fastapi.testclient import TestClient
 
 from api.auth import Principal
+from api.courses import default_values
 from api.disclosure import FULL, Disclosure, disclosure_for, problem_view, report_view
 from api.main import create_app
-from api.models import Student
+from api.models import Assignment, Student
 from grader.report import ProblemResult, Report, Visibility
 
 DUE = datetime(2026, 12, 1, 12, 0, tzinfo=UTC)
@@ -82,7 +83,8 @@ def test_what_each_caller_may_see(
     seeds: bool,
     shown: set[str],
 ) -> None:
-    disclosure = disclosure_for(caller, make_settings(**settings), now)
+    assignment = Assignment(**default_values(make_settings(**settings)))
+    disclosure = disclosure_for(caller, assignment, now)
     assert (disclosure.seeds, set(disclosure.shown)) == (seeds, shown)
 
 

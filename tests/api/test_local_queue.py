@@ -11,6 +11,7 @@ import pytest
 from api_testing import BOTH_DATABASES, SettingsFactory
 from sqlalchemy.orm import Session, sessionmaker
 
+from api.courses import DEFAULT_ASSIGNMENT_ID, DEFAULT_COURSE_ID
 from api.database import make_engine, make_session_factory, migrate
 from api.jobs.local import DatabaseQueue
 from api.models import JobStatus, Student, Submission, utcnow
@@ -34,11 +35,16 @@ def _queue(
 
 def _submit(sessions: sessionmaker[Session], count: int = 1) -> list[int]:
     with sessions() as session:
-        student = Student(name=f"student-{time.monotonic_ns()}", token_sha256=f"{time.monotonic_ns():064d}")
+        student = Student(
+            course_id=DEFAULT_COURSE_ID,
+            name=f"student-{time.monotonic_ns()}",
+            token_sha256=f"{time.monotonic_ns():064d}",
+        )
         session.add(student)
         session.flush()
         rows = [
             Submission(
+                assignment_id=DEFAULT_ASSIGNMENT_ID,
                 student_id=student.id,
                 filename="opengym.py",
                 sha256="0" * 64,

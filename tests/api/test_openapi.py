@@ -12,6 +12,7 @@ from pydantic import SecretStr
 from schemathesis.checks import not_a_server_error
 
 from api.context import ServiceContext
+from api.courses import DEFAULT_COURSE_ID
 from api.main import create_app
 from api.settings import Settings
 from api.students import create_student
@@ -40,7 +41,7 @@ def service_settings(tmp_path_factory: pytest.TempPathFactory, request: pytest.F
 def student_token(service_settings: Settings) -> str:
     context = ServiceContext.open(service_settings, pool_size=0)
     with context.sessions() as session:
-        _, token = create_student(session, "schemathesis")
+        _, token = create_student(session, DEFAULT_COURSE_ID, "schemathesis")
     context.close()
     return token
 

@@ -7,7 +7,7 @@ import sqlalchemy as sa
 from alembic import op
 
 revision = "0005"
-down_revision = "0003"  # the lead re-chains this after 0004_courses at merge time
+down_revision = "0004"
 branch_labels = None
 depends_on = None
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from api.lti.claims import Role, role_of
+from api.lti.claims import Role, is_teaching_assistant, role_of
 from api.lti.launch import Launch, frame_origins
 from api.lti.sessions import redacted
 from api.models import LtiPlatform
@@ -88,3 +88,20 @@ def test_registered_ancestors_frame_the_tool_whole_origins_only() -> None:
     kept = frame_origins(launch).split(" ")
     assert len(" ".join(kept)) <= 500 and all(origin.endswith(".example.edu") for origin in kept[1:])
     assert len(kept) < 11, "every origin was kept past the column's 500 characters"
+
+
+@pytest.mark.parametrize(
+    ("roles", "teaching_assistant"),
+    [
+        ([f"{MEMBERSHIP}#Instructor"], False),
+        ([f"{MEMBERSHIP}#Administrator"], False),
+        ([f"{MEMBERSHIP}#Instructor", f"{MEMBERSHIP}/Instructor#TeachingAssistant"], True),
+        ([f"{MEMBERSHIP}#TeachingAssistant"], True),
+    ],
+    ids=["instructor", "administrator", "canvas-ta", "membership-ta"],
+)
+def test_a_teaching_assistant_is_told_apart_from_an_instructor(
+    roles: list[str], teaching_assistant: bool
+) -> None:
+    assert role_of(roles) is Role.STAFF
+    assert is_teaching_assistant(roles) is teaching_assistant

@@ -10,6 +10,7 @@ import pytest
 from api_testing import BOTH_DATABASES, SettingsFactory
 from sqlalchemy.orm import Session
 
+from api.courses import DEFAULT_ASSIGNMENT_ID, DEFAULT_COURSE_ID
 from api.database import make_engine, make_session_factory, migrate
 from api.lti.publisher import (
     FAILED,
@@ -21,7 +22,18 @@ from api.lti.publisher import (
     publishing_status,
     sync_outbox,
 )
-from api.models import LtiLink, LtiMember, LtiPlatform, LtiScore, LtiUser, Student, Submission, utcnow
+from api.models import (
+    Assignment,
+    LtiLink,
+    LtiMember,
+    LtiPlatform,
+    LtiScore,
+    LtiUser,
+    Student,
+    Submission,
+    utcnow,
+)
+from api.overrides import record_override
 from api.settings import GradebookPolicy
 
 
@@ -53,6 +65,7 @@ def _member(session: Session, name: str, lineitem_url: str | None = None) -> tup
                 deployment_id="d",
                 context_id="course",
                 resource_link_id="link",
+                assignment_id=DEFAULT_ASSIGNMENT_ID,
                 title="",
                 ags_scopes=[],
                 custom={},
@@ -61,11 +74,13 @@ def _member(session: Session, name: str, lineitem_url: str | None = None) -> tup
         session.flush()
     link = session.query(LtiLink).one()
     link.lineitem_url = lineitem_url
-    student = Student(name=name, token_sha256=name.ljust(64, "0"))
-    session.add(student)
-    session.flush()
-    user = LtiUser(platform_id=platform.id, sub="sub-" + name, student_id=student.id, name=name)
+    user = LtiUser(platform_id=platform.id, sub="sub-" + name, name=name)
     session.add(user)
+    session.flush()
+    student = Student(
+        course_id=DEFAULT_COURSE_ID, name=name, token_sha256=name.ljust(64, "0"), lti_user_id=user.id
+    )
+    session.add(student)
     session.flush()
     member = LtiMember(link_id=link.id, user_id=user.id)
     session.add(member)
@@ -75,6 +90,7 @@ def _member(session: Session, name: str, lineitem_url: str | None = None) -> tup
 
 def _graded(session: Session, student: Student, score: float, status: str = "done") -> Submission:
     row = Submission(
+        assignment_id=DEFAULT_ASSIGNMENT_ID,
         student_id=student.id,
         filename="opengym.py",
         sha256="0" * 64,
@@ -90,6 +106,13 @@ def _graded(session: Session, student: Student, score: float, status: str = "don
     session.add(row)
     session.commit()
     return row
+
+
+def _sync(session: Session, policy: GradebookPolicy) -> int:
+    """One outbox round with the default assignment keeping its ``policy``'s score."""
+    session.get_one(Assignment, DEFAULT_ASSIGNMENT_ID).gradebook_policy = policy.value
+    session.commit()
+    return sync_outbox(session)
 
 
 def _row(session: Session, member: LtiMember) -> LtiScore:
@@ -109,21 +132,21 @@ def test_a_regrade_that_changes_the_score_is_sent_again_and_one_that_does_not_is
 ) -> None:
     student, member = _member(session, "ada")
     submission = _graded(session, student, 1.0)
-    assert sync_outbox(session, GradebookPolicy.LATEST) == 1
+    assert _sync(session, GradebookPolicy.LATEST) == 1
     assert (_row(session, member).status, _row(session, member).score) == (PENDING, 1.0)
     _as_sent(session, member)
 
     submission.status = "queued"  # a regrade: the row is graded again
     session.commit()
-    assert sync_outbox(session, GradebookPolicy.LATEST) == 0, "a score still held by the LMS"
+    assert _sync(session, GradebookPolicy.LATEST) == 0, "a score still held by the LMS"
     submission.status, submission.score = "done", 1.0
     session.commit()
-    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
+    assert _sync(session, GradebookPolicy.LATEST) == 0
     assert _row(session, member).status == SENT
 
     submission.score = 2.0  # the regrade found more
     session.commit()
-    assert sync_outbox(session, GradebookPolicy.LATEST) == 1
+    assert _sync(session, GradebookPolicy.LATEST) == 1
     assert (_row(session, member).status, _row(session, member).score) == (PENDING, 2.0)
 
 
@@ -138,28 +161,28 @@ def test_the_gradebook_policy_chooses_the_score_sent(
         _graded(session, student, score)
     _graded(session, student, 0.0, status="failed")
     _graded(session, student, 0.0, status="queued")
-    sync_outbox(session, policy)
+    _sync(session, policy)
     assert _row(session, member).score == kept
 
 
 def test_a_student_without_a_graded_submission_gets_no_row(session: Session) -> None:
     student, _ = _member(session, "cy")
     _graded(session, student, 0.0, status="running")
-    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
-    assert publishing_status(session) == []
+    assert _sync(session, GradebookPolicy.LATEST) == 0
+    assert publishing_status(session, DEFAULT_COURSE_ID) == []
 
 
 def test_going_back_to_the_score_the_lms_holds_sends_nothing(session: Session) -> None:
     student, member = _member(session, "dee")
     first = _graded(session, student, 2.0)
-    sync_outbox(session, GradebookPolicy.BEST)
+    _sync(session, GradebookPolicy.BEST)
     _as_sent(session, member)
     later = _graded(session, student, 3.0)
-    sync_outbox(session, GradebookPolicy.BEST)
+    _sync(session, GradebookPolicy.BEST)
     assert (_row(session, member).status, _row(session, member).submission_id) == (PENDING, later.id)
     later.score = 1.0  # regraded lower before it was sent: the best is the score the LMS holds already
     session.commit()
-    sync_outbox(session, GradebookPolicy.BEST)
+    _sync(session, GradebookPolicy.BEST)
     row = _row(session, member)
     assert (row.status, row.submission_id, row.score) == (SENT, first.id, 2.0)
 
@@ -167,12 +190,12 @@ def test_going_back_to_the_score_the_lms_holds_sends_nothing(session: Session) -
 def test_the_instructor_sees_each_students_state_and_error(session: Session) -> None:
     student, member = _member(session, "eve")
     _graded(session, student, 1.0)
-    sync_outbox(session, GradebookPolicy.LATEST)
+    _sync(session, GradebookPolicy.LATEST)
     row = _row(session, member)
     row.status, row.attempts, row.error = RETRYING, 2, "publishing the score: the LMS answered 500"
     row.next_attempt_at = utcnow() + timedelta(seconds=4)
     session.commit()
-    (shown,) = publishing_status(session)
+    (shown,) = publishing_status(session, DEFAULT_COURSE_ID)
     assert shown["student"] == "eve"
     assert (shown["status"], shown["attempts"], shown["error"]) == (
         RETRYING,
@@ -188,7 +211,7 @@ def test_the_instructor_sees_each_students_state_and_error(session: Session) -> 
     ids=lambda value: str(value),
 )
 def test_refused_sends_wait_twice_as_long_each_time_up_to_ten_minutes(attempts: int, seconds: float) -> None:
-    assert PublishPolicy(GradebookPolicy.LATEST, 8, 2.0).wait(attempts) == seconds
+    assert PublishPolicy(8, 2.0).wait(attempts) == seconds
 
 
 def test_the_states_are_distinct() -> None:
@@ -205,7 +228,7 @@ def test_a_submission_being_graded_is_announced_without_a_score_where_the_line_i
 ) -> None:
     student, member = _member(session, "fay", lineitem_url)
     submission = _graded(session, student, 0.0, status="queued")
-    sync_outbox(session, GradebookPolicy.LATEST)
+    _sync(session, GradebookPolicy.LATEST)
     session.expire_all()
     assert [(row.status, row.score) for row in session.query(LtiScore).all()] == expected
     if not expected:
@@ -213,28 +236,28 @@ def test_a_submission_being_graded_is_announced_without_a_score_where_the_line_i
     _as_sent(session, member)
     submission.status, submission.score, submission.max_score = "done", 2.0, 3.0
     session.commit()
-    sync_outbox(session, GradebookPolicy.LATEST)
+    _sync(session, GradebookPolicy.LATEST)
     assert (_row(session, member).status, _row(session, member).score) == (PENDING, 2.0)
 
 
 def test_a_new_upload_never_announces_pending_over_a_score_the_lms_holds(session: Session) -> None:
     student, member = _member(session, "gus", "https://lms.example/lineitems/1")
     graded = _graded(session, student, 2.0)
-    sync_outbox(session, GradebookPolicy.LATEST)
+    _sync(session, GradebookPolicy.LATEST)
     _as_sent(session, member)
     _graded(session, student, 0.0, status="running")
-    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
+    assert _sync(session, GradebookPolicy.LATEST) == 0
     assert (_row(session, member).status, _row(session, member).submission_id) == (SENT, graded.id)
 
 
 def test_a_regrade_of_the_only_graded_upload_never_announces_pending_over_its_score(session: Session) -> None:
     student, member = _member(session, "hal", "https://lms.example/lineitems/1")
     submission = _graded(session, student, 2.0)
-    sync_outbox(session, GradebookPolicy.LATEST)
+    _sync(session, GradebookPolicy.LATEST)
     _as_sent(session, member)
     submission.status = "running"  # regraded: for a while nothing of the student's is graded
     session.commit()
-    assert sync_outbox(session, GradebookPolicy.LATEST) == 0
+    assert _sync(session, GradebookPolicy.LATEST) == 0
     assert (_row(session, member).status, _row(session, member).score) == (SENT, 2.0)
 
 
@@ -265,3 +288,26 @@ def test_the_publisher_counts_its_finished_rounds_and_says_when_it_stopped(
     stopped = publisher.progress()
     assert not stopped["running"] and stopped["rounds"] >= running["rounds"]
     assert stopped["last_round_at"] >= running["last_round_at"]
+
+
+def test_the_lms_is_sent_the_final_score_again_when_an_override_or_the_late_policy_changes_it(
+    session: Session,
+) -> None:
+    student, member = _member(session, "ida")
+    submission = _graded(session, student, 2.0)
+    submission.report = {"problems": [{"id": "car", "score": 2.0, "max_score": 3.0}]}
+    assignment = session.get_one(Assignment, DEFAULT_ASSIGNMENT_ID)
+    _sync(session, GradebookPolicy.LATEST)
+    _as_sent(session, member)
+    record_override(
+        session, assignment, student_name="ida", problem="car", points=3.0, reason="by hand", author="t"
+    )
+    assert _sync(session, GradebookPolicy.LATEST) == 1
+    assert (_row(session, member).status, _row(session, member).score) == (PENDING, 3.0)
+    _as_sent(session, member)
+    due = submission.created_at - timedelta(days=1, seconds=1)  # two days late: half the maximum (3) taken
+    assignment.late_policy = {"due": due.isoformat() + "+00:00", "penalty_per_day": 0.25}
+    session.commit()
+    assert _sync(session, GradebookPolicy.LATEST) == 1
+    assert (_row(session, member).status, _row(session, member).score) == (PENDING, 1.5)
+    assert _sync(session, GradebookPolicy.LATEST) == 0, "an unchanged final score is not sent again"
