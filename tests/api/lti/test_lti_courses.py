@@ -15,7 +15,7 @@ import pytest
 from api_testing import instructor_headers
 from live_server import LiveProcess
 from lti_platform import INSTRUCTOR, LEARNER, TEACHING_ASSISTANT, LaunchSpec, LtiPlatform
-from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, landed, tool_environment, upload, wait
+from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, browser, landed, tool_environment, upload, wait
 
 from api.lti.claims import CONTEXT
 
@@ -64,7 +64,7 @@ def test_each_context_is_a_course_and_a_role_counts_in_its_own_only(
     teacher_b = platform.add_person("teacher-b", "Bert Instructor", INSTRUCTOR)
     ta_b = platform.add_person("ta-b", "Tia Assistant", TEACHING_ASSISTANT, INSTRUCTOR)
     lee = platform.add_person("learner-lee", "Lee Twice", LEARNER)
-    with httpx.Client() as client:
+    with browser() as client:
         staff_a, _ = landed(client, tool.url, platform.launch(client, LaunchSpec(teacher_a, "link-a")))
         staff_b, page = landed(
             client, tool.url, platform.launch(client, LaunchSpec(teacher_b, "link-b", claims=COURSE_B))
