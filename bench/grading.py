@@ -16,7 +16,6 @@ import argparse
 import heapq
 import os
 import platform
-import re
 import sys
 import time
 from datetime import date
@@ -25,11 +24,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from results_section import replace_section  # noqa: E402
+
 from grader.grading.grade import grade_submission  # noqa: E402
 from grader.report import Report  # noqa: E402
 from grader.sandbox import IsolationPolicy  # noqa: E402
-
-RESULTS = ROOT / "bench" / "RESULTS.md"
 
 
 def list_schedule(durations: list[float], workers: int) -> float:
@@ -114,14 +113,7 @@ def section(
 
 def write_section(text: str) -> None:
     """Replace (or append) the `## Grading` section of bench/RESULTS.md."""
-    current = RESULTS.read_text(encoding="utf-8")
-    pattern = re.compile(r"^## Grading\n.*?(?=^## |\Z)", re.MULTILINE | re.DOTALL)
-    updated = (
-        pattern.sub(lambda _: text + "\n", current)
-        if pattern.search(current)
-        else (current.rstrip("\n") + "\n\n\n" + text)
-    )
-    RESULTS.write_text(updated, encoding="utf-8")
+    replace_section("## Grading", text + "\n")
 
 
 def main() -> None:

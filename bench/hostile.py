@@ -17,15 +17,15 @@ import argparse
 import json
 import os
 import platform
-import re
 import subprocess
 import sys
 import time
 from datetime import date
 from pathlib import Path
 
+from results_section import replace_section
+
 ROOT = Path(__file__).resolve().parents[1]
-RESULTS = ROOT / "bench" / "RESULTS.md"
 HEADING = "## Integrity and bounded cost"
 
 HONEST = "classic_complete.py"
@@ -147,10 +147,7 @@ def main() -> None:
     text = table(rows, call_seconds, arguments.heading, (before, os.getloadavg()))
     print(text)
     if arguments.write:
-        current = RESULTS.read_text(encoding="utf-8")
-        pattern = re.compile(rf"^{re.escape(arguments.heading)}\n.*?(?=^## |\Z)", re.S | re.M)
-        updated = pattern.sub(text + "\n", current) if pattern.search(current) else current + "\n" + text
-        RESULTS.write_text(updated, encoding="utf-8")
+        replace_section(arguments.heading, text + "\n")
 
 
 if __name__ == "__main__":

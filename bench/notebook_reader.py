@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import re
 import resource
 import statistics
 import sys
@@ -29,12 +28,12 @@ sys.path.insert(0, str(ROOT))
 
 import nbformat  # noqa: E402
 from nbformat.v4 import new_code_cell, new_notebook  # noqa: E402
+from results_section import replace_section  # noqa: E402
 
 from grader.lab.problems import PROBLEM_IDS  # noqa: E402
 from grader.submission.notebook import NotebookModule, build_module  # noqa: E402
 from grader.submission.notebook.bounded import CPU_SECONDS, MEMORY_BYTES  # noqa: E402
 
-RESULTS = ROOT / "bench" / "RESULTS.md"
 HEADING = "## Fourth round: notebook reader"
 SAMPLES = [
     *sorted((ROOT / "submissions" / "notebooks").glob("*.ipynb")),
@@ -121,12 +120,7 @@ def main() -> None:
     text = "\n".join(lines)
     print(text)
     if arguments.write:
-        current = RESULTS.read_text(encoding="utf-8")
-        pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.S | re.M)
-        updated = (
-            pattern.sub(text + "\n", current) if pattern.search(current) else current.rstrip() + "\n\n" + text
-        )
-        RESULTS.write_text(updated, encoding="utf-8")
+        replace_section(HEADING, text + "\n")
 
 
 if __name__ == "__main__":

@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import re
 import statistics
 import sys
 import time
@@ -25,6 +24,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from results_section import replace_section  # noqa: E402
+
 from grader.grading.grade import grade_submission  # noqa: E402
 from grader.lab.assignment import load_config  # noqa: E402
 from grader.lab.problems import PROBLEM_IDS  # noqa: E402
@@ -33,7 +34,6 @@ from grader.render.html import render_html  # noqa: E402
 from grader.report import Report  # noqa: E402
 from grader.submission.notebook import NotebookModule, build_module  # noqa: E402
 
-RESULTS = ROOT / "bench" / "RESULTS.md"
 PY = ROOT / "submissions" / "classic_complete.py"
 NOTEBOOK = ROOT / "submissions" / "notebooks" / "classic_complete.ipynb"
 HEADING = "## Reach (issue 10)"
@@ -133,10 +133,7 @@ def main() -> int:
     text = section(only, times, build_ms, report, load)
     print(text)
     if args.write:
-        current = RESULTS.read_text(encoding="utf-8")
-        pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.MULTILINE | re.DOTALL)
-        updated = pattern.sub(text, current) if pattern.search(current) else current.rstrip() + "\n\n" + text
-        RESULTS.write_text(updated, encoding="utf-8")
+        replace_section(HEADING, text)
     return 0
 
 
