@@ -91,7 +91,33 @@ def _serve(
     return ServedRaw(real, stepper, limit)
 
 
-class ServedWrapper(gymnasium.Wrapper[Any, Any, Any, Any]):
+class _PlayedThroughStepper:
+    """What every served level does alike: reset, step and close through the chain's stepper (so each
+    episode is recorded at whichever level it is played; below the time limit its truncation is not seen),
+    and render as the real object it stands for does."""
+
+    served: gymnasium.Env[Any, Any]
+    stepper: gymnasium.Env[Any, Any]
+    limit: TimeLimit[Any, Any] | None
+
+    def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
+        """Reset through the stepper (the recorder deals the start)."""
+        return self.stepper.reset(seed=seed, options=options)  # type: ignore[no-any-return]
+
+    def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
+        """Step through the stepper; below the time limit (for the raw env: always), no truncation by it."""
+        return below_time_limit(self.stepper.step(action), self.limit)  # type: ignore[return-value]
+
+    def render(self) -> Any:
+        """Render as the real wrapper or raw env does."""
+        return self.served.render()
+
+    def close(self) -> None:
+        """Close the whole env (through the stepper, which notes a closed env the grader passed)."""
+        self.stepper.close()
+
+
+class ServedWrapper(_PlayedThroughStepper, gymnasium.Wrapper[Any, Any, Any, Any]):
     """A wrapper of gymnasium's chain as student code sees it: `env.env` of `gym.make`'s env, and so on.
 
     Its `env` is the next served level; `reset` and `step` go through the chain's stepper (the recorder), so
@@ -117,22 +143,6 @@ class ServedWrapper(gymnasium.Wrapper[Any, Any, Any, Any]):
     def served_of(level: ServedWrapper) -> gymnasium.Env[Any, Any]:
         """The real wrapper `level` stands for (read by `real_env`)."""
         return level.served
-
-    def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
-        """Reset through the stepper (the recorder deals the start)."""
-        return self.stepper.reset(seed=seed, options=options)  # type: ignore[no-any-return]
-
-    def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
-        """Step through the stepper; below the time limit, its truncation is not seen."""
-        return below_time_limit(self.stepper.step(action), self.limit)  # type: ignore[return-value]
-
-    def render(self) -> Any:
-        """Render as the real wrapper does."""
-        return self.served.render()
-
-    def close(self) -> None:
-        """Close the whole env (through the stepper, which notes a closed env the grader passed)."""
-        self.stepper.close()
 
     @property
     def spec(self) -> Any:  # type: ignore[override]
@@ -170,7 +180,7 @@ class ServedWrapper(gymnasium.Wrapper[Any, Any, Any, Any]):
 _RAW_OWN = frozenset({"served", "stepper", "limit"})
 
 
-class ServedRaw(gymnasium.Env[Any, Any]):
+class ServedRaw(_PlayedThroughStepper, gymnasium.Env[Any, Any]):
     """The raw env as the last `env.env` of the chain: its own attributes read and written, its episodes
     stepped through the chain's stepper (recorded), with no time limit."""
 
@@ -189,22 +199,6 @@ class ServedRaw(gymnasium.Env[Any, Any]):
     def served_of(level: ServedRaw) -> gymnasium.Env[Any, Any]:
         """The raw env `level` stands for (read by `real_env`)."""
         return level.served  # type: ignore[no-any-return]
-
-    def reset(self, *, seed: Any = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
-        """Reset through the stepper (the recorder deals the start)."""
-        return self.stepper.reset(seed=seed, options=options)  # type: ignore[no-any-return]
-
-    def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
-        """Step through the stepper; the raw env has no time limit."""
-        return below_time_limit(self.stepper.step(action), self.limit)  # type: ignore[return-value]
-
-    def render(self) -> Any:
-        """Render as the raw env does."""
-        return self.served.render()
-
-    def close(self) -> None:
-        """Close the whole env (through the stepper)."""
-        self.stepper.close()
 
     @property
     def unwrapped(self) -> gymnasium.Env[Any, Any]:
