@@ -12,7 +12,7 @@ from fake_grader import held
 from sqlalchemy import select
 from sqlalchemy.orm import Session, sessionmaker
 
-from api.courses import DEFAULT_ASSIGNMENT_ID, DEFAULT_COURSE_ID
+from api.courses import DEFAULT_ASSIGNMENT_ID, DEFAULT_COURSE_ID, sync_default
 from api.database import make_engine, make_session_factory, migrate
 from api.jobs.local import DatabaseQueue
 from api.jobs.runner import run_job
@@ -46,6 +46,7 @@ def _grade(
     stop: bool = False,
 ) -> Submission:
     with sessions() as session:
+        sync_default(session, settings)  # as a service start does: the default follows the settings
         student = session.scalars(select(Student)).first()
         if student is None:
             student = Student(course_id=DEFAULT_COURSE_ID, name="ada", token_sha256="a" * 64)
