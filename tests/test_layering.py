@@ -35,6 +35,7 @@ GRADER_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("what came in, and plain data", ("submission", "report", "errors", "seeds")),
     ("untrusted execution", ("sandbox",)),
     ("the lab's dialects", ("compat",)),
+    ("the parent's parser", ("parsing",)),
 )
 """The entries of grader/ (its folders and its few plain-data modules), top layer first: a module imports
 only its own layer or those below it (a module of the same layer too, as long as no circle forms)."""

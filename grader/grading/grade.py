@@ -26,12 +26,12 @@ Its contract:
 
 from __future__ import annotations
 
-import ast
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
+from grader import parsing
 from grader.grading.outcomes import GradingListener, OnResult, Outcomes, Silent, Submission
 from grader.grading.plan import GradingPlan
 from grader.grading.plugin import SessionPlan
@@ -234,7 +234,7 @@ def _read_as_notebook(data: bytes, shown: str, plan: GradingPlan, *, valid: bool
                 return None
         except UnicodeDecodeError:
             return None
-    elif defines_only(ast.parse(data), data.decode("utf-8-sig")):
+    elif defines_only(parsing.parse(data), data.decode("utf-8-sig")):
         return None
     served = [problem for problem in plan.problems if _runs_cells_first(plan, problem)]
     edition = EDITIONS.get(plan.edition)

@@ -20,6 +20,8 @@ import re
 import tokenize
 from dataclasses import dataclass, field
 
+from grader import parsing
+
 MAX_TOKENS_PER_FILE = 200_000
 """A lab solution is a few thousand tokens; beyond this a file is padding and is cut (and says so)."""
 OUTPUT_CALLS = frozenset({"print", "clear_output", "display", "pprint"})
@@ -87,7 +89,7 @@ def normalise(source: str) -> NormalisedSource:
         SyntaxError: When it is not Python (also for nesting too deep for the parser).
     """
     try:
-        tree = ast.parse(source)
+        tree = parsing.parse(source)
     except (ValueError, RecursionError, MemoryError) as error:
         raise SyntaxError(f"the parser gave up ({type(error).__name__})") from None
     facts = _facts(tree)

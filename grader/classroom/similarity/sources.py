@@ -10,11 +10,11 @@ setup file), the graded file first; docs/similarity.md says why not the graded f
 
 from __future__ import annotations
 
-import ast
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from grader import parsing
 from grader.classroom import ClassDownload, GradedFileRule, discover
 from grader.classroom.graded_file import is_candidate
 from grader.classroom.model import Skipped
@@ -303,7 +303,7 @@ def _notebook_code(path: Path, data: bytes, shown: str) -> SourceText | Unreadab
 
 def _parses(code: str) -> bool:
     try:
-        ast.parse(code)
+        parsing.parse(code)
     except (SyntaxError, ValueError, RecursionError, MemoryError):
         return False
     return True

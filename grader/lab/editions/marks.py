@@ -15,6 +15,7 @@ import ast
 from dataclasses import dataclass
 from pathlib import Path
 
+from grader import parsing
 from grader.lab.editions.pack import Edition
 from grader.submission.notebook import MAX_NOTEBOOK_BYTES, is_notebook, read_notebook
 from grader.submission.untrusted_file import UnsafeFile, read_untrusted
@@ -113,7 +114,7 @@ def _parsed(sources: list[bytes]) -> list[ast.Module]:
     trees: list[ast.Module] = []
     for source in sources:
         try:
-            trees.append(ast.parse(source))
+            trees.append(parsing.parse(source))
         except (SyntaxError, ValueError, RecursionError, MemoryError):
             continue  # a cell with IPython syntax or a broken cell: the others still count
     return trees

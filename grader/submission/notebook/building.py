@@ -28,6 +28,7 @@ import symtable
 from collections.abc import Collection, Iterator, Sequence
 from dataclasses import dataclass, field
 
+from grader import parsing
 from grader.submission.notebook import rules
 from grader.submission.notebook.ipython import transform_cell
 from grader.submission.notebook.models import NotebookModule, NotebookSummary, SkippedCode, UnboundGlobal
@@ -208,7 +209,7 @@ def _add_cell(builder: _Builder, cell: Cell) -> None:
         for bound in special.binds:
             builder.skipped_bindings.setdefault(bound, entry)
     try:
-        tree = transformed.tree or ast.parse(transformed.source)
+        tree = transformed.tree or parsing.parse(transformed.source)
     except (SyntaxError, ValueError) as error:
         _broken_cell(builder, cell, transformed.source, error)
         return
@@ -639,7 +640,7 @@ def globals_needed(source: str, graded: Collection[str]) -> set[str]:
     for child in module.get_children():
         if child.get_type() in ("function", "class"):
             reads.setdefault(child.get_name(), set()).update(_globals_read(child))
-    for statement in ast.parse(source).body:
+    for statement in parsing.parse(source).body:
         if isinstance(statement, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
             made_of: list[ast.expr | None] = [*statement.decorator_list]
             if not isinstance(statement, ast.ClassDef):

@@ -41,6 +41,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from grader import parsing
+
 ESCAPES = {"!": "shell command", "%": "IPython magic", "?": "help request", ",": "IPython autocall",
            ";": "IPython autocall", "/": "IPython autocall"}  # fmt: skip
 """What the line an escape starts is called in the report (IPython's ESCAPE_SINGLES; ``!!`` and ``??``
@@ -338,7 +340,7 @@ def _parsed(lines: list[str]) -> ast.Module | None:
     trigger, a line starting with ``!``, ``%``, ``?``, ``,``, ``;`` or ``/``, ``= !``, ``= %name`` or a
     trailing ``?``, is a syntax error in Python), and the tokenizer, pure Python and slow, need not run."""
     try:
-        return ast.parse("\n".join(lines))
+        return parsing.parse("\n".join(lines))
     except (SyntaxError, ValueError, MemoryError, RecursionError):
         return None
 

@@ -30,6 +30,7 @@ import re
 from collections.abc import Collection
 from dataclasses import dataclass
 
+from grader import parsing
 from grader.submission.notebook.building import (
     DROPPED_DECORATOR,
     globals_needed,
@@ -101,7 +102,7 @@ def build_script(
     whole_source, whole = _placed([(cell.lines, source) for cell, source in runnable if _parsed(source)])
     run_cells = _runnable_cells(runnable, whole_source, marked=_has_markers(text))
     source, origins = _aligned(builder.future, builder.kept, builder.origins, by_number)
-    if not any(isinstance(kept, _DEFINITIONS) for kept in ast.parse(source).body) and not builder.broken:
+    if not any(isinstance(kept, _DEFINITIONS) for kept in parsing.parse(source).body) and not builder.broken:
         return None  # nothing to call: what the file does at import is its verdict, as it always was
     needed = globals_needed(source, [function for function in graded if function not in served])
     used = sorted(needed & (builder.affected | (builder.touched - builder.defined)))
@@ -262,7 +263,7 @@ def script_cells(text: str) -> list[ScriptCell]:
 
 def _parsed(text: str) -> ast.Module | None:
     try:
-        return ast.parse(text)
+        return parsing.parse(text)
     except (SyntaxError, ValueError):
         return None
 
