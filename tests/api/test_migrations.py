@@ -114,6 +114,11 @@ def test_a_database_of_before_courses_keeps_every_row_in_the_default_course(
     ]
 
 
+def _sent(score: dict[str, object]) -> dict[str, object]:
+    """A score row as migrated: whose, for which link and submission, and what it says."""
+    return {key: score[key] for key in ("student", "link_id", "submission_id", "score", "max_score")}
+
+
 @BOTH_DATABASES
 def test_the_service_answers_on_a_migrated_database_as_before(make_settings: SettingsFactory) -> None:
     settings = make_settings()
@@ -124,7 +129,11 @@ def test_the_service_answers_on_a_migrated_database_as_before(make_settings: Set
         assert client.get("/submissions", headers=bearer(tokens["ada"])).json() == ANSWERS["ada_submissions"]
         overrides = client.get("/students/ada/overrides", headers=instructor_headers()).json()
         assert overrides == ANSWERS["ada_overrides"]
-        assert client.get("/lti/scores", headers=instructor_headers()).json() == ANSWERS["scores"]
+        # the service's publisher may already be trying the fixture's unreachable LMS: what it sends is kept,
+        # how far it got (status, attempts, error) is its own
+        assert [_sent(score) for score in client.get("/lti/scores", headers=instructor_headers()).json()] == [
+            _sent(score) for score in ANSWERS["scores"]
+        ]
         # and it goes on: a job queued before is graded as the default assignment's, an old token uploads,
         # a taken name is still taken, a new student is made
         jobs = client.app.state.context.jobs  # type: ignore[attr-defined]
