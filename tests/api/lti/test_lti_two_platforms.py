@@ -1,6 +1,7 @@
-"""One `gymgrade serve`, two LMSs that are not ours: a platform built on `lti1p3platform` (course A) and an
-Open edX LMS whose LTI side is Open edX's own `lti-consumer-xblock` (its passport shared by two runs of
-course B, 2025 and 2026, deployment "1"). Staff of course B see nothing of A's (nor of B's other run); a
+"""One `gymgrade serve`, two LMSs that are not ours: a platform built on `lti1p3platform` (course A, and
+its second deployment's course with the same context and resource link ids) and an Open edX LMS whose LTI
+side is Open edX's own `lti-consumer-xblock` (its passport shared by two runs of course B, 2025 and 2026,
+deployment "1"). Staff of course B see nothing of A's (nor of B's other run); a
 learner retaking B has two enrolments whose scores reach only their own run's line item; an override in
 B reaches Open edX, which keeps only a newer score; Open edX's NRPS and deep linking answer the tool; a
 session link opened in another browser and a state replayed from another browser are refused."""
@@ -18,6 +19,8 @@ from api_testing import instructor_headers
 from live_server import LiveProcess
 from lti_platform import INSTRUCTOR, LEARNER, LaunchSpec, LtiPlatform
 from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, browser, landed, tool_environment, upload, wait
+
+from api.lti.claims import DEPLOYMENT_ID
 
 pytest.importorskip("lti_consumer", reason="pip install -e '.[dev]' (lti-consumer-xblock)")
 
@@ -60,6 +63,13 @@ def lms(tool: LiveProcess) -> Iterator[Lms]:
         for body in (lms_a.manual_registration, openedx.registration(platforms.passport)):
             response = httpx.post(tool.url + "/lti/platforms", json=body, headers=instructor_headers())
             assert response.status_code == 201, response.text
+            if body["issuer"] == lms_a.issuer:
+                second = httpx.post(
+                    f"{tool.url}/lti/platforms/{response.json()['id']}/deployments",
+                    json={"deployment_id": "deployment-2"},
+                    headers=instructor_headers(),
+                )
+                assert second.status_code == 200, second.text
         yield platforms
 
 
@@ -68,9 +78,8 @@ def _score_at(block: Block, user: User) -> float | None:
     return None if held is None else held.get("scoreGiven")
 
 
-def _scores_at_a(lms_a: LtiPlatform, link: str, sub: str) -> list[float]:
-    items = [item_id for item_id, item in lms_a.line_items.items() if item.get("resourceLinkId") == link]
-    return [s["scoreGiven"] for item in items for s in lms_a.scores.get(item, []) if s["userId"] == sub]
+def _graded(scores: list[dict[str, Any]]) -> list[tuple[str, float]]:
+    return [(s["userId"], s["scoreGiven"]) for s in scores if s.get("scoreGiven") is not None]
 
 
 def _signed_out(client: httpx.Client, tool: LiveProcess, token: str, *, name: str) -> bool:
@@ -82,12 +91,21 @@ def test_two_platforms_courses_apart_retake_and_override(lms: Lms, tool: LivePro
     openedx, run_2025, run_2026 = lms.openedx, lms.run_2025, lms.run_2026
     teacher_a = lms.a.add_person("teacher-a", "Alma Instructor", INSTRUCTOR)
     lee = lms.a.add_person("learner-lee", "Lee Elsewhere", LEARNER)
+    dee = lms.a.add_person("learner-dee", "Dee Deployed", LEARNER)
+    # the second deployment's link: the same context and resource link ids, its own line item
+    deployment_2 = {DEPLOYMENT_ID: "deployment-2"}
+    item_2 = lms.a.add_line_item("link-a", 3.0)
     prof_b = openedx.add_user("bruno", "Bruno Professor", {RUN_2026: "staff"})
     prof_2025 = openedx.add_user("berta", "Berta Former", {RUN_2025: "instructor"})
     rita = openedx.add_user("rita", "Rita Retake", {RUN_2025: "student", RUN_2026: "student"})
     with browser() as client:
         staff_a, _ = landed(client, tool.url, lms.a.launch(client, LaunchSpec(teacher_a, "link-a")))
         lee_a, _ = landed(client, tool.url, lms.a.launch(client, LaunchSpec(lee, "link-a")))
+        dee_a, _ = landed(
+            client,
+            tool.url,
+            lms.a.launch(client, LaunchSpec(dee, "link-a", claims=deployment_2, lineitem=item_2)),
+        )
         staff_2025, _ = landed(client, tool.url, openedx.launch(client, prof_2025, run_2025))
         staff_b, page = landed(client, tool.url, openedx.launch(client, prof_b, run_2026))
         assert "All submissions" in page.text and "signed in as Bruno Professor" in page.text
@@ -96,7 +114,8 @@ def test_two_platforms_courses_apart_retake_and_override(lms: Lms, tool: LivePro
         assert "signed in as Rita Retake" in page.text and 'id="upload"' in page.text
 
         in_a = upload(client, tool.url, lee_a, ONE_PROBLEM)
-        wait(lambda: _scores_at_a(lms.a, "link-a", lee.sub), "Lee's score at LMS A")
+        in_a2 = upload(client, tool.url, dee_a, TWO_PROBLEMS)
+        wait(lambda: len(lms.a.scores) == 2, "Lee's and Dee's scores at LMS A")
         first_try = upload(client, tool.url, rita_2025, ONE_PROBLEM)
         wait(lambda: _score_at(run_2025, rita) is not None, "Rita's 2025 score at Open edX")
         retake = upload(client, tool.url, rita_2026, TWO_PROBLEMS)
@@ -110,12 +129,17 @@ def test_two_platforms_courses_apart_retake_and_override(lms: Lms, tool: LivePro
         assert [(s["userId"], s["scoreGiven"]) for s in run_2026.accepted if "scoreGiven" in s] == [
             (rita.external_id, 2.0)
         ]
-        assert {s["userId"] for scores in lms.a.scores.values() for s in scores} == {lee.sub}
+        (item_1,) = set(lms.a.scores) - {item_2}
+        wait(lambda: _graded(lms.a.scores[item_1]) and _graded(lms.a.scores[item_2]), "graded at LMS A")
+        assert _graded(lms.a.scores[item_1]) == [(lee.sub, 1.0)]
+        assert _graded(lms.a.scores[item_2]) == [(dee.sub, 2.0)]
         assert run_2025.refused == [] and run_2026.refused == []
 
         # staff of B (Open edX, 2026) see nothing of course A's nor of the 2025 run's, and the reverse
         for token, other in (
             (staff_b, in_a),
+            (staff_b, in_a2),
+            (staff_a, in_a2),
             (staff_b, first_try),
             (staff_a, retake),
             (staff_2025, retake),
@@ -129,6 +153,10 @@ def test_two_platforms_courses_apart_retake_and_override(lms: Lms, tool: LivePro
         gradebook_b = client.get(tool.url + "/ui/gradebook.csv", params={"lti_session": staff_b})
         assert gradebook_b.status_code == 200, gradebook_b.text
         assert "Rita Retake" in gradebook_b.text and "Lee Elsewhere" not in gradebook_b.text
+        gradebook_a = client.get(tool.url + "/ui/gradebook.csv", params={"lti_session": staff_a}).text
+        assert (
+            "Lee Elsewhere" in gradebook_a and "Dee Deployed" not in gradebook_a and "Rita" not in gradebook_a
+        )
 
         # an override by B's staff reaches Open edX's 2026 line item (a newer score, which Open edX keeps),
         # and the 2025 run's stays as it was
