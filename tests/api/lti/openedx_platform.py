@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
-from urllib.parse import parse_qsl, quote, urlsplit
+from urllib.parse import parse_qsl, quote
 
 import httpx
 import jwt
@@ -93,6 +93,7 @@ class User:
     lms_id: int
     username: str
     full_name: str
+    """Empty: the course shares no PII with LTI tools (Open edX's default), so no name is sent."""
     external_id: str = field(default_factory=lambda: uuid.uuid4().hex)
     roles: dict[str, str] = field(default_factory=dict)
     """By course key: ``student``, ``staff`` or ``instructor`` (Open edX's course roles)."""
@@ -203,7 +204,7 @@ class OpenEdxPlatform:
             config_id=block.config_id,
             resource_link_id=block.usage_key,
             external_user_id=user.external_id,
-            name=user.full_name,
+            name=user.full_name or None,
             launch_presentation_document_target="iframe",
             context_id=block.course_key,
             context_type=["course_offering"],
@@ -413,7 +414,7 @@ class OpenEdxPlatform:
                     "status": "Active",
                     "user_id": user.external_id,
                     "roles": CONTEXT_ROLES[user.roles[block.course_key]],
-                    "name": user.full_name,
+                    **({"name": user.full_name} if user.full_name else {}),
                 }
                 for user in self.users.values()
                 if block.course_key in user.roles
@@ -517,8 +518,3 @@ def form_of(page: str) -> dict[str, str]:
         raise AssertionError(f"no launch form in the page: {page[:500]}")
     fields = dict(re.findall(r'<input name="(\w+)" value="([^"]*)"', page))
     return {"action": html.unescape(action.group(1)), **{k: html.unescape(v) for k, v in fields.items()}}
-
-
-def query_of(url: str) -> dict[str, str]:
-    """A URL's query parameters."""
-    return dict(parse_qsl(urlsplit(url).query))

@@ -243,3 +243,7 @@ def test_a_session_link_in_another_browser_and_a_replayed_state_are_refused(
         assert replayed.status_code == 403
         assert "did not come from the browser its login started in" in html.unescape(replayed.text)
         assert "signed in as Vera Victim" in own.get(tool.url + "/", params={"lti_session": token}).text
+        # Open edX's default shares no name with the tool: the learner is named from their LTI id
+        nameless = openedx.add_user("nemo", "", {RUN_2026: "student"})
+        _, page = landed(own, tool.url, openedx.launch(own, nameless, block))
+        assert f"signed in as lti {nameless.external_id}" in page.text
