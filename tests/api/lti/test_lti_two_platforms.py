@@ -189,9 +189,15 @@ def test_two_platforms_courses_apart_retake_and_override(lms: Lms, tool: LivePro
 
 def test_open_edx_deep_linking_sets_the_links_launch(lms: Lms, tool: LiveProcess) -> None:
     """Course staff add the tool by deep linking (Open edX's DL launch, Studio's side); the consumer decodes
-    the tool's response, and the block's launches carry what was picked."""
+    the tool's response, and the block's launches carry what was picked. The block has its own client id
+    (a component's own configuration, Open edX's default): a second registration of the same issuer."""
     openedx = lms.openedx
-    block = openedx.add_block(lms.passport, "course-v1:Uni+RL2+2026", "Reinforcement learning 2 - Uni")
+    own = Passport()
+    registered = httpx.post(
+        tool.url + "/lti/platforms", json=openedx.registration(own), headers=instructor_headers()
+    )
+    assert registered.status_code == 201, registered.text
+    block = openedx.add_block(own, "course-v1:Uni+RL2+2026", "Reinforcement learning 2 - Uni")
     author = openedx.add_user("dora", "Dora Author", {block.course_key: "instructor"})
     learner = openedx.add_user("lino", "Lino Linked", {block.course_key: "student"})
     with browser() as client:
