@@ -27,6 +27,8 @@ from live_server import (
 )
 
 from api.deps import SESSION_COOKIE
+from api.lti.deep_linking import choices, graded_edition
+from api.web import templates
 from grader.classroom.report import ClassEntry, write_class_report
 from grader.cli import main
 from grader.lab.assignment import load_config
@@ -191,6 +193,34 @@ def test_every_service_page_passes_wcag_a_and_aa(chromium: Any, service: Service
         assert_accessible(page, name)
     finally:
         context.close()
+
+
+LTI_PAGES = {
+    "lti-storage": ("lti_storage.html", {"action": "get", "target": "_parent", "origin": "https://lms.example",
+                    "key": "k", "value": "", "next": "", "id_token": "t", "state": "s"}),
+    "lti-picker": ("lti_picker.html", {"choices": choices(), "graded": graded_edition("rl1"), "picker": "p"}),
+    "lti-post": ("lti_post.html", {"action": "https://lms.example/deep-link", "jwt": "j"}),
+    "lti-registered": ("lti_registered.html", {"platform": {"issuer": "https://lms.example", "client_id": "c",
+                                                            "deployment_ids": ["1"]}}),
+}  # fmt: skip
+"""The pages only a platform's launch or registration reaches, rendered from their templates with what those
+give them, on the service's origin (its stylesheet applied) with their scripts held back (they would post
+on to the platform)."""
+
+
+@pytest.mark.parametrize("name", list(LTI_PAGES))
+def test_the_pages_of_lti_launches_pass_wcag_a_and_aa(chromium: Any, service: Service, name: str) -> None:
+    template, context = LTI_PAGES[name]
+    html = templates.get_template(template).render({**context, "session_query": ""})
+    page = chromium.new_page()
+    try:
+        page.route("**/*.js", lambda route: route.abort())
+        page.goto(service.process.url + "/ui/static/style.css")
+        page.set_content(html)
+        assert page.eval_on_selector("main", "main => getComputedStyle(main).maxWidth") == "960px"
+        assert_accessible(page, name)
+    finally:
+        page.close()
 
 
 def test_the_check_html_report_passes_wcag_a_and_aa(chromium: Any, service: Service, tmp_path: Path) -> None:
