@@ -210,7 +210,7 @@ def _course(
         "course": course,
         "assignments": [_assignment_row(assignment) for assignment in assignments_of(session, course)],
         "staff": staff_of(session, course),
-        "manages": caller.is_operator or caller.role is StaffRole.INSTRUCTOR,
+        "manages": caller.manages_course,
         "editions": [edition.value for edition in EditionName],
         "assignment_error": assignment_error,
         "staff_error": staff_error,
