@@ -277,9 +277,13 @@ def test_axe_core_finds_what_the_rules_forbid(chromium: Any, tmp_path: Path) -> 
 def _assert_file_accessible(chromium: Any, page_path: Path, what: str) -> list[tuple[float, float]]:
     """Open a written page and assert it; the sizes of its links (width, height in CSS pixels)."""
     page = chromium.new_page()
+    requests: list[str] = []
+    page.on("request", lambda request: requests.append(request.url))
     try:
         page.goto(page_path.as_uri())
         assert_accessible(page, what)
+        # axe-core came with the package: nothing but the page itself (and its data: images) was fetched
+        assert [url for url in requests if not url.startswith("data:")] == [page_path.as_uri()], requests
         sizes: list[list[float]] = page.eval_on_selector_all(
             "a[href]",
             "links => links.map(link => link.getBoundingClientRect()).map(box => [box.width, box.height])",
