@@ -1,4 +1,5 @@
-"""The Jinja2 environment of the web pages (autoescaping on) and the security headers they are sent with.
+"""The Jinja2 environment of the web pages (autoescaping on), the security headers they are sent with, and
+how a page answers (:func:`page`, an LTI launch's session carried in its links; :func:`signed_in`).
 
 The pages show each problem's figures through `page_figures` (`grader.render.figures.problem_figures`, the
 HTML report's figures, each problem drawn once and cached): a finished report's with its edition's

@@ -7,7 +7,7 @@ from __future__ import annotations
 import tomllib
 from typing import Annotated, Any, TypeVar
 
-from fastapi import APIRouter, Form, Path, Request
+from fastapi import APIRouter, Form, Request
 from fastapi.responses import RedirectResponse, Response
 from pydantic import BaseModel, ValidationError
 from sqlalchemy.orm import Session
@@ -24,7 +24,7 @@ from api.courses import (
     scope_of,
     staff_of,
 )
-from api.deps import AnyPageCallerDep, SessionDep
+from api.deps import AnyPageCallerDep, CoursePath, SessionDep
 from api.errors import CourseExists, InvalidRequest
 from api.handlers import status_of
 from api.models import Assignment, Course
@@ -37,7 +37,6 @@ router = APIRouter(include_in_schema=False)
 
 Model = TypeVar("Model", bound=BaseModel)
 
-CoursePath = Annotated[str, Path(pattern=SLUG_PATTERN)]
 FIELD_LABELS = {
     "slug": "Short name",
     "title": "Title",
