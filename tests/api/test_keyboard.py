@@ -97,3 +97,50 @@ def test_keyboard_alone_signs_in_uploads_reads_the_report_and_records_an_overrid
             assert "graded by hand: the threshold is right" in student.inner_text("#overrides")
         finally:
             browser.close()
+
+
+def test_keyboard_alone_creates_a_course_and_its_first_instructor(server: LiveProcess) -> None:
+    if shutil.which(CHROMIUM) is None:
+        pytest.skip(f"Chromium is not installed at {CHROMIUM} (apt-get install -y chromium)")
+    sync_api = pytest.importorskip("playwright.sync_api", reason="pip install playwright")
+    with sync_api.sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
+        try:
+            operator = browser.new_page()
+            _sign_in(operator, server.url, INSTRUCTOR_TOKEN)
+            operator.wait_for_selector("#override")
+            tab_to(operator, "#nav-courses")
+            operator.keyboard.press("Enter")
+            operator.wait_for_selector("#new-course")
+            for field, value in (
+                ("#course-slug", "rl-2026"),
+                ("#course-title", "Reinforcement learning 2026"),
+            ):
+                tab_to(operator, field)
+                operator.keyboard.type(value)
+            operator.keyboard.press("Enter")
+            operator.wait_for_url("**/ui/courses/rl-2026")
+            tab_to(operator, "#staff-name")
+            operator.keyboard.type("Grace Hopper")
+            tab_to(operator, "#new-staff button[type=submit]")
+            operator.keyboard.press("Enter")
+            operator.wait_for_selector("#staff-token")
+            token = operator.inner_text("#staff-token")
+
+            instructor = browser.new_context().new_page()
+            _sign_in(instructor, server.url, token)
+            instructor.wait_for_url("**/ui/courses")
+            tab_to(instructor, 'a[href="/ui/courses/rl-2026"]')
+            instructor.keyboard.press("Enter")
+            instructor.wait_for_selector("#new-assignment")
+            for field, value in (("#assignment-slug", "lab-2"), ("#assignment-title", "Policy iteration")):
+                tab_to(instructor, field)
+                instructor.keyboard.type(value)
+            tab_to(instructor, "#assignment-edition")
+            instructor.keyboard.type("v2026")  # a select is chosen by typing its option's first letters
+            tab_to(instructor, "#new-assignment button[type=submit]")
+            instructor.keyboard.press("Space")
+            instructor.wait_for_selector("#course-notice")
+            assert "v2026" in instructor.inner_text("#assignment-lab-2")
+        finally:
+            browser.close()
