@@ -54,6 +54,11 @@ class Principal:
         """True for the operator."""
         return self.student is None and self.course_id is None
 
+    @property
+    def manages_course(self) -> bool:
+        """True for a course's instructors and the operator: they add its staff, assignments and students."""
+        return self.is_instructor and self.role is StaffRole.INSTRUCTOR
+
     def course(self) -> int | None:
         """The caller's course (None: the operator, of every course)."""
         return self.student.course_id if self.student is not None else self.course_id
@@ -72,7 +77,7 @@ class Principal:
     def require_course_instructor(self) -> None:
         """Raise InstructorOnly unless the caller is an instructor of their course or the operator."""
         self.require_instructor()
-        if self.role is not StaffRole.INSTRUCTOR:
+        if not self.manages_course:
             raise InstructorOnly(
                 "this endpoint needs an instructor's token; a teaching assistant's was sent: ask the course's instructor"  # noqa: E501
             )

@@ -22,10 +22,12 @@ from sqlalchemy.orm import Session
 from api.auth import Principal
 from api.errors import CourseExists, CourseNotFound, InvalidRequest
 from api.models import Assignment, Course, Extension, LtiLink, Staff, Student
+from api.schemas import AssignmentCreate
 from api.security import new_token, token_digest
 from api.settings import GradebookPolicy, SeedPolicy, Settings
 from api.students import printable
 from grader.classroom.late import LatePolicy, read_late_policy
+from grader.seeds import held_out_seed
 
 DEFAULT_COURSE_ID = 1
 DEFAULT_ASSIGNMENT_ID = 1
@@ -176,6 +178,27 @@ def create_staff(session: Session, course: Course, name: str, role: str) -> tupl
     return staff, token
 
 
+def assignment_values(body: AssignmentCreate) -> dict[str, Any]:
+    """The columns of a new assignment as ``body`` asks (for :func:`create_assignment`): its lab follows from
+    its edition, a fixed policy without a seed draws a secret one, dates are kept in UTC.
+
+    Raises:
+        InvalidRequest: A date falls outside the years 1 to 9999 once in UTC.
+    """
+    values = body.model_dump(exclude={"late", "due_date", "edition", "seed"})
+    values["lab"], values["edition"] = None, body.edition.value if body.edition is not None else None
+    values["seed"] = body.seed if body.seed is not None else held_out_seed(2**31 - 1)
+    try:
+        values["due_date"] = body.due_date.astimezone(UTC).replace(tzinfo=None) if body.due_date else None
+        values["late_policy"] = body.late.model_dump(mode="json") if body.late is not None else None
+        if body.late is not None:
+            body.late.due.astimezone(UTC)
+    except OverflowError:
+        message = "a date in UTC falls outside the years 1 to 9999; give a date within them"
+        raise InvalidRequest(message, [(["body", "due_date"], message, "value_error")]) from None
+    return values
+
+
 def create_assignment(session: Session, course: Course, values: dict[str, Any]) -> Assignment:
     """Add an assignment to a course (committed): ``values`` are its columns but ``course_id``.
 
@@ -242,3 +265,8 @@ def launch_scope(session: Session, caller: Principal) -> Scope:
             raise CourseNotFound("this course has no assignment yet: open one from the LMS")
         assignment = first[0]
     return Scope(course, assignment)
+
+
+def staff_of(session: Session, course: Course) -> list[Staff]:
+    """The course's instructors and teaching assistants, oldest first."""
+    return list(session.scalars(select(Staff).where(Staff.course_id == course.id).order_by(Staff.id)))

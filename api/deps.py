@@ -185,10 +185,10 @@ async def get_student(caller: CallerDep) -> Student:
 StudentDep = Annotated[Student, Depends(get_student)]
 
 
-def get_page_caller(request: Request, session: SessionDep, settings: SettingsDep) -> Principal | None:
+def get_any_page_caller(request: Request, session: SessionDep, settings: SettingsDep) -> Principal | None:
     """The web page's signed-in caller (from the session cookie, or an LTI launch's session carried in the
-    page's links), or None when signed out. The pages are the default course's: a caller of another course
-    is refused there (CourseNotFound)."""
+    page's links), of whatever course, or None when signed out: for the pages of no course (the list of
+    courses) and those whose course the route checks itself."""
     launched = request.query_params.get(SESSION_PARAMETER, "")
     caller: Principal | None
     if launched.startswith(SESSION_PREFIX):
@@ -202,6 +202,16 @@ def get_page_caller(request: Request, session: SessionDep, settings: SettingsDep
             caller = authenticate(session, settings, token) if token else None
         except NotAuthenticated:
             caller = None
+    return caller
+
+
+AnyPageCallerDep = Annotated[Principal | None, Depends(get_any_page_caller)]
+
+
+def get_page_caller(request: Request, session: SessionDep, caller: AnyPageCallerDep) -> Principal | None:
+    """The web page's signed-in caller (:func:`get_any_page_caller`), or None when signed out. The pages are
+    the default course's (an LTI launch's: its course's): a caller of another course is refused there
+    (CourseNotFound)."""
     if caller is not None:
         caller.require_member(get_scope(request, session).course.id)
     return caller

@@ -1,4 +1,5 @@
-"""The Jinja2 environment of the web pages (autoescaping on) and the security headers they are sent with.
+"""The Jinja2 environment of the web pages (autoescaping on), the security headers they are sent with, and
+how a page answers (:func:`page`, an LTI launch's session carried in its links; :func:`signed_in`).
 
 The pages show each problem's figures through `page_figures` (`grader.render.figures.problem_figures`, the
 HTML report's figures, each problem drawn once and cached): a finished report's with its edition's
@@ -14,9 +15,15 @@ import json
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlencode
 
+from fastapi import Request
+from fastapi.responses import Response
 from fastapi.templating import Jinja2Templates
 
+from api.auth import Principal
+from api.errors import NotAuthenticated
+from api.lti.sessions import SESSION_PARAMETER
 from grader.lab.assignment import AssignmentConfig, load_config
 from grader.lab.editions.choice import edition_config
 from grader.render.figures import Figure, problem_figures
@@ -96,3 +103,30 @@ def page_headers(frame_origins: str | None = None) -> dict[str, str]:
 
 
 PAGE_HEADERS = page_headers()
+
+
+def page(request: Request, template: str, context: dict[str, Any], status_code: int = 200) -> Response:
+    """A page rendered with its security headers; an LTI launch's pages carry its session in their links
+    (``session_query``) and may be framed by its LMS."""
+    launched: Principal | None = getattr(request.state, "lti_caller", None)
+    return templates.TemplateResponse(
+        request,
+        template,
+        {**context, "session_query": session_query(launched)},
+        status_code=status_code,
+        headers=page_headers(launched.frame_origin if launched is not None else None),
+    )
+
+
+def session_query(caller: Principal | None) -> str:
+    """``?lti_session=...`` for the links and forms of a page an LTI launch signed in, else nothing."""
+    if caller is None or caller.session_token is None:
+        return ""
+    return "?" + urlencode({SESSION_PARAMETER: caller.session_token})
+
+
+def signed_in(caller: Principal | None) -> Principal:
+    """The page's caller; raise NotAuthenticated (the error page says how to sign in) when signed out."""
+    if caller is None:
+        raise NotAuthenticated("you are signed out; sign in with your token on the start page")
+    return caller

@@ -5,11 +5,16 @@ routes of ``students``, ``submissions``, ``gradebook`` and ``overrides`` under `
 
 from __future__ import annotations
 
-from datetime import UTC
-
 from fastapi import APIRouter, Depends
 
-from api.courses import assignments_of, courses_of, create_assignment, create_course, create_staff
+from api.courses import (
+    assignment_values,
+    assignments_of,
+    courses_of,
+    create_assignment,
+    create_course,
+    create_staff,
+)
 from api.deps import (
     AnyCallerDep,
     CallerDep,
@@ -40,7 +45,6 @@ from api.schemas import (
     StaffCreated,
 )
 from grader.lab.editions.choice import service_edition
-from grader.seeds import held_out_seed
 
 router = APIRouter(tags=["courses"])
 course_router = APIRouter(tags=["courses"], prefix="/courses/{course}", dependencies=[Depends(in_course)])
@@ -136,18 +140,7 @@ def post_assignment(
 ) -> AssignmentView:
     """Add an assignment to the course: the lab and edition its uploads are graded as, its seeds, due date,
     gradebook and late policy. Its routes are under /courses/{course}/assignments/{assignment}."""
-    values = body.model_dump(exclude={"late", "due_date", "edition", "seed"})
-    values["lab"], values["edition"] = None, body.edition.value if body.edition is not None else None
-    values["seed"] = body.seed if body.seed is not None else held_out_seed(2**31 - 1)
-    try:
-        values["due_date"] = body.due_date.astimezone(UTC).replace(tzinfo=None) if body.due_date else None
-        values["late_policy"] = body.late.model_dump(mode="json") if body.late is not None else None
-        if body.late is not None:
-            body.late.due.astimezone(UTC)
-    except OverflowError:
-        message = "a date in UTC falls outside the years 1 to 9999; give a date within them"
-        raise InvalidRequest(message, [(["body", "due_date"], message, "value_error")]) from None
-    return _assignment_view(course, create_assignment(session, course, values))
+    return _assignment_view(course, create_assignment(session, course, assignment_values(body)))
 
 
 @course_router.get(

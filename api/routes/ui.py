@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Any
-from urllib.parse import urlencode
+from typing import Annotated
 
 from fastapi import APIRouter, File, Form, Request, UploadFile
 from fastapi.responses import RedirectResponse, Response
 from sqlalchemy.orm import Session
 
 from api.auth import Principal, authenticate
+from api.courses import DEFAULT_COURSE_ID
 from api.deps import (
     SESSION_COOKIE,
     ContextDep,
@@ -31,41 +31,16 @@ from api.errors import (
 from api.gradebook import gradebook_csv
 from api.lti.publisher import publishing_status
 from api.lti.roster import import_roster
-from api.lti.sessions import SESSION_PARAMETER
 from api.models import Assignment, JobStatus, LtiLink
 from api.overrides import overrides_shown, record_override
 from api.settings import Settings
 from api.submissions import create_submission, detail, get_submission, list_submissions, summary
 from api.uploads import check_upload
-from api.web import page_headers, templates
+from api.web import page, session_query, signed_in
 
 router = APIRouter(include_in_schema=False)
 
 FINAL_STATUSES = frozenset({JobStatus.DONE.value, JobStatus.FAILED.value})
-
-
-def _page(request: Request, template: str, context: dict[str, Any], status_code: int = 200) -> Response:
-    launched: Principal | None = getattr(request.state, "lti_caller", None)
-    return templates.TemplateResponse(
-        request,
-        template,
-        {**context, "session_query": _session_query(launched)},
-        status_code=status_code,
-        headers=page_headers(launched.frame_origin if launched is not None else None),
-    )
-
-
-def _session_query(caller: Principal | None) -> str:
-    """``?lti_session=...`` for the links and forms of a page an LTI launch signed in, else nothing."""
-    if caller is None or caller.session_token is None:
-        return ""
-    return "?" + urlencode({SESSION_PARAMETER: caller.session_token})
-
-
-def _signed_in(caller: Principal | None) -> Principal:
-    if caller is None:
-        raise NotAuthenticated("you are signed out; sign in with your token on the start page")
-    return caller
 
 
 @router.get("/")
@@ -78,7 +53,7 @@ def home(
 ) -> Response:
     """The start page: the sign-in form, or the caller's submissions and the upload form."""
     if caller is None:
-        return _page(request, "signin.html", {})
+        return page(request, "signin.html", {})
     return _home(request, session, caller, settings, assignment, None)
 
 
@@ -87,7 +62,7 @@ def roster_import(
     request: Request, session: SessionDep, context: ContextDep, caller: PageCallerDep
 ) -> Response:
     """Import the course roster of the link an instructor launched from (Names and Role Provisioning)."""
-    instructor = _signed_in(caller)
+    instructor = signed_in(caller)
     instructor.require_instructor()
     link = session.get(LtiLink, instructor.lti_link_id) if instructor.lti_link_id is not None else None
     if link is None:
@@ -95,19 +70,21 @@ def roster_import(
             "the roster is imported from a launch in the LMS; open the tool from the course"
         )
     found = import_roster(session, link, context.access_tokens)
-    return _page(request, "roster.html", {"caller": instructor, "found": found})
+    return page(request, "roster.html", {"caller": instructor, "found": found})
 
 
 @router.post("/ui/sign-in")
 def sign_in(
     request: Request, session: SessionDep, settings: SettingsDep, token: Annotated[str, Form()] = ""
 ) -> Response:
-    """Check the token and keep it in an HttpOnly, SameSite=Strict cookie."""
+    """Check the token and keep it in an HttpOnly, SameSite=Strict cookie; the staff of a course other than
+    the default go on to their course's page."""
     try:
-        authenticate(session, settings, token.strip())
+        caller = authenticate(session, settings, token.strip())
     except NotAuthenticated as error:
-        return _page(request, "signin.html", {"error": str(error)}, status_code=401)
-    response = RedirectResponse("/", status_code=303)
+        return page(request, "signin.html", {"error": str(error)}, status_code=401)
+    elsewhere = caller.is_instructor and caller.course() not in (None, DEFAULT_COURSE_ID)
+    response = RedirectResponse("/ui/courses" if elsewhere else "/", status_code=303)
     response.set_cookie(
         SESSION_COOKIE, token.strip(), httponly=True, samesite="strict", secure=request.url.scheme == "https"
     )
@@ -132,15 +109,15 @@ def upload(
     file: Annotated[UploadFile, File()],
 ) -> Response:
     """Upload from the form, then show the submission's page."""
-    student = _signed_in(caller).require_student()
+    student = signed_in(caller).require_student()
     content = file.file.read(settings.max_upload_bytes + 1)
     upload = check_upload(file.filename, content, max_bytes=settings.max_upload_bytes)
     submission = create_submission(session, settings, assignment, student, upload, dispatcher)
-    return RedirectResponse(f"/ui/submissions/{submission.id}{_session_query(caller)}", status_code=303)
+    return RedirectResponse(f"/ui/submissions/{submission.id}{session_query(caller)}", status_code=303)
 
 
 @router.get("/ui/submissions/{submission_id}")
-def submission_page(
+def submissionpage(
     request: Request,
     submission_id: int,
     session: SessionDep,
@@ -148,7 +125,7 @@ def submission_page(
     assignment: PageAssignmentDep,
 ) -> Response:
     """A submission's page; its live part is refreshed from the fragment below until grading ends."""
-    return _submission(request, "submission.html", session, _signed_in(caller), assignment, submission_id)
+    return _submission(request, "submission.html", session, signed_in(caller), assignment, submission_id)
 
 
 @router.get("/ui/submissions/{submission_id}/live")
@@ -160,7 +137,7 @@ def submission_fragment(
     assignment: PageAssignmentDep,
 ) -> Response:
     """The live part of a submission's page: status, finished problems, report."""
-    return _submission(request, "_live.html", session, _signed_in(caller), assignment, submission_id)
+    return _submission(request, "_live.html", session, signed_in(caller), assignment, submission_id)
 
 
 def _submission(
@@ -174,7 +151,7 @@ def _submission(
     disclosure = disclosure_for(caller, assignment)
     submission = get_submission(session, caller, assignment, submission_id)
     view = detail(submission, disclosure, overrides_shown(session, submission, disclosure))
-    return _page(request, template, {"submission": view, "final": view.status in FINAL_STATUSES})
+    return page(request, template, {"submission": view, "final": view.status in FINAL_STATUSES})
 
 
 @router.post("/ui/overrides")
@@ -191,8 +168,8 @@ def override(
     submission_id: Annotated[str, Form()] = "",
 ) -> Response:
     """The instructor's override form: kept with who and when, or the reason it was refused."""
-    signed_in = _signed_in(caller)
-    signed_in.require_instructor()
+    staff = signed_in(caller)
+    staff.require_instructor()
     try:
         value = float(points)
         upload = int(submission_id) if submission_id.strip() else None
@@ -200,7 +177,7 @@ def override(
         return _home(
             request,
             session,
-            signed_in,
+            staff,
             settings,
             assignment,
             f"points {points!r} is not a number",
@@ -209,12 +186,12 @@ def override(
     try:
         record_override(
             session, assignment, student_name=student, problem=problem.strip(), points=value, reason=reason,
-            author=signed_in.name, submission_id=upload,
+            author=staff.name, submission_id=upload,
         )  # fmt: skip
     except (InvalidRequest, NothingGradedYet, StudentNotFound, SubmissionNotFound) as refused:
-        return _home(request, session, signed_in, settings, assignment, str(refused), error=True)
+        return _home(request, session, staff, settings, assignment, str(refused), error=True)
     kept = f"{problem} of {student} set to {value:g}: {reason}"
-    return _home(request, session, signed_in, settings, assignment, kept)
+    return _home(request, session, staff, settings, assignment, kept)
 
 
 def _home(
@@ -235,13 +212,13 @@ def _home(
         "lms_scores": publishing_status(session, assignment.course_id) if caller.is_instructor else [],
         "override_message": message, "override_error": error,
     }  # fmt: skip
-    return _page(request, "home.html", context, status_code=422 if error else 200)
+    return page(request, "home.html", context, status_code=422 if error else 200)
 
 
 @router.get("/ui/gradebook.csv")
 def gradebook_download(session: SessionDep, assignment: PageAssignmentDep, caller: PageCallerDep) -> Response:
     """The gradebook for the signed-in instructor."""
-    _signed_in(caller).require_instructor()
+    signed_in(caller).require_instructor()
     return Response(
         gradebook_csv(session, assignment),
         media_type="text/csv; charset=utf-8",

@@ -28,7 +28,9 @@ STYLE = (
     "figcaption{font-size:.85rem;color:#555}table{border-collapse:collapse;font-size:.85rem}"
     "td,th{border:1px solid #ddd;padding:.2rem .4rem;text-align:left;vertical-align:top}"
     ".count{font-weight:bold}.diagnosis{white-space:pre-wrap}.who{font-size:.85rem;color:#333}"
-    ".late{color:#a60}.error{color:#a00}.missing{color:#777}"
+    ".late{color:#a60}.error{color:#a00}.missing{color:#666}"
+    # WCAG 2.2's target size (2.5.8): a student's link is at least 24 by 24 CSS pixels, in a list or a table.
+    "a.student{display:inline-block;min-width:24px;min-height:24px;line-height:24px;text-align:center}"
 )
 
 

@@ -23,7 +23,9 @@ STYLE = (
     ".pair{border-top:2px solid #ccc;margin-top:1.5rem}"
     ".sides{display:grid;grid-template-columns:minmax(0,1fr) minmax(0,1fr);gap:.5rem}"
     "pre{white-space:pre;overflow-x:auto;background:#f6f6f6;padding:.5rem;font-size:.8rem;margin:.2rem 0}"
-    ".ln{color:#999;user-select:none}.side h4{margin:.3rem 0;font-size:.85rem}.reason{color:#a00}"
+    ".ln{color:#666;user-select:none}.side h4{margin:.3rem 0;font-size:.85rem}.reason{color:#a00}"
+    # WCAG 2.2's target size (2.5.8): the pairs' links are at least 24 by 24 CSS pixels.
+    "a.pair-link{display:inline-block;min-width:24px;min-height:24px;line-height:24px;text-align:center}"
 )
 CSP = content_security_policy(STYLE, images=False)
 
