@@ -23,7 +23,8 @@
    problems ran before it in that child (on xdist scheduling).
 
 `--write` replaces the `## Speed (issue 11)` section at the end of bench/RESULTS.md (with `--ab`: the section
-`## The grader's own CPU and the plain run (issue 44): FILE, N problems`). `--ab BASELINE_ROOT` runs
+`## The grader's own CPU and the plain run (issue 44): FILE, N problems`; `--fixed-problem ID` adds a
+session's fixed cost, a check of that cheap problem alone on one worker). `--ab BASELINE_ROOT` runs
 only step 2, with the grader of another tree (a worktree of `main`, say) alternated with this one's: an
 A/B of a change, e.g. `--ab /work/main --only taxi --rounds 2`, wall and CPU (every process of a run, in a
 cgroup v1 `cpuacct` group where available). `--breakdown` runs only step 1 and prints its per-problem table
@@ -694,6 +695,8 @@ def ab_main(args: argparse.Namespace, submission: Path, problems: Sequence[str],
     )
     lines = ab_lines(labels["baseline"], grades, plain, load, plain_child_envs)
     lines += share_lines(grades, plain, plain_child_envs)
+    if args.fixed_problem:
+        lines += fixed_cost_lines(args, submission, labels)
     print("\n".join(lines))
     if args.write:
         heading = f"{AB_HEADING}: {submission.name}, {len(problems)} problems"
@@ -701,6 +704,29 @@ def ab_main(args: argparse.Namespace, submission: Path, problems: Sequence[str],
         stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
         replace_section(heading, "\n".join([heading, "", f"`{command}`, {stamp}.", "", *lines, ""]))
     return 0
+
+
+def fixed_cost_lines(args: argparse.Namespace, submission: Path, labels: dict[str, Path]) -> list[str]:
+    """A session's fixed cost for each tree: `gymgrade check --only ID --workers 1` of a problem that costs
+    almost nothing (its CPU is the CLI, the pytest session, one xdist worker and one sandbox child),
+    alternated, `--rounds` times each."""
+    cpu: dict[str, list[float]] = {label: [] for label in labels}
+    for round_index in range(max(args.rounds, 2)):
+        order = list(labels) if round_index % 2 == 0 else list(labels)[::-1]
+        for label in order:
+            run, _ = gymgrade_run(submission, 1, args.seed, args.config, [args.fixed_problem], labels[label])
+            if run.cpu is not None:
+                cpu[label].append(run.cpu)
+            print(f"3. fixed cost, {label}: {run.cpu} s CPU", flush=True)
+    medians = ", ".join(
+        f"{label} {statistics.median(values):.2f} s ({seconds(values)})"
+        for label, values in cpu.items()
+        if values
+    )
+    return [
+        f"- A session's fixed cost (`gymgrade check --only {args.fixed_problem} --workers 1`: the CLI, "
+        f"pytest, one xdist worker, one sandbox child; CPU, median (each)): {medians or 'n/a (no cgroup)'}."
+    ]
 
 
 def share_lines(
@@ -744,6 +770,12 @@ def main() -> int:
     )
     parser.add_argument(
         "--breakdown", action="store_true", help="only the per-problem table of one serial grading (step 1)"
+    )
+    parser.add_argument(
+        "--fixed-problem",
+        default=None,
+        metavar="ID",
+        help="with --ab: also a session's fixed cost, a check of only this (cheap) problem on one worker",
     )
     parser.add_argument(
         "--plain-child", nargs=2, type=Path, metavar=("CALLS", "SUBMISSION"), help=argparse.SUPPRESS
