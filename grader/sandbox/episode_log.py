@@ -43,7 +43,10 @@ from grader.sandbox.text import clean_plain, clean_text
 MAX_ID_LENGTH = 200
 MAX_SEED = 2**64
 MAX_REMEMBERED_KEYS = 1024
-"""Distinct environments whose `environment_key` is remembered per process (a call makes a few)."""
+"""Distinct environments whose `environment_key` is remembered per process (a call makes a few); when
+full, it starts afresh, so a worker that graded many files keeps remembering."""
+MAX_REMEMBERED_KEY_LENGTH = 1024
+"""Longer keys (a string argument a student made long) are made again each time, never kept."""
 _SCALAR_KINDS = frozenset({str, int, bool, type(None)})
 """Argument types remembered by value and type: equal values of these types have the same JSON text
 (floats are not: ``0.0 == -0.0``; containers are not: ``[1] == [True]``)."""
@@ -114,7 +117,9 @@ def environment_key(env_id: str, env_kwargs: dict[str, Any]) -> str:
     key = _REMEMBERED_KEYS.get(signature)
     if key is None:
         key = _key_text(env_id, env_kwargs)
-        if len(_REMEMBERED_KEYS) < MAX_REMEMBERED_KEYS:
+        if len(key) <= MAX_REMEMBERED_KEY_LENGTH:
+            if len(_REMEMBERED_KEYS) >= MAX_REMEMBERED_KEYS:
+                _REMEMBERED_KEYS.clear()
             _REMEMBERED_KEYS[signature] = key
     return key
 

@@ -13,7 +13,15 @@ from grader.sandbox.child.errors import InvalidEpisodeLogError
 from grader.sandbox.child.frames import encode_frame, encode_value, parse_payload
 from grader.sandbox.child.log_block import NO_EPISODES, log_block
 from grader.sandbox.child.recorder import EpisodeRecord
-from grader.sandbox.episode_log import EpisodeLog, WireLog, environment_key, episodes_from_plain
+from grader.sandbox.episode_log import (
+    _REMEMBERED_KEYS,
+    MAX_REMEMBERED_KEY_LENGTH,
+    MAX_REMEMBERED_KEYS,
+    EpisodeLog,
+    WireLog,
+    environment_key,
+    episodes_from_plain,
+)
 from grader.sandbox.limits import CallBudget
 
 STEPS = [(1, -1.0), (4, -10.0), (5, 20.0)]
@@ -580,3 +588,12 @@ def test_each_logs_environment_is_its_id_and_arguments_key() -> None:
     )
     assert first.environment == environment_key("Taxi-v4", {"is_rainy": False})
     assert second.environment == environment_key("Taxi-v4", {"is_rainy": 0}) != first.environment
+
+
+def test_what_environment_keys_remember_stays_bounded_and_keys_stay_right() -> None:
+    long_name = "x" * (MAX_REMEMBERED_KEY_LENGTH + 1)
+    assert environment_key("Taxi-v4", {"name": long_name}) == environment_key("Taxi-v4", {"name": long_name})
+    assert all(long_name not in key for key in _REMEMBERED_KEYS.values())
+    for number in range(MAX_REMEMBERED_KEYS + 10):
+        assert environment_key("Taxi-v4", {"seed": number}) == f'["Taxi-v4", {{"seed": {number}}}]'
+    assert 0 < len(_REMEMBERED_KEYS) <= MAX_REMEMBERED_KEYS
