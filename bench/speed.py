@@ -22,7 +22,9 @@
    graded in both orders, which shows that a shared child makes a problem's report depend on which
    problems ran before it in that child (on xdist scheduling).
 
-`--write` replaces the `## Speed (issue 11)` section at the end of bench/RESULTS.md. `--ab BASELINE_ROOT` runs
+`--write` replaces the `## Speed (issue 11)` section at the end of bench/RESULTS.md (with `--ab`: the section
+`## The grader's own CPU and the plain run (issue 44): FILE, N problems`; `--fixed-problem ID` adds a
+session's fixed cost, a check of that cheap problem alone on one worker). `--ab BASELINE_ROOT` runs
 only step 2, with the grader of another tree (a worktree of `main`, say) alternated with this one's: an
 A/B of a change, e.g. `--ab /work/main --only taxi --rounds 2`, wall and CPU (every process of a run, in a
 cgroup v1 `cpuacct` group where available). `--breakdown` runs only step 1 and prints its per-problem table
@@ -47,7 +49,7 @@ import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from datetime import date
+from datetime import UTC, date, datetime
 from pathlib import Path
 from typing import Any
 
@@ -59,6 +61,7 @@ from grading_probe import ProblemCost, SharedChild, grade_serially, graded, leak
 from results_section import replace_section  # noqa: E402
 
 HEADING = "## Speed (issue 11)"
+AB_HEADING = "## The grader's own CPU and the plain run (issue 44)"
 PLAIN_CHILD_ENVS = "plain, the child's envs"
 DEFAULT_SUBMISSION = ROOT / "submissions" / "classic_complete.py"
 ACCEPTANCE_DIR = ROOT / "grader" / "grading" / "cases"
@@ -666,6 +669,7 @@ def ab_main(args: argparse.Namespace, submission: Path, problems: Sequence[str],
     grades: dict[str, list[tuple[Run, Any]]] = {label: [] for label in labels}
     plain: list[tuple[Run, dict[str, Any]]] = []
     plain_child_envs: list[tuple[Run, dict[str, Any]]] = []
+    loads: list[float] = []
     with tempfile.TemporaryDirectory(prefix="gymgrade-speed-") as scratch:
         calls_file = Path(scratch) / "calls.pickle"
         calls_file.write_bytes(pickle.dumps(calls))
@@ -683,10 +687,66 @@ def ab_main(args: argparse.Namespace, submission: Path, problems: Sequence[str],
                         gymgrade_run(submission, args.workers, args.seed, args.config, problems, labels[kind])
                     )
                     run = grades[kind][-1][0]
+                loads.append(os.getloadavg()[0])
                 print(f"2. {kind}: {run.wall:.1f} s wall", flush=True)
-    load = f"load average {load_before:.1f} before, {os.getloadavg()[0]:.1f} after"
-    print("\n".join(ab_lines(labels["baseline"], grades, plain, load, plain_child_envs)))
+    load = (
+        f"load average {load_before:.1f} before, {os.getloadavg()[0]:.1f} after, "
+        f"after each run min {min(loads):.1f}, median {statistics.median(loads):.1f}, max {max(loads):.1f}"
+    )
+    lines = ab_lines(labels["baseline"], grades, plain, load, plain_child_envs)
+    lines += share_lines(grades, plain, plain_child_envs)
+    if args.fixed_problem:
+        lines += fixed_cost_lines(args, submission, labels)
+    print("\n".join(lines))
+    if args.write:
+        heading = f"{AB_HEADING}: {submission.name}, {len(problems)} problems"
+        command = " ".join(["python", "bench/speed.py", *sys.argv[1:]])
+        stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
+        replace_section(heading, "\n".join([heading, "", f"`{command}`, {stamp}.", "", *lines, ""]))
     return 0
+
+
+def fixed_cost_lines(args: argparse.Namespace, submission: Path, labels: dict[str, Path]) -> list[str]:
+    """A session's fixed cost for each tree: `gymgrade check --only ID --workers 1` of a problem that costs
+    almost nothing (its CPU is the CLI, the pytest session, one xdist worker and one sandbox child),
+    alternated, `--rounds` times each."""
+    cpu: dict[str, list[float]] = {label: [] for label in labels}
+    for round_index in range(max(args.rounds, 2)):
+        order = list(labels) if round_index % 2 == 0 else list(labels)[::-1]
+        for label in order:
+            run, _ = gymgrade_run(submission, 1, args.seed, args.config, [args.fixed_problem], labels[label])
+            if run.cpu is not None:
+                cpu[label].append(run.cpu)
+            print(f"3. fixed cost, {label}: {run.cpu} s CPU", flush=True)
+    medians = ", ".join(
+        f"{label} {statistics.median(values):.2f} s ({seconds(values)})"
+        for label, values in cpu.items()
+        if values
+    )
+    return [
+        f"- A session's fixed cost (`gymgrade check --only {args.fixed_problem} --workers 1`: the CLI, "
+        f"pytest, one xdist worker, one sandbox child; CPU, median (each)): {medians or 'n/a (no cgroup)'}."
+    ]
+
+
+def share_lines(
+    grades: dict[str, list[tuple[Run, Any]]],
+    plain: Sequence[tuple[Run, dict[str, Any]]],
+    plain_child_envs: Sequence[tuple[Run, dict[str, Any]]],
+) -> list[str]:
+    """The issue's two figures for each grader: wall against the plain run, and its own CPU as a share of the
+    student's (grading CPU less the plain run's on the child's envs, over the latter)."""
+    lines = []
+    student_cpu = _median_cpu([run for run, _ in plain_child_envs])
+    for label, runs in grades.items():
+        wall, _ = _ratios([run for run, _ in runs], [run for run, _ in plain])
+        cpu = _median_cpu([run for run, _ in runs])
+        share = "n/a" if cpu is None or not student_cpu else f"{(cpu - student_cpu) / student_cpu:.0%}"
+        lines.append(
+            f"- **{label}: {wall:.2f}x the plain run's wall** (goal <= 1.0), **the grader's own CPU "
+            f"{share} of the student's** (goal <= 25%)."
+        )
+    return lines
 
 
 # -------------------------------------------------------------------------------------------------- main
@@ -710,6 +770,12 @@ def main() -> int:
     )
     parser.add_argument(
         "--breakdown", action="store_true", help="only the per-problem table of one serial grading (step 1)"
+    )
+    parser.add_argument(
+        "--fixed-problem",
+        default=None,
+        metavar="ID",
+        help="with --ab: also a session's fixed cost, a check of only this (cheap) problem on one worker",
     )
     parser.add_argument(
         "--plain-child", nargs=2, type=Path, metavar=("CALLS", "SUBMISSION"), help=argparse.SUPPRESS

@@ -22,7 +22,11 @@ How a problem is run (`run_problem`):
   the longest problem) against the cost: module-level state (a notebook's global env, Q-table or list) would
   carry from one problem into the next, so a problem's report would depend on which problems xdist happened to
   run before it in that worker; one child's life-long CPU limit, memory growth and restart after a fatal
-  outcome would be shared too.
+  outcome would be shared too. Weighed again for issue 44: a child per submission that imports numpy and
+  gymnasium once and forks a fresh process per problem inside the same sandbox would save the interpreter
+  start and imports of each later problem (about 0.16 s of CPU each), but that fork's problems would share the
+  sandbox's private /tmp, System V IPC, process-count limit and user id, so a process one problem left
+  behind (or that stopped or killed the forking parent) could reach the next problem's verdict; not built.
 """
 
 from __future__ import annotations

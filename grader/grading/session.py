@@ -48,6 +48,7 @@ from grader.grading.plugin import (
     SessionPlan,
     read_outcome,
 )
+from grader.lab.ids import acceptance_module_name
 
 ACCEPTANCE_DIR = Path(__file__).with_name("cases")
 OutcomeCallback = Callable[[ProblemCase, CaseOutcome], None]
@@ -60,7 +61,9 @@ _PLUGINS = (
     "no:unraisableexception",
     "no:threadexception",
 )
-_BASE_ARGS = (*(argument for plugin in _PLUGINS for argument in ("-p", plugin)), "-q")
+_BASE_ARGS = (*(argument for plugin in _PLUGINS for argument in ("-p", plugin)), "--assert=plain", "-q")
+"""``--assert=plain``: no case needs pytest's assertion rewriting, whose import hook parsed every case
+module again and looked at every import of the session (about 0.1 s of CPU per process of a session)."""
 _SESSION_ENVIRONMENT = {"PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1", "PYTHONDONTWRITEBYTECODE": "1"}
 _CALLER_SETTINGS = ("PYTEST_ADDOPTS", "PYTEST_PLUGINS")
 """Environment variables through which the caller's own pytest settings would reach the session."""
@@ -86,8 +89,17 @@ def acceptance_args(plan: SessionPlan, workers: int) -> list[str]:
     hooks of the calling process, and the second forces garbage collections that cost about a second per
     session.
     """
-    args = [str(ACCEPTANCE_DIR), "-c", str(ACCEPTANCE_DIR / "pytest.ini"), "--rootdir", str(ACCEPTANCE_DIR)]
-    return [*args, *_BASE_ARGS, "-n", str(max(workers, 1)), plan.option()]
+    settings = ["-c", str(ACCEPTANCE_DIR / "pytest.ini"), "--rootdir", str(ACCEPTANCE_DIR)]
+    return [*case_paths(plan), *settings, *_BASE_ARGS, "-n", str(max(workers, 1)), plan.option()]
+
+
+def case_paths(plan: SessionPlan) -> list[str]:
+    """What a session collects: the acceptance module of each planned problem (the whole folder when none is
+    planned). Every process of the session (the workers, and the controller with ``-n 0``) collects, and a
+    module it collected only to deselect cost it the module's import and collection."""
+    if not plan.problems:
+        return [str(ACCEPTANCE_DIR)]
+    return [str(ACCEPTANCE_DIR / f"{acceptance_module_name(problem)}.py") for problem in plan.problems]
 
 
 def run_session(

@@ -191,7 +191,12 @@ class GameRules:
         Call after `problem_with` accepted every log. No episode at all counts as the lab's game.
         """
         played: dict[str, Game] = {}
+        environments: set[str] = set()
         for log in logs:
+            environment = log.environment
+            if environment in environments:  # the same id and arguments: the same game
+                continue
+            environments.add(environment)
             game = self.game_of(log)
             if game is not None:
                 played.setdefault(game.name, game)

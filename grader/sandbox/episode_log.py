@@ -12,6 +12,7 @@ slices of the decoded columns. Nothing in a log is trusted: `grader.sandbox.repl
 from __future__ import annotations
 
 import itertools
+import json
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
@@ -41,6 +42,15 @@ from grader.sandbox.text import clean_plain, clean_text
 
 MAX_ID_LENGTH = 200
 MAX_SEED = 2**64
+MAX_REMEMBERED_KEYS = 1024
+"""Distinct environments whose `environment_key` is remembered per process (a call makes a few); when
+full, it starts afresh, so a worker that graded many files keeps remembering."""
+MAX_REMEMBERED_KEY_LENGTH = 1024
+"""Longer keys (a string argument a student made long) are made again each time, never kept."""
+_SCALAR_KINDS = frozenset({str, int, bool, type(None)})
+"""Argument types remembered by value and type: equal values of these types have the same JSON text
+(floats are not: ``0.0 == -0.0``; containers are not: ``[1] == [True]``)."""
+_REMEMBERED_KEYS: dict[tuple[Any, ...], str] = {}
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,6 +72,15 @@ class EpisodeLog(EpisodeHeader):
     reset_options: dict[str, Any] | None = None
 
     @property
+    def environment(self) -> str:
+        """`environment_key` of the env the episode was played in (its id and arguments), made once."""
+        # In the instance's own dict: `functools.cached_property` takes a lock that costs more than the key.
+        key = self.__dict__.get("_environment")
+        if key is None:
+            key = self.__dict__["_environment"] = environment_key(self.env_id, self.env_kwargs)
+        return key
+
+    @property
     def steps(self) -> int:
         """Number of steps logged, including steps after the episode ended."""
         return len(self.actions)
@@ -80,6 +99,33 @@ class EpisodeLog(EpisodeHeader):
         )
 
     __hash__ = None  # type: ignore[assignment]  # mutable lists inside
+
+
+def environment_key(env_id: str, env_kwargs: dict[str, Any]) -> str:
+    """One text per environment (id and arguments, in any order): a cache's or a grouping's key.
+
+    The JSON of ``[env_id, env_kwargs]`` with sorted keys (`repr` for what JSON cannot hold). Tens of
+    thousands of logged episodes share a few environments, so the text of arguments that are all plain
+    scalars is remembered by (name, type, value) and made once per process.
+    """
+    items = []
+    for name, value in env_kwargs.items():
+        if type(value) not in _SCALAR_KINDS or type(name) is not str:
+            return _key_text(env_id, env_kwargs)
+        items.append((name, type(value).__name__, value))
+    signature = (env_id, *sorted(items))
+    key = _REMEMBERED_KEYS.get(signature)
+    if key is None:
+        key = _key_text(env_id, env_kwargs)
+        if len(key) <= MAX_REMEMBERED_KEY_LENGTH:
+            if len(_REMEMBERED_KEYS) >= MAX_REMEMBERED_KEYS:
+                _REMEMBERED_KEYS.clear()
+            _REMEMBERED_KEYS[signature] = key
+    return key
+
+
+def _key_text(env_id: str, env_kwargs: dict[str, Any]) -> str:
+    return json.dumps([env_id, env_kwargs], sort_keys=True, default=repr)
 
 
 def _same_action(mine: Any, theirs: Any) -> bool:

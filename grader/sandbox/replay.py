@@ -48,7 +48,6 @@ gymnasium and judges the replay, never the log:
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import threading
 import warnings
@@ -65,7 +64,7 @@ from grader.compat import register_envs
 from grader.sandbox.batched import REPLAYERS, BatchedEpisode, BatchedReplayer
 from grader.sandbox.child.frames import paused_gc
 from grader.sandbox.child.seeding import reset_seeds
-from grader.sandbox.episode_log import EpisodeLog
+from grader.sandbox.episode_log import EpisodeLog, environment_key
 
 MAX_CACHED_ENVS = 16
 MAX_BATCH_CELLS = 2_000_000
@@ -154,7 +153,7 @@ def _replay_all(logs: Sequence[EpisodeLog]) -> list[Replay]:
     for position, log in enumerate(logs):
         for number, replayer in enumerate(REPLAYERS):
             if replayer.is_batchable(log):
-                groups.setdefault((number, _cache_key(log.env_id, log.env_kwargs)), []).append(position)
+                groups.setdefault((number, log.environment), []).append(position)
                 break
     for (number, _), positions in groups.items():
         first = logs[positions[0]]
@@ -354,15 +353,11 @@ def _own(observation: Any) -> Any:
 _local = threading.local()
 
 
-def _cache_key(env_id: str, env_kwargs: dict[str, Any]) -> str:
-    return json.dumps([env_id, env_kwargs], sort_keys=True, default=repr)
-
-
 def _cached_env(env_id: str, env_kwargs: dict[str, Any]) -> tuple[gymnasium.Env[Any, Any] | None, str]:
     """One env per (id, kwargs) per thread; the env checker is skipped (these envs are gymnasium's own)."""
     cache: dict[str, gymnasium.Env[Any, Any]] = getattr(_local, "envs", None) or {}
     _local.envs = cache
-    key = _cache_key(env_id, env_kwargs)
+    key = environment_key(env_id, env_kwargs)
     env = cache.get(key)
     if env is not None:
         return env, ""

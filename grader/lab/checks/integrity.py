@@ -84,7 +84,7 @@ def _replay_refusal(logs: Sequence[EpisodeLog], rules: GameRules | None) -> str 
         return None
     if rules is None:
         return f"this problem plays no episodes, but the call logged {len(logs)}"
-    environments = {(log.env_id, log.requested_id, repr(sorted(log.env_kwargs.items()))): log for log in logs}
+    environments = {(log.requested_id, log.environment): log for log in logs}
     for log in environments.values():
         problem = rules.problem_with(log)
         if problem:

@@ -49,8 +49,28 @@ class SeededDraws:
         self._kept_half: int | None = None
 
     def choice(self, sequence: Sequence[_T]) -> _T:
-        """The element `Generator.choice(sequence)` returns (as the sequence holds it)."""
-        return sequence[self.bounded(len(sequence))]
+        """The element `Generator.choice(sequence)` returns (as the sequence holds it).
+
+        `bounded(len(sequence))` written out, its common path in one call: Blackjack's replay draws a
+        few hundred thousand cards, and the calls of `bounded`, `_next_uint32` and `_next_uint64` cost
+        more than their arithmetic.
+        """
+        count = len(sequence)
+        if count == 1:
+            return sequence[0]
+        half = self._kept_half
+        if half is not None:
+            self._kept_half = None
+        else:
+            state = self._state = (self._state * _PCG_MULTIPLIER + self._increment) & _LOW_128
+            mixed = ((state >> 64) ^ state) & _LOW_64
+            rotation = state >> 122
+            raw = ((mixed >> rotation) | (mixed << (64 - rotation))) & _LOW_64
+            self._kept_half, half = raw >> 32, raw & _LOW_32
+        product = half * count
+        if product & _LOW_32 < count:  # Lemire's rejection, rare: `bounded` goes on from this draw
+            return sequence[self._rejected(product, count)]
+        return sequence[product >> 32]
 
     def random(self) -> float:
         """`Generator.random()`: the top 53 bits of the next 64-bit output."""
@@ -61,12 +81,16 @@ class SeededDraws:
         if count == 1:
             return 0
         product = self._next_uint32() * count
-        leftover = product & _LOW_32
-        if leftover < count:
-            threshold = (_LOW_32 - (count - 1)) % count
-            while leftover < threshold:
-                product = self._next_uint32() * count
-                leftover = product & _LOW_32
+        if product & _LOW_32 < count:
+            return self._rejected(product, count)
+        return product >> 32
+
+    def _rejected(self, product: int, count: int) -> int:
+        """Lemire's method after a first draw whose low half fell below `count`: redraw while it is below
+        the threshold (numpy's `buffered_bounded_lemire_uint32`)."""
+        threshold = (_LOW_32 - (count - 1)) % count
+        while product & _LOW_32 < threshold:
+            product = self._next_uint32() * count
         return product >> 32
 
     def _next_uint64(self) -> int:

@@ -4,13 +4,16 @@ seeds."""
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import io
 import os
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
+from _pytest.assertion.rewrite import AssertionRewritingHook
 from grading_support import CLASSIC_COMPLETE, FAST_OVERRIDES, write_config
 
 from grader.grading.grade import grade_files
@@ -23,7 +26,13 @@ from grader.grading.plugin import (
     outcome_json,
     read_outcome,
 )
-from grader.grading.session import SessionEnd, acceptance_args, session_environment
+from grader.grading.session import (
+    ACCEPTANCE_DIR,
+    SessionEnd,
+    acceptance_args,
+    case_paths,
+    session_environment,
+)
 from grader.lab.assignment import DEFAULT_CONFIG_PATH, load_config
 from grader.lab.editions import EDITIONS
 from grader.lab.editions.choice import edition_config
@@ -88,6 +97,49 @@ def test_collection_runs_the_longest_expected_checks_first_under_the_planned_ids
     assert collected.node_ids == [
         ProblemCase(index, CLASSIC_COMPLETE, problem).node_id for problem in expected for index in range(2)
     ]
+
+
+class CollectedModules:
+    """A plugin object that keeps the modules a collection imported and the assertion hooks it ran under."""
+
+    def __init__(self) -> None:
+        self.modules: list[str] = []
+        self.rewriting_hooks: list[object] = []
+
+    def pytest_collectreport(self, report: pytest.CollectReport) -> None:
+        if report.nodeid.endswith(".py"):
+            self.modules.append(report.nodeid)
+
+    def pytest_collection_finish(self, session: pytest.Session) -> None:
+        self.rewriting_hooks = [hook for hook in sys.meta_path if isinstance(hook, AssertionRewritingHook)]
+
+
+@pytest.mark.parametrize("problems", [("car",), ("taxi", "random_blackjack")], ids=["one", "two"])
+def test_a_session_collects_only_the_planned_problems_modules_without_rewriting_asserts(
+    fast_config: Path, problems: tuple[str, ...]
+) -> None:
+    plan = SessionPlan(
+        grading=GradingPlan.load(fast_config, problems),
+        submissions=(CLASSIC_COMPLETE,),
+        seed=0,
+        policy=IsolationPolicy.ALLOW_FALLBACK,
+    )
+    callers_hooks = [hook for hook in sys.meta_path if isinstance(hook, AssertionRewritingHook)]
+    collected = CollectedModules()
+    with session_environment({}), contextlib.redirect_stdout(io.StringIO()):
+        exit_code = pytest.main(
+            [*acceptance_args(plan, workers=1), "-n", "0", "--collect-only"], plugins=[collected]
+        )
+    assert exit_code == pytest.ExitCode.OK
+    assert sorted(collected.modules) == sorted(f"test_{problem}.py" for problem in problems)
+    assert collected.rewriting_hooks == callers_hooks  # the caller's own, if any; none of the session's
+
+
+def test_a_plan_without_problems_collects_the_cases_folder_never_the_callers_directory() -> None:
+    # Without a path, pytest would collect the working directory: the caller's own tests.
+    grading = dataclasses.replace(GradingPlan.load(None, ["car"]), problems=())
+    plan = SessionPlan(grading=grading, submissions=(), seed=0, policy=IsolationPolicy.ALLOW_FALLBACK)
+    assert case_paths(plan) == [str(ACCEPTANCE_DIR)]
 
 
 def test_the_plan_reaches_the_workers_whatever_the_files_are_called(fast_config: Path) -> None:

@@ -13,7 +13,15 @@ from grader.sandbox.child.errors import InvalidEpisodeLogError
 from grader.sandbox.child.frames import encode_frame, encode_value, parse_payload
 from grader.sandbox.child.log_block import NO_EPISODES, log_block
 from grader.sandbox.child.recorder import EpisodeRecord
-from grader.sandbox.episode_log import EpisodeLog, WireLog, episodes_from_plain
+from grader.sandbox.episode_log import (
+    _REMEMBERED_KEYS,
+    MAX_REMEMBERED_KEY_LENGTH,
+    MAX_REMEMBERED_KEYS,
+    EpisodeLog,
+    WireLog,
+    environment_key,
+    episodes_from_plain,
+)
 from grader.sandbox.limits import CallBudget
 
 STEPS = [(1, -1.0), (4, -10.0), (5, 20.0)]
@@ -533,3 +541,59 @@ def test_logs_with_array_actions_compare_by_dtype_and_values() -> None:
     assert same == log(np.array([0.5], dtype=np.float32))
     assert same != log(np.array([0.5], dtype=np.float64))
     assert same != log(np.array([0.25], dtype=np.float32))
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [
+        ({"sab": True}, {"sab": 1}),
+        ({"sab": 1}, {"sab": True}),
+        ({"natural": False}, {"natural": 0}),
+        ({"limit": 0}, {"limit": 0.0}),
+        ({"limit": 0.0}, {"limit": -0.0}),
+        ({"map": [1]}, {"map": [True]}),
+        ({"name": None}, {"name": "None"}),
+        ({}, {"sab": False}),
+    ],
+    ids=[
+        "True-then-1",
+        "1-then-True",
+        "False-then-0",
+        "int-then-float",
+        "zero-then-minus-zero",
+        "nested-bool",
+        "None-then-text",
+        "none-then-one",
+    ],
+)
+def test_environments_whose_arguments_differ_in_type_or_value_have_different_keys(
+    first: dict[str, Any], second: dict[str, Any]
+) -> None:
+    # Each made twice: the second time from what the first made is remembered.
+    keys = [environment_key("Blackjack-v1", arguments) for arguments in (first, second, first, second)]
+    assert keys[0] == keys[2] != keys[1] == keys[3]
+
+
+def test_an_environments_key_ignores_the_order_of_its_arguments_and_names_its_id() -> None:
+    assert environment_key("Taxi-v4", {"a": 1, "b": "x"}) == environment_key("Taxi-v4", {"b": "x", "a": 1})
+    assert environment_key("Taxi-v4", {"a": [1, {"y": 2, "x": 3}]}) == environment_key(
+        "Taxi-v4", {"a": [1, {"x": 3, "y": 2}]}
+    )
+    assert environment_key("Taxi-v4", {}) != environment_key("Taxi-v3", {})
+
+
+def test_each_logs_environment_is_its_id_and_arguments_key() -> None:
+    first, second = episodes_from_plain(
+        through_a_frame([recorded(kwargs={"is_rainy": False}), recorded(env_index=1, kwargs={"is_rainy": 0})])
+    )
+    assert first.environment == environment_key("Taxi-v4", {"is_rainy": False})
+    assert second.environment == environment_key("Taxi-v4", {"is_rainy": 0}) != first.environment
+
+
+def test_what_environment_keys_remember_stays_bounded_and_keys_stay_right() -> None:
+    long_name = "x" * (MAX_REMEMBERED_KEY_LENGTH + 1)
+    assert environment_key("Taxi-v4", {"name": long_name}) == environment_key("Taxi-v4", {"name": long_name})
+    assert all(long_name not in key for key in _REMEMBERED_KEYS.values())
+    for number in range(MAX_REMEMBERED_KEYS + 10):
+        assert environment_key("Taxi-v4", {"seed": number}) == f'["Taxi-v4", {{"seed": {number}}}]'
+    assert 0 < len(_REMEMBERED_KEYS) <= MAX_REMEMBERED_KEYS

@@ -324,6 +324,23 @@ def test_card_draws_choose_as_generator_choice_does(sequence: list[object]) -> N
     ]
 
 
+@pytest.mark.parametrize("kept", [0, 1], ids=["rejected", "kept"])
+def test_a_card_drawn_after_a_rejected_draw_is_numpys(kept: int) -> None:
+    # A kept 32-bit half of 0 makes `choice` of 13 cards reject it and draw again (0 * 13 is below
+    # Lemire's threshold for 13, 2**32 % 13 == 9); a half of 1 is used. numpy is set to the same state.
+    deck = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 10, 10, 10]
+    for seed in (0, 3, 2**50 + 1):
+        generator = np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed)))
+        draws = seeded_draws([seed])[0]
+        generator.integers(0, 13)  # both now keep the high half of their first output
+        draws.choice(deck)
+        state = generator.bit_generator.state
+        generator.bit_generator.state = {**state, "has_uint32": 1, "uinteger": kept}
+        draws._kept_half = kept
+
+        assert [draws.choice(deck) for _ in range(20)] == [deck[generator.integers(0, 13)] for _ in range(20)]
+
+
 def test_seeded_draws_interleave_doubles_and_bounded_draws_as_numpy_does() -> None:
     # A double takes a whole 64-bit output; the high half of an earlier 32-bit draw stays kept.
     operations = [13, "random", 13, 4, "random", "random", 3, 13, 13, 13, "random", 2**32 - 5] * 5
