@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from datetime import timedelta
 
 from sqlalchemy import func, select
-from sqlalchemy.orm import Session, joinedload
+from sqlalchemy.orm import Session, defer, joinedload
 
 from api.auth import Principal
 from api.courses import seed_policy_of
@@ -148,10 +148,10 @@ def list_submissions(
     session: Session, caller: Principal, assignment: Assignment, student_name: str | None = None
 ) -> list[Submission]:
     """The caller's submissions to the assignment (all of them, or one student's, for its staff), newest
-    first."""
+    first; their files and progress are not read (a listing shows neither)."""
     query = (
         select(Submission)
-        .options(joinedload(Submission.student))
+        .options(joinedload(Submission.student), defer(Submission.content), defer(Submission.progress))
         .where(Submission.assignment_id == assignment.id)
         .order_by(Submission.id.desc())
     )
