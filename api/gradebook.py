@@ -101,11 +101,8 @@ def with_reports(session: Session, kept: dict[int, Any]) -> dict[int, KeptSubmis
     reports: dict[int, dict[str, Any] | None] = {}
     for start in range(0, len(ids), REPORTS_PER_QUERY):
         chunk = ids[start : start + REPORTS_PER_QUERY]
-        reports.update(
-            session.execute(select(Submission.id, Submission.report).where(Submission.id.in_(chunk)))
-            .tuples()
-            .all()
-        )
+        found = session.execute(select(Submission.id, Submission.report).where(Submission.id.in_(chunk)))
+        reports.update((submission_id, report) for submission_id, report in found)
     return {
         student_id: KeptSubmission(
             row.id, row.student_id, row.created_at, row.sha256, row.score, row.max_score, reports.get(row.id)
