@@ -17,7 +17,6 @@ the report is made once by `gymgrade check submissions/classic_complete.py --for
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import os
 import platform
@@ -190,8 +189,8 @@ def populate(url: str, report: dict[str, Any]) -> dict[str, float]:
             )  # fmt: skip
         timed(
             "submissions",
-            "INSERT INTO submissions (assignment_id, student_id, filename, sha256, content, size, seed, status, "
-            "created_at, started_at, finished_at, attempts, progress, report, score, max_score) "
+            "INSERT INTO submissions (assignment_id, student_id, filename, sha256, content, size, seed, "
+            "status, created_at, started_at, finished_at, attempts, progress, report, score, max_score) "
             "SELECT a.id, s.id, 'opengym.py', md5(a.id || '-' || s.id || '-' || k) || md5(s.id::text), "
             "%(content)s, %(size)s, (a.id * 7919 + s.id * 31 + k) %% 2147483647, 'done', u.at, u.at, "
             "u.at + interval '80 seconds', 1, r.progress, r.report, r.score, r.max_score "
@@ -210,8 +209,8 @@ def populate(url: str, report: dict[str, Any]) -> dict[str, float]:
         )
         timed(
             "overrides and extensions",
-            "INSERT INTO overrides (assignment_id, student_id, submission_id, problem, points, reason, author, "
-            "created_at) SELECT a.id, s.id, NULL, 'car', 1.0, 'checked by hand', 'instructor', now() "
+            "INSERT INTO overrides (assignment_id, student_id, submission_id, problem, points, reason, "
+            "author, created_at) SELECT a.id, s.id, NULL, 'car', 1.0, 'checked by hand', 'instructor', now() "
             "FROM assignments a JOIN students s ON s.course_id = a.course_id "
             "WHERE s.id %% 10 = a.id %% 10",
         )
@@ -230,11 +229,9 @@ def populate(url: str, report: dict[str, Any]) -> dict[str, float]:
 
 def counts(url: str) -> dict[str, int]:
     """Rows per table, and the database's size in MB."""
+    tables = ("courses", "assignments", "staff", "students", "submissions", "overrides", "extensions")
     with connect(url) as db:
-        found = {
-            table: int(db.execute(f"SELECT count(*) FROM {table}").fetchone()[0])  # noqa: S608
-            for table in ("courses", "assignments", "staff", "students", "submissions", "overrides", "extensions")
-        }
+        found = {table: int(db.execute(f"SELECT count(*) FROM {table}").fetchone()[0]) for table in tables}
         found["MB"] = int(db.execute("SELECT pg_database_size(current_database())").fetchone()[0]) // 2**20
     return found
 
@@ -432,8 +429,13 @@ def measure(server: Server, layout: dict[str, Any], requests: int) -> list[dict[
     return rows
 
 
-def section(args: argparse.Namespace, found: dict[str, int], taken: dict[str, float], rows: list[dict[str, Any]],
-            report_bytes: int) -> str:  # fmt: skip
+def section(
+    args: argparse.Namespace,
+    found: dict[str, Any],
+    taken: dict[str, float],
+    rows: list[dict[str, Any]],
+    report_bytes: int,
+) -> str:
     """The RESULTS.md section."""
     table = "\n".join(
         f"| {row['case']} | {row['p50']:.1f} | {row['p95']:.1f} | {row['p99']:.1f} | {row['max']:.0f} | "
@@ -449,11 +451,13 @@ def section(args: argparse.Namespace, found: dict[str, int], taken: dict[str, fl
     return (
         f"{HEADING}\n\n"
         f"`python bench/service_scale.py --requests {args.requests}`, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "  # noqa: E501
-        f"{platform.machine()} ({os.cpu_count()} cores, shared), Python {platform.python_version()}, PostgreSQL "
-        f"{found['server_version']}, `gymgrade serve` (uvicorn, one process, no grading workers) on loopback. "
+        f"{platform.machine()} ({os.cpu_count()} cores, shared), Python {platform.python_version()}, "
+        f"PostgreSQL {found['server_version']}, `gymgrade serve` (uvicorn, one process, no grading workers) "
+        "on loopback. "
         f"Database: {found['courses']} courses, {found['assignments']} assignments, {found['staff']} staff, "
         f"{found['students']} enrolments, {found['submissions']} graded submissions (each a real report of "
-        f"`classic_complete.py`, {report_bytes / 1024:.0f} KB, scores varied, with its progress and an 8 KB file), "
+        f"`classic_complete.py`, {report_bytes / 1024:.0f} KB, scores varied, with its progress and an 8 KB "
+        "file), "
         f"{found['overrides']} overrides, {found['extensions']} extensions, a late policy on a third of the "
         f"assignments; {found['MB']} MB; filled in {sum(taken.values()):.0f} s "
         f"({', '.join(f'{name} {seconds:.0f} s' for name, seconds in taken.items())}).\n\n"

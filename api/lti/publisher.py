@@ -273,7 +273,16 @@ def _claim_and_send(
         session.commit()
         if claimed.rowcount != 1:  # type: ignore[attr-defined]
             return 0
-        return _send(session, tokens, policy, shared, session.get_one(LtiScore, due.id))
+        # One query for the row and what its send reads: _send's gets then find them in the session.
+        row = session.execute(
+            select(LtiScore, LtiMember, LtiLink, LtiUser, LtiPlatform)
+            .join(LtiMember, LtiMember.id == LtiScore.member_id)
+            .join(LtiLink, LtiLink.id == LtiMember.link_id)
+            .join(LtiUser, LtiUser.id == LtiMember.user_id)
+            .join(LtiPlatform, LtiPlatform.id == LtiLink.platform_id)
+            .where(LtiScore.id == due.id)
+        ).one()[0]
+        return _send(session, tokens, policy, shared, row)
 
 
 def _scopes(link: LtiLink) -> tuple[str, ...]:
