@@ -5,11 +5,13 @@ from __future__ import annotations
 import time
 from collections.abc import Iterator
 from datetime import timedelta
+from typing import Any
 
 import pytest
 from api_testing import BOTH_DATABASES, SettingsFactory
 from cryptography.fernet import Fernet
 from scores_platform import ScoresPlatform
+from sqlalchemy import event, select
 from sqlalchemy.orm import Session
 
 from api.courses import DEFAULT_ASSIGNMENT_ID, DEFAULT_COURSE_ID
@@ -384,3 +386,38 @@ def test_a_round_sends_each_score_once_at_most_the_concurrency_at_once_with_one_
         assert lms.sends_by_user() == {f"sub-{number}": 2 if number == 4 else 1 for number in range(9)}
         assert lms.scores[-1]["scoreGiven"] == 2.5
     engine.dispose()
+
+
+def test_a_round_reads_the_reports_only_of_learners_an_override_or_a_late_policy_can_change(
+    session: Session,
+) -> None:
+    plain, _ = _member(session, "jo")
+    overridden, _ = _member(session, "kim")
+    for student in (plain, overridden):
+        _graded(session, student, 2.0).report = {"problems": [{"id": "car", "score": 2.0, "max_score": 3.0}]}
+    session.commit()
+    statements: list[tuple[str, Any]] = []
+
+    def record(_connection: Any, _cursor: Any, statement: str, parameters: Any, *_rest: Any) -> None:
+        statements.append((statement, parameters))
+
+    event.listen(session.get_bind(), "before_cursor_execute", record)
+    try:
+        _sync(session, GradebookPolicy.LATEST)
+        assert not [sql for sql, _ in statements if "submissions.report" in sql], "nobody overridden"
+        record_override(
+            session,
+            session.get_one(Assignment, DEFAULT_ASSIGNMENT_ID),
+            student_name="kim",
+            problem="car",
+            points=3.0,
+            reason="by hand",
+            author="t",
+        )
+        statements.clear()
+        _sync(session, GradebookPolicy.LATEST)
+    finally:
+        event.remove(session.get_bind(), "before_cursor_execute", record)
+    (read,) = [parameters for sql, parameters in statements if "submissions.report" in sql]
+    kim = session.scalars(select(Submission.id).where(Submission.student_id == overridden.id)).one()
+    assert list(read) == [kim], "the overridden learner's report only"
