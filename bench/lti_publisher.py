@@ -38,7 +38,14 @@ sys.path.insert(0, str(ROOT / "tests" / "api"))
 
 from api_testing import free_port  # noqa: E402
 from results_section import replace_section  # noqa: E402
-from service_scale import connect, migrated_database, postgres  # noqa: E402
+from service_scale import (  # noqa: E402
+    REPORT_VARIANTS,
+    connect,
+    migrated_database,
+    postgres,
+    real_report,
+    store_report_variants,
+)
 
 from api.database import make_engine, make_session_factory  # noqa: E402
 from api.lti.keys import protect_keys  # noqa: E402
@@ -50,14 +57,6 @@ COURSES = 20
 CHANGED = 100
 TARGET_SECONDS = 300.0
 WAIT_SECONDS = 1800.0
-REPORT = (
-    '{"score": %(score)s, "max_score": 5.0, "problems": ['
-    '{"id": "random_blackjack", "score": 1.0, "max_score": 1.0, "visibility": "visible"}, '
-    '{"id": "blackjack", "score": 1.0, "max_score": 1.0, "visibility": "visible"}, '
-    '{"id": "cartpole", "score": 1.0, "max_score": 1.0, "visibility": "visible"}, '
-    '{"id": "car", "score": 1.0, "max_score": 1.0, "visibility": "visible"}, '
-    '{"id": "taxi", "score": 1.0, "max_score": 1.0, "visibility": "visible"}]}'
-)
 
 
 def serve_platform(port: int, delay: float) -> None:
@@ -103,11 +102,12 @@ def serve_platform(port: int, delay: float) -> None:
     uvicorn.run(app, host="127.0.0.1", port=port, log_level="warning", access_log=False)
 
 
-def populate(url: str, lms: str, scores: int) -> None:
+def populate(url: str, lms: str, scores: int, report: dict[str, Any]) -> None:
     """COURSES courses, each an assignment and an LTI link with its line item, and ``scores`` learners
-    (users, enrolments, link members) with one graded submission each."""
+    (users, enrolments, link members) with one graded submission each (``report``, scores varied)."""
     per_course = -(-scores // COURSES)
     with connect(url) as db:
+        store_report_variants(db, report)
         db.execute(
             "INSERT INTO lti_platforms (issuer, client_id, deployment_ids, jwks_url, auth_url, token_url, "
             "created_at, frame_ancestors) VALUES (%(lms)s::text, 'bench', '[\"d\"]', "
@@ -154,10 +154,10 @@ def populate(url: str, lms: str, scores: int) -> None:
             "INSERT INTO submissions (assignment_id, student_id, filename, sha256, content, size, seed, "
             "status, created_at, started_at, finished_at, attempts, progress, report, score, max_score) "
             "SELECT a.id, s.id, 'opengym.py', md5(s.id::text) || md5(s.name), '\\x00', 1, s.id, 'done', "
-            "now(), now(), now(), 1, '[]', "
-            "replace(%(report)s, '%%(score)s', ((s.id %% 6)::float)::text)::json, (s.id %% 6)::float, 5.0 "
-            "FROM students s JOIN assignments a ON a.course_id = s.course_id",
-            {"report": REPORT},
+            "now(), now(), now(), 1, r.progress, r.report, r.score, r.max_score "
+            "FROM students s JOIN assignments a ON a.course_id = s.course_id "
+            "JOIN bench_reports r ON r.variant = s.id %% %(variants)s",
+            {"variants": REPORT_VARIANTS},
         )
         db.execute("VACUUM ANALYZE")
 
@@ -186,7 +186,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     try:
         with postgres() as cluster:
             url = migrated_database(cluster)
-            populate(url, lms, args.scores)
+            populate(url, lms, args.scores, real_report(args.report))
             wait_until(lambda: _answers(lms), "the fake platform to answer")
             settings = Settings(
                 database_url=url,
@@ -281,7 +281,8 @@ def section(args: argparse.Namespace, found: dict[str, Any]) -> str:
         f"{found['load'][1]:.1f} at the end), Python {platform.python_version()}, PostgreSQL. The real "
         "publisher (`ScorePublisher`, a round every second) against a fake platform on loopback (its own "
         f"process) answering every token and score request after {args.delay * 1000:.0f} ms; {COURSES} "
-        f"courses, each a link with its line item, {args.scores} learners with a graded upload each.\n\n"
+        f"courses, each a link with its line item, {args.scores} learners with a graded upload each (a real "
+        "report of `classic_complete.py`, scores varied); no overrides, no late policy.\n\n"
         "| what | figure |\n|---|---|\n"
         f"| {args.scores} pending scores, from the publisher's start to the last accepted | "
         f"**{found['seconds']:.1f} s** ({args.scores / found['seconds']:.0f} per second; target "
@@ -302,6 +303,7 @@ def main() -> None:
     parser.add_argument("--scores", type=int, default=10_000)
     parser.add_argument("--delay", type=float, default=0.1)
     parser.add_argument("--concurrency", type=int, default=8)
+    parser.add_argument("--report", type=Path, default=None, help="a report JSON to store (else graded now)")
     parser.add_argument("--write", action="store_true")
     args = parser.parse_args()
     found = run(args)

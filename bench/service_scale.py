@@ -113,6 +113,26 @@ def report_variants(report: dict[str, Any]) -> list[dict[str, Any]]:
     return variants
 
 
+def store_report_variants(db: Any, report: dict[str, Any]) -> None:
+    """The temporary table ``bench_reports`` (variant, report, progress, score, max_score) of the
+    connection: ``report_variants(report)``, for the submissions' rows to be made from on the server."""
+    db.execute(
+        "CREATE TEMPORARY TABLE bench_reports (variant int, report json, progress json, score float, "
+        "max_score float)"
+    )
+    for variant, shaped in enumerate(report_variants(report)):
+        db.execute(
+            "INSERT INTO bench_reports VALUES (%s, %s::json, %s::json, %s, %s)",
+            (
+                variant,
+                json.dumps(shaped),
+                json.dumps(shaped["problems"]),
+                shaped["score"],
+                shaped["max_score"],
+            ),
+        )
+
+
 def student_token(course: int, number: int) -> str:
     """The bench's token of student ``number`` of course ``course`` (its SHA-256 is stored)."""
     return f"bench-student-{course}-{number}"
@@ -177,16 +197,7 @@ def populate(url: str, report: dict[str, Any]) -> dict[str, float]:
             "FROM courses c CROSS JOIN generate_series(1, %(students)s) n ORDER BY c.id, n",
             {"students": STUDENTS_PER_COURSE},
         )
-        db.execute(
-            "CREATE TEMPORARY TABLE bench_reports (variant int, report json, progress json, score float, "
-            "max_score float)"
-        )
-        for variant, shaped in enumerate(report_variants(report)):
-            db.execute(
-                "INSERT INTO bench_reports VALUES (%s, %s::json, %s::json, %s, %s)",
-                (variant, json.dumps(shaped), json.dumps(shaped["problems"]), shaped["score"],
-                 shaped["max_score"]),
-            )  # fmt: skip
+        store_report_variants(db, report)
         timed(
             "submissions",
             "INSERT INTO submissions (assignment_id, student_id, filename, sha256, content, size, seed, "
