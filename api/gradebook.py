@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any, TypeVar
@@ -130,11 +130,11 @@ def gradebook_export(
         )
     students, chosen = _chosen(session, assignment)
     problem_ids = _problem_ids(row.report for row in chosen.values())
-    finals = final_grades(session, assignment, chosen)
+    reports = {student_id: _report(picked) for student_id, picked in chosen.items()}
+    finals = final_grades(session, assignment, chosen, reports)
     rows = []
     for student in students:
-        picked = chosen.get(student.id)
-        report = _report(picked)
+        report = reports.get(student.id)
         final = finals[student.id] if student.id in finals else _final(student.id, None, None, {}, None)
         rows.append(
             GradeRow(
@@ -152,16 +152,29 @@ def gradebook_export(
     return write(rows, problem_ids, names)
 
 
-def final_grades(session: Session, assignment: Assignment, chosen: dict[int, Any]) -> dict[int, FinalGrade]:
+def final_grades(
+    session: Session,
+    assignment: Assignment,
+    chosen: dict[int, Any],
+    reports: Mapping[int, Report | None] | None = None,
+) -> dict[int, FinalGrade]:
     """The final grade of each enrolment's kept submission (``chosen``: enrolment id -> its row, with
     ``id``, ``created_at``, ``score``, ``max_score``, ``report``): the instructor's overrides that count for
     it and the assignment's late penalty by its upload time applied. What every gradebook format shows and
-    what the LMS receives.
+    what the LMS receives. ``reports``: the rows' reports as :func:`_report` makes them, where the caller
+    made them already (by enrolment id).
     """
     counted = counted_overrides(session, assignment.id, chosen)
     late = late_policy_of(session, assignment)
+    made = reports if reports is not None else {}
     return {
-        student_id: _final(student_id, picked, _report(picked), counted.get(student_id, {}), late)
+        student_id: _final(
+            student_id,
+            picked,
+            made[student_id] if student_id in made else _report(picked),
+            counted.get(student_id, {}),
+            late,
+        )
         for student_id, picked in chosen.items()
     }
 
