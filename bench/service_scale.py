@@ -192,7 +192,7 @@ def populate(url: str, report: dict[str, Any]) -> dict[str, float]:
         timed(
             "students",
             "INSERT INTO students (course_id, name, token_sha256, created_at) "
-            "SELECT c.id, 'student ' || lpad(n::text, 3, '0'), "
+            "SELECT c.id, (100000 + c.id * 100 + n)::text, "
             "encode(sha256(convert_to('bench-student-' || c.id || '-' || n, 'UTF8')), 'hex'), now() "
             "FROM courses c CROSS JOIN generate_series(1, %(students)s) n ORDER BY c.id, n",
             {"students": STUDENTS_PER_COURSE},
@@ -399,7 +399,7 @@ def layout_of(url: str) -> dict[str, Any]:
             "SELECT s.name, max(u.id) FROM submissions u JOIN students s ON s.id = u.student_id "
             "WHERE u.assignment_id = 1 GROUP BY s.name"
         ).fetchall()
-    latest = {int(name.split()[-1]): submission for name, submission in rows}
+    latest = {int(name) % 100: submission for name, submission in rows}
     return {"slugs": ["opengym", "rl2", "opengym-classic"], "default_submissions": latest}
 
 
@@ -468,7 +468,7 @@ def section(
         f"Database: {found['courses']} courses, {found['assignments']} assignments, {found['staff']} staff, "
         f"{found['students']} enrolments, {found['submissions']} graded submissions (each a real report of "
         f"`classic_complete.py`, {report_bytes / 1024:.0f} KB, scores varied, with its progress and an 8 KB "
-        "file), "
+        "file; students named by a Canvas-like user id, as the Canvas export needs), "
         f"{found['overrides']} overrides, {found['extensions']} extensions, a late policy on a third of the "
         f"assignments; {found['MB']} MB; filled in {sum(taken.values()):.0f} s "
         f"({', '.join(f'{name} {seconds:.0f} s' for name, seconds in taken.items())}).\n\n"
