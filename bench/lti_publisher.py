@@ -31,6 +31,7 @@ from typing import Any
 
 import httpx
 from cryptography.fernet import Fernet
+from pydantic import SecretStr
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -191,10 +192,10 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
             settings = Settings(
                 database_url=url,
                 data_dir=Path(tempfile.gettempdir()),
-                instructor_token="bench-operator-" + "q" * 24,
+                instructor_token=SecretStr("bench-operator-" + "q" * 24),
                 lti_allow_http=True,
                 lti_allowed_networks="127.0.0.0/8",
-                key_encryption_key=Fernet.generate_key().decode("ascii"),
+                key_encryption_key=SecretStr(Fernet.generate_key().decode("ascii")),
                 lti_publish_seconds=1.0,
                 lti_publish_concurrency=args.concurrency,
             )

@@ -71,7 +71,7 @@ def postgres() -> Iterator[PostgresServer]:
 
 def migrated_database(server: PostgresServer) -> str:
     """A new database of the cluster at the newest migration; its SQLAlchemy URL."""
-    url = server.new_database()
+    url: str = server.new_database()
     engine = make_engine(Settings(database_url=url, development=True, data_dir=Path(tempfile.gettempdir())))
     migrate(engine)
     engine.dispose()
