@@ -53,6 +53,11 @@ class Disclosure:
     shown: frozenset[str]
     due_date: datetime | None = None
 
+    @property
+    def everything(self) -> bool:
+        """True when every problem is shown, whatever its visibility (the staff's view)."""
+        return self.shown >= EVERY_VISIBILITY
+
     def shows(self, problem: JsonObject) -> bool:
         """True when the problem's result may be shown (reports without visibility are visible)."""
         return str(problem.get("visibility", "visible")) in self.shown
@@ -120,6 +125,8 @@ def report_view(report: JsonObject, disclosure: Disclosure) -> JsonObject:
 
 def withholds_any(report: JsonObject | None, disclosure: Disclosure) -> bool:
     """True when ``disclosure`` withholds some problem of ``report`` (so also its total score)."""
+    if disclosure.everything:
+        return False
     problems = report.get("problems", []) if report else []
     return any(not disclosure.shows(problem) for problem in problems)
 

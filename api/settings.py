@@ -175,6 +175,12 @@ class Settings(BrokerSettings):
     lti_publish_seconds: float = Field(
         default=2.0, gt=0, description="How often the server publishes new scores to the LMS (LTI AGS)."
     )
+    lti_publish_concurrency: int = Field(
+        default=8,
+        ge=1,
+        le=32,
+        description="The most scores the server sends to one LMS at once (each waits for the LMS's answer).",
+    )
     lti_publish_attempts: int = Field(
         default=8,
         gt=0,

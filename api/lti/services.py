@@ -84,17 +84,25 @@ class Grant:
 
 
 class AccessTokens:
-    """Access tokens per (platform, scopes), requested with client_credentials and kept until near expiry."""
+    """Access tokens per (platform, scopes), requested with client_credentials and kept until near expiry.
+    Threads asking at once for a token not held yet wait for one request: the platform is asked once."""
 
     def __init__(self, outbound: Outbound, allowed_hosts: tuple[str, ...] = ()) -> None:
         self._outbound = outbound
         self._allowed_hosts = allowed_hosts
         self._lock = threading.Lock()
         self._tokens: dict[tuple[int, str], tuple[float, str]] = {}
+        self._asking: dict[tuple[int, str], threading.Lock] = {}
 
     def token(self, session: Session, platform: LtiPlatform, scopes: tuple[str, ...]) -> Grant:
         """A bearer token for ``scopes`` at the platform (raises ServiceFailed)."""
         key = (platform.id, " ".join(sorted(scopes)))
+        with self._lock:
+            asking = self._asking.setdefault(key, threading.Lock())
+        with asking:
+            return self._held_or_new(session, platform, key)
+
+    def _held_or_new(self, session: Session, platform: LtiPlatform, key: tuple[int, str]) -> Grant:
         with self._lock:
             cached = self._tokens.get(key)
         if cached is not None and cached[0] > time.monotonic():

@@ -9,11 +9,14 @@ import socket
 import subprocess
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import pytest
 from fastapi.testclient import TestClient
+from sqlalchemy import event
 
 from api.settings import Settings
 
@@ -171,3 +174,19 @@ def graded_upload(client: TestClient, token: str, scores: dict[str, float]) -> i
     if not jobs.complete(submission_id, "test-worker", report):
         raise RuntimeError(f"could not complete submission {submission_id}")
     return submission_id
+
+
+@contextmanager
+def recorded_statements(client: TestClient) -> Iterator[list[tuple[str, Any]]]:
+    """Every SQL statement (and its parameters) the app of ``client`` runs inside the block."""
+    statements: list[tuple[str, Any]] = []
+
+    def record(_connection: Any, _cursor: Any, statement: str, parameters: Any, *_rest: Any) -> None:
+        statements.append((statement, parameters))
+
+    engine = client.app.state.context.engine  # type: ignore[attr-defined]
+    event.listen(engine, "before_cursor_execute", record)
+    try:
+        yield statements
+    finally:
+        event.remove(engine, "before_cursor_execute", record)

@@ -6,7 +6,14 @@ import csv
 import io
 
 import pytest
-from api_testing import BOTH_DATABASES, SettingsFactory, add_student, bearer, instructor_headers
+from api_testing import (
+    BOTH_DATABASES,
+    SettingsFactory,
+    add_student,
+    bearer,
+    instructor_headers,
+    recorded_statements,
+)
 from fastapi.testclient import TestClient
 
 from api.main import create_app
@@ -142,3 +149,28 @@ def test_a_canvas_export_names_the_services_lab_unless_given_a_title(
         )
     assert response.status_code == 200, response.text
     assert next(csv.reader(io.StringIO(response.text)))[-1] == column
+
+
+def _gradebook_statements(client: TestClient) -> list[tuple[str, object]]:
+    with recorded_statements(client) as statements:
+        _rows(client)
+    return statements
+
+
+def test_the_gradebook_reads_in_as_many_queries_for_any_class_and_only_the_kept_reports(
+    client: TestClient,
+) -> None:
+    kept = []
+    for number in range(2):
+        token = add_student(client, f"s{number}")
+        _graded(client, token, {"car": 0.0})
+        kept.append(_graded(client, token, {"car": 1.0}))
+    few = _gradebook_statements(client)
+    for number in range(2, 6):
+        token = add_student(client, f"s{number}")
+        _graded(client, token, {"car": 0.0})
+        kept.append(_graded(client, token, {"car": 1.0}))
+    many = _gradebook_statements(client)
+    assert len(many) == len(few), "no query per student"
+    (reports,) = [(sql, parameters) for sql, parameters in many if "submissions.report" in sql]
+    assert sorted(reports[1]) == sorted(kept), "the reports of the kept uploads only (latest policy)"

@@ -7,7 +7,15 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from api_testing import BOTH_DATABASES, SettingsFactory, add_student, bearer, instructor_headers
+from api_testing import (
+    BOTH_DATABASES,
+    SettingsFactory,
+    add_student,
+    bearer,
+    graded_upload,
+    instructor_headers,
+    recorded_statements,
+)
 from fastapi.testclient import TestClient
 
 from api.main import create_app
@@ -275,3 +283,21 @@ def test_notebooks_are_accepted_and_graded_under_their_own_name(client: TestClie
     assert (view["status"], view["filename"]) == ("queued", "opengym.ipynb")
     assert grading_file_name("opengym.ipynb") == "opengym.ipynb"
     assert grading_file_name("my lab.ipynb") == "submission.ipynb"
+
+
+def test_the_staff_listing_reads_no_file_progress_or_report_and_one_query_for_any_number(
+    client: TestClient,
+) -> None:
+    token = add_student(client, "ada")
+    graded_upload(client, token, {"car": 1.0})
+    with recorded_statements(client) as one:
+        assert len(client.get("/submissions", headers=instructor_headers()).json()) == 1
+    for _ in range(3):
+        graded_upload(client, token, {"car": 0.5})
+    with recorded_statements(client) as four:
+        listed = client.get("/submissions", headers=instructor_headers()).json()
+    assert [item["score"] for item in listed] == [0.5, 0.5, 0.5, 1.0], "totals are the staff's to see"
+    assert len(four) == len(one), "no query per submission"
+    read = " ".join(sql for sql, _ in four)
+    for column in ("submissions.content", "submissions.progress", "submissions.report"):
+        assert column not in read

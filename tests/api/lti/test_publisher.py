@@ -5,13 +5,19 @@ from __future__ import annotations
 import time
 from collections.abc import Iterator
 from datetime import timedelta
+from typing import Any
 
 import pytest
 from api_testing import BOTH_DATABASES, SettingsFactory
+from cryptography.fernet import Fernet
+from scores_platform import ScoresPlatform
+from sqlalchemy import event, select
 from sqlalchemy.orm import Session
 
 from api.courses import DEFAULT_ASSIGNMENT_ID, DEFAULT_COURSE_ID
 from api.database import make_engine, make_session_factory, migrate
+from api.lti.claims import SCOPE_LINEITEM, SCOPE_SCORE
+from api.lti.keys import protect_keys
 from api.lti.publisher import (
     FAILED,
     PENDING,
@@ -311,3 +317,107 @@ def test_the_lms_is_sent_the_final_score_again_when_an_override_or_the_late_poli
     assert _sync(session, GradebookPolicy.LATEST) == 1
     assert (_row(session, member).status, _row(session, member).score) == (PENDING, 1.5)
     assert _sync(session, GradebookPolicy.LATEST) == 0, "an unchanged final score is not sent again"
+
+
+def test_a_round_sends_each_score_once_at_most_the_concurrency_at_once_with_one_token_and_one_line_item(
+    make_settings: SettingsFactory,
+) -> None:
+    settings = make_settings(
+        lti_allow_http=True,
+        lti_allowed_networks="127.0.0.0/8",
+        key_encryption_key=Fernet.generate_key().decode("ascii"),
+        lti_publish_concurrency=3,
+    )
+    engine = make_engine(settings)
+    migrate(engine)
+    sessions = make_session_factory(engine)
+    protect_keys(sessions, settings)
+    with ScoresPlatform(together=3).running() as lms, sessions() as session:
+        platform = LtiPlatform(
+            issuer=lms.url,
+            client_id="c",
+            deployment_ids=["d"],
+            jwks_url=lms.url + "/jwks",
+            auth_url=lms.url + "/auth",
+            token_url=lms.url + "/token",
+        )
+        session.add(platform)
+        session.flush()
+        link = LtiLink(
+            platform_id=platform.id,
+            deployment_id="d",
+            context_id="course",
+            resource_link_id="link",
+            assignment_id=DEFAULT_ASSIGNMENT_ID,
+            title="",
+            lineitems_url=lms.url + "/lineitems",
+            ags_scopes=[SCOPE_LINEITEM, SCOPE_SCORE],
+            custom={},
+        )
+        session.add(link)
+        session.flush()
+        submissions = {}
+        for number in range(9):
+            user = LtiUser(platform_id=platform.id, sub=f"sub-{number}", name=f"p{number}")
+            session.add(user)
+            session.flush()
+            student = Student(
+                course_id=DEFAULT_COURSE_ID,
+                name=f"p{number}",
+                token_sha256=f"{number:064d}",
+                lti_user_id=user.id,
+            )
+            session.add(student)
+            session.add(LtiMember(link_id=link.id, user_id=user.id))
+            session.commit()
+            submissions[user.sub] = _graded(session, student, float(number % 3))
+        publisher = ScorePublisher(sessions, settings)
+
+        assert publisher.run_once() == 9
+        assert lms.sends_by_user() == {f"sub-{number}": 1 for number in range(9)}
+        assert lms.most_in_flight == 3, "three at once (the barrier lets none through alone), never more"
+        assert (lms.tokens_granted, lms.line_items_made) == (1, 1)
+
+        assert publisher.run_once() == 0, "an unchanged score is not sent again"
+        submissions["sub-4"].score = 2.5
+        session.commit()
+        lms.one_at_a_time()
+        assert publisher.run_once() == 1
+        assert lms.sends_by_user() == {f"sub-{number}": 2 if number == 4 else 1 for number in range(9)}
+        assert lms.scores[-1]["scoreGiven"] == 2.5
+    engine.dispose()
+
+
+def test_a_round_reads_the_reports_only_of_learners_an_override_or_a_late_policy_can_change(
+    session: Session,
+) -> None:
+    plain, _ = _member(session, "jo")
+    overridden, _ = _member(session, "kim")
+    for student in (plain, overridden):
+        _graded(session, student, 2.0).report = {"problems": [{"id": "car", "score": 2.0, "max_score": 3.0}]}
+    session.commit()
+    statements: list[tuple[str, Any]] = []
+
+    def record(_connection: Any, _cursor: Any, statement: str, parameters: Any, *_rest: Any) -> None:
+        statements.append((statement, parameters))
+
+    event.listen(session.get_bind(), "before_cursor_execute", record)
+    try:
+        _sync(session, GradebookPolicy.LATEST)
+        assert not [sql for sql, _ in statements if "submissions.report" in sql], "nobody overridden"
+        record_override(
+            session,
+            session.get_one(Assignment, DEFAULT_ASSIGNMENT_ID),
+            student_name="kim",
+            problem="car",
+            points=3.0,
+            reason="by hand",
+            author="t",
+        )
+        statements.clear()
+        _sync(session, GradebookPolicy.LATEST)
+    finally:
+        event.remove(session.get_bind(), "before_cursor_execute", record)
+    (read,) = [parameters for sql, parameters in statements if "submissions.report" in sql]
+    kim = session.scalars(select(Submission.id).where(Submission.student_id == overridden.id)).one()
+    assert list(read) == [kim], "the overridden learner's report only"
