@@ -244,7 +244,6 @@ def section(
             "",
             "",
         ),
-        "",
     ]
     parts = []
     for name in problems:
