@@ -20,11 +20,11 @@ from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
 from api.auth import Principal
-from api.errors import CourseExists, CourseNotFound, InvalidRequest
+from api.errors import CourseExists, CourseNotFound, InvalidRequest, StaffNotFound
 from api.models import Assignment, Course, Extension, LtiLink, Staff, Student
 from api.security import new_token, token_digest
 from api.settings import GradebookPolicy, SeedPolicy, Settings
-from api.students import printable
+from api.students import MAX_ID, printable
 from grader.classroom.late import LatePolicy, read_late_policy
 
 DEFAULT_COURSE_ID = 1
@@ -174,6 +174,44 @@ def create_staff(session: Session, course: Course, name: str, role: str) -> tupl
     session.add(staff)
     session.commit()
     return staff, token
+
+
+def staff_of(session: Session, course: Course) -> list[Staff]:
+    """The course's staff, oldest first."""
+    return list(session.scalars(select(Staff).where(Staff.course_id == course.id).order_by(Staff.id)))
+
+
+def find_staff(session: Session, course: Course, staff_id: int) -> Staff:
+    """The course's staff member with id ``staff_id``.
+
+    Raises:
+        StaffNotFound: The course has no staff member of that id.
+    """
+    staff = session.get(Staff, staff_id) if 1 <= staff_id <= MAX_ID else None
+    if staff is None or staff.course_id != course.id:
+        raise StaffNotFound(
+            f"no staff member {staff_id} in course {course.slug!r}; list them with GET /courses/{course.slug}/staff"  # noqa: E501
+        )
+    return staff
+
+
+def new_staff_token(session: Session, staff: Staff) -> str:
+    """Give a staff member a new API token, the old one (if any) no longer accepted (committed).
+
+    Returns:
+        The token in clear (never stored; only its SHA-256 is).
+    """
+    token = new_token()
+    staff.token_sha256 = token_digest(token)
+    session.commit()
+    return token
+
+
+def revoke_staff_token(session: Session, staff: Staff) -> None:
+    """Revoke a staff member's API token: its digest is forgotten, so the next request with it is nobody's
+    (committed). Their LTI launches, if any, still sign them in."""
+    staff.token_sha256 = None
+    session.commit()
 
 
 def create_assignment(session: Session, course: Course, values: dict[str, Any]) -> Assignment:

@@ -17,13 +17,12 @@ from api.jobs.job_queue import Dispatcher
 from api.models import Assignment, JobStatus, Student, Submission, utcnow
 from api.schemas import OverrideShown, SubmissionDetail, SubmissionSummary
 from api.settings import SeedPolicy, Settings
-from api.students import find_student
+from api.students import MAX_ID, find_student
 from api.uploads import CheckedUpload
 from grader.seeds import held_out_seed
 
 RATE_WINDOW = timedelta(seconds=60)
 MAX_SEED = 2**31 - 1
-MAX_ID = 2**31 - 1  # the largest id every database's integer column holds
 
 
 def create_submission(

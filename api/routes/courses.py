@@ -7,9 +7,19 @@ from __future__ import annotations
 
 from datetime import UTC
 
-from fastapi import APIRouter, Depends
+from fastapi import APIRouter, Depends, Response
 
-from api.courses import assignments_of, courses_of, create_assignment, create_course, create_staff
+from api.courses import (
+    assignments_of,
+    courses_of,
+    create_assignment,
+    create_course,
+    create_staff,
+    find_staff,
+    new_staff_token,
+    revoke_staff_token,
+    staff_of,
+)
 from api.deps import (
     AnyCallerDep,
     CallerDep,
@@ -27,10 +37,11 @@ from api.errors import (
     MalformedBody,
     NotAuthenticated,
     OperatorOnly,
+    StaffNotFound,
     UploadTooLarge,
 )
 from api.handlers import error_responses
-from api.models import Assignment, Course
+from api.models import Assignment, Course, Staff
 from api.schemas import (
     AssignmentCreate,
     AssignmentView,
@@ -38,6 +49,7 @@ from api.schemas import (
     CourseView,
     StaffCreate,
     StaffCreated,
+    StaffView,
 )
 from grader.lab.editions.choice import service_edition
 from grader.seeds import held_out_seed
@@ -114,7 +126,61 @@ def post_staff(
     """Add an instructor or a teaching assistant to the course (the operator, or the course's instructor);
     the token in the response is shown only this once and reaches this course only."""
     staff, token = create_staff(session, course, body.name, body.role)
-    return StaffCreated(name=staff.name, role=body.role, token=token)
+    return StaffCreated(id=staff.id, name=staff.name, role=body.role, token=token)
+
+
+def _staff_view(staff: Staff) -> StaffView:
+    return StaffView(
+        id=staff.id,
+        name=staff.name,
+        role=staff.role,  # type: ignore[arg-type]  # a StaffRole value, checked by StaffView
+        token=staff.token_sha256 is not None,
+        lti=staff.lti_user_id is not None,
+    )
+
+
+@course_router.get(
+    "/staff",
+    response_model=list[StaffView],
+    responses=error_responses(NotAuthenticated, InstructorOnly, CourseNotFound, InvalidRequest),
+)
+def get_staff(session: SessionDep, _instructor: CourseInstructorDep, course: CourseDep) -> list[StaffView]:
+    """The course's staff, oldest first, with whether each has an API token (never the token)."""
+    return [_staff_view(staff) for staff in staff_of(session, course)]
+
+
+@course_router.post(
+    "/staff/{staff_id}/token",
+    status_code=201,
+    response_model=StaffCreated,
+    responses=error_responses(
+        NotAuthenticated, InstructorOnly, CourseNotFound, StaffNotFound, InvalidRequest
+    ),
+)
+def post_staff_token(
+    staff_id: int, session: SessionDep, _instructor: CourseInstructorDep, course: CourseDep
+) -> StaffCreated:
+    """A new API token for a staff member (their old one stops working), shown only this once."""
+    staff = find_staff(session, course, staff_id)
+    token = new_staff_token(session, staff)
+    return StaffCreated(id=staff.id, name=staff.name, role=staff.role, token=token)  # type: ignore[arg-type]
+
+
+@course_router.delete(
+    "/staff/{staff_id}/token",
+    status_code=204,
+    response_class=Response,
+    responses=error_responses(
+        NotAuthenticated, InstructorOnly, CourseNotFound, StaffNotFound, InvalidRequest
+    ),
+)
+def delete_staff_token(
+    staff_id: int, session: SessionDep, _instructor: CourseInstructorDep, course: CourseDep
+) -> Response:
+    """Revoke a staff member's API token: a request with it is refused from now on (401). Nothing to revoke
+    is no error."""
+    revoke_staff_token(session, find_staff(session, course, staff_id))
+    return Response(status_code=204)
 
 
 @course_router.post(

@@ -14,7 +14,8 @@ from fastapi.testclient import TestClient
 
 from api.courses import DEFAULT_ASSIGNMENT_ID, default_assignment, sync_default
 from api.main import create_app
-from api.models import Assignment, Extension, Student, Submission
+from api.models import Assignment, Extension, Staff, Student, Submission
+from api.security import token_digest
 
 pytestmark = pytest.mark.slow  # each starts the service on a fresh database (about a second)
 
@@ -234,3 +235,49 @@ def test_an_assignment_grades_as_its_own_lab_and_a_name_is_unique_in_its_course_
             "/courses/a/assignments", json={"slug": "lab1", "title": "X"}, headers=instructor_headers()
         )
         assert taken.status_code == 409
+
+
+def test_a_staff_token_reaches_one_course_with_its_role_and_is_revoked(
+    make_settings: SettingsFactory,
+) -> None:
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        a, b = _course(client, "a", "rl1"), _course(client, "b", "rl1")
+        operator = instructor_headers()
+        made = client.post("/courses/a/staff", json={"name": "Bot", "role": "ta"}, headers=operator).json()
+        token = bearer(made["token"])
+        assert client.get(f"{A}/submissions", headers=token).status_code == 200
+        assert client.get(f"{B}/submissions", headers=token).status_code == 404  # another course's
+        assert (
+            client.post("/courses/a/students", json={"name": "x"}, headers=token).status_code == 403
+        )  # a TA's
+        listed = client.get("/courses/a/staff", headers=bearer(a["instructor"])).json()
+        assert [(row["name"], row["role"], row["token"]) for row in listed] == [
+            ("instructor of a", "instructor", True), ("ta of a", "ta", True), ("Bot", "ta", True)
+        ]  # fmt: skip
+        assert "token_sha256" not in listed[0] and all(made["token"] not in str(row) for row in listed)
+        with client.app.state.context.sessions() as session:  # type: ignore[attr-defined]
+            stored = session.get_one(Staff, made["id"]).token_sha256
+            assert stored == token_digest(made["token"])  # only the digest is kept
+        # another course's instructor, and a TA, may neither list nor revoke
+        assert (
+            client.delete(f"/courses/a/staff/{made['id']}/token", headers=bearer(b["instructor"])).status_code
+            == 404
+        )
+        assert (
+            client.delete(f"/courses/a/staff/{made['id']}/token", headers=bearer(a["ta"])).status_code == 403
+        )
+        assert client.delete(f"/courses/b/staff/{made['id']}/token", headers=operator).status_code == 404
+        assert (
+            client.delete(f"/courses/a/staff/{made['id']}/token", headers=bearer(a["instructor"])).status_code
+            == 204
+        )
+        assert client.get(f"{A}/submissions", headers=token).status_code == 401
+        assert [row["token"] for row in client.get("/courses/a/staff", headers=operator).json()] == [
+            True,
+            True,
+            False,
+        ]
+        renewed = client.post(f"/courses/a/staff/{made['id']}/token", headers=operator)
+        assert renewed.status_code == 201 and renewed.json()["role"] == "ta"
+        assert client.get(f"{A}/submissions", headers=bearer(renewed.json()["token"])).status_code == 200
+        assert client.get(f"{A}/submissions", headers=token).status_code == 401
