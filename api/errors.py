@@ -69,6 +69,10 @@ class StaffNotFound(ServiceError):
     """Raised when a staff member's id is not one of the course's."""
 
 
+class LinkNotFound(ServiceError):
+    """Raised when an LTI resource link's id is not one of the links opening the assignment."""
+
+
 class NoLatePolicy(ServiceError):
     """Raised when an extension is granted on an assignment without a late policy: it would change nothing."""
 

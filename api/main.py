@@ -15,7 +15,18 @@ from api.deps import ASSIGNMENT_PREFIX, COURSE_PREFIX, in_assignment, in_course
 from api.handlers import install_error_handlers
 from api.limits import BodyLimitMiddleware
 from api.lti.sessions import redact_access_log
-from api.routes import courses, extensions, gradebook, health, lti, overrides, students, submissions, ui
+from api.routes import (
+    courses,
+    extensions,
+    gradebook,
+    health,
+    lti,
+    lti_scoped,
+    overrides,
+    students,
+    submissions,
+    ui,
+)
 from api.settings import Settings, load_settings
 from api.web import STATIC_DIR
 
@@ -58,6 +69,7 @@ def create_app(settings: Settings | None = None, *, run_workers: bool = True) ->
         app.include_router(module.router)
     app.include_router(courses.router)
     app.include_router(courses.course_router)
+    app.include_router(lti_scoped.router)
     app.include_router(_mounted_again(students.router, COURSE_PREFIX, in_course, "_of_course"))
     for module in (submissions, gradebook, overrides, extensions):
         app.include_router(_mounted_again(module.router, ASSIGNMENT_PREFIX, in_assignment, SCOPED_SUFFIX))

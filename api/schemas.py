@@ -324,3 +324,42 @@ class AssignmentView(BaseModel):
     due_date: UtcDateTime | None
     gradebook_policy: str
     late: dict[str, Any] | None
+
+
+class LtiLinkView(BaseModel):
+    """A resource link of an LMS course that opens the assignment: its platform, context, title, line item and
+    custom parameters."""
+
+    model_config = ConfigDict(from_attributes=True)
+
+    id: int
+    platform_id: int
+    context_id: str
+    resource_link_id: str
+    title: str
+    lineitem_url: str | None
+    custom: dict[str, str]
+
+
+class RosterImported(BaseModel):
+    """What a roster import (LTI Names and Role Provisioning) found: learners (each now has an enrolment and a
+    gradebook row), staff, and members skipped (inactive, or of no role the tool knows)."""
+
+    learners: int
+    staff: int
+    skipped: int
+
+
+class LtiScoreView(BaseModel):
+    """One student's score publishing to the LMS for a link: the kept (final) score, the one the LMS holds,
+    the publishing's state, its attempts and last error."""
+
+    student: str
+    link_id: int
+    submission_id: int
+    score: float | None
+    max_score: float | None
+    sent_score: float | None
+    status: Literal["pending", "sent", "retrying", "failed"]
+    attempts: int
+    error: str | None

@@ -204,6 +204,17 @@ def course_of(session: Session, link: LtiLink) -> int:
     return session.get_one(Assignment, link.assignment_id).course_id
 
 
+def links_of(session: Session, course_id: int | None, assignment_id: int | None = None) -> list[LtiLink]:
+    """The resource links opening the assignment ``assignment_id`` (None: any) of course ``course_id`` (None:
+    any course), oldest first."""
+    query = select(LtiLink).join(Assignment, Assignment.id == LtiLink.assignment_id).order_by(LtiLink.id)
+    if course_id is not None:
+        query = query.where(Assignment.course_id == course_id)
+    if assignment_id is not None:
+        query = query.where(LtiLink.assignment_id == assignment_id)
+    return list(session.scalars(query))
+
+
 def ensure_member(session: Session, link: LtiLink, user: LtiUser) -> LtiMember:
     """The user as a member of the link (their enrolment's scores in the link's assignment go to the
     link's line item)."""
