@@ -224,6 +224,8 @@ def create_assignment(session: Session, course: Course, values: dict[str, Any]) 
     from grader.lab.editions.choice import service_edition  # the packs import the checks: only here
     from grader.lab.editions.errors import LabConflict, UnknownEdition, UnknownLab
 
+    if values.get("config_toml") is not None:
+        values = {**values, **_configured(values["config_toml"], values.get("edition"))}
     try:
         service_edition(values.get("edition"), values.get("lab"))
     except (UnknownEdition, UnknownLab, LabConflict) as error:
@@ -237,6 +239,44 @@ def create_assignment(session: Session, course: Course, values: dict[str, Any]) 
         session, f"course {course.slug!r} has an assignment {values['slug']!r} already; choose another slug"
     )
     return assignment
+
+
+def _configured(text: str, edition: str | None) -> dict[str, Any]:
+    """An assignment's configuration checked as ``gymgrade grade --config`` checks a file, and the edition it
+    grades: ``config_toml`` and ``edition`` of the assignment's row.
+
+    The configuration's edition is the assignment's: one that names none (``edition``, ``lab``) is given the
+    assignment's ``edition`` (its first line); one that names another is refused; without ``edition`` the
+    assignment grades the configuration's.
+
+    Raises:
+        InvalidRequest: The text is not an assignment configuration, or grades another edition.
+    """
+    import tomllib
+
+    from grader.errors import ConfigError
+    from grader.lab.assignment import config_from_data
+    from grader.lab.editions.errors import LabConflict, UnknownEdition, UnknownLab
+
+    def refused(message: str) -> InvalidRequest:
+        return InvalidRequest(message, [(["body", "config"], message, "value_error")])
+
+    try:
+        data = tomllib.loads(text)
+        if edition is not None and data.get("edition") is None and data.get("lab") is None:
+            text = f'edition = "{edition}"\n' + text
+            data = {**data, "edition": edition}
+        config = config_from_data(data, where="the assignment's config")
+    except tomllib.TOMLDecodeError as error:
+        raise refused(f"config is not TOML ({error}): send an assignment configuration file's text") from None
+    except (ConfigError, UnknownEdition, UnknownLab, LabConflict) as error:
+        raise refused(f"config is not an assignment configuration: {error}") from None
+    if edition is not None and config.edition != edition:
+        raise refused(
+            f"config grades edition {config.edition!r}, the assignment edition {edition!r}: "
+            "make them agree, or leave one of them out"
+        )
+    return {"config_toml": text, "edition": config.edition}
 
 
 def _commit_new(session: Session, taken: str) -> None:

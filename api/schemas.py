@@ -12,6 +12,8 @@ from api.students import MAX_NAME_CHARS, name_pattern
 from grader.lab.editions import EDITIONS
 
 Status = Literal["queued", "running", "done", "failed"]
+MAX_CONFIG_CHARS = 64 * 1024
+"""The longest assignment configuration accepted (the bundled ones are under 8,000 characters)."""
 
 
 def _as_utc(moment: datetime) -> datetime:
@@ -308,6 +310,13 @@ class AssignmentCreate(BaseModel):
     )
     gradebook_policy: Literal["latest", "best"] = "latest"
     late: LateTable | None = None
+    config: str | None = Field(
+        default=None,
+        max_length=MAX_CONFIG_CHARS,
+        description="The assignment configuration (points, visibility, checks' numbers and limits) as the text of a TOML file "  # noqa: E501
+        "like grader/lab/assignment.toml (`gymgrade grade --config`'s); its edition is the assignment's. "
+        "Unset: the edition's bundled configuration.",
+    )
 
 
 class AssignmentView(BaseModel):
@@ -324,6 +333,7 @@ class AssignmentView(BaseModel):
     due_date: UtcDateTime | None
     gradebook_policy: str
     late: dict[str, Any] | None
+    config: str | None = Field(description="The assignment configuration's TOML text; null: the edition's bundled one.")  # noqa: E501
 
 
 class LtiLinkView(BaseModel):

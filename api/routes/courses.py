@@ -76,6 +76,7 @@ def _assignment_view(course: Course, assignment: Assignment) -> AssignmentView:
         due_date=assignment.due_date,
         gradebook_policy=assignment.gradebook_policy,
         late=assignment.late_policy,
+        config=assignment.config_toml,
     )
 
 
@@ -200,10 +201,12 @@ def delete_staff_token(
 def post_assignment(
     body: AssignmentCreate, session: SessionDep, _instructor: CourseInstructorDep, course: CourseDep
 ) -> AssignmentView:
-    """Add an assignment to the course: the lab and edition its uploads are graded as, its seeds, due date,
-    gradebook and late policy. Its routes are under /courses/{course}/assignments/{assignment}."""
-    values = body.model_dump(exclude={"late", "due_date", "edition", "seed"})
+    """Add an assignment to the course: the lab and edition its uploads are graded as, its configuration
+    (points, visibility), seeds, due date, gradebook and late policy. Its routes are under
+    /courses/{course}/assignments/{assignment}."""
+    values = body.model_dump(exclude={"late", "due_date", "edition", "seed", "config"})
     values["lab"], values["edition"] = None, body.edition.value if body.edition is not None else None
+    values["config_toml"] = body.config
     values["seed"] = body.seed if body.seed is not None else held_out_seed(2**31 - 1)
     try:
         values["due_date"] = body.due_date.astimezone(UTC).replace(tzinfo=None) if body.due_date else None
