@@ -333,7 +333,9 @@ class AssignmentView(BaseModel):
     due_date: UtcDateTime | None
     gradebook_policy: str
     late: dict[str, Any] | None
-    config: str | None = Field(description="The assignment configuration's TOML text; null: the edition's bundled one.")  # noqa: E501
+    config: str | None = Field(
+        description="The assignment configuration's TOML text; null: the edition's bundled one."
+    )
 
 
 class LtiLinkView(BaseModel):

@@ -169,13 +169,7 @@ def ensure_link(
     ags = claims.get(names.AGS_ENDPOINT) or {}
     nrps = claims.get(names.NRPS) or {}
     link_id = str(resource.get("id"))
-    link = session.scalars(
-        select(LtiLink).where(
-            LtiLink.platform_id == platform.id,
-            LtiLink.deployment_id == deployment_id,
-            LtiLink.resource_link_id == link_id,
-        )
-    ).first()
+    link = existing_link(session, platform, deployment_id, claims)
     if link is None:
         course = ensure_course(session, platform, deployment_id, claims)
         title = str(resource.get("title") or context.get("title") or "")
@@ -197,6 +191,20 @@ def ensure_link(
     link.custom = {str(k): str(v) for k, v in custom.items()} if isinstance(custom, dict) else {}
     session.flush()
     return link
+
+
+def existing_link(
+    session: Session, platform: LtiPlatform, deployment_id: str, claims: dict[str, Any]
+) -> LtiLink | None:
+    """The resource link a launch names, if a launch made it before (nothing is written)."""
+    resource = claims.get(names.RESOURCE_LINK) or {}
+    return session.scalars(
+        select(LtiLink).where(
+            LtiLink.platform_id == platform.id,
+            LtiLink.deployment_id == deployment_id,
+            LtiLink.resource_link_id == str(resource.get("id")),
+        )
+    ).first()
 
 
 def course_of(session: Session, link: LtiLink) -> int:

@@ -41,6 +41,7 @@ from api.lti.deep_linking import (
 from api.lti.keys import public_jwks, rotate
 from api.lti.launch import (
     STATE_SECONDS,
+    Launch,
     Login,
     accept_launch,
     frame_origins,
@@ -48,13 +49,13 @@ from api.lti.launch import (
     tool_state,
     verify_launch,
 )
-from api.lti.people import course_of, links_of
+from api.lti.people import course_of, existing_link, links_of
 from api.lti.platforms import PlatformRegistration, add_deployment, checked_origins, register_platform
 from api.lti.publisher import publishing_status
 from api.lti.registration import ToolUrls, check_ticket, register_dynamically, registration_ticket
 from api.lti.roster import import_roster
 from api.lti.sessions import SESSION_PARAMETER
-from api.models import LtiLink, LtiPlatform
+from api.models import Assignment, LtiLink, LtiPlatform
 from api.schemas import LtiLinkView
 from api.settings import Settings
 from api.web import page_headers, templates
@@ -172,8 +173,9 @@ def launch(
         )
     else:
         custom = checked.claims.get(names.CUSTOM)
-        graded = graded_edition(settings.edition, settings.lab)
-        check_link_edition(custom if isinstance(custom, dict) else {}, graded)
+        check_link_edition(
+            custom if isinstance(custom, dict) else {}, _link_edition(session, settings, checked)
+        )
         landing = accept_launch(
             session, checked, session_seconds=settings.lti_session_seconds, browser_digest=browser_digest
         )
@@ -181,6 +183,16 @@ def launch(
     if browser_secret is not None:
         set_cookie(response, SESSION_COOKIE, browser_secret, max_age=settings.lti_session_seconds, path="/")
     return response
+
+
+def _link_edition(session: Session, settings: Settings, checked: Launch) -> str:
+    """The edition a launch's link grades: its assignment's once a launch made it, else (a new link, whose
+    assignment is made as the default one) the service's."""
+    link = existing_link(session, checked.platform, checked.deployment_id, checked.claims)
+    assignment = session.get(Assignment, link.assignment_id) if link is not None else None
+    if assignment is None:
+        return graded_edition(settings.edition, settings.lab)
+    return graded_edition(assignment.edition, assignment.lab)
 
 
 def _from_platform_storage(
