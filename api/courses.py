@@ -269,6 +269,8 @@ def _configured(text: str, edition: str | None) -> dict[str, Any]:
         config = config_from_data(data, where="the assignment's config")
     except tomllib.TOMLDecodeError as error:
         raise refused(f"config is not TOML ({error}): send an assignment configuration file's text") from None
+    except RecursionError:  # tomllib reads nested arrays and tables recursively
+        raise refused("config nests arrays or tables too deeply to be an assignment configuration") from None
     except (ConfigError, UnknownEdition, UnknownLab, LabConflict) as error:
         raise refused(f"config is not an assignment configuration: {error}") from None
     if edition is not None and config.edition != edition:

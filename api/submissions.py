@@ -144,10 +144,15 @@ def get_submission(
 
 
 def list_submissions(
-    session: Session, caller: Principal, assignment: Assignment, student_name: str | None = None
+    session: Session,
+    caller: Principal,
+    assignment: Assignment,
+    student_name: str | None = None,
+    *,
+    enrolment: Student | None = None,
 ) -> list[Submission]:
-    """The caller's submissions to the assignment (all of them, or one student's, for its staff), newest
-    first."""
+    """The caller's submissions to the assignment (all of them, or one student's, for its staff: the
+    ``enrolment``, or the course's student called ``student_name``), newest first."""
     query = (
         select(Submission)
         .options(joinedload(Submission.student))
@@ -156,6 +161,8 @@ def list_submissions(
     )
     if caller.student is not None:
         query = query.where(Submission.student_id == caller.student.id)
+    elif enrolment is not None:
+        query = query.where(Submission.student_id == enrolment.id)
     elif student_name is not None:
         student = find_student(session, assignment.course_id, student_name)
         query = query.where(Submission.student_id == student.id)

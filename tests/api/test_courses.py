@@ -370,12 +370,13 @@ def test_each_assignment_grades_with_its_own_lab_edition_and_configuration(
     [
         ({"edition": "rl1", "config": "not = [toml"}, "config is not TOML"),
         ({"edition": "rl1", "config": "[problems]\n"}, "config is not an assignment configuration"),
+        ({"edition": "rl1", "config": "a = " + "[" * 30000}, "config nests arrays or tables too deeply"),
         (
             {"edition": "v2024", "config": RL1_CONFIG.read_text(encoding="utf-8")},
             "config grades edition 'rl1', the assignment edition 'v2024'",
         ),
     ],
-    ids=["not-toml", "not-a-configuration", "another-edition"],
+    ids=["not-toml", "not-a-configuration", "too-deep", "another-edition"],
 )
 def test_an_assignment_configuration_is_checked_when_it_is_given(
     make_settings: SettingsFactory, body: dict[str, str], expected: str

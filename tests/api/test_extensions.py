@@ -1,5 +1,5 @@
-"""Extensions and overrides over the API, keyed by enrolment: granted by the course's staff, followed by the
-gradebook, refused on another course's enrolment or an assignment without a late policy."""
+"""Extensions, overrides and regrades over the API, keyed by enrolment: granted by the course's staff,
+followed by the gradebook, refused on another course's enrolment or an assignment without a late policy."""
 
 from __future__ import annotations
 
@@ -151,3 +151,8 @@ def test_an_override_is_made_and_listed_by_enrolment(make_settings: SettingsFact
         by_id = client.get(f"{A}/enrolments/{ids['ada']}/overrides", headers=ta).json()
         assert by_name == by_id and [row["points"] for row in by_id] == [1.5]
         assert client.get(f"{A}/enrolments/{ids['bob']}/overrides", headers=ta).json() == []
+        ada_uploads = [row["id"] for row in client.get(f"{A}/submissions?student=ada", headers=ta).json()]
+        regraded = client.post(f"{A}/enrolments/{ids['ada']}/regrade", headers=ta)
+        assert (regraded.status_code, [row["id"] for row in regraded.json()]) == (202, ada_uploads)
+        assert client.post(f"{A}/enrolments/{ids['ada']}/regrade", headers=ta).status_code == 409  # queued
+        assert client.post(f"{A}/enrolments/{2**40}/regrade", headers=ta).status_code == 404
