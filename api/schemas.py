@@ -313,8 +313,7 @@ class AssignmentCreate(BaseModel):
     config: str | None = Field(
         default=None,
         max_length=MAX_CONFIG_CHARS,
-        description="The assignment configuration (points, visibility, checks' numbers and limits) as the text of a TOML file "  # noqa: E501
-        "like grader/lab/assignment.toml (`gymgrade grade --config`'s); its edition is the assignment's. "
+        description="The assignment configuration (points, visibility, checks' numbers and limits) as the text of a TOML file like grader/lab/assignment.toml (`gymgrade grade --config`'s); its edition is the assignment's. "  # noqa: E501
         "Unset: the edition's bundled configuration.",
     )
 

@@ -345,8 +345,7 @@ class Settings(BrokerSettings):
         ):
             raise ValueError(
                 "GYMGRADE_OPERATOR_TOKEN and GYMGRADE_INSTRUCTOR_TOKEN are both set, to different tokens: "
-                "expected one operator token; unset GYMGRADE_INSTRUCTOR_TOKEN (its single-course name) "
-                "or give both the same value"
+                "expected one operator token; unset GYMGRADE_INSTRUCTOR_TOKEN (its single-course name) or give both the same value"  # noqa: E501
             )
         if self.development:
             return self
