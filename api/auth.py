@@ -1,9 +1,10 @@
 """Who is calling: the operator (one configured token), a course's staff (instructor or teaching assistant,
 a stored token digest) or a course's student (a stored token digest), and what each may reach.
 
-The operator is the service's: today's ``GYMGRADE_INSTRUCTOR_TOKEN``, which creates courses and their first
-staff and acts as the instructor of every course (the embedded default course's, as before courses). A staff
-member or student belongs to one course; anything of another course is not found for them.
+The operator is the service's: ``GYMGRADE_OPERATOR_TOKEN`` (or ``GYMGRADE_INSTRUCTOR_TOKEN``, its name for a
+single course), which creates courses and their first staff and acts as the instructor of every course (the
+embedded default course's, as before courses). A staff member or student belongs to one course; anything of
+another course is not found for them. A staff member's API token is revoked by forgetting its digest.
 """
 
 from __future__ import annotations
@@ -86,7 +87,7 @@ class Principal:
         """Raise OperatorOnly unless the caller is the operator."""
         if not self.is_operator:
             raise OperatorOnly(
-                "this endpoint needs the operator's token (GYMGRADE_INSTRUCTOR_TOKEN); "
+                "this endpoint needs the operator's token (GYMGRADE_OPERATOR_TOKEN); "
                 "a course's token was sent"
             )
 
@@ -104,7 +105,7 @@ def authenticate(session: Session, settings: Settings, token: str | None) -> Pri
 
     Args:
         session: A database session.
-        settings: Service settings (the operator's token, GYMGRADE_INSTRUCTOR_TOKEN).
+        settings: Service settings (the operator's token, ``Settings.operator``).
         token: The token sent, or None.
 
     Returns:
@@ -115,7 +116,7 @@ def authenticate(session: Session, settings: Settings, token: str | None) -> Pri
     """
     if not token:
         raise NotAuthenticated("no token sent; expected `Authorization: Bearer <your token>`")
-    operator = settings.instructor_token
+    operator = settings.operator
     if operator is not None and same_secret(token, operator.get_secret_value()):
         return Principal(name="instructor", student=None)
     digest = token_digest(token)

@@ -23,7 +23,7 @@ def add_serve_command(subparsers: argparse._SubParsersAction[argparse.ArgumentPa
         help="run the HTTP submission service (settings from GYMGRADE_* variables)",
         description="Run the HTTP submission service with uvicorn. "
         "Configure it with GYMGRADE_* environment variables; "
-        "GYMGRADE_INSTRUCTOR_TOKEN is required.",
+        "GYMGRADE_OPERATOR_TOKEN (or GYMGRADE_INSTRUCTOR_TOKEN, its single-course name) is required.",
     )
     parser.add_argument("--host", default=DEFAULT_HOST, help=f"address to listen on (default {DEFAULT_HOST})")
     parser.add_argument(

@@ -20,12 +20,12 @@ from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
 from api.auth import Principal
-from api.errors import CourseExists, CourseNotFound, InvalidRequest
+from api.errors import CourseExists, CourseNotFound, InvalidRequest, StaffNotFound
 from api.models import Assignment, Course, Extension, LtiLink, Staff, Student
 from api.schemas import AssignmentCreate
 from api.security import new_token, token_digest
 from api.settings import GradebookPolicy, SeedPolicy, Settings
-from api.students import printable
+from api.students import MAX_ID, printable
 from grader.classroom.late import LatePolicy, read_late_policy
 from grader.seeds import held_out_seed
 
@@ -185,8 +185,9 @@ def assignment_values(body: AssignmentCreate) -> dict[str, Any]:
     Raises:
         InvalidRequest: A date falls outside the years 1 to 9999 once in UTC.
     """
-    values = body.model_dump(exclude={"late", "due_date", "edition", "seed"})
+    values = body.model_dump(exclude={"late", "due_date", "edition", "seed", "config"})
     values["lab"], values["edition"] = None, body.edition.value if body.edition is not None else None
+    values["config_toml"] = body.config
     values["seed"] = body.seed if body.seed is not None else held_out_seed(2**31 - 1)
     try:
         values["due_date"] = body.due_date.astimezone(UTC).replace(tzinfo=None) if body.due_date else None
@@ -199,6 +200,44 @@ def assignment_values(body: AssignmentCreate) -> dict[str, Any]:
     return values
 
 
+def staff_of(session: Session, course: Course) -> list[Staff]:
+    """The course's staff, oldest first."""
+    return list(session.scalars(select(Staff).where(Staff.course_id == course.id).order_by(Staff.id)))
+
+
+def find_staff(session: Session, course: Course, staff_id: int) -> Staff:
+    """The course's staff member with id ``staff_id``.
+
+    Raises:
+        StaffNotFound: The course has no staff member of that id.
+    """
+    staff = session.get(Staff, staff_id) if 1 <= staff_id <= MAX_ID else None
+    if staff is None or staff.course_id != course.id:
+        raise StaffNotFound(
+            f"no staff member {staff_id} in course {course.slug!r}; list them with GET /courses/{course.slug}/staff"  # noqa: E501
+        )
+    return staff
+
+
+def new_staff_token(session: Session, staff: Staff) -> str:
+    """Give a staff member a new API token, the old one (if any) no longer accepted (committed).
+
+    Returns:
+        The token in clear (never stored; only its SHA-256 is).
+    """
+    token = new_token()
+    staff.token_sha256 = token_digest(token)
+    session.commit()
+    return token
+
+
+def revoke_staff_token(session: Session, staff: Staff) -> None:
+    """Revoke a staff member's API token: its digest is forgotten, so the next request with it is nobody's
+    (committed). Their LTI launches, if any, still sign them in."""
+    staff.token_sha256 = None
+    session.commit()
+
+
 def create_assignment(session: Session, course: Course, values: dict[str, Any]) -> Assignment:
     """Add an assignment to a course (committed): ``values`` are its columns but ``course_id``.
 
@@ -209,6 +248,8 @@ def create_assignment(session: Session, course: Course, values: dict[str, Any]) 
     from grader.lab.editions.choice import service_edition  # the packs import the checks: only here
     from grader.lab.editions.errors import LabConflict, UnknownEdition, UnknownLab
 
+    if values.get("config_toml") is not None:
+        values = {**values, **_configured(values["config_toml"], values.get("edition"))}
     try:
         service_edition(values.get("edition"), values.get("lab"))
     except (UnknownEdition, UnknownLab, LabConflict) as error:
@@ -222,6 +263,46 @@ def create_assignment(session: Session, course: Course, values: dict[str, Any]) 
         session, f"course {course.slug!r} has an assignment {values['slug']!r} already; choose another slug"
     )
     return assignment
+
+
+def _configured(text: str, edition: str | None) -> dict[str, Any]:
+    """An assignment's configuration checked as ``gymgrade grade --config`` checks a file, and the edition it
+    grades: ``config_toml`` and ``edition`` of the assignment's row.
+
+    The configuration's edition is the assignment's: one that names none (``edition``, ``lab``) is given the
+    assignment's ``edition`` (its first line); one that names another is refused; without ``edition`` the
+    assignment grades the configuration's.
+
+    Raises:
+        InvalidRequest: The text is not an assignment configuration, or grades another edition.
+    """
+    import tomllib
+
+    from grader.errors import ConfigError
+    from grader.lab.assignment import config_from_data
+    from grader.lab.editions.errors import LabConflict, UnknownEdition, UnknownLab
+
+    def refused(message: str) -> InvalidRequest:
+        return InvalidRequest(message, [(["body", "config"], message, "value_error")])
+
+    try:
+        data = tomllib.loads(text)
+        if edition is not None and data.get("edition") is None and data.get("lab") is None:
+            text = f'edition = "{edition}"\n' + text
+            data = {**data, "edition": edition}
+        config = config_from_data(data, where="the assignment's config")
+    except tomllib.TOMLDecodeError as error:
+        raise refused(f"config is not TOML ({error}): send an assignment configuration file's text") from None
+    except RecursionError:  # tomllib reads nested arrays and tables recursively
+        raise refused("config nests arrays or tables too deeply to be an assignment configuration") from None
+    except (ConfigError, UnknownEdition, UnknownLab, LabConflict) as error:
+        raise refused(f"config is not an assignment configuration: {error}") from None
+    if edition is not None and config.edition != edition:
+        raise refused(
+            f"config grades edition {config.edition!r}, the assignment edition {edition!r}: "
+            "make them agree, or leave one of them out"
+        )
+    return {"config_toml": text, "edition": config.edition}
 
 
 def _commit_new(session: Session, taken: str) -> None:
@@ -265,8 +346,3 @@ def launch_scope(session: Session, caller: Principal) -> Scope:
             raise CourseNotFound("this course has no assignment yet: open one from the LMS")
         assignment = first[0]
     return Scope(course, assignment)
-
-
-def staff_of(session: Session, course: Course) -> list[Staff]:
-    """The course's instructors and teaching assistants, oldest first."""
-    return list(session.scalars(select(Staff).where(Staff.course_id == course.id).order_by(Staff.id)))

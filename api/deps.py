@@ -31,7 +31,7 @@ SESSION_COOKIE = "gymgrade_token"
 
 bearer_scheme = HTTPBearer(
     auto_error=False,
-    description="The operator's token (GYMGRADE_INSTRUCTOR_TOKEN), a course staff member's from POST /courses/{course}/staff, or a student's from POST /students.",  # noqa: E501
+    description="The operator's token (GYMGRADE_OPERATOR_TOKEN or GYMGRADE_INSTRUCTOR_TOKEN), a course staff member's from POST /courses/{course}/staff, or a student's from POST /students.",  # noqa: E501
 )
 
 

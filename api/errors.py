@@ -65,6 +65,18 @@ class CourseExists(ServiceError):
     """Raised when a course or assignment is created under a slug that is already taken."""
 
 
+class StaffNotFound(ServiceError):
+    """Raised when a staff member's id is not one of the course's."""
+
+
+class LinkNotFound(ServiceError):
+    """Raised when an LTI resource link's id is not one of the links opening the assignment."""
+
+
+class NoLatePolicy(ServiceError):
+    """Raised when an extension is granted on an assignment without a late policy: it would change nothing."""
+
+
 class StudentOnly(ServiceError):
     """Raised when the instructor's token is used to upload (submissions belong to students)."""
 
@@ -74,7 +86,7 @@ class SubmissionNotFound(ServiceError):
 
 
 class StudentNotFound(ServiceError):
-    """Raised when a named student does not exist."""
+    """Raised when a named student, or an enrolment's id, is not of the course."""
 
 
 class GradingInProgress(ServiceError):

@@ -15,7 +15,19 @@ from api.deps import ASSIGNMENT_PREFIX, COURSE_PREFIX, in_assignment, in_course
 from api.handlers import install_error_handlers
 from api.limits import BodyLimitMiddleware
 from api.lti.sessions import redact_access_log
-from api.routes import course_pages, courses, gradebook, health, lti, overrides, students, submissions, ui
+from api.routes import (
+    course_pages,
+    courses,
+    extensions,
+    gradebook,
+    health,
+    lti,
+    lti_scoped,
+    overrides,
+    students,
+    submissions,
+    ui,
+)
 from api.settings import Settings, load_settings
 from api.web import STATIC_DIR
 
@@ -54,12 +66,13 @@ def create_app(settings: Settings | None = None, *, run_workers: bool = True) ->
     app = FastAPI(title="gymgrade", version="0.1.0", description=DESCRIPTION, lifespan=lifespan)
     app.add_middleware(BodyLimitMiddleware, max_upload_bytes=settings.max_upload_bytes)
     install_error_handlers(app)
-    for module in (students, submissions, gradebook, overrides, health, ui, course_pages, lti):
+    for module in (students, submissions, gradebook, overrides, extensions, health, ui, course_pages, lti):
         app.include_router(module.router)
     app.include_router(courses.router)
     app.include_router(courses.course_router)
+    app.include_router(lti_scoped.router)
     app.include_router(_mounted_again(students.router, COURSE_PREFIX, in_course, "_of_course"))
-    for module in (submissions, gradebook, overrides):
+    for module in (submissions, gradebook, overrides, extensions):
         app.include_router(_mounted_again(module.router, ASSIGNMENT_PREFIX, in_assignment, SCOPED_SUFFIX))
     app.mount("/ui/static", StaticFiles(directory=STATIC_DIR), name="static")
 

@@ -69,15 +69,43 @@ def record_override(
     author: str,
     submission_id: int | None = None,
 ) -> Override:
-    """Check and keep an override.
+    """Check and keep an override of the course's student called ``student_name`` (see
+    :func:`record_enrolment_override`).
 
     Raises:
         StudentNotFound: No such student.
+    """
+    return record_enrolment_override(
+        session,
+        assignment,
+        find_student(session, assignment.course_id, student_name),
+        problem=problem,
+        points=points,
+        reason=reason,
+        author=author,
+        submission_id=submission_id,
+    )
+
+
+def record_enrolment_override(
+    session: Session,
+    assignment: Assignment,
+    student: Student,
+    *,
+    problem: str,
+    points: float,
+    reason: str,
+    author: str,
+    submission_id: int | None = None,
+) -> Override:
+    """Check and keep an override of an enrolment (of the assignment's course).
+
+    Raises:
         SubmissionNotFound: ``submission_id`` is not a graded upload of theirs.
+        NothingGradedYet: None of their uploads of the assignment is graded yet.
         InvalidRequest: An unknown problem, points outside what it is worth, or no reason (the message says
             what was expected, as ``gymgrade grade --overrides`` does).
     """
-    student = find_student(session, assignment.course_id, student_name)
     graded = _graded(session, assignment, student, submission_id)
     reason = reason.strip()
     if not reason:
@@ -109,9 +137,8 @@ def record_override(
     return override
 
 
-def list_overrides(session: Session, assignment: Assignment, student_name: str) -> list[Override]:
+def list_overrides(session: Session, assignment: Assignment, student: Student) -> list[Override]:
     """Every override of an enrolment in the assignment, oldest first."""
-    student = find_student(session, assignment.course_id, student_name)
     return list(
         session.scalars(
             select(Override)
@@ -170,5 +197,6 @@ __all__ = [
     "list_overrides",
     "maxima_of",
     "overrides_shown",
+    "record_enrolment_override",
     "record_override",
 ]

@@ -12,6 +12,8 @@ from api.students import MAX_NAME_CHARS, name_pattern
 from grader.lab.editions import EDITIONS
 
 Status = Literal["queued", "running", "done", "failed"]
+MAX_CONFIG_CHARS = 64 * 1024
+"""The longest assignment configuration accepted (the bundled ones are under 8,000 characters)."""
 
 
 def _as_utc(moment: datetime) -> datetime:
@@ -43,8 +45,19 @@ class StudentCreate(BaseModel):
 class StudentCreated(BaseModel):
     """The new student and their bearer token (shown once; only its SHA-256 is stored)."""
 
+    id: int = Field(description="The enrolment's id: what its overrides and extensions are keyed by.")
     name: str
     token: str
+
+
+class EnrolmentView(BaseModel):
+    """A student's enrolment in a course: its id (what overrides and extensions are keyed by) and its name."""
+
+    id: int
+    name: str
+    lti: bool = Field(
+        description="True for a platform user of the course's LMS context (an LTI launch or roster)."
+    )
 
 
 class SubmissionAccepted(BaseModel):
@@ -160,6 +173,7 @@ class OverrideView(BaseModel):
     """A recorded override, with who made it and when."""
 
     id: int
+    enrolment: int = Field(description="The enrolment's id (GET .../students lists them).")
     student: str
     submission_id: int | None
     problem: str
@@ -206,11 +220,25 @@ class StaffCreate(BaseModel):
 
 
 class StaffCreated(BaseModel):
-    """The new staff member and their bearer token (shown once; only its SHA-256 is stored)."""
+    """The new staff member (or a new token of theirs) and their bearer token, which reaches their course only
+    with their role's rights (shown once; only its SHA-256 is stored)."""
 
+    id: int = Field(description="The staff member's id: revoke the token with DELETE .../staff/{id}/token.")
     name: str
     role: Literal["instructor", "ta"]
     token: str
+
+
+class StaffView(BaseModel):
+    """A member of a course's staff (never their token)."""
+
+    id: int
+    name: str
+    role: Literal["instructor", "ta"]
+    token: bool = Field(description="True while the member has an API token (false: none yet, or revoked).")
+    lti: bool = Field(
+        description="True for a platform user whose launches from the course's context are staff's."
+    )
 
 
 def _written(value: object) -> object:
@@ -231,6 +259,28 @@ class LateTable(BaseModel):
     penalty_per_day: float = Field(ge=0.0, le=1.0, strict=True)
     max_penalty: float = Field(default=1.0, ge=0.0, le=1.0, strict=True)
     grace_minutes: float = Field(default=0.0, ge=0.0, le=7 * 24 * 60, strict=True)
+
+
+class ExtensionCreate(BaseModel):
+    """An enrolment's own due time for the assignment's late policy."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    due: WrittenDateTime = Field(
+        description="The enrolment's due time, ISO 8601 (UTC when no offset is given)."
+    )
+    reason: str = Field(min_length=1, max_length=1000, description="Why, kept with who granted it.")
+
+
+class ExtensionView(BaseModel):
+    """An enrolment's extension of one assignment, with who granted it and when."""
+
+    enrolment: int
+    student: str
+    due: UtcDateTime
+    reason: str
+    author: str
+    created_at: UtcDateTime
 
 
 EditionName = Enum("EditionName", {name: name for name in EDITIONS}, type=str)  # type: ignore[misc]
@@ -260,6 +310,12 @@ class AssignmentCreate(BaseModel):
     )
     gradebook_policy: Literal["latest", "best"] = "latest"
     late: LateTable | None = None
+    config: str | None = Field(
+        default=None,
+        max_length=MAX_CONFIG_CHARS,
+        description="The assignment configuration (points, visibility, checks' numbers and limits) as the text of a TOML file like grader/lab/assignment.toml (`gymgrade grade --config`'s); its edition is the assignment's. "  # noqa: E501
+        "Unset: the edition's bundled configuration.",
+    )
 
 
 class AssignmentView(BaseModel):
@@ -276,3 +332,45 @@ class AssignmentView(BaseModel):
     due_date: UtcDateTime | None
     gradebook_policy: str
     late: dict[str, Any] | None
+    config: str | None = Field(
+        description="The assignment configuration's TOML text; null: the edition's bundled one."
+    )
+
+
+class LtiLinkView(BaseModel):
+    """A resource link of an LMS course that opens the assignment: its platform, context, title, line item and
+    custom parameters."""
+
+    model_config = ConfigDict(from_attributes=True)
+
+    id: int
+    platform_id: int
+    context_id: str
+    resource_link_id: str
+    title: str
+    lineitem_url: str | None
+    custom: dict[str, str]
+
+
+class RosterImported(BaseModel):
+    """What a roster import (LTI Names and Role Provisioning) found: learners (each now has an enrolment and a
+    gradebook row), staff, and members skipped (inactive, or of no role the tool knows)."""
+
+    learners: int
+    staff: int
+    skipped: int
+
+
+class LtiScoreView(BaseModel):
+    """One student's score publishing to the LMS for a link: the kept (final) score, the one the LMS holds,
+    the publishing's state, its attempts and last error."""
+
+    student: str
+    link_id: int
+    submission_id: int
+    score: float | None
+    max_score: float | None
+    sent_score: float | None
+    status: Literal["pending", "sent", "retrying", "failed"]
+    attempts: int
+    error: str | None

@@ -77,11 +77,18 @@ class Settings(BrokerSettings):
         default=None,
         description="URL of a PostgreSQL database (postgresql+psycopg://...); unset: SQLite in DATA_DIR.",
     )
+    operator_token: SecretStr | None = Field(
+        default=None,
+        description="Bearer token of the operator, who creates courses and their staff and acts as every course's instructor; "  # noqa: E501
+        "required (or INSTRUCTOR_TOKEN, its name for a single course) unless DEVELOPMENT is set.",
+    )
     instructor_token: SecretStr | None = Field(
-        default=None, description="Bearer token of the instructor; required unless DEVELOPMENT is set."
+        default=None,
+        description="The operator's token under its single-course name (the default course's instructor): "
+        "the same as OPERATOR_TOKEN; set one of the two (both only with the same value).",
     )
     development: bool = Field(
-        default=False, description="Development mode: allows a missing or weak instructor token."
+        default=False, description="Development mode: allows a missing or weak operator token."
     )
     max_upload_bytes: int = Field(default=256 * 1024, gt=0, description="Largest accepted submission file.")
     rate_limit_per_minute: int = Field(
@@ -337,6 +344,15 @@ class Settings(BrokerSettings):
                 f"GYMGRADE_VISIBILITY_TIMEOUT_SECONDS must exceed GYMGRADE_GRADING_TIMEOUT_SECONDS ({self.grading_timeout_seconds:g}), found {self.visibility_timeout_seconds:g}: "  # noqa: E501
                 "a task would be delivered to a second worker while the first is still grading it"
             )
+        if (
+            self.operator_token is not None
+            and self.instructor_token is not None
+            and self.operator_token.get_secret_value() != self.instructor_token.get_secret_value()
+        ):
+            raise ValueError(
+                "GYMGRADE_OPERATOR_TOKEN and GYMGRADE_INSTRUCTOR_TOKEN are both set, to different tokens: "
+                "expected one operator token; unset GYMGRADE_INSTRUCTOR_TOKEN (its single-course name) or give both the same value"  # noqa: E501
+            )
         if self.development:
             return self
         if self.seed_policy is SeedPolicy.FIXED and self.seed == PRACTICE_SEED:
@@ -345,15 +361,24 @@ class Settings(BrokerSettings):
                 "that is the public practice seed of `gymgrade check`, so a file could memorise every start; "
                 "expected the random policy (the default) or a secret GYMGRADE_SEED (e.g. `python -c 'import secrets; print(secrets.randbelow(2**31))'`)"  # noqa: E501
             )
-        if self.instructor_token is None:
+        operator = self.operator
+        if operator is None:
             raise ValueError(
-                "GYMGRADE_INSTRUCTOR_TOKEN is not set; "
+                "GYMGRADE_OPERATOR_TOKEN (or GYMGRADE_INSTRUCTOR_TOKEN) is not set; "
                 "expected a long random token (e.g. `python -c 'import secrets; print(secrets.token_urlsafe(32))'`), or GYMGRADE_DEVELOPMENT=1 for local development"  # noqa: E501
             )
-        problem = token_weakness(self.instructor_token.get_secret_value())
+        problem = token_weakness(operator.get_secret_value())
         if problem is not None:
-            raise ValueError(f"GYMGRADE_INSTRUCTOR_TOKEN is weak: {problem}")
+            name = (
+                "GYMGRADE_OPERATOR_TOKEN" if self.operator_token is not None else "GYMGRADE_INSTRUCTOR_TOKEN"
+            )
+            raise ValueError(f"{name} is weak: {problem}")
         return self
+
+    @property
+    def operator(self) -> SecretStr | None:
+        """The operator's token: OPERATOR_TOKEN, else INSTRUCTOR_TOKEN (its single-course name), else None."""
+        return self.operator_token if self.operator_token is not None else self.instructor_token
 
     @property
     def sqlalchemy_url(self) -> str:

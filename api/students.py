@@ -1,4 +1,5 @@
-"""Creating students (a course's enrolments, each with its own token) and finding them by name in a course."""
+"""Creating students (a course's enrolments, each with its own token) and finding them in a course: by their
+id (what overrides and extensions are keyed by) or by their name (unique in the course)."""
 
 from __future__ import annotations
 
@@ -15,6 +16,8 @@ from api.models import Student
 from api.security import new_token, token_digest
 
 MAX_NAME_CHARS = 100
+MAX_ID = 2**31 - 1
+"""The largest id every database's integer column holds: a larger one in a path is nobody's."""
 # Control, format (bidi overrides, zero-width), surrogate, private-use and line/paragraph separator
 # characters. Unassigned code points are allowed: a newer Unicode than the server's may assign them (new
 # emoji), and no JSON Schema pattern could follow the server's Unicode version.
@@ -132,3 +135,22 @@ def find_student(session: Session, course_id: int, name: str) -> Student:
     if student is None:
         raise StudentNotFound(f"no student is named {name!r}; list names with GET /gradebook.csv")
     return student
+
+
+def find_enrolment(session: Session, course_id: int, enrolment_id: int) -> Student:
+    """The course's enrolment with id ``enrolment_id``.
+
+    Raises:
+        StudentNotFound: The course has no enrolment of that id.
+    """
+    student = session.get(Student, enrolment_id) if 1 <= enrolment_id <= MAX_ID else None
+    if student is None or student.course_id != course_id:
+        raise StudentNotFound(
+            f"no enrolment {enrolment_id} in this course; list the course's with GET .../students"
+        )
+    return student
+
+
+def enrolments_of(session: Session, course_id: int) -> list[Student]:
+    """The course's enrolments, by name."""
+    return list(session.scalars(select(Student).where(Student.course_id == course_id).order_by(Student.name)))

@@ -17,13 +17,12 @@ from api.jobs.job_queue import Dispatcher
 from api.models import Assignment, JobStatus, Student, Submission, utcnow
 from api.schemas import OverrideShown, SubmissionDetail, SubmissionSummary
 from api.settings import SeedPolicy, Settings
-from api.students import find_student
+from api.students import MAX_ID, find_student
 from api.uploads import CheckedUpload
 from grader.seeds import held_out_seed
 
 RATE_WINDOW = timedelta(seconds=60)
 MAX_SEED = 2**31 - 1
-MAX_ID = 2**31 - 1  # the largest id every database's integer column holds
 
 
 def create_submission(
@@ -145,13 +144,19 @@ def get_submission(
 
 
 def list_submissions(
-    session: Session, caller: Principal, assignment: Assignment, student_name: str | None = None
+    session: Session,
+    caller: Principal,
+    assignment: Assignment,
+    student_name: str | None = None,
+    *,
+    enrolment: Student | None = None,
 ) -> list[Submission]:
-    """The caller's submissions to the assignment (all of them, or one student's, for its staff), newest
-    first. Their files and progress are not read (a listing shows neither), nor, for the staff, their
-    reports: staff see every problem (``api.disclosure.FULL``), so no total is withheld from them and
-    :func:`summary` reads no report (a report is a row's largest column: 100 of them were most of a staff
-    listing's time, bench/service_scale.py)."""
+    """The caller's submissions to the assignment (all of them, or one student's, for its staff: the
+    ``enrolment``, or the course's student called ``student_name``), newest first. Their files and progress
+    are not read (a listing shows neither), nor, for the staff, their reports: staff see every problem
+    (``api.disclosure.FULL``), so no total is withheld from them and :func:`summary` reads no report (a
+    report is a row's largest column: 100 of them were most of a staff listing's time,
+    bench/service_scale.py)."""
     unread = [Submission.content, Submission.progress, *([Submission.report] if caller.is_instructor else [])]
     query = (
         select(Submission)
@@ -161,6 +166,8 @@ def list_submissions(
     )
     if caller.student is not None:
         query = query.where(Submission.student_id == caller.student.id)
+    elif enrolment is not None:
+        query = query.where(Submission.student_id == enrolment.id)
     elif student_name is not None:
         student = find_student(session, assignment.course_id, student_name)
         query = query.where(Submission.student_id == student.id)

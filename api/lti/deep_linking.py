@@ -39,8 +39,8 @@ def graded_edition(setting: str | None, lab: str | None = None) -> str:
 
 
 def check_link_edition(custom: dict[str, object], graded: str) -> None:
-    """Refuse a link made for another edition than the one the service grades (its students would be
-    graded on problems their template does not pose).
+    """Refuse a link made for another edition than the one its assignment grades (``graded``; a new link's
+    is the service's): its students would be graded on problems their template does not pose.
 
     Raises:
         LaunchRefused: The link's custom ``edition`` names another edition.
@@ -48,8 +48,8 @@ def check_link_edition(custom: dict[str, object], graded: str) -> None:
     wanted = custom.get("edition")
     if wanted is not None and wanted != graded:
         raise LaunchRefused(
-            f"this assignment was added for edition {wanted!r}, and this service grades {graded!r} (GYMGRADE_EDITION); "  # noqa: E501
-            "the instructor adds the assignment again with the service's edition, or runs a service for that edition"  # noqa: E501
+            f"this assignment was added for edition {wanted!r}, and this service grades {graded!r} here (the edition of the link's assignment); "  # noqa: E501
+            "the instructor adds the assignment again with that edition"
         )
 
 

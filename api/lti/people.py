@@ -169,13 +169,7 @@ def ensure_link(
     ags = claims.get(names.AGS_ENDPOINT) or {}
     nrps = claims.get(names.NRPS) or {}
     link_id = str(resource.get("id"))
-    link = session.scalars(
-        select(LtiLink).where(
-            LtiLink.platform_id == platform.id,
-            LtiLink.deployment_id == deployment_id,
-            LtiLink.resource_link_id == link_id,
-        )
-    ).first()
+    link = existing_link(session, platform, deployment_id, claims)
     if link is None:
         course = ensure_course(session, platform, deployment_id, claims)
         title = str(resource.get("title") or context.get("title") or "")
@@ -199,9 +193,34 @@ def ensure_link(
     return link
 
 
+def existing_link(
+    session: Session, platform: LtiPlatform, deployment_id: str, claims: dict[str, Any]
+) -> LtiLink | None:
+    """The resource link a launch names, if a launch made it before (nothing is written)."""
+    resource = claims.get(names.RESOURCE_LINK) or {}
+    return session.scalars(
+        select(LtiLink).where(
+            LtiLink.platform_id == platform.id,
+            LtiLink.deployment_id == deployment_id,
+            LtiLink.resource_link_id == str(resource.get("id")),
+        )
+    ).first()
+
+
 def course_of(session: Session, link: LtiLink) -> int:
     """The id of the course whose assignment the link opens."""
     return session.get_one(Assignment, link.assignment_id).course_id
+
+
+def links_of(session: Session, course_id: int | None, assignment_id: int | None = None) -> list[LtiLink]:
+    """The resource links opening the assignment ``assignment_id`` (None: any) of course ``course_id`` (None:
+    any course), oldest first."""
+    query = select(LtiLink).join(Assignment, Assignment.id == LtiLink.assignment_id).order_by(LtiLink.id)
+    if course_id is not None:
+        query = query.where(Assignment.course_id == course_id)
+    if assignment_id is not None:
+        query = query.where(LtiLink.assignment_id == assignment_id)
+    return list(session.scalars(query))
 
 
 def ensure_member(session: Session, link: LtiLink, user: LtiUser) -> LtiMember:

@@ -362,9 +362,11 @@ def _send(
     return 1
 
 
-def publishing_status(session: Session, course_id: int | None) -> list[dict[str, Any]]:
-    """Each student's row of the course (None: of every course): the kept score, the one the LMS holds, the
-    state, the attempts, the last error."""
+def publishing_status(
+    session: Session, course_id: int | None, assignment_id: int | None = None
+) -> list[dict[str, Any]]:
+    """Each student's row of the course (None: of every course) and assignment (None: every one of it): the
+    kept score, the one the LMS holds, the state, the attempts, the last error."""
     query = (
         select(LtiScore, LtiMember, Student)
         .join(LtiMember, LtiMember.id == LtiScore.member_id)
@@ -378,6 +380,8 @@ def publishing_status(session: Session, course_id: int | None) -> list[dict[str,
     )
     if course_id is not None:
         query = query.where(Assignment.course_id == course_id)
+    if assignment_id is not None:
+        query = query.where(Assignment.id == assignment_id)
     rows = session.execute(query).all()
     return [
         {

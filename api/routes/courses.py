@@ -5,7 +5,7 @@ routes of ``students``, ``submissions``, ``gradebook`` and ``overrides`` under `
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Depends
+from fastapi import APIRouter, Depends, Response
 
 from api.courses import (
     assignment_values,
@@ -14,6 +14,10 @@ from api.courses import (
     create_assignment,
     create_course,
     create_staff,
+    find_staff,
+    new_staff_token,
+    revoke_staff_token,
+    staff_of,
 )
 from api.deps import (
     AnyCallerDep,
@@ -32,10 +36,11 @@ from api.errors import (
     MalformedBody,
     NotAuthenticated,
     OperatorOnly,
+    StaffNotFound,
     UploadTooLarge,
 )
 from api.handlers import error_responses
-from api.models import Assignment, Course
+from api.models import Assignment, Course, Staff
 from api.schemas import (
     AssignmentCreate,
     AssignmentView,
@@ -43,6 +48,7 @@ from api.schemas import (
     CourseView,
     StaffCreate,
     StaffCreated,
+    StaffView,
 )
 from grader.lab.editions.choice import service_edition
 
@@ -68,6 +74,7 @@ def _assignment_view(course: Course, assignment: Assignment) -> AssignmentView:
         due_date=assignment.due_date,
         gradebook_policy=assignment.gradebook_policy,
         late=assignment.late_policy,
+        config=assignment.config_toml,
     )
 
 
@@ -118,7 +125,61 @@ def post_staff(
     """Add an instructor or a teaching assistant to the course (the operator, or the course's instructor);
     the token in the response is shown only this once and reaches this course only."""
     staff, token = create_staff(session, course, body.name, body.role)
-    return StaffCreated(name=staff.name, role=body.role, token=token)
+    return StaffCreated(id=staff.id, name=staff.name, role=body.role, token=token)
+
+
+def _staff_view(staff: Staff) -> StaffView:
+    return StaffView(
+        id=staff.id,
+        name=staff.name,
+        role=staff.role,  # type: ignore[arg-type]  # a StaffRole value, checked by StaffView
+        token=staff.token_sha256 is not None,
+        lti=staff.lti_user_id is not None,
+    )
+
+
+@course_router.get(
+    "/staff",
+    response_model=list[StaffView],
+    responses=error_responses(NotAuthenticated, InstructorOnly, CourseNotFound, InvalidRequest),
+)
+def get_staff(session: SessionDep, _instructor: CourseInstructorDep, course: CourseDep) -> list[StaffView]:
+    """The course's staff, oldest first, with whether each has an API token (never the token)."""
+    return [_staff_view(staff) for staff in staff_of(session, course)]
+
+
+@course_router.post(
+    "/staff/{staff_id}/token",
+    status_code=201,
+    response_model=StaffCreated,
+    responses=error_responses(
+        NotAuthenticated, InstructorOnly, CourseNotFound, StaffNotFound, InvalidRequest
+    ),
+)
+def post_staff_token(
+    staff_id: int, session: SessionDep, _instructor: CourseInstructorDep, course: CourseDep
+) -> StaffCreated:
+    """A new API token for a staff member (their old one stops working), shown only this once."""
+    staff = find_staff(session, course, staff_id)
+    token = new_staff_token(session, staff)
+    return StaffCreated(id=staff.id, name=staff.name, role=staff.role, token=token)  # type: ignore[arg-type]
+
+
+@course_router.delete(
+    "/staff/{staff_id}/token",
+    status_code=204,
+    response_class=Response,
+    responses=error_responses(
+        NotAuthenticated, InstructorOnly, CourseNotFound, StaffNotFound, InvalidRequest
+    ),
+)
+def delete_staff_token(
+    staff_id: int, session: SessionDep, _instructor: CourseInstructorDep, course: CourseDep
+) -> Response:
+    """Revoke a staff member's API token: a request with it is refused from now on (401). Nothing to revoke
+    is no error."""
+    revoke_staff_token(session, find_staff(session, course, staff_id))
+    return Response(status_code=204)
 
 
 @course_router.post(
@@ -138,8 +199,9 @@ def post_staff(
 def post_assignment(
     body: AssignmentCreate, session: SessionDep, _instructor: CourseInstructorDep, course: CourseDep
 ) -> AssignmentView:
-    """Add an assignment to the course: the lab and edition its uploads are graded as, its seeds, due date,
-    gradebook and late policy. Its routes are under /courses/{course}/assignments/{assignment}."""
+    """Add an assignment to the course: the lab and edition its uploads are graded as, its configuration
+    (points, visibility), seeds, due date, gradebook and late policy. Its routes are under
+    /courses/{course}/assignments/{assignment}."""
     return _assignment_view(course, create_assignment(session, course, assignment_values(body)))
 
 

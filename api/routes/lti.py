@@ -1,9 +1,9 @@
 """The LTI 1.3 tool's routes: keys, registration, login and launch, deep linking, roster and scores.
 
 Browser-facing routes (login, launch, register, the lab picker) are reached from the LMS; the platform,
-registration and key routes are the operator's; the links, rosters and scores are the default course's
-staff's (and the operator's). All of them are JSON with a bearer token. None is part of the OpenAPI schema
-of the grading API.
+registration and key routes are the operator's; the links, rosters and scores here are the default course's
+staff's (and the operator's, of every course); one assignment's are ``api.routes.lti_scoped``'s. All of them
+are JSON with a bearer token. None is part of the OpenAPI schema of the grading API.
 """
 
 from __future__ import annotations
@@ -41,6 +41,7 @@ from api.lti.deep_linking import (
 from api.lti.keys import public_jwks, rotate
 from api.lti.launch import (
     STATE_SECONDS,
+    Launch,
     Login,
     accept_launch,
     frame_origins,
@@ -48,13 +49,14 @@ from api.lti.launch import (
     tool_state,
     verify_launch,
 )
-from api.lti.people import course_of
+from api.lti.people import course_of, existing_link, links_of
 from api.lti.platforms import PlatformRegistration, add_deployment, checked_origins, register_platform
 from api.lti.publisher import publishing_status
 from api.lti.registration import ToolUrls, check_ticket, register_dynamically, registration_ticket
 from api.lti.roster import import_roster
 from api.lti.sessions import SESSION_PARAMETER
 from api.models import Assignment, LtiLink, LtiPlatform
+from api.schemas import LtiLinkView
 from api.settings import Settings
 from api.web import page_headers, templates
 
@@ -171,8 +173,9 @@ def launch(
         )
     else:
         custom = checked.claims.get(names.CUSTOM)
-        graded = graded_edition(settings.edition, settings.lab)
-        check_link_edition(custom if isinstance(custom, dict) else {}, graded)
+        check_link_edition(
+            custom if isinstance(custom, dict) else {}, _link_edition(session, settings, checked)
+        )
         landing = accept_launch(
             session, checked, session_seconds=settings.lti_session_seconds, browser_digest=browser_digest
         )
@@ -180,6 +183,16 @@ def launch(
     if browser_secret is not None:
         set_cookie(response, SESSION_COOKIE, browser_secret, max_age=settings.lti_session_seconds, path="/")
     return response
+
+
+def _link_edition(session: Session, settings: Settings, checked: Launch) -> str:
+    """The edition a launch's link grades: its assignment's once a launch made it, else (a new link, whose
+    assignment is made as the default one) the service's."""
+    link = existing_link(session, checked.platform, checked.deployment_id, checked.claims)
+    assignment = session.get(Assignment, link.assignment_id) if link is not None else None
+    if assignment is None:
+        return graded_edition(settings.edition, settings.lab)
+    return graded_edition(assignment.edition, assignment.lab)
 
 
 def _from_platform_storage(
@@ -431,30 +444,18 @@ def rotate_keys(session: SessionDep, settings: SettingsDep, _operator: OperatorD
 
 @router.get("/lti/links")
 def get_links(session: SessionDep, instructor: InstructorDep, course: CourseDep) -> list[dict[str, Any]]:
-    """The resource links students launched from, of the course's assignments (the operator's: all)."""
-    query = select(LtiLink).join(Assignment, Assignment.id == LtiLink.assignment_id).order_by(LtiLink.id)
-    if not instructor.is_operator:
-        query = query.where(Assignment.course_id == course.id)
-    return [
-        {
-            "id": link.id,
-            "platform_id": link.platform_id,
-            "context_id": link.context_id,
-            "resource_link_id": link.resource_link_id,
-            "title": link.title,
-            "lineitem_url": link.lineitem_url,
-            "custom": link.custom,
-        }
-        for link in session.scalars(query)
-    ]
+    """The resource links students launched from, of the default course's assignments (the operator's: every
+    course's); one assignment's: GET /courses/{course}/assignments/{assignment}/lti/links."""
+    links = links_of(session, None if instructor.is_operator else course.id)
+    return [LtiLinkView.model_validate(link).model_dump(mode="json") for link in links]
 
 
 @router.post("/lti/links/{link_id}/roster")
 def post_roster(
     link_id: int, session: SessionDep, context: ContextDep, instructor: InstructorDep, course: CourseDep
 ) -> dict[str, int]:
-    """Import the link's course roster (Names and Role Provisioning): a link of the course's only (the
-    operator's: any)."""
+    """Import the link's course roster (Names and Role Provisioning): a link of the default course's only (the
+    operator's: any); one assignment's link: POST .../assignments/{assignment}/lti/links/{id}/roster."""
     link = session.get(LtiLink, link_id)
     if link is None or not (instructor.is_operator or course_of(session, link) == course.id):
         raise LtiRequestInvalid(f"no LTI link has id {link_id}; list them with GET /lti/links")
@@ -473,5 +474,6 @@ def get_publisher(context: ContextDep, _operator: OperatorDep) -> dict[str, Any]
 @router.get("/lti/scores")
 def get_scores(session: SessionDep, instructor: InstructorDep, course: CourseDep) -> list[dict[str, Any]]:
     """Each student's score publishing to the LMS: kept score, the one the LMS holds, state, last error (the
-    course's; the operator's: every course's)."""
+    default course's; the operator's: every course's); one assignment's: GET
+    /courses/{course}/assignments/{assignment}/lti/scores."""
     return publishing_status(session, None if instructor.is_operator else course.id)

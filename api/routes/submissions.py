@@ -34,6 +34,7 @@ from api.errors import (
 from api.handlers import error_responses
 from api.overrides import overrides_shown
 from api.schemas import SubmissionAccepted, SubmissionDetail, SubmissionSummary
+from api.students import find_enrolment
 from api.submissions import create_submission, detail, get_submission, list_submissions, regrade, summary
 from api.uploads import check_upload, upload_rules
 
@@ -197,4 +198,25 @@ def post_student_regrade(
 ) -> list[SubmissionAccepted]:
     """Grade every upload of one student again, each on its recorded seed; nobody else's is touched."""
     ids = regrade(session, list_submissions(session, instructor, assignment, name), dispatcher)
+    return [SubmissionAccepted(id=submission_id) for submission_id in ids]
+
+
+@router.post(
+    "/enrolments/{enrolment}/regrade",
+    status_code=202,
+    response_model=list[SubmissionAccepted],
+    responses=error_responses(
+        NotAuthenticated, CourseNotFound, InstructorOnly, StudentNotFound, GradingInProgress, InvalidRequest
+    ),
+)
+def post_enrolment_regrade(
+    enrolment: int,
+    session: SessionDep,
+    dispatcher: DispatcherDep,
+    assignment: AssignmentDep,
+    instructor: InstructorDep,
+) -> list[SubmissionAccepted]:
+    """Grade every upload of one enrolment again, each on its recorded seed; nobody else's is touched."""
+    student = find_enrolment(session, assignment.course_id, enrolment)
+    ids = regrade(session, list_submissions(session, instructor, assignment, enrolment=student), dispatcher)
     return [SubmissionAccepted(id=submission_id) for submission_id in ids]

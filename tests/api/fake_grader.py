@@ -162,3 +162,48 @@ def grade_submission(
         if _directive(source, "internal-error") is not None
         else [],
     )
+
+
+def grade_as_configured(
+    path: Path,
+    *,
+    seed: int = 0,
+    workers: int | None = None,
+    only: Sequence[str] | None = None,
+    policy: Any = None,
+    on_progress: Callable[[ProblemResult], None] | None = None,
+    config: Path | None = None,
+    name: str | None = None,
+) -> Report:
+    """A grader that grades nothing but reports the configuration it was given: every enabled problem of
+    ``config`` (the bundled one when None) passed with its configured points and visibility, and the
+    configuration's edition as each problem's ``measurements["edition"]``."""
+    plan = GradingPlan.load(config, only)
+    data = path.read_bytes()
+    problems = []
+    for problem_id in plan.problems:
+        result = ProblemResult(
+            id=problem_id,
+            title=plan.titles[problem_id],
+            status="passed",
+            score=plan.points[problem_id],
+            max_score=plan.points[problem_id],
+            feedback="as configured",
+            measurements={"edition": plan.edition},
+            visibility=plan.visibility[problem_id],
+            seed=seed,
+        )
+        problems.append(result)
+        if on_progress is not None:
+            on_progress(result)
+    return Report(
+        submission=name or path.name,
+        sha256=hashlib.sha256(data).hexdigest(),
+        seed=seed,
+        config_sha256=plan.config_sha256,
+        gymnasium_version="fake",
+        grader_version=grader.__version__,
+        score=sum(p.score for p in problems),
+        max_score=sum(p.max_score for p in problems),
+        problems=problems,
+    )

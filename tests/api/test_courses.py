@@ -5,16 +5,20 @@ from __future__ import annotations
 
 import csv
 import io
+import time
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 import pytest
 from api_testing import SettingsFactory, add_student, bearer, graded_upload, instructor_headers
 from fastapi.testclient import TestClient
+from live_server import GRADING_WAIT_SECONDS
 
+import grader.lab as grader_lab
 from api.courses import DEFAULT_ASSIGNMENT_ID, default_assignment, sync_default
 from api.main import create_app
-from api.models import Assignment, Extension, Student, Submission
+from api.models import Assignment, Extension, Staff, Student, Submission
+from api.security import token_digest
 
 pytestmark = pytest.mark.slow  # each starts the service on a fresh database (about a second)
 
@@ -234,3 +238,153 @@ def test_an_assignment_grades_as_its_own_lab_and_a_name_is_unique_in_its_course_
             "/courses/a/assignments", json={"slug": "lab1", "title": "X"}, headers=instructor_headers()
         )
         assert taken.status_code == 409
+
+
+def test_a_staff_token_reaches_one_course_with_its_role_and_is_revoked(
+    make_settings: SettingsFactory,
+) -> None:
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        a, b = _course(client, "a", "rl1"), _course(client, "b", "rl1")
+        operator = instructor_headers()
+        made = client.post("/courses/a/staff", json={"name": "Bot", "role": "ta"}, headers=operator).json()
+        token = bearer(made["token"])
+        assert client.get(f"{A}/submissions", headers=token).status_code == 200
+        assert client.get(f"{B}/submissions", headers=token).status_code == 404  # another course's
+        assert (
+            client.post("/courses/a/students", json={"name": "x"}, headers=token).status_code == 403
+        )  # a TA's
+        listed = client.get("/courses/a/staff", headers=bearer(a["instructor"])).json()
+        assert [(row["name"], row["role"], row["token"]) for row in listed] == [
+            ("instructor of a", "instructor", True), ("ta of a", "ta", True), ("Bot", "ta", True)
+        ]  # fmt: skip
+        assert "token_sha256" not in listed[0] and all(made["token"] not in str(row) for row in listed)
+        with client.app.state.context.sessions() as session:  # type: ignore[attr-defined]
+            stored = session.get_one(Staff, made["id"]).token_sha256
+            assert stored == token_digest(made["token"])  # only the digest is kept
+        # another course's instructor, and a TA, may neither list nor revoke
+        assert (
+            client.delete(f"/courses/a/staff/{made['id']}/token", headers=bearer(b["instructor"])).status_code
+            == 404
+        )
+        assert (
+            client.delete(f"/courses/a/staff/{made['id']}/token", headers=bearer(a["ta"])).status_code == 403
+        )
+        assert client.delete(f"/courses/b/staff/{made['id']}/token", headers=operator).status_code == 404
+        assert (
+            client.delete(f"/courses/a/staff/{made['id']}/token", headers=bearer(a["instructor"])).status_code
+            == 204
+        )
+        assert client.get(f"{A}/submissions", headers=token).status_code == 401
+        assert [row["token"] for row in client.get("/courses/a/staff", headers=operator).json()] == [
+            True,
+            True,
+            False,
+        ]
+        renewed = client.post(f"/courses/a/staff/{made['id']}/token", headers=operator)
+        assert renewed.status_code == 201 and renewed.json()["role"] == "ta"
+        assert client.get(f"{A}/submissions", headers=bearer(renewed.json()["token"])).status_code == 200
+        assert client.get(f"{A}/submissions", headers=token).status_code == 401
+
+
+RL1_CONFIG = Path(grader_lab.__file__).parent / "editions" / "rl1.toml"
+
+
+def _config(edition_file: Path, points: dict[str, float], hidden: str) -> str:
+    """An edition's bundled configuration with some problems' points changed and one problem hidden."""
+    text = edition_file.read_text(encoding="utf-8")
+    for problem, value in points.items():
+        table = f"[problems.{problem}]\n"
+        start = text.index(table)
+        at = text.index("points = 1.0", start)
+        text = text[:at] + f"points = {value}" + text[at + len("points = 1.0") :]
+    table = f"[problems.{hidden}]\n"
+    return text.replace(table, table + 'visibility = "hidden"\n')
+
+
+def _done(client: TestClient, path: str, headers: dict[str, str]) -> dict[str, object]:
+    deadline = time.monotonic() + GRADING_WAIT_SECONDS  # bounds a hang only: the event is the status
+    while True:
+        view: dict[str, object] = client.get(path, headers=headers).json()
+        if view["status"] in ("done", "failed") or time.monotonic() > deadline:
+            return view
+        time.sleep(0.05)
+
+
+def test_each_assignment_grades_with_its_own_lab_edition_and_configuration(
+    make_settings: SettingsFactory,
+) -> None:
+    settings = make_settings(grader="fake_grader:grade_as_configured", workers=1, edition="classic")
+    lab = Path(grader_lab.__file__).parent
+    configs = {
+        "one": ("rl1", _config(lab / "editions" / "rl1.toml", {"car": 4.0}, hidden="taxi")),
+        "two": ("v2024", _config(lab / "rl2" / "v2024.toml", {"value_iteration": 3.0}, hidden="frozen_lake")),
+    }
+    with TestClient(create_app(settings)) as client:
+        operator = instructor_headers()
+        client.post("/courses", json={"slug": "c", "title": "C"}, headers=operator)
+        for slug, (edition, text) in configs.items():
+            body = {"slug": slug, "title": slug, "edition": edition, "config": text}
+            made = client.post("/courses/c/assignments", json=body, headers=operator)
+            assert made.status_code == 201, made.text
+            assert (made.json()["lab"], made.json()["edition"], made.json()["config"]) == (
+                "opengym" if slug == "one" else "rl2", edition, text
+            )  # fmt: skip
+        token = bearer(
+            client.post("/courses/c/students", json={"name": "ada"}, headers=operator).json()["token"]
+        )
+        seen = {}
+        for slug in configs:
+            upload = client.post(
+                f"/courses/c/assignments/{slug}/submissions",
+                files={"file": ("opengym.py", b"x = 1\n")},
+                headers=token,
+            )
+            location = upload.headers["Location"]
+            staff = _done(client, location, operator)
+            assert staff["status"] == "done", staff
+            student = client.get(location, headers=token).json()
+            seen[slug] = (staff, student)
+        one, two = seen["one"], seen["two"]
+        problems = {
+            slug: {p["id"]: p for p in staff["report"]["problems"]} for slug, (staff, _) in seen.items()
+        }
+        # each grading had its assignment's configuration: its edition's problems, points and visibility
+        assert {p["measurements"]["edition"] for p in problems["one"].values()} == {"rl1"}
+        assert {p["measurements"]["edition"] for p in problems["two"].values()} == {"v2024"}
+        assert "car" in problems["one"] and "value_iteration" not in problems["one"]
+        assert (problems["one"]["car"]["max_score"], problems["two"]["value_iteration"]["max_score"]) == (
+            4.0,
+            3.0,
+        )
+        assert (problems["one"]["taxi"]["visibility"], problems["two"]["frozen_lake"]["visibility"]) == (
+            "hidden", "hidden"
+        )  # fmt: skip
+        # and the student's view withholds each assignment's own hidden problem
+        for (_, student), hidden in ((one, "taxi"), (two, "frozen_lake")):
+            shown = {p["id"]: p["status"] for p in student["report"]["problems"]}
+            assert shown[hidden] == "withheld" and {s for p, s in shown.items() if p != hidden} == {"passed"}
+
+
+@pytest.mark.parametrize(
+    ("body", "expected"),
+    [
+        ({"edition": "rl1", "config": "not = [toml"}, "config is not TOML"),
+        ({"edition": "rl1", "config": "[problems]\n"}, "config is not an assignment configuration"),
+        ({"edition": "rl1", "config": "a = " + "[" * 30000}, "config nests arrays or tables too deeply"),
+        (
+            {"edition": "v2024", "config": RL1_CONFIG.read_text(encoding="utf-8")},
+            "config grades edition 'rl1', the assignment edition 'v2024'",
+        ),
+    ],
+    ids=["not-toml", "not-a-configuration", "too-deep", "another-edition"],
+)
+def test_an_assignment_configuration_is_checked_when_it_is_given(
+    make_settings: SettingsFactory, body: dict[str, str], expected: str
+) -> None:
+    with TestClient(create_app(make_settings(), run_workers=False)) as client:
+        client.post("/courses", json={"slug": "c", "title": "C"}, headers=instructor_headers())
+        refused = client.post(
+            "/courses/c/assignments", json={"slug": "x", "title": "X", **body}, headers=instructor_headers()
+        )
+        assert refused.status_code == 422 and refused.json()["detail"].startswith(expected), refused.text
+        assert refused.json()["problems"][0]["location"] == ["body", "config"]

@@ -51,7 +51,14 @@ MALFORMED_MULTIPART = b"--b\r\n-208660--b--\r\n"
             "OPTIONS is not supported at /submissions; use GET, POST",
             {"Allow": "GET, POST"},
         ),
-        ("delete", "/students", {}, 405, "DELETE is not supported at /students; use POST", {"Allow": "POST"}),
+        (
+            "delete",
+            "/students",
+            {},
+            405,
+            "DELETE is not supported at /students; use GET, POST",
+            {"Allow": "GET, POST"},
+        ),
         ("get", "/nothing", {}, 404, "nothing is at /nothing; the API's operations are listed at /docs", {}),
         (
             "get",

@@ -15,7 +15,10 @@ STRONG = "Zq3-vK9_pL2xR7mN4tB8wY6c"
 @pytest.mark.parametrize(
     ("environment", "message"),
     [
-        ({}, "GYMGRADE_INSTRUCTOR_TOKEN is not set; expected a long random token"),
+        (
+            {},
+            "GYMGRADE_OPERATOR_TOKEN (or GYMGRADE_INSTRUCTOR_TOKEN) is not set; expected a long random token",
+        ),
         (
             {"GYMGRADE_INSTRUCTOR_TOKEN": "secret"},
             "GYMGRADE_INSTRUCTOR_TOKEN is weak: expected at least 24 "
@@ -26,13 +29,23 @@ STRONG = "Zq3-vK9_pL2xR7mN4tB8wY6c"
             "GYMGRADE_INSTRUCTOR_TOKEN is weak: expected at least 10 "
             "distinct characters, found 2; generate a random one",
         ),
+        (
+            {"GYMGRADE_OPERATOR_TOKEN": "secret"},
+            "GYMGRADE_OPERATOR_TOKEN is weak: expected at least 24 characters, found 6",
+        ),
+        (
+            {"GYMGRADE_OPERATOR_TOKEN": STRONG, "GYMGRADE_INSTRUCTOR_TOKEN": STRONG[::-1]},
+            "GYMGRADE_OPERATOR_TOKEN and GYMGRADE_INSTRUCTOR_TOKEN are both set, to different tokens: "
+            "expected one operator token",
+        ),
     ],
-    ids=["missing", "short", "repetitive"],
+    ids=["missing", "short", "repetitive", "operator-short", "two-different"],
 )
 def test_unsafe_tokens_are_refused_outside_development(
     monkeypatch: pytest.MonkeyPatch, environment: dict[str, str], message: str
 ) -> None:
     monkeypatch.delenv("GYMGRADE_INSTRUCTOR_TOKEN", raising=False)
+    monkeypatch.delenv("GYMGRADE_OPERATOR_TOKEN", raising=False)
     monkeypatch.delenv("GYMGRADE_DEVELOPMENT", raising=False)
     for name, value in environment.items():
         monkeypatch.setenv(name, value)
@@ -71,6 +84,26 @@ def test_environment_variables_are_read_with_the_prefix(
     )
     assert settings.allow_weak_isolation
     assert settings.sqlalchemy_url == f"sqlite:///{tmp_path}/gymgrade.sqlite3"
+
+
+@pytest.mark.parametrize(
+    "names",
+    [
+        ("GYMGRADE_OPERATOR_TOKEN",),
+        ("GYMGRADE_INSTRUCTOR_TOKEN",),
+        ("GYMGRADE_OPERATOR_TOKEN", "GYMGRADE_INSTRUCTOR_TOKEN"),
+    ],
+    ids=["operator", "instructor", "both-alike"],
+)
+def test_the_operator_token_is_read_under_either_name(
+    monkeypatch: pytest.MonkeyPatch, names: tuple[str, ...]
+) -> None:
+    for name in ("GYMGRADE_OPERATOR_TOKEN", "GYMGRADE_INSTRUCTOR_TOKEN", "GYMGRADE_DEVELOPMENT"):
+        monkeypatch.delenv(name, raising=False)
+    for name in names:
+        monkeypatch.setenv(name, STRONG)
+    operator = Settings().operator
+    assert operator is not None and operator.get_secret_value() == STRONG
 
 
 def test_database_url_takes_precedence(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -116,3 +116,28 @@ def test_each_context_is_a_course_and_a_role_counts_in_its_own_only(
     assert done.status_code == 201, done.text
     wait(lambda: _scores_at(platform, "link-a", lee.sub)[-1] == 3.0, "the overridden score at the LMS")
     assert _scores_at(platform, "link-b", lee.sub) == [2.0]
+
+
+def test_a_launch_is_checked_against_its_links_assignment_not_the_services_edition(
+    platform: LtiPlatform, tool: LiveProcess
+) -> None:
+    learner = platform.add_person("learner-edition", "Eda", LEARNER)
+    classic = {"lab": "OpenGym AI (classic gym)", "edition": "classic"}
+    rl1 = {"lab": "Reinforcement Learning 1", "edition": "rl1"}
+    with browser() as client:
+        landed(client, tool.url, platform.launch(client, LaunchSpec(learner, "link-edition", custom=classic)))
+    # the link's assignment grades rl1 now (as an assignment of its course may), the service still classic
+    database = Path(tool._env["GYMGRADE_DATA_DIR"]) / "gymgrade.sqlite3"
+    with sqlite3.connect(database) as connection:
+        connection.execute(
+            "UPDATE assignments SET edition = 'rl1', lab = NULL WHERE id = "
+            "(SELECT assignment_id FROM lti_links WHERE resource_link_id = 'link-edition')"
+        )
+    with browser() as client:
+        _, page = landed(
+            client, tool.url, platform.launch(client, LaunchSpec(learner, "link-edition", custom=rl1))
+        )
+        assert "signed in as Eda" in page.text
+        refused = platform.launch(client, LaunchSpec(learner, "link-edition", custom=classic))
+    assert refused.status_code == 403
+    assert "added for edition 'classic', and this service grades 'rl1'" in refused.text.replace("&#39;", "'")
