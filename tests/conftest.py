@@ -118,7 +118,7 @@ def _is_full_run(config: pytest.Config) -> bool:
 
 @pytest.hookimpl(optionalhook=True)  # xdist's hook: a run without xdist (test_conftest's) has none
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int | None:
-    """`-n auto`: xdist's count of the cores for the default and the full run, 0 (one process) for any other."""
+    """`-n auto`: xdist's count of the cores for the default run and the full run, 0 for any other."""
     if _is_default_run(config) or _is_full_run(config):
         return None  # xdist's own answer: the machine's cores
     return 0

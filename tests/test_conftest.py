@@ -3,7 +3,6 @@ fails the run and is named; a declared one, an xfail and any skip outside CI do 
 
 from __future__ import annotations
 
-import os
 import textwrap
 from pathlib import Path
 
@@ -135,7 +134,8 @@ ALONE_SUITE = """
         done = sorted(path.name for path in MARKS.glob("done-*"))
         stopped = sorted(path.name for path in MARKS.glob("stopped-*"))
         assert done == [f"done-{n}" for n in range(6)], done
-        assert stopped == [f"stopped-gw{n}" for n in range(2) if f"gw{n}" != os.environ["PYTEST_XDIST_WORKER"]]
+        others = [f"gw{n}" for n in range(2) if f"gw{n}" != os.environ["PYTEST_XDIST_WORKER"]]
+        assert stopped == [f"stopped-{worker}" for worker in others], stopped
 
     @pytest.mark.parametrize("n", range(6))
     def test_plain(n):
@@ -153,14 +153,16 @@ def pytest_sessionfinish(session):  # on a worker: before xdist tells the contro
 
 
 @pytest.mark.slow  # starts an xdist session
-@pytest.mark.parametrize("arguments", [("-m", ""), ("-n", "2", "-m", "")], ids=["full-run", "asked-for-workers"])
+@pytest.mark.parametrize(
+    "arguments", [("-m", ""), ("-n", "2", "-m", "")], ids=["full-run", "asked-for-workers"]
+)
 def test_an_alone_test_runs_once_every_other_worker_has_stopped(
     pytester: pytest.Pytester, monkeypatch: pytest.MonkeyPatch, arguments: tuple[str, ...]
 ) -> None:
     marks = pytester.mkdir("marks")
     monkeypatch.setenv("MARKS", str(marks))
     monkeypatch.setenv("PYTEST_DISABLE_PLUGIN_AUTOLOAD", "1")
-    monkeypatch.setenv("PYTEST_XDIST_AUTO_NUM_WORKERS", "2")  # xdist's own `-n auto` answer, whatever the cores
+    monkeypatch.setenv("PYTEST_XDIST_AUTO_NUM_WORKERS", "2")  # xdist's `-n auto` answer, whatever the cores
     pytester.makeconftest(CONFTEST.read_text(encoding="utf-8") + WORKER_STOPS)
     pytester.makeini('[pytest]\ntestpaths = .\naddopts = -p xdist.plugin -n auto -m "not slow"\n'
                      'markers =\n    alone(reason): alone\n')  # fmt: skip
