@@ -5,7 +5,8 @@ Runs the command `.ci/run` holds (`bash scripts/setup.sh && scripts/run python3 
 one-process run), and records the wall time, pytest's summary (the test count), the CPU time of everything
 it waited for, the cores and the load average: sampled every 10 s during the run, since on a shared machine
 the wall time follows the load (an idle 2-core machine has a load of about 2 while the suite runs).
-`--write` replaces the `## Full test run (issue 44)` section of bench/RESULTS.md.
+`--write` replaces the `## Full test run (issue 44)` section of bench/RESULTS.md; `--log FILE` keeps the
+whole output (`PYTEST_ADDOPTS=--durations=50` adds pytest's slowest tests to it without changing the command).
 
     python bench/suite_duration.py --write          # the README's command, as .ci/run runs it
     python bench/suite_duration.py -- tests/grader/sandbox      # one directory, distributed as the full run
@@ -70,7 +71,7 @@ def measure(command: str) -> dict[str, object]:
         "cpu": usage.ru_utime + usage.ru_stime,
         "loads": loads,
         "summary": summaries[-1] if summaries else run.stdout[-300:].strip(),
-        "tail": "\n".join(run.stdout.splitlines()[-40:]),
+        "output": run.stdout + run.stderr,
     }
 
 
@@ -93,6 +94,7 @@ def section(result: dict[str, object]) -> str:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--write", action="store_true", help=f"replace {HEADING!r} in bench/RESULTS.md")
+    parser.add_argument("--log", type=Path, help="write the run's whole output to this file")
     parser.add_argument("pytest_args", nargs="*", help="after --: run only pytest -m '' with these arguments")
     arguments = parser.parse_args()
     command = readme_command()
@@ -100,7 +102,10 @@ def main() -> int:
         command = 'scripts/run python3 -m pytest -m "" ' + shlex.join(arguments.pytest_args)
     result = measure(command)
     text = section(result)
-    print(result["tail"])
+    output = str(result["output"])
+    print("\n".join(output.splitlines()[-40:]))
+    if arguments.log:
+        arguments.log.write_text(output, encoding="utf-8")
     print(text)
     if arguments.write:
         replace_section(HEADING, text)
