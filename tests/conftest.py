@@ -206,6 +206,16 @@ class AloneLastScheduling(LoadGroupScheduling):  # type: ignore[misc,valid-type]
         if self._runner is not None and self._only_alone_left() and self.nodes == [self._runner]:
             super()._assign_work_unit(self._runner)
 
+    def mark_test_complete(self, node: object, item_index: int, duration: float = 0) -> None:
+        super().mark_test_complete(node, item_index, duration)
+        # A finished group leaves the worker's books: loadscope sums every group a worker ever had at each
+        # event, which a run of 4,000 single-test groups would pay some millions of times.
+        scope = self._split_scope(self.registered_collections[node][item_index])
+        assigned = self.assigned_work.get(node, {})
+        work = assigned.get(scope)
+        if work is not None and all(work.values()):
+            del assigned[scope]
+
     def remove_node(self, node: object) -> str | None:
         crashitem: str | None = super().remove_node(node)  # a crashed worker's tests go back in the queue
         if node is self._runner:
