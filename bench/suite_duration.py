@@ -9,8 +9,8 @@ the wall time follows the load (an idle 2-core machine has a load of about 2 whi
 whole output (`PYTEST_ADDOPTS=--durations=50` adds pytest's slowest tests to it without changing the command).
 
     python bench/suite_duration.py --write          # the README's command, as .ci/run runs it
-    python bench/suite_duration.py -- tests/grader/sandbox      # one directory, distributed as the full run
-    python bench/suite_duration.py -- -n 0 tests/grader/sandbox  # the same in one process
+    python bench/suite_duration.py -- -n 2 tests/grader/sandbox  # one directory, scheduled as the full run
+    python bench/suite_duration.py -- -n 0 tests/grader/sandbox  # the same in one process (as before)
 """
 
 from __future__ import annotations

@@ -67,10 +67,13 @@ MODULE_SKIP = """
         (DECLARED_FOR_ANOTHER_REASON, "true", (), 1, "test_as_root: needs a Debian machine"),
         (XFAIL, "true", (), 0, None),
         (MODULE_SKIP, "true", (), 1, "test_module.py: pip install a_module_nobody_has"),
+        pytest.param(MODULE_SKIP, "true", XDIST, 1, "test_module.py: pip install a_module_nobody_has",
+                     marks=pytest.mark.slow),  # a worker's collection skip reaches the controller
     ],
     ids=[
         "undeclared-skip-under-ci", "undeclared-skip-under-ci-xdist", "no-ci", "ci-false", "declared",
         "declared-xdist", "declared-for-another-reason", "xfail", "module-level-skip",
+        "module-level-skip-xdist",
     ],
 )  # fmt: skip
 def test_skips_under_ci(
