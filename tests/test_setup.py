@@ -111,6 +111,7 @@ def _debian_python() -> str | None:
 
 @pytest.mark.slow
 @pytest.mark.install
+@pytest.mark.xdist_group("install")  # one setup.sh at a time, and first: the longest tests
 @pytest.mark.sandbox
 def test_debians_python3_first_on_path_grades_with_full_isolation(tmp_path: Path) -> None:
     reason = _debian_python()
@@ -124,6 +125,7 @@ def test_debians_python3_first_on_path_grades_with_full_isolation(tmp_path: Path
 
 @pytest.mark.slow
 @pytest.mark.install
+@pytest.mark.xdist_group("install")  # one setup.sh at a time, and first: the longest tests
 @pytest.mark.sandbox
 def test_a_virtualenv_under_tmp_grades_with_full_isolation(tmp_path: Path) -> None:
     project = _fresh_copy(tmp_path / "fresh")
@@ -139,6 +141,7 @@ def test_a_virtualenv_under_tmp_grades_with_full_isolation(tmp_path: Path) -> No
 
 @pytest.mark.slow
 @pytest.mark.install
+@pytest.mark.xdist_group("install")  # one setup.sh at a time, and first: the longest tests
 @pytest.mark.sandbox
 @pytest.mark.expected_skip("already unprivileged")  # the test that runs as root drops to another user
 def test_an_unprivileged_user_grades_with_the_strongest_isolation_available_and_names_the_rest() -> None:

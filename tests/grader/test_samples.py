@@ -24,7 +24,10 @@ from grader.lab.problems import PROBLEM_IDS, ProblemId
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
 
-pytestmark = pytest.mark.slow  # grades every sample submission through the real sandbox
+pytestmark = [
+    pytest.mark.slow,  # grades every sample submission through the real sandbox
+    pytest.mark.xdist_group("samples"),  # one worker grades `reports` for all samples
+]
 
 VERDICTS = SUBMISSIONS / "verdicts.toml"
 HONEST_VERDICTS = SUBMISSIONS / "honest" / "verdicts.toml"

@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,6 +21,7 @@ from grader import cli
 from grader.classroom import command
 from grader.lab.problems import PROBLEMS
 from grader.report import Report
+from grader.sandbox.isolation import bubblewrap, cgroup, privileges, seccomp
 
 
 @pytest.fixture(scope="module")
@@ -126,12 +128,23 @@ def test_check_calls_find_qvalues_when_the_config_says_always(
     assert "greedy_mean_return" in result.measurements
 
 
+def _forget_isolation_probes() -> None:
+    # Each layer probes the machine once per process; a probe made under this PATH must neither be one
+    # made before it nor outlive it (the next test in this process, whatever xdist sent it, grades for real).
+    for layer in (bubblewrap, cgroup, privileges, seccomp):
+        layer._probe_machine.cache_clear()
+
+
 @pytest.fixture
-def without_bubblewrap(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def without_bubblewrap(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """A machine like a student's laptop: `bwrap` (and `setpriv`) cannot be found on PATH."""
     empty = tmp_path / "bin"
     empty.mkdir()
     monkeypatch.setenv("PATH", str(empty))
+    _forget_isolation_probes()
+    yield
+    monkeypatch.undo()
+    _forget_isolation_probes()
 
 
 @pytest.mark.slow  # a grading through the sandbox

@@ -279,6 +279,7 @@ def test_an_upload_linking_to_the_secret_is_refused_and_the_secret_stays_private
     assert secret_file.stat().st_mode & 0o077 == 0, "unreadable to the sandbox's uid"
 
 
+@pytest.mark.xdist_group("gradescope-bundle")  # one worker builds the `gradescope` bundle for all
 def test_a_regrade_copies_an_uploads_links_as_links(gradescope: Path, tmp_path: Path) -> None:
     secret = tmp_path / "instructor_secret.txt"
     secret.write_text(NAME_LIKE_SECRET + "\n")
@@ -400,6 +401,7 @@ def _tapes_module() -> Any:
     return module
 
 
+@pytest.mark.xdist_group("gradescope-bundle")  # one worker builds the `gradescope` bundle for all
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:.*CartPole-v0 is out of date:DeprecationWarning")
 def test_two_uploads_get_different_starts_and_a_recorded_one_regrades_identically(
@@ -454,6 +456,7 @@ def test_two_uploads_get_different_starts_and_a_recorded_one_regrades_identicall
     assert _cartpole(json.loads((tmp_path / "same-seed.json").read_text()))["status"] == "passed"
 
 
+@pytest.mark.xdist_group("gradescope-bundle")  # one worker builds the `gradescope` bundle for all
 @pytest.mark.slow
 def test_student_code_that_opens_the_secret_by_its_path_reads_nothing(
     gradescope: Path, tmp_path: Path

@@ -114,6 +114,7 @@ def batch(tmp_path_factory: pytest.TempPathFactory, fast_config: Path) -> tuple[
     return out, reports
 
 
+@pytest.mark.xdist_group("grade-batch")  # one worker grades `batch` for all
 def test_a_crashing_submission_does_not_stop_the_batch(batch: tuple[Path, list[Report]]) -> None:
     _, (crashing, complete, empty) = batch
     assert [problem.status for problem in crashing.problems] == ["error", "error"]
@@ -125,6 +126,7 @@ def test_a_crashing_submission_does_not_stop_the_batch(batch: tuple[Path, list[R
     assert all(not report.grader_errors for report in (crashing, complete, empty))
 
 
+@pytest.mark.xdist_group("grade-batch")  # one worker grades `batch` for all
 def test_batch_writes_a_report_per_submission_and_grades_csv(batch: tuple[Path, list[Report]]) -> None:
     out, reports = batch
     assert sorted(path.name for path in out.iterdir()) == [

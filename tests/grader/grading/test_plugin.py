@@ -213,6 +213,7 @@ def test_an_unreadable_outcome_is_the_graders_own_failure(carried: object) -> No
     assert CASE_OUTCOME.validate_json(outcome_json(outcome)) == outcome
 
 
+@pytest.mark.xdist_group("plugin-reports")  # one worker grades `reports` for all
 @pytest.mark.slow  # grades through pytest-xdist sessions
 def test_serial_and_parallel_runs_give_the_same_report(reports: dict[str, Report]) -> None:
     serial, parallel = reports["serial"], reports["parallel"]
@@ -221,6 +222,7 @@ def test_serial_and_parallel_runs_give_the_same_report(reports: dict[str, Report
     assert serial.graded_view() == parallel.graded_view()
 
 
+@pytest.mark.xdist_group("plugin-reports")  # one worker grades `reports` for all
 @pytest.mark.slow  # grades through pytest-xdist sessions
 def test_a_grading_is_a_function_of_bytes_and_seed(reports: dict[str, Report]) -> None:
     def seeds_and_measurements(report: Report) -> list[tuple[int, dict[str, Any]]]:
@@ -231,6 +233,7 @@ def test_a_grading_is_a_function_of_bytes_and_seed(reports: dict[str, Report]) -
     assert first != second, "a different grading seed must play different episodes"
 
 
+@pytest.mark.xdist_group("plugin-reports")  # one worker grades `reports` for all
 @pytest.mark.slow  # grades through pytest-xdist sessions
 def test_every_check_reports_its_timings_apart_from_the_verdict(reports: dict[str, Report]) -> None:
     report = reports["parallel"]

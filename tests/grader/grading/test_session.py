@@ -147,6 +147,10 @@ def test_an_outcome_callback_that_raises_ends_the_session_and_its_workers(tmp_pa
     assert _gone(workers), "the workers must be stopped when the session is abandoned"
 
 
+@pytest.mark.alone(
+    "sends SIGINT to its own process: a KeyboardInterrupt escaping there would end an xdist worker, and "
+    "xdist ends the whole run on a worker's Ctrl-C; run last, alone, it can cost no other test"
+)
 def test_ctrl_c_during_a_session_reaches_the_caller(tmp_path: Path) -> None:
     if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
         pytest.skip("Ctrl-C does not raise KeyboardInterrupt in this process")

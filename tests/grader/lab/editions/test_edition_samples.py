@@ -129,6 +129,7 @@ def test_at_least_five_sarsa0_mistakes_are_pinned() -> None:
     assert all(sample.feedback.get("sarsa0") for sample in failing)
 
 
+@pytest.mark.xdist_group("edition-samples")  # one worker grades `reports` for all samples
 @pytest.mark.slow  # grades every edition's samples through the sandbox
 @pytest.mark.parametrize("sample", SAMPLES, ids=[sample.file for sample in SAMPLES])
 def test_sample_gets_its_verdicts(sample: Sample, reports: dict[str, Report]) -> None:

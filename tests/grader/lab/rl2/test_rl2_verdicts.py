@@ -79,6 +79,7 @@ def reports() -> dict[str, Report]:
     return found
 
 
+@pytest.mark.xdist_group("rl2-samples")  # one worker grades `reports` for all samples
 @pytest.mark.slow  # grades every sample through the sandbox (about a minute on two cores)
 @pytest.mark.parametrize("sample", SAMPLES, ids=[sample.file for sample in SAMPLES])
 def test_sample_gets_its_verdicts(sample: Sample, reports: dict[str, Report]) -> None:

@@ -26,7 +26,10 @@ from grader.lab.editions import edition_of
 from grader.report import Report
 from grader.sandbox import IsolationPolicy
 
-pytestmark = pytest.mark.slow  # grades notebooks and their exports through the real sandbox
+pytestmark = [
+    pytest.mark.slow,  # grades notebooks and their exports through the real sandbox
+    pytest.mark.xdist_group("export-verdicts"),  # one worker grades `reports` for all
+]
 
 SEED = 20261207
 LAB_EPISODES = "N=70_000"
