@@ -9,6 +9,7 @@ import shutil
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import httpx
@@ -228,6 +229,10 @@ LTI_PAGES = {
     "lti-storage": ("lti_storage.html", {"action": "get", "target": "_parent", "origin": "https://lms.example",
                     "key": "k", "value": "", "next": "", "id_token": "t", "state": "s"}),
     "lti-picker": ("lti_picker.html", {"choices": choices(), "graded": graded_edition("rl1"), "picker": "p"}),
+    "lti-picker-assignments": ("lti_picker.html", {"choices": choices(), "graded": graded_edition("rl1"),
+                               "picker": "p", "assignments": [
+                                   (SimpleNamespace(slug="lab-1", title="Lab 1"), "rl1"),
+                                   (SimpleNamespace(slug="lab-2", title="Lab 2"), "v2026")]}),
     "lti-post": ("lti_post.html", {"action": "https://lms.example/deep-link", "jwt": "j"}),
     "lti-registered": ("lti_registered.html", {"platform": {"issuer": "https://lms.example", "client_id": "c",
                                                             "deployment_ids": ["1"]}}),
