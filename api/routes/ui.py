@@ -19,12 +19,15 @@ from api.courses import DEFAULT_COURSE_ID
 from api.deps import (
     ASSIGNMENT_PAGES,
     SESSION_COOKIE,
+    AnyPageCallerDep,
     ContextDep,
     DispatcherDep,
     PageAssignmentDep,
     PageCallerDep,
     SessionDep,
     SettingsDep,
+    get_page_assignment,
+    get_page_caller,
     get_scope,
     in_assignment,
 )
@@ -59,14 +62,23 @@ FINAL_STATUSES = frozenset({JobStatus.DONE.value, JobStatus.FAILED.value})
 def home(
     request: Request,
     session: SessionDep,
-    caller: PageCallerDep,
+    caller: AnyPageCallerDep,
     settings: SettingsDep,
-    assignment: PageAssignmentDep,
 ) -> Response:
-    """The start page: the sign-in form, or the caller's submissions and the upload form."""
+    """The start page: the sign-in form, or the caller's submissions and the upload form; at ``/``, a caller
+    of a course other than the default goes on to the courses' pages (their course's assignments)."""
     if caller is None:
         return page(request, "signin.html", {})
+    if "assignment" not in request.path_params and caller.session_token is None and _elsewhere(caller):
+        return RedirectResponse("/ui/courses", status_code=303)
+    assignment = get_page_assignment(request, session, get_page_caller(request, session, caller))
     return _home(request, session, caller, settings, assignment, None)
+
+
+def _elsewhere(caller: Principal) -> bool:
+    """True for a caller (signed in with a token) of a course other than the default, whose start is the
+    courses' pages."""
+    return caller.course() not in (None, DEFAULT_COURSE_ID)
 
 
 @router.post("/ui/lti/roster")
@@ -95,8 +107,7 @@ def sign_in(
         caller = authenticate(session, settings, token.strip())
     except NotAuthenticated as error:
         return page(request, "signin.html", {"error": str(error)}, status_code=401)
-    elsewhere = caller.course() not in (None, DEFAULT_COURSE_ID)
-    response = RedirectResponse("/ui/courses" if elsewhere else "/", status_code=303)
+    response = RedirectResponse("/ui/courses" if _elsewhere(caller) else "/", status_code=303)
     response.set_cookie(
         SESSION_COOKIE, token.strip(), httponly=True, samesite="strict", secure=request.url.scheme == "https"
     )

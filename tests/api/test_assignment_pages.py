@@ -91,7 +91,8 @@ def test_a_student_reaches_their_course_assignments_and_uploads_to_the_one_whose
     assert client.get(f"{PAGES.format('lab-2')}/submissions/{submission_id}/live").status_code == 200
     assert client.get(f"{PAGES.format('lab-1')}/submissions/{submission_id}").status_code == 404
     assert client.get(f"/ui/submissions/{submission_id}").status_code == 404  # the default course's
-    assert client.get("/").status_code == 404
+    start = client.get("/", follow_redirects=False)  # the start page: their course's assignments
+    assert (start.status_code, start.headers["location"]) == (303, "/ui/courses")
     assert client.get("/ui/courses/default/assignments/default").status_code == 404
     assert client.get("/ui/courses/rl-b/assignments/lab-3").status_code == 404
 
