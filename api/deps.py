@@ -73,6 +73,9 @@ COURSE_PREFIX = "/courses/{course}"
 ASSIGNMENT_PREFIX = COURSE_PREFIX + "/assignments/{assignment}"
 """Where a course's routes, and one of its assignments' routes, are mounted; the same routes without the
 prefix are the embedded default course's and assignment's."""
+ASSIGNMENT_PAGES = "/ui" + ASSIGNMENT_PREFIX
+"""Where an assignment's web pages are (its home page, upload, reports, overrides and gradebook); the same
+pages at ``/`` and ``/ui/...`` are the default assignment's (or an LTI launch's)."""
 
 CoursePath = Annotated[str, Path(pattern=SLUG_PATTERN, description="The course's slug.")]
 AssignmentPath = Annotated[
@@ -194,7 +197,8 @@ def get_any_page_caller(request: Request, session: SessionDep, settings: Setting
     if launched.startswith(SESSION_PREFIX):
         caller = session_caller(session, launched, request.cookies.get(BROWSER_COOKIE))
         request.state.lti_caller = caller
-        if caller is not None:  # the pages of a launch are its course's and its link's assignment's
+        if caller is not None and "course" not in request.path_params:
+            # the default pages of a launch are its course's and its link's assignment's
             request.state.scope = launch_scope(session, caller)
     else:
         token = request.cookies.get(SESSION_COOKIE)
@@ -210,8 +214,8 @@ AnyPageCallerDep = Annotated[Principal | None, Depends(get_any_page_caller)]
 
 def get_page_caller(request: Request, session: SessionDep, caller: AnyPageCallerDep) -> Principal | None:
     """The web page's signed-in caller (:func:`get_any_page_caller`), or None when signed out. The pages are
-    the default course's (an LTI launch's: its course's): a caller of another course is refused there
-    (CourseNotFound)."""
+    the assignment's their path names (``ASSIGNMENT_PAGES``), else the default course's (an LTI launch's:
+    its course's): a caller of another course is refused there (CourseNotFound)."""
     if caller is not None:
         caller.require_member(get_scope(request, session).course.id)
     return caller
@@ -221,8 +225,8 @@ PageCallerDep = Annotated[Principal | None, Depends(get_page_caller)]
 
 
 def get_page_assignment(request: Request, session: SessionDep, _caller: PageCallerDep) -> Assignment:
-    """The assignment of the pages: an LTI launch's link's, else the default's (the caller is known first:
-    a launch's session decides the scope)."""
+    """The assignment of the pages: the one their path names, else an LTI launch's link's, else the
+    default's (the caller is known first: a launch's session decides the scope of the unprefixed pages)."""
     assignment = get_scope(request, session).assignment
     assert assignment is not None  # the default scope and a launch's have their assignment
     return assignment

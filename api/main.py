@@ -68,6 +68,7 @@ def create_app(settings: Settings | None = None, *, run_workers: bool = True) ->
     install_error_handlers(app)
     for module in (students, submissions, gradebook, overrides, extensions, health, ui, course_pages, lti):
         app.include_router(module.router)
+    app.include_router(ui.assignment_router)
     app.include_router(courses.router)
     app.include_router(courses.course_router)
     app.include_router(lti_scoped.router)

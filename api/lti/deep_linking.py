@@ -1,6 +1,8 @@
-"""Deep Linking 2.0: an instructor adding the tool to the course picks the lab and edition; the link made
-carries them as custom parameters (``lab``, ``edition``). No line item is asked for here: the first
-published score makes it (by resourceId), with the score's real maximum."""
+"""Deep Linking 2.0: an instructor adding the tool to the course picks the lab and edition (a new assignment
+configured as the default one), or one of the course's assignments; the link made carries them as custom
+parameters (``lab``, ``edition``, and ``assignment``: the slug of the course's assignment it opens). No line
+item is asked for here: the first published score makes it (by resourceId), with the score's real
+maximum."""
 
 from __future__ import annotations
 
@@ -12,12 +14,14 @@ from joserfc import jwt
 from joserfc.errors import JoseError
 from sqlalchemy.orm import Session
 
+from api.courses import assignments_of
 from api.errors import LaunchRefused, LtiRequestInvalid
 from api.lti import claims as names
 from api.lti.keys import ALGORITHM, published_keys, sign
 from api.lti.launch import Launch
+from api.lti.people import LINKED_ASSIGNMENT, context_id_of, course_of_context, named_assignment
 from api.lti.spent import TokenSpent, spend
-from api.models import LtiPlatform
+from api.models import Assignment, LtiPlatform
 from grader.lab.editions import EDITIONS
 from grader.lab.editions.choice import service_edition
 
@@ -69,6 +73,7 @@ def picker_token(session: Session, launch: Launch) -> str:
             "purpose": PICKER_PURPOSE,
             "platform": launch.platform.id,
             "deployment": launch.deployment_id,
+            "context": context_id_of(launch.claims),
             "return_url": str(return_url),
             "data": settings.get("data"),
             "jti": secrets.token_urlsafe(16),
@@ -78,14 +83,34 @@ def picker_token(session: Session, launch: Launch) -> str:
     )
 
 
+def assignments_offered(
+    session: Session, platform_id: int, deployment_id: str, context_id: str
+) -> list[Assignment]:
+    """The assignments of the course of an LMS context, which the picker offers (none before its first
+    launch)."""
+    course = course_of_context(session, platform_id, deployment_id, context_id)
+    if course is None:
+        return []
+    return assignments_of(session, course)
+
+
 def deep_linking_response(
-    session: Session, token: str, edition: str, launch_url: str, *, graded: str, grace_seconds: float
+    session: Session,
+    token: str,
+    edition: str,
+    launch_url: str,
+    *,
+    graded: str,
+    grace_seconds: float,
+    assignment: str = "",
 ) -> tuple[str, str]:
-    """The return URL and the signed LtiDeepLinkingResponse JWT for the picked edition.
+    """The return URL and the signed LtiDeepLinkingResponse JWT for the picked edition, or (``assignment``
+    not empty) for the picked assignment of the course.
 
     Raises:
         LaunchRefused: The picker's token is not the tool's, or expired.
-        LtiRequestInvalid: No such edition, or not the one the service grades (``graded``).
+        LtiRequestInvalid: No such edition, or not the one the service grades (``graded``); no such
+            assignment in the course.
     """
     try:
         picked = jwt.decode(token, published_keys(session, grace_seconds), algorithms=[ALGORITHM])
@@ -97,16 +122,30 @@ def deep_linking_response(
     context = picked.claims
     if context.get("purpose") != PICKER_PURPOSE:
         raise LaunchRefused("the lab picker's token was issued for something else")
-    if edition not in EDITIONS:
+    platform = session.get(LtiPlatform, context["platform"])
+    if platform is None:
+        raise LaunchRefused("the platform of this deep linking request is no longer registered")
+    item_title = ""
+    if assignment:
+        course = course_of_context(
+            session, platform.id, str(context["deployment"]), str(context.get("context"))
+        )
+        picked_assignment = named_assignment(
+            session, course.id if course is not None else None, {LINKED_ASSIGNMENT: assignment}
+        )
+        if picked_assignment is None:
+            raise LtiRequestInvalid(
+                f"this course has no assignment {assignment!r}; pick one the lab picker lists, or a lab"
+            )
+        edition = graded = graded_edition(picked_assignment.edition, picked_assignment.lab)
+        item_title = picked_assignment.title
+    elif edition not in EDITIONS:
         raise LtiRequestInvalid(f"no edition is named {edition!r}; pick one of {', '.join(EDITIONS)}")
     if edition != graded:
         raise LtiRequestInvalid(
             f"this service grades edition {graded!r} (GYMGRADE_EDITION), so a link for {edition!r} would grade its students on other problems; "  # noqa: E501
             f"pick {graded!r}, or add the tool of a service run for {edition!r}"
         )
-    platform = session.get(LtiPlatform, context["platform"])
-    if platform is None:
-        raise LaunchRefused("the platform of this deep linking request is no longer registered")
     try:
         spend(session, PICKER_PURPOSE, str(context.get("jti")), int(context["exp"]))
     except TokenSpent:
@@ -114,6 +153,9 @@ def deep_linking_response(
             "this lab picker's form was sent already (it adds one link); start again from the LMS"
         ) from None
     title = EDITIONS[edition].title
+    custom = {"lab": title, "edition": edition}
+    if assignment:
+        custom[LINKED_ASSIGNMENT] = assignment
     now = int(time.time())
     claims: dict[str, Any] = {
         "iss": platform.client_id,
@@ -127,9 +169,9 @@ def deep_linking_response(
         names.DEEP_LINKING_ITEMS: [
             {
                 "type": "ltiResourceLink",
-                "title": f"gymgrade: {title}",
+                "title": f"gymgrade: {item_title or title}",
                 "url": launch_url,
-                "custom": {"lab": title, "edition": edition},
+                "custom": custom,
             }
         ],
     }

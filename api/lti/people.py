@@ -95,14 +95,8 @@ def ensure_course(
     """The course of the launch's context: found by (platform, deployment, context id), else the unclaimed
     default course, else a new course titled after the context. Nothing is committed."""
     context = claims.get(names.CONTEXT) or {}
-    context_id = str(context.get("id") or "")[:255]
-    course = session.scalars(
-        select(Course).where(
-            Course.lti_platform_id == platform.id,
-            Course.lti_deployment_id == deployment_id,
-            Course.lti_context_id == context_id,
-        )
-    ).first()
+    context_id = context_id_of(claims)
+    course = course_of_context(session, platform.id, deployment_id, context_id)
     if course is not None:
         return course
     default = session.get_one(Course, DEFAULT_COURSE_ID)
@@ -121,9 +115,47 @@ def ensure_course(
     return course
 
 
-def _assignment_for_new_link(session: Session, course: Course, title: str) -> int:
-    """The assignment a new link of the course opens: the default assignment for the default course's first
-    link, else a new one configured as the default assignment (the service's lab, edition and policies)."""
+def context_id_of(claims: dict[str, Any]) -> str:
+    """The id of a launch's context (its course in the LMS), as courses keep it."""
+    context = claims.get(names.CONTEXT) or {}
+    return str(context.get("id") or "")[:255]
+
+
+def course_of_context(
+    session: Session, platform_id: int, deployment_id: str, context_id: str
+) -> Course | None:
+    """The course of an LMS context, None before its first launch (nothing is written)."""
+    return session.scalars(
+        select(Course).where(
+            Course.lti_platform_id == platform_id,
+            Course.lti_deployment_id == deployment_id,
+            Course.lti_context_id == context_id,
+        )
+    ).first()
+
+
+LINKED_ASSIGNMENT = "assignment"
+"""The custom parameter of a deep link naming the course's assignment it opens (its slug)."""
+
+
+def named_assignment(session: Session, course_id: int | None, custom: object) -> Assignment | None:
+    """The assignment of course ``course_id`` a link's custom parameters name (``LINKED_ASSIGNMENT``, as the
+    lab picker writes it), None when they name none or one the course does not have."""
+    slug = custom.get(LINKED_ASSIGNMENT) if isinstance(custom, dict) else None
+    if course_id is None or not isinstance(slug, str):
+        return None
+    return session.scalars(
+        select(Assignment).where(Assignment.course_id == course_id, Assignment.slug == slug)
+    ).first()
+
+
+def _assignment_for_new_link(session: Session, course: Course, title: str, custom: object) -> int:
+    """The assignment a new link of the course opens: the course's assignment its custom parameters name (a
+    deep link picked it), else the default assignment for the default course's first link, else a new one
+    configured as the default assignment (the service's lab, edition and policies)."""
+    named = named_assignment(session, course.id, custom)
+    if named is not None:
+        return named.id
     if course.id == DEFAULT_COURSE_ID:
         linked = session.scalars(
             select(LtiLink.id).where(LtiLink.assignment_id == DEFAULT_ASSIGNMENT_ID)
@@ -177,7 +209,7 @@ def ensure_link(
             platform_id=platform.id,
             deployment_id=deployment_id,
             resource_link_id=link_id,
-            assignment_id=_assignment_for_new_link(session, course, title),
+            assignment_id=_assignment_for_new_link(session, course, title, claims.get(names.CUSTOM)),
             lineitem_url=None,
         )
         session.add(link)

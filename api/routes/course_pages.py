@@ -1,6 +1,8 @@
 """The web pages of courses: the operator lists and creates courses; a course's staff see its assignments and
-staff, and its instructors (and the operator) add assignments and staff. The same rules and functions as the
-API's ``/courses`` routes (``api.courses``), the same sign-in as every page (``api.routes.ui``)."""
+staff, and its instructors (and the operator) add assignments and staff; its students see its assignments.
+Each assignment links to its own pages (``api.routes.ui``, under ``ASSIGNMENT_PAGES``). The same rules and
+functions as the API's ``/courses`` routes (``api.courses``), the same sign-in as every page
+(``api.routes.ui``)."""
 
 from __future__ import annotations
 
@@ -14,7 +16,6 @@ from sqlalchemy.orm import Session
 
 from api.auth import Principal, StaffRole
 from api.courses import (
-    DEFAULT_ASSIGNMENT_ID,
     assignment_values,
     assignments_of,
     courses_of,
@@ -24,7 +25,7 @@ from api.courses import (
     scope_of,
     staff_of,
 )
-from api.deps import AnyPageCallerDep, CoursePath, SessionDep
+from api.deps import ASSIGNMENT_PAGES, AnyPageCallerDep, CoursePath, SessionDep
 from api.errors import CourseExists, InvalidRequest
 from api.handlers import status_of
 from api.models import Assignment, Course
@@ -52,8 +53,9 @@ FIELD_LABELS = {
 
 @router.get("/ui/courses")
 def courses_page(request: Request, session: SessionDep, caller: AnyPageCallerDep) -> Response:
-    """The courses the signed-in staff member or operator may reach, and the operator's form for a new one."""
-    return _courses(request, session, _staff(caller))
+    """The courses the signed-in caller may reach (a staff member's or student's own, the operator's every
+    one), and the operator's form for a new one."""
+    return _courses(request, session, signed_in(caller))
 
 
 @router.post("/ui/courses")
@@ -79,9 +81,10 @@ def course_form(
 def course_page(
     request: Request, course: CoursePath, session: SessionDep, caller: AnyPageCallerDep
 ) -> Response:
-    """A course: its assignments and staff, and for its instructors the forms that add them."""
-    staff = _staff(caller)
-    return _course(request, session, staff, _course_of(session, staff, course))
+    """A course: its assignments (each a link to its pages) and, for its staff, its staff and for its
+    instructors the forms that add them."""
+    member = signed_in(caller)
+    return _course(request, session, member, _course_of(session, member, course))
 
 
 @router.post("/ui/courses/{course}/assignments")
@@ -207,8 +210,10 @@ def _course(
     context = {
         "caller": caller,
         "course": course,
-        "assignments": [_assignment_row(assignment) for assignment in assignments_of(session, course)],
-        "staff": staff_of(session, course),
+        "assignments": [
+            _assignment_row(course, assignment) for assignment in assignments_of(session, course)
+        ],
+        "staff": staff_of(session, course) if caller.is_instructor else [],
         "manages": caller.manages_course,
         "editions": [edition.value for edition in EditionName],
         "assignment_error": assignment_error,
@@ -220,8 +225,9 @@ def _course(
     return page(request, "course.html", context, status_code=status_of(refused) if refused else 200)
 
 
-def _assignment_row(assignment: Assignment) -> dict[str, Any]:
-    """What the course page shows of an assignment: its settings and each problem's points and visibility."""
+def _assignment_row(course: Course, assignment: Assignment) -> dict[str, Any]:
+    """What the course page shows of an assignment: where its pages are, its settings and each problem's
+    points and visibility."""
     choice = service_edition(assignment.edition, assignment.lab)
     if assignment.config_toml is not None:
         config = config_from_data(
@@ -240,5 +246,5 @@ def _assignment_row(assignment: Assignment) -> dict[str, Any]:
         "edition": choice.edition.name,
         "problems": problems,
         "points": sum(problem["points"] for problem in problems),
-        "default": assignment.id == DEFAULT_ASSIGNMENT_ID,
+        "pages": ASSIGNMENT_PAGES.format(course=course.slug, assignment=assignment.slug),
     }

@@ -32,6 +32,7 @@ from api.lti.binding import (
     state_name,
 )
 from api.lti.deep_linking import (
+    assignments_offered,
     check_link_edition,
     choices,
     deep_linking_response,
@@ -49,7 +50,14 @@ from api.lti.launch import (
     tool_state,
     verify_launch,
 )
-from api.lti.people import course_of, existing_link, links_of
+from api.lti.people import (
+    context_id_of,
+    course_of,
+    course_of_context,
+    existing_link,
+    links_of,
+    named_assignment,
+)
 from api.lti.platforms import PlatformRegistration, add_deployment, checked_origins, register_platform
 from api.lti.publisher import publishing_status
 from api.lti.registration import ToolUrls, check_ticket, register_dynamically, registration_ticket
@@ -166,6 +174,12 @@ def launch(
             {
                 "choices": choices(),
                 "graded": graded_edition(settings.edition, settings.lab),
+                "assignments": [
+                    (item, graded_edition(item.edition, item.lab))
+                    for item in assignments_offered(
+                        session, checked.platform.id, checked.deployment_id, context_id_of(checked.claims)
+                    )
+                ],
                 "picker": token,
                 "session_query": "",
             },
@@ -186,10 +200,18 @@ def launch(
 
 
 def _link_edition(session: Session, settings: Settings, checked: Launch) -> str:
-    """The edition a launch's link grades: its assignment's once a launch made it, else (a new link, whose
-    assignment is made as the default one) the service's."""
+    """The edition a launch's link grades: its assignment's once a launch made it, else (a new link) the
+    assignment's of the course its custom parameters name (a deep link to it), else (an assignment made as
+    the default one) the service's."""
     link = existing_link(session, checked.platform, checked.deployment_id, checked.claims)
     assignment = session.get(Assignment, link.assignment_id) if link is not None else None
+    if assignment is None:
+        course = course_of_context(
+            session, checked.platform.id, checked.deployment_id, context_id_of(checked.claims)
+        )
+        assignment = named_assignment(
+            session, course.id if course else None, checked.claims.get(names.CUSTOM)
+        )
     if assignment is None:
         return graded_edition(settings.edition, settings.lab)
     return graded_edition(assignment.edition, assignment.lab)
@@ -230,8 +252,10 @@ def deep_link(
     settings: SettingsDep,
     picker: Annotated[str, Form()] = "",
     edition: Annotated[str, Form()] = "",
+    assignment: Annotated[str, Form()] = "",
 ) -> Response:
-    """The instructor's pick: the signed LtiDeepLinkingResponse, posted back to the LMS by the browser."""
+    """The instructor's pick (an edition, or an assignment of the course): the signed LtiDeepLinkingResponse,
+    posted back to the LMS by the browser."""
     urls = tool_urls(request, settings)
     return_url, response_jwt = deep_linking_response(
         session,
@@ -240,6 +264,7 @@ def deep_link(
         urls.launch,
         graded=graded_edition(settings.edition, settings.lab),
         grace_seconds=settings.lti_key_grace_seconds,
+        assignment=assignment,
     )
     target = urlsplit(return_url)
     headers = page_headers(f"{target.scheme}://{target.netloc}")

@@ -9,6 +9,7 @@ import shutil
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import httpx
@@ -42,12 +43,15 @@ SIMILARITY_CORPUS = Path(__file__).resolve().parents[2] / "submissions" / "simil
 
 @dataclass(frozen=True)
 class Service:
-    """A real service with one graded upload, a second course with an instructor and a TA, and a ticket."""
+    """A real service with one graded upload, a second course with an instructor, a TA, a student and an
+    assignment with one graded upload, and a ticket."""
 
     process: LiveProcess
     tokens: dict[str, str]
-    """Each role's token: student, operator, instructor (of course rl-b), ta (of rl-b)."""
+    """Each role's token: student, operator, and of course rl-b: instructor, ta, student-b."""
     submission: int
+    submission_b: int
+    """The upload of rl-b's student to rl-b's assignment pfi."""
     report: dict[str, Any]
     registration_url: str
 
@@ -80,11 +84,17 @@ def service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Service]:
         for name, role in (("Grace", "instructor"), ("Alan", "ta")):
             staff[role] = _post(process.url, "/courses/rl-b/staff", {"name": name, "role": role})["token"]
         _post(process.url, "/courses/rl-b/assignments", {"slug": "pfi", "title": "PFI", "edition": "v2026"})
+        staff["student-b"] = _post(process.url, "/courses/rl-b/students", {"name": "bea"})["token"]
+        pfi = process.url + "/courses/rl-b/assignments/pfi"
+        submission_b = upload(pfi, staff["student-b"], PARTIAL_SOLUTION)
+        graded_b = wait_for(pfi, staff["student-b"], submission_b, {"done", "failed"})
+        assert graded_b["status"] == "done", graded_b
         yield Service(
             process=process,
             tokens={"student": student, "operator": INSTRUCTOR_TOKEN, "instructor": staff["instructor"],
-                    "ta": staff["ta"]},
+                    "ta": staff["ta"], "student-b": staff["student-b"]},
             submission=submission,
+            submission_b=submission_b,
             report=graded["report"],
             registration_url=_post(process.url, "/lti/registrations", {})["url"],
         )  # fmt: skip
@@ -167,6 +177,22 @@ VISITS = {
         _fill_and_send("#new-assignment", slug="lab-1", title="Lab 1"),
     ),
     "ta-course": Visit("#assignments", "ta", "/ui/courses/rl-b"),
+    "student-course": Visit("#assignments", "student-b", "/ui/courses/rl-b"),
+    "assignment-student-home": Visit("#upload", "student-b", "/ui/courses/rl-b/assignments/pfi"),
+    "assignment-student-report": Visit(
+        "#live", "student-b", "/ui/courses/rl-b/assignments/pfi/submissions/{submission_b}"
+    ),
+    "assignment-ta-home": Visit("#gradebook", "ta", "/ui/courses/rl-b/assignments/pfi"),
+    "assignment-ta-report": Visit(
+        "#live", "ta", "/ui/courses/rl-b/assignments/pfi/submissions/{submission_b}"
+    ),
+    "assignment-override-kept": Visit(
+        "#override-result.notice",
+        "instructor",
+        "/ui/courses/rl-b/assignments/pfi",
+        _fill_and_send("#override", student="bea", problem="total", points="1", reason="ok"),
+    ),
+    "error-other-course-report": Visit("p.error", "student-b", "/ui/submissions/{submission}"),
     "error-other-course": Visit("p.error", "ta", "/ui/courses/default"),
     "lti-registration-form": Visit(
         "#lti-register", None, "{registration_url}&openid_configuration=https://lms.example/.well-known"
@@ -184,7 +210,11 @@ def test_every_service_page_passes_wcag_a_and_aa(chromium: Any, service: Service
             token = service.tokens[visit.role]
             context.add_cookies([{"name": SESSION_COOKIE, "value": token, "url": service.process.url}])
         page = context.new_page()
-        path = visit.path.format(submission=service.submission, registration_url=service.registration_url)
+        path = visit.path.format(
+            submission=service.submission,
+            submission_b=service.submission_b,
+            registration_url=service.registration_url,
+        )
         page.goto(path if path.startswith("http") else service.process.url + path)
         if visit.act is not None:
             visit.act(page)
@@ -199,6 +229,10 @@ LTI_PAGES = {
     "lti-storage": ("lti_storage.html", {"action": "get", "target": "_parent", "origin": "https://lms.example",
                     "key": "k", "value": "", "next": "", "id_token": "t", "state": "s"}),
     "lti-picker": ("lti_picker.html", {"choices": choices(), "graded": graded_edition("rl1"), "picker": "p"}),
+    "lti-picker-assignments": ("lti_picker.html", {"choices": choices(), "graded": graded_edition("rl1"),
+                               "picker": "p", "assignments": [
+                                   (SimpleNamespace(slug="lab-1", title="Lab 1"), "rl1"),
+                                   (SimpleNamespace(slug="lab-2", title="Lab 2"), "v2026")]}),
     "lti-post": ("lti_post.html", {"action": "https://lms.example/deep-link", "jwt": "j"}),
     "lti-registered": ("lti_registered.html", {"platform": {"issuer": "https://lms.example", "client_id": "c",
                                                             "deployment_ids": ["1"]}}),

@@ -90,7 +90,9 @@ def test_a_teaching_assistant_sees_the_assignments_and_changes_nothing(client: T
     assert client.post("/ui/courses/rl-c/staff", data={"name": "Eve"}).status_code == 403
 
 
-def test_another_course_is_not_found_and_students_and_visitors_are_refused(client: TestClient) -> None:
+def test_another_course_is_not_found_and_visitors_and_students_refused_its_staff_forms(
+    client: TestClient,
+) -> None:
     token = _course_with_staff(client, "rl-d", "Grace")
     _sign_in(client, token)
     assert client.get("/ui/courses/default").status_code == 404
@@ -99,4 +101,11 @@ def test_another_course_is_not_found_and_students_and_visitors_are_refused(clien
     client.cookies.clear()
     assert client.get("/ui/courses").status_code == 401
     _sign_in(client, add_student(client, "ada"))
-    assert client.get("/ui/courses").status_code == 403
+    listed = client.get("/ui/courses")  # a student sees their own course, its assignments, not its staff
+    assert listed.status_code == 200 and "new-course" not in listed.text
+    assert '<a href="/ui/courses/default">' in listed.text and "/ui/courses/rl-d" not in listed.text
+    course = client.get("/ui/courses/default")
+    assert course.status_code == 200 and 'href="/ui/courses/default/assignments/default"' in course.text
+    assert 'id="staff"' not in course.text and "Gradebook keeps" not in course.text
+    assert client.get("/ui/courses/rl-d").status_code == 404
+    assert client.post("/ui/courses/default/staff", data={"name": "Eve"}).status_code == 403

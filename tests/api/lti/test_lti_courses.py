@@ -106,6 +106,20 @@ def test_each_context_is_a_course_and_a_role_counts_in_its_own_only(
             assert response.status_code == 404, (token, other, response.text)
         home_b = client.get(tool.url + "/", params={"lti_session": staff_b}).text
         assert f"/ui/submissions/{in_b}?" in home_b and f"/ui/submissions/{in_a}?" not in home_b
+        # the same under each assignment's own pages: a launch's session reaches its course's only
+        ((slug_b, assignment_b),) = _rows(
+            tool,
+            "SELECT c.slug, a.slug FROM assignments a JOIN courses c ON c.id = a.course_id "
+            "WHERE c.lti_context_id = 'course-b-2026'",
+        )
+        pages_b = f"{tool.url}/ui/courses/{slug_b}/assignments/{assignment_b}"
+        pages_a = f"{tool.url}/ui/courses/default/assignments/default"
+        for pages, submission, token, status in (
+            (pages_b, in_b, staff_b, 200), (pages_b, in_b, lee_b, 200), (pages_a, in_a, staff_a, 200),
+            (pages_a, in_a, staff_b, 404), (pages_b, in_b, staff_a, 404), (pages_b, in_a, lee_b, 404),
+        ):  # fmt: skip
+            response = client.get(f"{pages}/submissions/{submission}", params={"lti_session": token})
+            assert response.status_code == status, (pages, submission, response.text)
 
     # an override in course A (the default course's routes) reaches A's line item, and only it
     done = httpx.post(

@@ -27,6 +27,8 @@ from lti_platform import (
 )
 from lti_testing import ONE_PROBLEM, TWO_PROBLEMS, browser, landed, register, tool_environment, upload, wait
 
+from grader.lab.editions import EDITIONS
+
 pytestmark = [pytest.mark.e2e, pytest.mark.slow]
 
 PUBLISH_SECONDS = 0.2
@@ -376,6 +378,53 @@ def test_deep_linking_carries_the_lab_and_edition_picked(platform: LtiPlatform, 
             client, tool.url, platform.launch(client, LaunchSpec(learner, "link-dl", custom=item["custom"]))
         )
     assert "signed in as Lin Linked" in page.text
+
+
+def test_deep_linking_to_an_assignment_of_the_course_opens_it_in_its_own_lab(
+    platform: LtiPlatform, tool: LiveProcess
+) -> None:
+    teacher = platform.add_person("staff-ivo", "Ivo Instructor", INSTRUCTOR)
+    with browser() as client:  # the context's course exists once a launch made it: the default course, which
+        platform.launch(client, LaunchSpec(teacher, "", deep_linking=True))  # the first context claims
+    made = httpx.post(
+        f"{tool.url}/courses/default/assignments",
+        json={"slug": "pfi-rl1", "title": "Policy iteration", "edition": "rl1"},
+        headers=instructor_headers(),
+    )
+    assert made.status_code == 201, made.text
+    with browser() as client:
+        picker = platform.launch(client, LaunchSpec(teacher, "", deep_linking=True))
+        token = re.search(r'name="picker" value="([^"]+)"', picker.text)
+        assert token and 'name="assignment" value="pfi-rl1"' in picker.text, picker.text
+        unknown = client.post(
+            tool.url + "/lti/deep-link", data={"picker": token.group(1), "assignment": "nope"}
+        )
+        assert unknown.status_code == 400 and "this course has no assignment 'nope'" in unknown.text
+        answer = client.post(
+            tool.url + "/lti/deep-link", data={"picker": token.group(1), "assignment": "pfi-rl1"}
+        )
+        assert answer.status_code == 200, answer.text
+        action = re.search(r'action="([^"]+)"', answer.text)
+        response_jwt = re.search(r'name="JWT" value="([^"]+)"', answer.text)
+        assert action and response_jwt
+        accepted = client.post(html.unescape(action.group(1)), data={"JWT": response_jwt.group(1)})
+    (item,) = accepted.json()["items"]
+    assert item["title"] == "gymgrade: Policy iteration"
+    assert item["custom"] == {"lab": EDITIONS["rl1"].title, "edition": "rl1", "assignment": "pfi-rl1"}
+    learner = platform.add_person("learner-pfi", "Pia Picked", LEARNER)
+    with browser() as client:  # the service grades 'classic', the link's assignment 'rl1': it opens
+        _, page = landed(
+            client, tool.url, platform.launch(client, LaunchSpec(learner, "link-pfi", custom=item["custom"]))
+        )
+    assert "signed in as Pia Picked" in page.text
+    links = _operator_get(tool, "/courses/default/assignments/pfi-rl1/lti/links")
+    assert [link["resource_link_id"] for link in links] == ["link-pfi"]
+
+
+def _operator_get(tool: LiveProcess, path: str) -> Any:
+    response = httpx.get(tool.url + path, headers=instructor_headers())
+    assert response.status_code == 200, response.text
+    return response.json()
 
 
 def test_a_link_made_for_another_edition_is_refused_and_stores_nothing(
